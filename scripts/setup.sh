@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Set up printgen on a fresh Debian 12 machine: system slicers (when root), a venv in .venv,
+# and printgen with its extras. Safe to run again: it skips what is already there.
+# Usage: bash scripts/setup.sh [--with-slicers]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+if [[ "${1:-}" == "--with-slicers" ]]; then
+  need=()
+  command -v prusa-slicer >/dev/null || need+=(prusa-slicer)
+  command -v CuraEngine >/dev/null || need+=(cura-engine)
+  if ((${#need[@]})); then
+    if [[ $(id -u) -ne 0 ]]; then
+      echo "setup: ${need[*]} missing; run as root or: sudo apt-get install ${need[*]}" >&2
+      exit 2
+    fi
+    apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${need[@]}"
+  fi
+  # CuraEngine's printer definitions live in the big 'cura' package: take only its files.
+  if [[ ! -f /opt/cura-pkg/usr/share/cura/resources/definitions/fdmprinter.def.json ]]; then
+    tmp=$(mktemp -d)
+    (cd "$tmp" && apt-get download cura >/dev/null && dpkg-deb -x cura_*_all.deb /opt/cura-pkg)
+    rm -rf "$tmp"
+  fi
+fi
+
+if [[ ! -x .venv/bin/python ]]; then
+  python3 -m venv .venv
+fi
+.venv/bin/python -m pip install -q --upgrade pip
+.venv/bin/python -m pip install -q -e ".[all]"
