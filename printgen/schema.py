@@ -40,7 +40,7 @@ class Field:
 
     @property
     def name(self) -> str:
-        return split_unit_key(self.key)[0] if self.si else self.key
+        return split_unit_key(self.key)[0] if self.si and self.kind is float else self.key
 
     @property
     def unit(self) -> str:

@@ -1,0 +1,76 @@
+"""`Design`: what `printgen select` chose, and what geometry, G-code and verification build.
+
+All dimensions in mm (print-side data); moduli and forces stay SI. A pass is one bead of
+`bead_width_mm` laid at one layer height; a section is `beads_across` beads side by side on
+each of `len(layer_heights_mm)` stacked layers.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Any
+
+
+@dataclass(frozen=True)
+class Section:
+    """A printed rectangular section: beads side by side x layers stacked (mm)."""
+
+    bead_width_mm: float
+    beads_across: int
+    layer_heights_mm: tuple[float, ...]
+
+    @property
+    def width_mm(self) -> float:
+        return self.bead_width_mm * self.beads_across
+
+    @property
+    def thickness_mm(self) -> float:
+        return float(sum(self.layer_heights_mm))
+
+    @property
+    def passes(self) -> int:
+        return self.beads_across * len(self.layer_heights_mm)
+
+    @property
+    def area_mm2(self) -> float:
+        return self.width_mm * self.thickness_mm
+
+
+@dataclass(frozen=True)
+class NetDesign:
+    """Diamond net: panel size, mesh diagonals (x across, y up), strand section, border."""
+
+    material: str
+    print_style: str
+    width_mm: float
+    height_mm: float
+    mesh_x_mm: float
+    mesh_y_mm: float
+    strand: Section
+    border_width_mm: float
+
+
+@dataclass(frozen=True)
+class CableDesign:
+    """A border cable: a straight strip with an eyelet at each end (mm)."""
+
+    name: str
+    material: str
+    print_style: str
+    length_mm: float  # eyelet centre to eyelet centre
+    section: Section
+    eyelet_inner_mm: float
+    eyelet_outer_mm: float
+
+
+@dataclass(frozen=True)
+class Design:
+    """A complete printable model at scale 1/lambda on one printer."""
+
+    scale: float
+    printer: str
+    net: NetDesign
+    cables: tuple[CableDesign, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
