@@ -38,6 +38,11 @@ PANEL_LAW = [
     Field("kappa_kn_per_m_per_m", list),
     positive("panel_length_mm", 1e4),
     positive("panel_width_mm", 1e4, required=False),
+    # Geometry of the tested net, so the law can be rescaled to another strand or mesh.
+    positive("strand_width_mm", 100.0, required=False),
+    positive("strand_thickness_mm", 100.0, required=False),
+    positive("mesh_along_load_mm", 1e4, required=False),
+    positive("mesh_across_load_mm", 1e4, required=False),
     *PROVENANCE,
 ]
 DATASHEET = [positive("tensile_modulus_gpa", 500.0), positive("failure_stress_mpa", 5000.0),
@@ -97,6 +102,15 @@ class PanelLaw:
     panel_width: float | None
     source: str
     conditions: str
+    strand_width: float | None = None  # m, tested net's strand
+    strand_thickness: float | None = None  # m
+    mesh_along_load: float | None = None  # m, mesh diagonal along the load
+    mesh_across_load: float | None = None  # m
+
+    @property
+    def has_geometry(self) -> bool:
+        return None not in (self.strand_width, self.strand_thickness,
+                            self.mesh_along_load, self.mesh_across_load)
 
     def force_per_width(self, strain: np.ndarray | float) -> np.ndarray:
         """Panel force per unit width (N/m) at `strain`; zero in compression."""
@@ -216,7 +230,8 @@ def _panel_law(raw: dict | None, where: str) -> PanelLaw | None:
     if any(b <= a for a, b in zip([0.0, *knees], knees, strict=False)) or min(kappas) <= 0:
         raise ProfileError(f"{loc}: knee strains must increase from 0 and kappas be > 0")
     return PanelLaw(tuple(knees), tuple(kappas), t["panel_length"], t["panel_width"],
-                    t["source"], t["conditions"])
+                    t["source"], t["conditions"], t["strand_width"], t["strand_thickness"],
+                    t["mesh_along_load"], t["mesh_across_load"])
 
 
 def _number(v: object, where: str, key: str) -> float:
