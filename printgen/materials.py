@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from printgen.errors import ProfileError
+from printgen.laws import piecewise_linear
 from printgen.profiles import list_profiles, load_raw
 from printgen.schema import Field, positive, read_table
 
@@ -114,13 +115,8 @@ class PanelLaw:
 
     def force_per_width(self, strain: np.ndarray | float) -> np.ndarray:
         """Panel force per unit width (N/m) at `strain`; zero in compression."""
-        eps = np.maximum(np.asarray(strain, dtype=float), 0.0)
-        knots = np.array([0.0, *self.knee_strains])
-        slopes = np.array(self.kappas) * self.panel_length  # N/m per unit strain
-        # Each segment contributes slope * (part of eps that lies in the segment).
-        upper = np.append(knots[1:], np.inf)
-        part = np.clip(eps[..., None] - knots, 0.0, upper - knots)
-        return part @ slopes
+        slopes = [k * self.panel_length for k in self.kappas]  # N/m per unit strain
+        return piecewise_linear(strain, self.knee_strains, slopes)
 
     def kappa_at(self, strain: float) -> float:
         """Tangent panel stiffness (N/m per m) at `strain`."""
