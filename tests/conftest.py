@@ -33,3 +33,27 @@ def require_shared(rel: str) -> Path:
     if os.environ.get("PRINTGEN_REQUIRE_SLICERS") or os.environ.get("CI"):
         pytest.fail(msg)
     pytest.skip(msg)
+
+
+def reference_design_1_40():
+    """The reference's final 1:40 design (barrier-physics.md): TPE diamond net 20.6 x 9.4 mm
+    with 0.6 x 0.95 mm strands (three passes), PETG cables 0.9 x 0.6 mm (2 x 2 passes)."""
+    from printgen.design import CableDesign, Design, NetDesign, Section
+
+    net = NetDesign(
+        material="tpe", print_style="net-3pass", width_mm=330.0, height_mm=100.0,
+        mesh_x_mm=20.6, mesh_y_mm=9.4, strand=Section(0.6, 1, (0.35, 0.30, 0.30)),
+        border_width_mm=1.2,
+    )
+    cable = Section(0.45, 2, (0.30, 0.30))
+    cables = tuple(
+        CableDesign(name=n, material="petg", print_style="cable-4pass", length_mm=length,
+                    section=cable, eyelet_inner_mm=3.0, eyelet_outer_mm=6.0)
+        for n, length in (("top", 345.0), ("bottom", 345.0), ("left", 115.0), ("right", 115.0))
+    )
+    return Design(scale=40.0, printer="generic-350", net=net, cables=cables)
+
+
+@pytest.fixture
+def design_1_40():
+    return reference_design_1_40()
