@@ -15,13 +15,20 @@ from dataclasses import dataclass
 import numpy as np
 
 from printgen.design import Section
-from printgen.errors import DesignError, PrintabilityError
+from printgen.errors import InputError, PrintabilityError
 from printgen.laws import piecewise_linear
-from printgen.materials import Material
-from printgen.printers import PrintStyle, Printer, check_pass
-from printgen.section import area_m2, equal_area_diameter, net_membrane_law
+from printgen.materials import Material, load_material
+from printgen.printers import Printer, PrintStyle, check_pass, load_print_style, load_printer
+from printgen.profiles import list_profiles
+from printgen.prototype import Prototype
+from printgen.section import (area_m2, diamond_factor, equal_area_diameter, net_membrane_law,
+                              square_factor)
 from printgen.similitude import ScaledTargets
-from printgen.units import G
+from printgen.units import MM, G
+
+DEFAULT_PRINTER = "generic-350"
+DEFAULT_NET_PRINT = "net-3pass"
+DEFAULT_CABLE_PRINT = "cable-4pass"
 
 MAX_BEADS_ACROSS = {"cable": 6, "net": 2}  # wider strands are no longer "strands"
 MAX_LAYERS = {"cable": 6, "net": 5}
@@ -72,6 +79,9 @@ class Selection:
     net: tuple[Candidate, ...]
     cable_rationale: str
     net_rationale: str
+    printer: str
+    net_print: str
+    cable_print: str
 
     @property
     def cable(self) -> Candidate | None:
@@ -144,11 +154,119 @@ def cable_candidate(t: ScaledTargets, m: Material, sec: Section, printer: Printe
                      force, sf, speed, tuple(reasons), score)
 
 
-def target_net_law(t: ScaledTargets, proto_net_factor: float) -> tuple[tuple, tuple]:
-    """(knees, membrane slopes N/m) of the model net target."""
-    knees = tuple(r.prototype for r in ())  # placeholder-free: filled below
-    membranes = [t.values[k] for k in sorted(t.values) if k.startswith("membrane_")]
-    if membranes:
-        knees = t.knees
-        return knees, tuple(membranes)
-    return (), (t["strand_ea"] * proto_net_factor,)
+def target_net_law(p: Prototype, t: ScaledTargets) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """(knee strains, membrane slopes N/m) of the model net's target force-per-width law.
+
+    From the prototype's panel law (kappa * L_p scaled by lambda^-2), else from its strand E*A
+    and mesh geometry (square: one strand per mesh across; diamond: `diamond_factor`).
+    """
+    if p.net.panel_law is not None:
+        knees, kappas = p.net.panel_law[0], p.net.panel_law[1]
+        return tuple(knees), tuple(t[f"membrane_{i}"] for i in range(len(kappas)))
+    if p.net.pattern == "square":
+        factor = square_factor(t["mesh_x"])
+    else:
+        factor = diamond_factor(t["mesh_y"], t["mesh_x"])
+    return (), (t["strand_ea"] * factor,)
+
+
+def model_mesh(p: Prototype, t: ScaledTargets) -> tuple[float, float]:
+    """(mesh_x, mesh_y) of the printed net in m: the lab's choice, else the scaled mesh."""
+    m = p.model
+    if m.mesh_x_mm is not None and m.mesh_y_mm is not None:
+        return m.mesh_x_mm * MM, m.mesh_y_mm * MM
+    return t["mesh_x"], t["mesh_y"]
+
+
+def net_candidate(p: Prototype, t: ScaledTargets, m: Material, sec: Section,
+                  printer: Printer) -> Candidate:
+    """Score one net candidate: its membrane law (diamond geometry) against the target law."""
+    mesh_x, mesh_y = model_mesh(p, t)
+    knees, slopes, source = net_membrane_law(m, sec, mesh_y, mesh_x)
+    t_knees, t_slopes = target_net_law(p, t)
+    got = piecewise_linear(NET_STRAINS, knees, slopes)
+    want = piecewise_linear(NET_STRAINS, t_knees, t_slopes)
+    log_ratio = np.log(got / want)
+    low, high = (float(np.interp(s, NET_STRAINS, got / want) - 1) for s in CHECK_STRAINS)
+    speed, reasons = print_limits(sec, m, printer, f"net {m.name} strand "
+                                  f"{sec.width_mm:g}x{sec.thickness_mm:g} mm")
+    force = peak_strand_force(t, mesh_x, mesh_y)
+    sf = m.failure_stress()[0] * area_m2(sec) / force
+    if sf < MIN_SAFETY_FACTOR:
+        reasons.append(f"safety factor {sf:.2f} below {MIN_SAFETY_FACTOR} at {force:.3g} N")
+    rms = float(np.sqrt(np.mean(log_ratio**2)))
+    modulus, mod_source = m.modulus()
+    measured = "measured" if source == "measured panel law" else mod_source
+    score = rms + DATASHEET_PENALTY * (measured == "datasheet") + PASS_PENALTY * sec.passes
+    return Candidate("net", m.key, m.name, modulus, source, sec, slopes[0], t_slopes[0],
+                     float(got[0] / want[0] - 1), low, high, rms,
+                     equal_area_diameter(sec) / t["strand_d"] - 1, force, sf, speed,
+                     tuple(reasons), score)
+
+
+def select(p: Prototype, t: ScaledTargets, *, printer: str | None = None,
+           materials: tuple[str, ...] | None = None) -> Selection:
+    """Rank every material x layout for cables and net; best feasible first."""
+    printer_obj = load_printer(printer or p.model.printer or DEFAULT_PRINTER)
+    names = materials or p.model.materials or tuple(list_profiles("materials"))
+    mats = [load_material(n) for n in names]
+    net_style = load_print_style(p.model.net_print or DEFAULT_NET_PRINT)
+    cable_style = load_print_style(p.model.cable_print or DEFAULT_CABLE_PRINT)
+    for style, comp in ((net_style, "net"), (cable_style, "cable")):
+        if style.component != comp:
+            raise InputError(f"print style {style.key!r} is for {style.component}s, not {comp}s; "
+                             f"pick a {comp} style (printgen profiles list)")
+    nets = [net_candidate(p, t, m, s, printer_obj) for m in mats
+            for s in layouts(net_style, "net")]
+    cables = []
+    if p.border is not None:
+        cables = [cable_candidate(t, m, s, printer_obj) for m in mats
+                  for s in layouts(cable_style, "cable")]
+    cables, nets = _rank(cables), _rank(nets)
+    if not any(c.feasible for c in nets):
+        raise PrintabilityError(f"no material and pass layout can print the net on "
+                                f"{printer_obj.key}: {nets[0].reasons[0]}")
+    return Selection(tuple(cables), tuple(nets), _rationale(cables, "cable"),
+                     _rationale(nets, "net"), printer_obj.key, net_style.key, cable_style.key)
+
+
+def _rank(cands: list[Candidate]) -> list[Candidate]:
+    # ties (same material, same passes) go to the squarest section: closest to a round cable
+    def aspect(c: Candidate) -> float:
+        w, t = c.section.width_mm, c.section.thickness_mm
+        return max(w / t, t / w)
+
+    return sorted(cands, key=lambda c: (not c.feasible, round(c.score, 9), aspect(c),
+                                        c.material, c.section.passes))
+
+
+def _rationale(ranked: list[Candidate], what: str) -> str:
+    """One paragraph explaining the winner against the runner-up."""
+    if not ranked:
+        return f"The prototype has no border cables: no {what} to select."
+    best = ranked[0]
+    if not best.feasible:
+        return f"No {what} can be printed: {best.reasons[0]}"
+    sec = best.section
+    layout = (f"{sec.beads_across} bead(s) of {sec.bead_width_mm:g} mm across x "
+              f"{len(sec.layer_heights_mm)} layer(s) = {sec.width_mm:g} x {sec.thickness_mm:g} mm, "
+              f"{sec.passes} passes")
+    if what == "cable":
+        fit = (f"E*A = {best.stiffness:.4g} N against the target {best.target:.4g} N "
+               f"({best.error:+.1%})")
+    else:
+        fit = (f"membrane stiffness {best.stiffness:.4g} N/m against {best.target:.4g} N/m at "
+               f"small strain ({best.error:+.1%}), {best.error_low:+.0%} at "
+               f"{CHECK_STRAINS[0]:.0%} and {best.error_high:+.0%} at {CHECK_STRAINS[1]:.0%} "
+               f"strain (RMS log error {best.error_rms:.2f} over 1-40 %)")
+    basis = ("a measured printed value" if "measured" in best.modulus_source else
+             "only a DATASHEET modulus (printed parts are often 2x softer: calibrate it)")
+    others = [c for c in ranked[1:] if c.feasible and c.material != best.material]
+    vs = (f" The best other material, {others[0].material_name}, scores {others[0].score:.3f} "
+          f"against {best.score:.3f} ({others[0].error:+.1%})." if others else "")
+    return (f"{best.material_name}, {layout}: {fit}, based on {basis} "
+            f"({best.modulus_source}). Its equal-area diameter breaks Pi3 (d / h_B) by "
+            f"{best.pi3_deviation:+.0%}: the section is an equivalent one that keeps the "
+            f"stiffness, not the geometric diameter. Safety factor {best.safety_factor:.1f} "
+            f"against failure at the estimated peak force {best.peak_force:.3g} N (overflow "
+            f"{OVERFLOW:.0%}); flow-limited speed {best.speed_mm_per_s:.3g} mm/s.{vs}")

@@ -1,0 +1,81 @@
+"""`printgen profiles list|show NAME`: the materials, printers and print styles available."""
+
+from __future__ import annotations
+
+import argparse
+
+from printgen.commands.common import add_json_arg, console, emit_json, table
+from printgen.errors import ProfileError
+from printgen.jsonout import jsonable
+from printgen.materials import load_material
+from printgen.printers import load_print_style, load_printer
+from printgen.profiles import KINDS, list_profiles, profile_path
+
+LOADERS = {"materials": load_material, "printers": load_printer, "prints": load_print_style}
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("profiles", help="list or show material, printer and print profiles")
+    verbs = p.add_subparsers(dest="verb", metavar="VERB")
+    verbs.required = True
+    ls = verbs.add_parser("list", help="list profiles")
+    ls.add_argument("--kind", choices=KINDS, help="only this kind")
+    add_json_arg(ls)
+    ls.set_defaults(func=run_list)
+    show = verbs.add_parser("show", help="show one profile, validated, in SI units")
+    show.add_argument("name")
+    show.add_argument("--kind", choices=KINDS, help="kind, when a name exists in several")
+    add_json_arg(show)
+    show.set_defaults(func=run_show)
+
+
+def run_list(args: argparse.Namespace) -> int:
+    kinds = [args.kind] if args.kind else list(KINDS)
+    found = {k: list_profiles(k) for k in kinds}
+    if args.json:
+        emit_json({k: [{"name": n, "path": profile_path(k, n)} for n in names]
+                   for k, names in found.items()})
+        return 0
+    rows = [[k, n, _summary(k, n)] for k, names in found.items() for n in names]
+    console().print(table("profiles", ["kind", "name", "summary"], rows))
+    return 0
+
+
+def _summary(kind: str, name: str) -> str:
+    obj = LOADERS[kind](name)
+    if kind == "materials":
+        e, src = obj.modulus()
+        law = ", panel law (measured)" if obj.panel_law else ""
+        return f"{obj.name}: E = {e / 1e9:.3g} GPa ({src}){law}"
+    if kind == "printers":
+        return (f"{obj.name}: nozzle {obj.nozzle_diameter_mm:g} mm, bed "
+                f"{obj.bed_x_mm:g} x {obj.bed_y_mm:g} mm")
+    return f"{obj.name}: {obj.component}, bead {obj.bead_width_mm:g} mm"
+
+
+def run_show(args: argparse.Namespace) -> int:
+    kinds = [args.kind] if args.kind else [k for k in KINDS if args.name.lower() in list_profiles(k)]
+    if not kinds:
+        known = "; ".join(f"{k}: {', '.join(list_profiles(k))}" for k in KINDS)
+        raise ProfileError(f"no profile named {args.name!r}; known: {known}")
+    if len(kinds) > 1:
+        raise ProfileError(f"{args.name!r} exists as {' and '.join(kinds)}; add --kind")
+    kind = kinds[0]
+    data = jsonable(LOADERS[kind](args.name))
+    if args.json:
+        emit_json({"kind": kind, "profile": data})
+        return 0
+    rows = [[k, str(v)] for k, v in _flatten(data)]
+    console().print(table(f"{kind[:-1]} {args.name} ({profile_path(kind, args.name)})",
+                          ["key", "value (SI)"], rows))
+    return 0
+
+
+def _flatten(d: dict, prefix: str = "") -> list[tuple[str, object]]:
+    out: list[tuple[str, object]] = []
+    for k, v in d.items():
+        if isinstance(v, dict):
+            out += _flatten(v, f"{prefix}{k}.")
+        else:
+            out.append((f"{prefix}{k}", v))
+    return out

@@ -1,0 +1,88 @@
+"""`printgen select`: ranked material x pass layouts for the cables and the net."""
+
+from __future__ import annotations
+
+import argparse
+
+from printgen.commands.common import (add_json_arg, add_prototype_args, console, emit_json, fmt,
+                                      table)
+from printgen.prototype import load_prototype
+from printgen.selection import Candidate, Selection, select
+from printgen.similitude import scale_targets
+
+SHOW = 8  # candidates shown per component in the table (all are in --json)
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("select", help="rank polymers and pass layouts against the targets")
+    add_prototype_args(p)
+    p.add_argument("--printer", help="printer profile (default: the prototype's [model] choice)")
+    p.add_argument("--materials", nargs="+", metavar="NAME",
+                   help="material profiles to consider (default: all)")
+    p.add_argument("--all", action="store_true", help="show every candidate, not the best 8")
+    add_json_arg(p)
+    p.set_defaults(func=run)
+
+
+def candidate_dict(c: Candidate) -> dict:
+    s = c.section
+    return {
+        "material": c.material, "material_name": c.material_name,
+        "modulus_pa": c.modulus, "modulus_source": c.modulus_source,
+        "section": {"bead_width_mm": s.bead_width_mm, "beads_across": s.beads_across,
+                    "layer_heights_mm": list(s.layer_heights_mm), "width_mm": s.width_mm,
+                    "thickness_mm": s.thickness_mm, "passes": s.passes},
+        "stiffness": c.stiffness, "target": c.target, "error": c.error,
+        "error_low_strain": c.error_low, "error_high_strain": c.error_high,
+        "error_rms_log": c.error_rms, "pi3_deviation": c.pi3_deviation,
+        "peak_force_n": c.peak_force, "safety_factor": c.safety_factor,
+        "speed_mm_per_s": c.speed_mm_per_s, "feasible": c.feasible,
+        "reasons": list(c.reasons), "score": c.score,
+    }
+
+
+def selection_dict(s: Selection) -> dict:
+    return {
+        "printer": s.printer, "net_print": s.net_print, "cable_print": s.cable_print,
+        "cable": {"rationale": s.cable_rationale,
+                  "ranked": [candidate_dict(c) for c in s.cables]},
+        "net": {"rationale": s.net_rationale, "ranked": [candidate_dict(c) for c in s.net]},
+    }
+
+
+def run(args: argparse.Namespace) -> int:
+    proto = load_prototype(args.prototype)
+    t = scale_targets(proto, args.scale)
+    s = select(proto, t, printer=args.printer,
+               materials=tuple(args.materials) if args.materials else None)
+    if args.json:
+        emit_json({"prototype": proto.name, "scale": t.scale, **selection_dict(s)})
+        return 0
+    show_selection(s, None if args.all else SHOW)
+    return 0
+
+
+def show_selection(s: Selection, limit: int | None) -> None:
+    out = console()
+    for what, cands, why, unit in (("cables", s.cables, s.cable_rationale, "E*A N"),
+                                   ("net", s.net, s.net_rationale, "N/m")):
+        if not cands:
+            continue
+        rows = [_row(i + 1, c) for i, c in enumerate(cands[:limit])]
+        cols = ["#", "material", "E source", "section mm", "passes", f"stiffness {unit}",
+                "error", "Pi3", "SF", "score", "printable"]
+        out.print(table(f"{what}: target {cands[0].target:.4g} {unit} "
+                        f"({len(cands)} candidates, best first)", cols, rows))
+        out.print(f"[bold]Choice:[/] {why}\n")
+
+
+def _row(rank: int, c: Candidate) -> list[str]:
+    s = c.section
+    err = f"{c.error:+.1%}"
+    if c.component == "net":
+        err += f" (rms {c.error_rms:.2f})"
+    source = "panel law" if "panel law" in c.modulus_source else c.modulus_source.split()[0]
+    return [str(rank), c.material_name, source, f"{s.width_mm:g} x {s.thickness_mm:g}",
+            str(s.passes), fmt(c.stiffness), err, f"{c.pi3_deviation:+.0%}",
+            f"{c.safety_factor:.1f}", f"{c.score:.3f}", "yes" if c.feasible else "NO: "
+            + c.reasons[0][:48]]

@@ -1,0 +1,54 @@
+"""`printgen targets`: the model's similitude targets, Pi groups and flow check."""
+
+from __future__ import annotations
+
+import argparse
+
+from printgen.commands.common import (add_json_arg, add_prototype_args, console, emit_json, fmt,
+                                      table)
+from printgen.prototype import load_prototype
+from printgen.similitude import ScaledTargets, scale_targets
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("targets", help="similitude targets of the model at 1/lambda")
+    add_prototype_args(p)
+    add_json_arg(p)
+    p.set_defaults(func=run)
+
+
+def targets_dict(t: ScaledTargets, name: str) -> dict:
+    return {
+        "prototype": name,
+        "scale": t.scale,
+        "targets": {r.key: {"label": r.label, "unit": r.unit, "exponent": r.exponent,
+                            "prototype": r.prototype, "model": r.model} for r in t.rows},
+        "pi_groups": {"prototype": t.pi_prototype, "model": t.pi_model},
+        "flow": t.flow,
+        "warnings": list(t.flow.warnings),
+    }
+
+
+def run(args: argparse.Namespace) -> int:
+    proto = load_prototype(args.prototype)
+    t = scale_targets(proto, args.scale)
+    if args.json:
+        emit_json(targets_dict(t, proto.name))
+        return 0
+    show_targets(proto.name, t)
+    return 0
+
+
+def show_targets(name: str, t: ScaledTargets) -> None:
+    out = console()
+    rows = [[r.label, r.unit, f"{r.exponent:g}", fmt(r.prototype), fmt(r.model)] for r in t.rows]
+    out.print(table(f"{name}: targets at 1:{t.scale:g} (model = prototype x lambda^exponent)",
+                    ["quantity", "unit", "exp", "prototype", "model"], rows))
+    pis = [[k, fmt(t.pi_prototype[k]), fmt(t.pi_model[k])] for k in t.pi_prototype]
+    out.print(table("Pi groups", ["group", "prototype", "model"], pis))
+    f = t.flow
+    out.print(f"Model flow: v = {f.velocity:.3g} m/s, h = {f.depth * 1e3:.3g} mm, "
+              f"Fr = {f.froude:.2f}, Re = {f.reynolds:.0f} (R_h = {f.hydraulic_radius * 1e3:.3g} "
+              f"mm), Q = {f.discharge * 1e3:.3g} L/s over {f.channel_width * 1e3:.0f} mm")
+    for w in f.warnings:
+        out.print(f"[bold yellow]warning:[/] {w}")
