@@ -21,8 +21,13 @@ from printgen.materials import Material, load_material
 from printgen.printers import Printer, PrintStyle, check_pass, load_print_style, load_printer
 from printgen.profiles import list_profiles
 from printgen.prototype import Prototype
-from printgen.section import (area_m2, diamond_factor, equal_area_diameter, net_membrane_law,
-                              square_factor)
+from printgen.section import (
+    area_m2,
+    diamond_factor,
+    equal_area_diameter,
+    net_membrane_law,
+    square_factor,
+)
 from printgen.similitude import ScaledTargets
 from printgen.units import MM, G
 
@@ -35,6 +40,7 @@ MAX_LAYERS = {"cable": 6, "net": 5}
 MIN_SAFETY_FACTOR = 1.5  # peak-load estimate is rough: keep margin
 DATASHEET_PENALTY = 0.10  # score added when only a datasheet modulus exists (~10 % error)
 PASS_PENALTY = 0.002  # per pass: prefer shorter prints among equals
+SCORE_DIGITS = 9  # scores equal to 1e-9 are ties (same E*A, different layout)
 MIN_SPEED_MM_S = 2.0  # slower than this, the flow limit makes the print impractical
 ASSUMED_SAG_RATIO = 0.2  # peak-force estimate: sag / span of a loaded cable or net strip
 OVERFLOW = 1.1  # peak relative loading h / h_B of the loading test
@@ -236,7 +242,7 @@ def _rank(cands: list[Candidate]) -> list[Candidate]:
         w, t = c.section.width_mm, c.section.thickness_mm
         return max(w / t, t / w)
 
-    return sorted(cands, key=lambda c: (not c.feasible, round(c.score, 9), aspect(c),
+    return sorted(cands, key=lambda c: (not c.feasible, round(c.score, SCORE_DIGITS), aspect(c),
                                         c.material, c.section.passes))
 
 

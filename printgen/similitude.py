@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 from printgen.errors import InputError
 from printgen.prototype import Prototype
-from printgen.units import G, NU_WATER
+from printgen.units import NU_WATER, G
 
 RE_TURBULENT = 2500.0  # model flow must stay turbulent (reference, section 2)
 

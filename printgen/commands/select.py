@@ -4,8 +4,14 @@ from __future__ import annotations
 
 import argparse
 
-from printgen.commands.common import (add_json_arg, add_prototype_args, console, emit_json, fmt,
-                                      table)
+from printgen.commands.common import (
+    add_json_arg,
+    add_prototype_args,
+    console,
+    emit_json,
+    fmt,
+    table,
+)
 from printgen.prototype import load_prototype
 from printgen.selection import Candidate, Selection, select
 from printgen.similitude import scale_targets

@@ -1,0 +1,110 @@
+"""Material and pass selection against the 1:40 targets (Lambert et al. 2023)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from proto_files import REALISTIC, SIMPLE, write_variant
+
+from printgen.design import Section
+from printgen.errors import PrintabilityError
+from printgen.materials import load_material
+from printgen.prototype import load_prototype
+from printgen.section import area_m2, diamond_factor, net_membrane_law
+from printgen.selection import SCORE_DIGITS, select
+from printgen.similitude import scale_targets
+
+EXACT = 1e-12  # closed-form arithmetic, round-off only
+
+
+@pytest.fixture(scope="module")
+def sel_1_40():
+    p = load_prototype(REALISTIC)
+    return select(p, scale_targets(p, 40))
+
+
+def _find(cands, material, width, thickness):
+    return next(c for c in cands if c.material == material
+                and math.isclose(c.section.width_mm, width)
+                and math.isclose(c.section.thickness_mm, thickness))
+
+
+def test_reference_cable_wins(sel_1_40):
+    """PETG 0.9 x 0.6 mm in four passes: E*A = 1.30 GPa x 0.54 mm^2 = 702 N vs 706.9 N."""
+    best = sel_1_40.cable
+    assert best.material == "petg"
+    assert (best.section.width_mm, best.section.thickness_mm, best.section.passes) == (0.9, 0.6, 4)
+    assert best.stiffness == pytest.approx(1.30e9 * 0.54e-6, rel=EXACT)
+    assert best.error == pytest.approx(702.0 / (100e9 * math.pi / 4 * 0.024**2 / 64e3) - 1,
+                                       rel=1e-9)
+    assert best.modulus_source == "measured"
+    assert best.pi3_deviation > 0.3  # the equivalent section is wider than the geometric one
+    assert "PETG" in sel_1_40.cable_rationale and "-0.7%" in sel_1_40.cable_rationale
+
+
+def test_reference_net_is_a_candidate_with_its_error(sel_1_40):
+    """TPE 0.6 x 0.95 mm strands, mesh 20.6 x 9.4 mm: the measured panel law (30 kN/m/m on a
+    43 mm panel) against the target 250 kN/m/m x 1.33 m / 40^2."""
+    c = _find(sel_1_40.net, "tpe", 0.6, 0.95)
+    assert c.feasible
+    assert c.stiffness == pytest.approx(30e3 * 0.043, rel=1e-9)
+    assert c.target == pytest.approx(250e3 * 1.33 / 1600, rel=EXACT)
+    assert c.error == pytest.approx(30e3 * 0.043 / (250e3 * 1.33 / 1600) - 1, rel=1e-9)
+    assert c.modulus_source == "measured panel law"
+
+
+def test_ranking_is_by_score_and_feasibility(sel_1_40):
+    for cands in (sel_1_40.cables, sel_1_40.net):
+        feasible = [c.feasible for c in cands]
+        assert feasible == sorted(feasible, reverse=True)
+        scores = [round(c.score, SCORE_DIGITS) for c in cands if c.feasible]
+        assert scores == sorted(scores)
+
+
+def test_datasheet_only_material_is_flagged(sel_1_40):
+    psu = next(c for c in sel_1_40.cables if c.material == "psu")
+    assert psu.modulus_source == "datasheet"
+    best_psu = min((c for c in sel_1_40.cables if c.material == "psu"), key=lambda c: c.score)
+    assert best_psu.score >= abs(math.log(best_psu.stiffness / best_psu.target)) + 0.1 - EXACT
+
+
+def test_weak_sections_are_rejected_for_strength(sel_1_40):
+    weak = [c for c in sel_1_40.cables if c.safety_factor < 1.5]
+    assert weak and all(not c.feasible and "safety factor" in c.reasons[0] for c in weak)
+
+
+def test_net_law_scales_with_strand_area_and_geometry():
+    """Rescaling the measured panel law: same geometry x2 area -> x2 slopes; a linear material
+    gives E A 2 sin^3 / a_across."""
+    tpe = load_material("tpe")
+    k1 = net_membrane_law(tpe, Section(0.6, 1, (0.35, 0.30, 0.30)), 9.4e-3, 20.6e-3)
+    k2 = net_membrane_law(tpe, Section(0.6, 2, (0.35, 0.30, 0.30)), 9.4e-3, 20.6e-3)
+    np.testing.assert_allclose(np.array(k2[1]) / np.array(k1[1]), 2.0, rtol=EXACT)
+    assert k1[0] == (0.40,)
+    petg = load_material("petg")
+    sec = Section(0.6, 1, (0.35,))
+    _, slopes, _ = net_membrane_law(petg, sec, 9.4e-3, 20.6e-3)
+    assert slopes[0] == pytest.approx(1.30e9 * area_m2(sec) * diamond_factor(9.4e-3, 20.6e-3),
+                                      rel=EXACT)
+
+
+def test_simple_barrier_gets_a_net_within_ten_percent():
+    p = load_prototype(SIMPLE)
+    s = select(p, scale_targets(p, 40))
+    assert s.cables == () and "no border cables" in s.cable_rationale
+    assert abs(s.net[0].error) < 0.10  # a soft polymer can match a scaled 100 GPa square net
+
+
+def test_printer_with_a_fine_nozzle_rejects_wide_layers(tmp_path):
+    """prusa-mk4 (0.4 mm nozzle): 0.35 mm first layer > 0.75 x 0.4 = 0.30 mm."""
+    p = load_prototype(REALISTIC)
+    with pytest.raises(PrintabilityError, match=r"layer height 0.35 mm exceeds 0.3 mm"):
+        select(p, scale_targets(p, 40), printer="prusa-mk4")
+
+
+def test_materials_option_restricts_candidates(tmp_path):
+    p = load_prototype(write_variant(tmp_path, {("model", "materials"): ["tpe", "petg"]}))
+    s = select(p, scale_targets(p, 40))
+    assert {c.material for c in s.cables + s.net} == {"tpe", "petg"}
