@@ -74,3 +74,4 @@ class Design:
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
+
