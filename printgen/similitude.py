@@ -156,3 +156,16 @@ def flow_check(p: Prototype, v: dict[str, float], lam: float) -> FlowCheck:
             warn.append(f"model Froude {froude:.2f} is outside the flume's range "
                         f"{f.froude_min:g}-{f.froude_max:g}")
     return FlowCheck(u, h, width, r_h, froude, reynolds, discharge, tuple(warn))
+
+
+def targets_record(t: ScaledTargets, name: str) -> dict:
+    """JSON-ready record of the targets (stable keys)."""
+    return {
+        "prototype": name,
+        "scale": t.scale,
+        "targets": {r.key: {"label": r.label, "unit": r.unit, "exponent": r.exponent,
+                            "prototype": r.prototype, "model": r.model} for r in t.rows},
+        "pi_groups": {"prototype": t.pi_prototype, "model": t.pi_model},
+        "flow": t.flow,
+        "warnings": list(t.flow.warnings),
+    }

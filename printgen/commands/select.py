@@ -13,7 +13,7 @@ from printgen.commands.common import (
     table,
 )
 from printgen.prototype import load_prototype
-from printgen.selection import Candidate, Selection, select
+from printgen.selection import Candidate, Selection, select, selection_record
 from printgen.similitude import scale_targets
 
 SHOW = 8  # candidates shown per component in the table (all are in --json)
@@ -30,39 +30,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def candidate_dict(c: Candidate) -> dict:
-    s = c.section
-    return {
-        "material": c.material, "material_name": c.material_name,
-        "modulus_pa": c.modulus, "modulus_source": c.modulus_source,
-        "section": {"bead_width_mm": s.bead_width_mm, "beads_across": s.beads_across,
-                    "layer_heights_mm": list(s.layer_heights_mm), "width_mm": s.width_mm,
-                    "thickness_mm": s.thickness_mm, "passes": s.passes},
-        "stiffness": c.stiffness, "target": c.target, "error": c.error,
-        "error_low_strain": c.error_low, "error_high_strain": c.error_high,
-        "error_rms_log": c.error_rms, "pi3_deviation": c.pi3_deviation,
-        "peak_force_n": c.peak_force, "safety_factor": c.safety_factor,
-        "speed_mm_per_s": c.speed_mm_per_s, "feasible": c.feasible,
-        "reasons": list(c.reasons), "score": c.score,
-    }
-
-
-def selection_dict(s: Selection) -> dict:
-    return {
-        "printer": s.printer, "net_print": s.net_print, "cable_print": s.cable_print,
-        "cable": {"rationale": s.cable_rationale,
-                  "ranked": [candidate_dict(c) for c in s.cables]},
-        "net": {"rationale": s.net_rationale, "ranked": [candidate_dict(c) for c in s.net]},
-    }
-
-
 def run(args: argparse.Namespace) -> int:
     proto = load_prototype(args.prototype)
     t = scale_targets(proto, args.scale)
     s = select(proto, t, printer=args.printer,
                materials=tuple(args.materials) if args.materials else None)
     if args.json:
-        emit_json({"prototype": proto.name, "scale": t.scale, **selection_dict(s)})
+        emit_json({"prototype": proto.name, "scale": t.scale, **selection_record(s)})
         return 0
     show_selection(s, None if args.all else SHOW)
     return 0

@@ -13,7 +13,7 @@ from printgen.commands.common import (
     table,
 )
 from printgen.prototype import load_prototype
-from printgen.similitude import ScaledTargets, scale_targets
+from printgen.similitude import ScaledTargets, scale_targets, targets_record
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -23,23 +23,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def targets_dict(t: ScaledTargets, name: str) -> dict:
-    return {
-        "prototype": name,
-        "scale": t.scale,
-        "targets": {r.key: {"label": r.label, "unit": r.unit, "exponent": r.exponent,
-                            "prototype": r.prototype, "model": r.model} for r in t.rows},
-        "pi_groups": {"prototype": t.pi_prototype, "model": t.pi_model},
-        "flow": t.flow,
-        "warnings": list(t.flow.warnings),
-    }
-
-
 def run(args: argparse.Namespace) -> int:
     proto = load_prototype(args.prototype)
     t = scale_targets(proto, args.scale)
     if args.json:
-        emit_json(targets_dict(t, proto.name))
+        emit_json(targets_record(t, proto.name))
         return 0
     show_targets(proto.name, t)
     return 0

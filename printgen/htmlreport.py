@@ -1,0 +1,60 @@
+"""A self-contained HTML report: headings, paragraphs, tables, and PNG figures embedded as
+base64, so one file can be mailed or opened offline. Plain data in, text out."""
+
+from __future__ import annotations
+
+import base64
+import html
+from dataclasses import dataclass, field
+
+CSS = """
+body { font-family: system-ui, sans-serif; max-width: 1100px; margin: 2em auto; color: #222;
+       line-height: 1.45; padding: 0 1em; }
+h1 { font-size: 1.6em; border-bottom: 2px solid #2a6; padding-bottom: .2em; }
+h2 { font-size: 1.25em; margin-top: 1.8em; color: #164; }
+table { border-collapse: collapse; margin: .8em 0; font-size: .92em; }
+th, td { border: 1px solid #ccc; padding: .25em .6em; text-align: right; }
+th { background: #eef5f0; } td:first-child, th:first-child { text-align: left; }
+.pass { color: #fff; background: #2a6; padding: .1em .5em; border-radius: .3em; }
+.fail { color: #fff; background: #c33; padding: .1em .5em; border-radius: .3em; }
+.note { color: #555; font-size: .9em; }
+figure { margin: 1em 0; } figcaption { color: #555; font-size: .9em; }
+img { max-width: 100%; }
+"""
+
+
+@dataclass
+class Report:
+    """Blocks of HTML in order; `add_*` append, `html()` renders."""
+
+    title: str
+    blocks: list[str] = field(default_factory=list)
+
+    def heading(self, text: str) -> None:
+        self.blocks.append(f"<h2>{html.escape(text)}</h2>")
+
+    def paragraph(self, text: str, cls: str = "") -> None:
+        attr = f' class="{cls}"' if cls else ""
+        self.blocks.append(f"<p{attr}>{html.escape(text)}</p>")
+
+    def verdict(self, ok: bool, text: str) -> None:
+        tag = '<span class="pass">PASS</span>' if ok else '<span class="fail">FAIL</span>'
+        self.blocks.append(f"<p>{tag} {html.escape(text)}</p>")
+
+    def table(self, columns: list[str], rows: list[list[str]]) -> None:
+        head = "".join(f"<th>{html.escape(c)}</th>" for c in columns)
+        body = "".join("<tr>" + "".join(f"<td>{html.escape(str(v))}</td>" for v in r) + "</tr>"
+                       for r in rows)
+        self.blocks.append(f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
+
+    def figure(self, png: bytes, caption: str) -> None:
+        data = base64.b64encode(png).decode("ascii")
+        self.blocks.append(f'<figure><img alt="{html.escape(caption)}" '
+                           f'src="data:image/png;base64,{data}"><figcaption>'
+                           f"{html.escape(caption)}</figcaption></figure>")
+
+    def html(self) -> str:
+        body = "\n".join(self.blocks)
+        return (f"<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+                f"<title>{html.escape(self.title)}</title><style>{CSS}</style></head>\n"
+                f"<body><h1>{html.escape(self.title)}</h1>\n{body}\n</body></html>\n")
