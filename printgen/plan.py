@@ -8,7 +8,6 @@ from printgen.prototype import Prototype
 from printgen.selection import Selection, model_mesh
 from printgen.similitude import ScaledTargets
 
-
 EYELET_INNER_MM = 3.2  # clearance for the M3 screws that hold the cables on the flume anchors
 EYELET_OUTER_MM = 6.4  # twice the hole: a ring 1.6 mm wide survives the cable's peak force
 BORDER_BEADS = 2  # the net's border frame is two beads wide: the cables thread along it

@@ -12,8 +12,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from printgen.design import Section
 from printgen.materials import Material
 
