@@ -176,6 +176,15 @@ def place_on_bed(size_mm: np.ndarray, printer: Printer, *, where: str) -> tuple[
         "choose a larger printer or a smaller part")
 
 
+def wall_loops(part_kind: str, part: NetDesign | CableDesign) -> int:
+    """Perimeter loops a slicer needs to fill the widest band of the part (2 beads a loop)."""
+    if part_kind == "net":
+        beads = max(part.strand.beads_across, _border_bead(part)[0])
+    else:
+        beads = max(part.section.beads_across, _ring_layout(part)[0])
+    return max(1, -(-beads // 2))
+
+
 def _border_bead(net: NetDesign) -> tuple[int, float]:
     """(loops, bead width mm) of the border: whole strand beads across its width."""
     n = max(1, round(net.border_width_mm / net.strand.bead_width_mm))
