@@ -19,6 +19,7 @@ COMMAND_MODULES = (
     "printgen.commands.targets",
     "printgen.commands.select",
     "printgen.commands.profiles",
+    "printgen.commands.make",
 )
 
 

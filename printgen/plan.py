@@ -9,7 +9,7 @@ from printgen.selection import Selection, model_mesh
 from printgen.similitude import ScaledTargets
 
 EYELET_INNER_MM = 3.2  # clearance for the M3 screws that hold the cables on the flume anchors
-EYELET_OUTER_MM = 6.4  # twice the hole: a ring 1.6 mm wide survives the cable's peak force
+EYELET_RING_BEADS = 4  # the eyelet ring is 4 cable beads wide (1.8 mm at 0.45 mm beads)
 BORDER_BEADS = 2  # the net's border frame is two beads wide: the cables thread along it
 
 
@@ -38,7 +38,9 @@ def make_design(prototype: Prototype, targets: ScaledTargets, selection: Selecti
         cables = tuple(
             CableDesign(name=name, material=c.material, print_style=selection.cable_print,
                         length_mm=round(length, 6), section=c.section,
-                        eyelet_inner_mm=EYELET_INNER_MM, eyelet_outer_mm=EYELET_OUTER_MM)
+                        eyelet_inner_mm=EYELET_INNER_MM,
+                        eyelet_outer_mm=round(EYELET_INNER_MM + 2 * EYELET_RING_BEADS
+                                              * c.section.bead_width_mm, 6))
             for name, length in (("top", width), ("bottom", width), ("left", height),
                                  ("right", height)))
     return Design(scale=targets.scale, printer=selection.printer, net=net, cables=cables)

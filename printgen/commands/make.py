@@ -1,0 +1,62 @@
+"""`printgen make PROTOTYPE --scale 40 [--printer NAME] [--out DIR] [--json]`: everything a lab
+needs, written atomically into DIR (default `out/<prototype>-1-<lambda>`)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from rich.console import Console
+
+from printgen.commands.common import add_json_arg, add_prototype_args, console, emit_json, table
+from printgen.make import make
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("make", help="targets, selection, parts, slicer profiles, G-code, "
+                                    "verification and report in one run")
+    add_prototype_args(p)
+    p.add_argument("--printer", help="printer profile (default: the prototype's [model] choice)")
+    p.add_argument("--out", "-o", type=Path, help="output directory")
+    p.add_argument("--drag", action="store_true",
+                   help="also verify under hydrostatic + drag at the Froude-scaled velocity")
+    add_json_arg(p)
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    out = args.out or Path("out") / f"{Path(args.prototype).stem}-1-{args.scale:g}"
+    err = Console(stderr=True, highlight=False)
+    t0 = time.perf_counter()
+    with err.status("planning") as status:
+        ctx = make(args.prototype, args.scale, out, printer=args.printer,
+                   options={"drag": args.drag},
+                   progress=lambda label: status.update(f"{label} ..."))
+    seconds = time.perf_counter() - t0
+    if args.json:
+        emit_json(ctx.record)
+        return 0
+    show_summary(ctx, out, seconds)
+    return 0
+
+
+def show_summary(ctx, out: Path, seconds: float) -> None:
+    c = console()
+    d = ctx.design
+    rows = [["net", f"{d.net.material.upper()} {d.net.strand.width_mm:g} x "
+             f"{d.net.strand.thickness_mm:g} mm, {d.net.strand.passes} passes",
+             f"{ctx.selection.net[0].error:+.0%} (small strain)"]]
+    if ctx.selection.cables:
+        cab = ctx.selection.cables[0]
+        rows.append(["cables", f"{cab.material_name} {cab.section.width_mm:g} x "
+                     f"{cab.section.thickness_mm:g} mm, {cab.section.passes} passes",
+                     f"{cab.error:+.1%} E*A"])
+    ver = ctx.record.get("verification")
+    if ver:
+        rows.append(["verification", ver["verdict"], ver["summary"]])
+    c.print(table(f"printgen make: 1:{ctx.targets.scale:g} in {seconds:.1f} s",
+                  ["item", "choice", "stiffness / result"], rows))
+    c.print(f"{len(ctx.record['files'])} files in {out}/ ; open {out / 'report.html'}")
+    sys.stdout.flush()
