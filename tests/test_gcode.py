@@ -1,0 +1,247 @@
+"""Direct G-code: toolpaths, writer, read-back, and the independent checker."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from conftest import require_shared
+from numpy.testing import assert_allclose
+
+from printgen.design import Section
+from printgen.errors import PrintabilityError
+from printgen.gcode import (
+    cable_toolpath,
+    cable_volume_budget,
+    gcode_text,
+    net_toolpath,
+    net_volume_budget,
+    read_gcode_text,
+    write_gcode,
+)
+from printgen.gcode.toolpath import BORDER, STRAND_MINUS, STRAND_PLUS, TRAVEL
+from printgen.geometry.net import diamond_net
+from printgen.materials import load_material
+from printgen.printers import load_print_style, load_printer
+
+VOLUME_TOL = 0.02  # the brief: read-back volume within 2 % of the design
+E_ROUND_REL = 1e-4  # E written with 5 decimals: relative rounding error of a volume sum
+GEOM_TOL_MM = 1e-6  # float round-off on coordinates built from the graph
+
+
+@pytest.fixture
+def net_setup(design_1_40):
+    d = design_1_40
+    return (d.net, load_printer(d.printer), load_print_style(d.net.print_style),
+            load_material(d.net.material))
+
+
+@pytest.fixture
+def cable_setup(design_1_40):
+    d = design_1_40
+    c = d.cables[0]  # 345 mm: only fits the 350 mm bed turned
+    return (c, load_printer(d.printer), load_print_style(c.print_style),
+            load_material(c.material))
+
+
+def test_net_strands_are_single_straight_moves_in_crossed_passes(net_setup):
+    net, printer, style, material = net_setup
+    tp = net_toolpath(net, printer, style, material, crossing_flow_factor=1.0)
+    g = diamond_net(net.width_mm, net.height_mm, net.mesh_x_mm, net.mesh_y_mm)
+    want = np.sort([np.hypot(*(g.nodes_mm[s[-1]] - g.nodes_mm[s[0]])) for s in g.strands])
+    lengths = tp.lengths_mm()
+    assert len(tp.layer_z_mm) == net.strand.passes == 3
+    assert_allclose(np.diff(np.concatenate([[0], tp.layer_z_mm])), net.strand.layer_heights_mm,
+                    atol=GEOM_TOL_MM)
+    for k in range(3):
+        strand = (tp.layer == k) & np.isin(tp.kind, (STRAND_PLUS, STRAND_MINUS))
+        assert_allclose(np.sort(lengths[strand]), want, atol=GEOM_TOL_MM)  # one move a strand
+        assert np.all(tp.width_mm[strand] == net.strand.bead_width_mm)
+        assert np.all(tp.height_mm[strand] == net.strand.layer_heights_mm[k])
+        first = tp.kind[strand][0]
+        assert first == (STRAND_PLUS if k % 2 == 0 else STRAND_MINUS)  # family order alternates
+        assert np.sum((tp.layer == k) & (tp.kind == BORDER)) == 4 * 2  # 2 loops of 0.6 mm
+        # one family is finished before the other starts
+        kinds = tp.kind[strand]
+        assert np.count_nonzero(np.diff(kinds)) == 1
+
+
+def test_flow_never_exceeds_the_material_limit(net_setup, cable_setup):
+    for part, printer, style, material in (net_setup, cable_setup):
+        tp = (net_toolpath if part is net_setup[0] else cable_toolpath)(part, printer, style,
+                                                                        material)
+        flow = tp.area_mm2() * tp.speed_mm_per_s
+        assert flow.max() <= material.print.max_volumetric_flow_mm3_per_s
+    # TPE 1.5 mm3/s over a 0.6 x 0.3 mm bead: 8.3 mm/s, below the profile's 15 mm/s
+    tp = net_toolpath(*net_setup)
+    ext = tp.extruding & (tp.layer > 0)
+    assert_allclose(tp.speed_mm_per_s[ext].max(), 0.995 * 1.5 / (0.6 * 0.3), rtol=1e-9)
+
+
+@pytest.mark.parametrize("relative_e", [True, False])
+def test_writer_e_is_bead_area_over_filament_area(net_setup, relative_e):
+    net, printer, style, material = net_setup
+    tp = net_toolpath(net, printer, style, material, crossing_flow_factor=0.5)
+    text = gcode_text(tp, printer, material, relative_e=relative_e)
+    assert ("M83" if relative_e else "M82") in text
+    rb = read_gcode_text(text, filament_diameter_mm=printer.filament_diameter_mm)
+    assert_allclose(rb.volume_mm3, tp.volume_mm3, rtol=E_ROUND_REL)
+    assert_allclose(rb.volume_per_layer_mm3, tp.volume_per_layer_mm3(), rtol=E_ROUND_REL)
+    fil = math.pi * printer.filament_diameter_mm ** 2 / 4
+    assert_allclose(rb.filament_mm * fil, tp.volume_mm3, rtol=E_ROUND_REL)
+
+
+def test_readback_deposits_the_designed_volume(net_setup):
+    net, printer, style, material = net_setup
+    g = diamond_net(net.width_mm, net.height_mm, net.mesh_x_mm, net.mesh_y_mm)
+    for f in (1.0, 0.5, 0.0):
+        tp = net_toolpath(net, printer, style, material, crossing_flow_factor=f)
+        rb = read_gcode_text(gcode_text(tp, printer, material))
+        budget = net_volume_budget(net, style, crossing_flow_factor=f)
+        assert abs(rb.volume_mm3 / budget.deposit_mm3 - 1) < VOLUME_TOL
+        # the designed solid = what was laid less the part laid twice (crossings, border)
+        laid_twice = f * budget.crossing_overlap_mm3 + budget.junction_overlap_mm3
+        assert abs((rb.volume_mm3 - laid_twice) / budget.solid_mm3 - 1) < VOLUME_TOL
+        assert len(rb.layer_z_mm) == 3
+        if f == 1.0:  # one path per strand plus the two border loops
+            assert rb.paths_per_layer.tolist() == [len(g.strands) + 2] * 3
+    assert budget.crossings_per_layer == sum(len(s) - 2 for s in g.strands) // 2
+    lo, hi = rb.bounds_mm
+    assert lo[0] >= printer.bed_margin_mm and hi[0] <= printer.bed_x_mm - printer.bed_margin_mm
+    assert lo[1] >= printer.bed_margin_mm and hi[1] <= printer.bed_y_mm - printer.bed_margin_mm
+
+
+def test_budget_solid_matches_the_union_of_strands(net_setup):
+    """Independent check of the analytic overlaps: shapely union of the beads of one layer."""
+    shapely = pytest.importorskip("shapely")
+    from shapely.geometry import LineString, box
+
+    net, style = net_setup[0], net_setup[2]
+    g = diamond_net(net.width_mm, net.height_mm, net.mesh_x_mm, net.mesh_y_mm)
+    w, bw = net.strand.width_mm, net.border_width_mm
+    sx, sy = g.size_mm
+    beads = [LineString(g.nodes_mm[[s[0], s[-1]]]).buffer(w / 2, cap_style="flat")
+             for s in g.strands]
+    ring = box(-bw / 2, -bw / 2, sx + bw / 2, sy + bw / 2).difference(
+        box(bw / 2, bw / 2, sx - bw / 2, sy - bw / 2))
+    area = shapely.unary_union([*beads, ring]).area
+    budget = net_volume_budget(net, style)
+    assert abs(budget.solid_mm3 / (area * net.strand.thickness_mm) - 1) < VOLUME_TOL
+
+
+def test_crossing_flow_is_reduced_over_the_crossing_span_only(net_setup):
+    net, printer, style, material = net_setup
+    tp = net_toolpath(net, printer, style, material, crossing_flow_factor=0.4)
+    g = diamond_net(net.width_mm, net.height_mm, net.mesh_x_mm, net.mesh_y_mm)
+    a, b = g.mesh_mm
+    sin_cross = 2 * a * b / (a * a + b * b)
+    n_cross = sum(len(s) - 2 for s in g.strands) // 2
+    reduced = (tp.flow == 0.4) & (tp.layer == 1)
+    span = net.strand.width_mm / sin_cross  # strand length lying over the crossing strand
+    assert_allclose(tp.lengths_mm()[reduced].sum(), n_cross * span, rtol=1e-9)
+    # only the family laid second in the layer is reduced (layer 1: the + family)
+    assert set(tp.kind[reduced]) == {STRAND_PLUS}
+
+
+def test_cable_toolpath_turns_long_cable_onto_bed_and_keeps_volume(cable_setup):
+    cable, printer, style, material = cable_setup
+    tp = cable_toolpath(cable, printer, style, material)
+    lo, hi = tp.bounds_mm()
+    ring = (cable.eyelet_outer_mm - cable.eyelet_inner_mm) / 2
+    assert lo[0] - ring / 2 >= printer.bed_margin_mm - GEOM_TOL_MM
+    assert hi[0] + ring / 2 <= printer.bed_x_mm - printer.bed_margin_mm + GEOM_TOL_MM
+    assert hi[1] - lo[1] > cable.eyelet_outer_mm  # turned: not a horizontal strip
+    assert abs(tp.volume_mm3 / cable_volume_budget(cable).solid_mm3 - 1) < VOLUME_TOL
+    assert len(tp.layer_z_mm) == len(cable.section.layer_heights_mm)
+
+
+def test_readback_of_hand_written_gcode():
+    """Analytic case: absolute and relative E, G92 resets, G91 relative moves, a retraction."""
+    lines = ["G21", "G90", "M82", "G92 E0", "G0 X0 Y0 Z0.3 F6000",
+             "G1 X10 Y0 E1.0 F600 ; 10 mm, 1 mm filament",
+             "G1 E0.2 F1800 ; retract 0.8", "G0 X10 Y5", "G1 E1.0 ; prime",
+             "G92 E0", "G1 X20 Y5 E0.5",  # 10 mm, 0.5 mm
+             "M83", "G0 Z0.6", "G91", "G1 X-20 E2.0 ; relative 20 mm, 2 mm", "G90"]
+    text = "\n".join(lines)
+    rb = read_gcode_text(text, filament_diameter_mm=1.75)
+    fil = math.pi * 1.75 ** 2 / 4
+    assert_allclose(rb.volume_per_layer_mm3, [1.5 * fil, 2.0 * fil], rtol=1e-12)
+    assert rb.paths_per_layer.tolist() == [2, 1]
+    assert_allclose(rb.bounds_mm, [[0, 0, 0.3], [20, 5, 0.6]])
+    ext = rb.toolpath.extruding
+    assert_allclose(rb.toolpath.width_mm[ext], [fil / 10 / 0.3, 0.5 * fil / 10 / 0.3,
+                                                2 * fil / 20 / 0.3], rtol=1e-12)
+    assert np.all(rb.toolpath.kind[~ext] == TRAVEL)
+
+
+# (change to the net design, change to the printer, expected message)
+BAD = {
+    "strand narrower than the nozzle prints": (
+        {"strand": Section(0.3, 1, (0.35, 0.3, 0.3))}, {},
+        r"bead width 0.3 mm is below 0.425 mm \(0.85 x the 0.5 mm nozzle"),
+    "zero passes": ({"strand": Section(0.6, 1, ())}, {}, "0 passes"),
+    "part larger than the bed": (
+        {}, {"bed_x_mm": 250.0, "bed_y_mm": 210.0},
+        r"part 330.8 x 99.9 mm does not fit the usable 240 x 200 mm"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD))
+def test_bad_designs_fail_before_writing(net_setup, tmp_path, case):
+    net, printer, style, material = net_setup
+    change, printer_change, message = BAD[case]
+    bad = dataclasses.replace(net, **change)
+    printer = dataclasses.replace(printer, **printer_change)
+    out = tmp_path / "net.gcode"
+    with pytest.raises(PrintabilityError, match=message):
+        write_gcode(out, net_toolpath(bad, printer, style, material), printer, material)
+    assert not out.exists()
+
+
+def _checker(path, *args):
+    script = require_shared("tools/gcode/check_gcode.py")
+    r = subprocess.run([sys.executable, str(script), str(path), "--json", "-", *args],
+                       check=False, capture_output=True, text=True, timeout=120)
+    return r.returncode, json.loads(r.stdout), r.stderr.strip().splitlines()[-1]
+
+
+def test_direct_net_gcode_passes_the_checker(net_setup, tmp_path):
+    net, printer, style, material = net_setup
+    p = material.print
+    tp = net_toolpath(net, printer, style, material)
+    path = write_gcode(tmp_path / "net.gcode", tp, printer, material)
+    rc, rep, summary = _checker(
+        path, "--bed", f"{printer.bed_x_mm:g}x{printer.bed_y_mm:g}x{printer.max_height_mm:g}",
+        "--width", f"{net.strand.bead_width_mm}", "--area-model", "rect", "--tol", "0.15",
+        "--layers", "3", "--first-layer-height", "0.35", "--layer-height", "0.3",
+        "--min-hotend", f"{p.first_layer_nozzle_temperature_deg_c:g}",
+        "--min-bed", f"{p.first_layer_bed_temperature_deg_c:g}",
+        "--max-flow", f"{p.max_volumetric_flow_mm3_per_s:g}",
+        "--expect-volume", f"{net_volume_budget(net, style).deposit_mm3:.3f}",
+        "--volume-tol", f"{VOLUME_TOL}")
+    assert rc == 0, summary
+    assert all(c["status"] == "PASS" for c in rep["checks"]), rep["checks"]
+    assert rep["strand_section"]["len_within_tol_frac"] == 1.0  # every move is w x h exactly
+    rb = read_gcode_text(path.read_text())
+    assert_allclose(rep["extruded_volume_mm3"], rb.volume_mm3, rtol=E_ROUND_REL)
+
+
+def test_direct_cable_gcode_passes_the_checker(cable_setup, tmp_path):
+    cable, printer, style, material = cable_setup
+    p = material.print
+    path = write_gcode(tmp_path / "cable.gcode", cable_toolpath(cable, printer, style, material),
+                       printer, material, relative_e=False)
+    rc, rep, summary = _checker(
+        path, "--bed", f"{printer.bed_x_mm:g}x{printer.bed_y_mm:g}", "--layers", "2",
+        "--width", "0.45", "--min-frac", "0.6",  # the eyelet rings are 0.5 mm beads
+        "--min-hotend", f"{p.first_layer_nozzle_temperature_deg_c:g}",
+        "--max-flow", f"{p.max_volumetric_flow_mm3_per_s:g}",
+        "--expect-volume", f"{cable_volume_budget(cable).solid_mm3:.3f}",
+        "--volume-tol", f"{VOLUME_TOL}")
+    assert rc == 0, summary
+    assert rep["e_mode_at_first_extrusion"] == "absolute"
