@@ -5,5 +5,4 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 out="${1:-out/realistic-1-40}"
-.venv/bin/printgen targets examples/realistic_barrier.toml --scale 40
-.venv/bin/printgen select examples/realistic_barrier.toml --scale 40
+.venv/bin/printgen make examples/realistic_barrier.toml --scale 40 --out "$out"
