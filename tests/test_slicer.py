@@ -1,0 +1,193 @@
+"""Slicer profiles: PrusaSlicer .ini and CuraEngine settings, sliced by the real slicers."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import re
+import subprocess
+
+import pytest
+from conftest import require_shared, require_tool
+from numpy.testing import assert_allclose
+
+from printgen.design import Section
+from printgen.errors import PrintabilityError
+from printgen.gcode import read_gcode
+from printgen.geometry.net import diamond_net
+from printgen.materials import load_material
+from printgen.printers import load_print_style, load_printer
+from printgen.slicer import allowed_prusa_keys, prusa_ini_text, prusa_settings, write_prusa_ini
+from printgen.slicer.cura import cura_cfg_text, cura_settings, write_cura_cfg
+
+READBACK_VS_CHECKER_TOL = 1e-3  # two parsers of the same file: only E rounding differs
+SLICE_TIMEOUT_S = 120
+
+
+def _setup(design, part):
+    return (load_printer(design.printer), load_print_style(part.print_style),
+            load_material(part.material))
+
+
+def _ini(text: str) -> dict[str, str]:
+    return dict(ln.split(" = ", 1) for ln in text.splitlines() if ln and not ln.startswith("#"))
+
+
+def test_ini_follows_the_measured_rules(design_1_40):
+    net = design_1_40.net
+    printer, style, material = _setup(design_1_40, net)
+    s = _ini(prusa_ini_text("net", net, printer, style, material))
+    assert set(s) <= allowed_prusa_keys()
+    bead = 1.15 * 0.6  # slicers.md: bead about 1.15 x the strand
+    for k in ("perimeter_extrusion_width", "external_perimeter_extrusion_width",
+              "first_layer_extrusion_width"):  # first layer width = bead width (pitfall 3)
+        assert_allclose(float(s[k]), bead, rtol=1e-3)
+    assert_allclose(float(s["min_bead_width"]), 0.85 * 0.6, rtol=1e-3)
+    assert 0.85 * 0.6 < net.strand.bead_width_mm < bead  # one bead per strand in Arachne
+    assert s["perimeter_generator"] == "arachne" and s["perimeters"] == "1"
+    assert s["use_relative_e_distances"] == "1" and s["layer_gcode"] == "G92 E0"
+    assert s["max_volumetric_speed"] == s["filament_max_volumetric_speed"] == "1.5"
+    assert (s["first_layer_height"], s["layer_height"]) == ("0.35", "0.3")
+    assert (s["first_layer_temperature"], s["bed_temperature"]) == ("230", "50")
+    assert "M190 S[first_layer_bed_temperature]" in s["start_gcode"]
+    assert "{" not in s["start_gcode"] and "\n" not in s["start_gcode"]
+
+
+def test_allowed_keys_are_known_to_prusaslicer():
+    exe = require_tool("prusa-slicer")
+    out = subprocess.run([exe, "--help-fff"], capture_output=True, text=True, check=False,
+                         timeout=SLICE_TIMEOUT_S).stdout
+    known = {m.replace("-", "_") for ln in out.splitlines() if ln.startswith(" --")
+             for m in re.findall(r"--([a-z0-9-]+)", ln)}
+    assert len(known) > 250  # the full option list, not an error message
+    assert sorted(allowed_prusa_keys() - known) == []
+
+
+def test_cable_profiles_fill_the_eyelet_band(design_1_40):
+    cable = design_1_40.cables[2]
+    printer, style, material = _setup(design_1_40, cable)
+    s = prusa_settings("cable", cable, printer, style, material)
+    # eyelet band (6 - 3) / 2 = 1.5 mm = 3 beads of 0.5 mm -> 2 perimeter loops
+    assert s["perimeters"] == "2"
+    c = cura_settings("cable", cable, printer, style, material)
+    assert c["wall_line_count"] == "2" and c["material_diameter"] == "1.75"
+    assert c["relative_extrusion"] == "true" and c["machine_heated_bed"] == "true"
+    flow = float(c["speed_print"]) * float(c["line_width"]) * 0.3
+    assert flow <= material.print.max_volumetric_flow_mm3_per_s
+
+
+@pytest.mark.parametrize("case", ["narrow strand", "zero passes", "larger than bed", "layers"])
+def test_bad_designs_fail_before_any_profile_is_written(design_1_40, tmp_path, case):
+    net = design_1_40.net
+    printer, style, material = _setup(design_1_40, net)
+    if case == "narrow strand":
+        net, msg = dataclasses.replace(net, strand=Section(0.3, 1, (0.35, 0.3))), "below 0.425"
+    elif case == "zero passes":
+        net, msg = dataclasses.replace(net, strand=Section(0.6, 1, ())), "0 passes"
+    elif case == "larger than bed":
+        printer = dataclasses.replace(printer, bed_x_mm=250.0, bed_y_mm=250.0)
+        msg = "does not fit"
+    else:
+        net = dataclasses.replace(net, strand=Section(0.6, 1, (0.35, 0.3, 0.25)))
+        msg = "vary above the first layer"
+    out = tmp_path / "net.ini"
+    with pytest.raises(PrintabilityError, match=msg):
+        write_prusa_ini(out, "net", net, printer, style, material)
+    assert not out.exists()
+    with pytest.raises(PrintabilityError, match="CuraEngine 4.13 cannot slice the diamond net"):
+        write_cura_cfg(tmp_path / "net.cfg", "net", net, printer, style, material)
+    assert not (tmp_path / "net.cfg").exists()
+
+
+# ----------------------------------------------------------------------------- slicing
+def _extrude(polys, thickness, path):
+    trimesh = pytest.importorskip("trimesh")
+    mesh = trimesh.creation.extrude_polygon(polys, thickness)
+    assert mesh.is_watertight
+    mesh.export(path)
+    return path
+
+
+def _net_stl(net, path):
+    """A reduced net's solid: union of the strand beads and the border ring, extruded."""
+    shapely = pytest.importorskip("shapely")
+    from shapely.geometry import LineString, box
+
+    g = diamond_net(net.width_mm, net.height_mm, net.mesh_x_mm, net.mesh_y_mm)
+    sx, sy = g.size_mm
+    bw, w = net.border_width_mm, net.strand.width_mm
+    parts = [LineString(g.nodes_mm[[s[0], s[-1]]]).buffer(w / 2, cap_style="flat")
+             for s in g.strands]
+    parts.append(box(-bw / 2, -bw / 2, sx + bw / 2, sy + bw / 2).difference(
+        box(bw / 2, bw / 2, sx - bw / 2, sy - bw / 2)))
+    return _extrude(shapely.unary_union(parts), net.strand.thickness_mm, path)
+
+
+def _cable_stl(cable, path):
+    shapely = pytest.importorskip("shapely")
+    from shapely.geometry import Point, box
+
+    half, w = cable.length_mm / 2, cable.section.width_mm
+    ends = (-half, half)
+    outline = shapely.unary_union([box(-half, -w / 2, half, w / 2)]
+                                  + [Point(x, 0).buffer(cable.eyelet_outer_mm / 2, 128)
+                                     for x in ends])
+    holes = shapely.unary_union([Point(x, 0).buffer(cable.eyelet_inner_mm / 2, 128)
+                                 for x in ends])
+    return _extrude(outline.difference(holes), cable.section.thickness_mm, path)
+
+
+def _run(script, stl, cfg, tmp_path, *args):
+    env = dict(os.environ, OUT_DIR=str(tmp_path), PYTHON=os.environ.get("PYTHON", "python3"))
+    r = subprocess.run(["bash", str(script), str(stl), str(cfg), *args], capture_output=True,
+                       text=True, env=env, timeout=SLICE_TIMEOUT_S, check=False)
+    return r.returncode, r.stdout.strip().splitlines()[-1] if r.stdout.strip() else r.stderr
+
+
+def test_prusaslicer_slices_a_generated_net_with_one_bead_per_strand(design_1_40, tmp_path):
+    require_tool("prusa-slicer")
+    script = require_shared("tools/gcode/slice_check.sh")
+    net = dataclasses.replace(design_1_40.net, width_mm=40.0, height_mm=60.0)  # reduced panel
+    printer, style, material = _setup(design_1_40, net)
+    ini = write_prusa_ini(tmp_path / "net.ini", "net", net, printer, style, material)
+    stl = _net_stl(net, tmp_path / "net.stl")
+    rc, summary = _run(script, stl, ini, tmp_path, "--width", f"{net.strand.width_mm}",
+                       "--area-model", "stadium", "--layers", f"{len(net.strand.layer_heights_mm)}",
+                       "--max-flow", f"{material.print.max_volumetric_flow_mm3_per_s:g}")
+    assert rc == 0, summary
+    assert summary.startswith("SLICE-CHECK OK")
+    rep = json.loads((tmp_path / "net.prusa.json").read_text())
+    # read-back of the slicer's own G-code agrees with the independent checker
+    rb = read_gcode(tmp_path / "net.prusa.gcode", filament_diameter_mm=printer.filament_diameter_mm)
+    assert len(rb.layer_z_mm) == rep["layer_count"] == 3
+    assert_allclose(rb.volume_mm3, rep["extruded_volume_mm3"], rtol=READBACK_VS_CHECKER_TOL)
+    assert rb.path_count == rep["paths"]["count"]
+    assert_allclose(rb.bounds_mm[:, :2].T, [rep["bounds_extrusion"][k] for k in "XY"],
+                    atol=1e-3)  # both read the 3-decimal coordinates
+
+
+def test_prusaslicer_slices_a_cable(design_1_40, tmp_path):
+    require_tool("prusa-slicer")
+    script = require_shared("tools/gcode/slice_check.sh")
+    cable = design_1_40.cables[2]
+    printer, style, material = _setup(design_1_40, cable)
+    ini = write_prusa_ini(tmp_path / "cable.ini", "cable", cable, printer, style, material)
+    rc, summary = _run(script, _cable_stl(cable, tmp_path / "cable.stl"), ini, tmp_path,
+                       "--width", f"{cable.section.bead_width_mm}", "--area-model", "stadium",
+                       "--layers", "2")
+    assert rc == 0, summary
+
+
+def test_curaengine_slices_a_cable(design_1_40, tmp_path):
+    require_tool("CuraEngine")
+    script = require_shared("tools/gcode/slice_check_cura.sh")
+    cable = design_1_40.cables[2]
+    printer, style, material = _setup(design_1_40, cable)
+    cfg = tmp_path / "cable.cfg"
+    cfg.write_text(cura_cfg_text("cable", cable, printer, style, material))
+    rc, summary = _run(script, _cable_stl(cable, tmp_path / "cable.stl"), cfg, tmp_path,
+                       "--width", f"{cable.section.bead_width_mm}", "--layers", "2",
+                       "--max-flow", f"{material.print.max_volumetric_flow_mm3_per_s:g}")
+    assert rc == 0, summary
+    assert summary.startswith("SLICE-CHECK OK slicer=CuraEngine-4.13")
