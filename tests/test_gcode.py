@@ -10,7 +10,7 @@ import sys
 
 import numpy as np
 import pytest
-from conftest import require_shared
+from conftest import ROOT, require_shared
 from numpy.testing import assert_allclose
 
 from printgen.design import Section
@@ -245,3 +245,17 @@ def test_direct_cable_gcode_passes_the_checker(cable_setup, tmp_path):
         "--volume-tol", f"{VOLUME_TOL}")
     assert rc == 0, summary
     assert rep["e_mode_at_first_extrusion"] == "absolute"
+
+
+def test_benchmark_writes_json_and_meets_the_goal(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "benchmarks.bench_gcode", "--out", str(tmp_path),
+                        "--repeat", "1"], cwd=ROOT, capture_output=True, text=True, check=False,
+                       timeout=120)
+    assert r.returncode == 0, r.stderr  # exit 1 when the 1 s goal is missed
+    report = json.loads(r.stdout)
+    assert json.loads((tmp_path / "bench_gcode.json").read_text()) == report
+    assert (tmp_path / "net.gcode").is_file()
+    assert report["net_gcode_s"] < report["goal_s"] == 1.0
+    for part in report["parts"].values():
+        assert abs(part["readback_vs_deposit"]) < VOLUME_TOL
+        assert part["max_flow_mm3_per_s"] <= part["flow_limit_mm3_per_s"]

@@ -1,0 +1,96 @@
+"""Benchmark: direct G-code for the 1:40 reference net (330 x 100 mm) and its cables.
+
+    python -m benchmarks.bench_gcode --out DIR [--repeat N]
+
+Times toolpath building, G-code writing and read-back (best of N), writes the G-code and
+`bench_gcode.json` into DIR and prints the JSON. Goal: the net's G-code in under 1 s.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from functools import partial
+from pathlib import Path
+
+GOAL_S = 1.0  # the brief: G-code for the 330 mm net in under a second
+
+
+def _best(fn, repeat: int):
+    best, out = float("inf"), None
+    for _ in range(repeat):
+        t = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - t)
+    return best, out
+
+
+def run(out_dir: Path, repeat: int = 5) -> dict:
+    from printgen.atomic import write_text
+    from printgen.gcode import (
+        cable_toolpath,
+        cable_volume_budget,
+        gcode_text,
+        net_toolpath,
+        net_volume_budget,
+        read_gcode_text,
+    )
+    from printgen.materials import load_material
+    from printgen.printers import load_print_style, load_printer
+    from tests.conftest import reference_design_1_40
+
+    d = reference_design_1_40()
+    printer = load_printer(d.printer)
+    half = 0.5  # crossing_flow_factor variant: every crossing splits the strand move
+    parts = [("net", d.net, net_toolpath, net_volume_budget),
+             ("net-crossing-flow-0.5", d.net,
+              partial(net_toolpath, crossing_flow_factor=half),
+              partial(net_volume_budget, crossing_flow_factor=half))]
+    parts += [(f"cable-{c.name}", c, cable_toolpath, lambda p, s: cable_volume_budget(p))
+              for c in d.cables]
+    results = {}
+    for name, part, build, budget in parts:
+        style, mat = load_print_style(part.print_style), load_material(part.material)
+        t_path, tp = _best(partial(build, part, printer, style, mat), repeat)
+        t_text, text = _best(partial(gcode_text, tp, printer, mat), repeat)
+        t_read, rb = _best(partial(read_gcode_text, text,
+                                   filament_diameter_mm=printer.filament_diameter_mm), repeat)
+        write_text(out_dir / f"{name}.gcode", text)
+        b = budget(part, style)
+        flow = float((tp.area_mm2() * tp.speed_mm_per_s).max())
+        results[name] = {
+            "toolpath_s": round(t_path, 5), "write_s": round(t_text, 5),
+            "gcode_total_s": round(t_path + t_text, 5), "readback_s": round(t_read, 5),
+            "moves": len(tp.width_mm), "lines": text.count("\n"), "bytes": len(text),
+            "layers": len(tp.layer_z_mm), "paths": rb.path_count,
+            "toolpath_volume_mm3": round(tp.volume_mm3, 3),
+            "readback_volume_mm3": round(rb.volume_mm3, 3),
+            "design_deposit_mm3": round(b.deposit_mm3, 3), "design_solid_mm3": round(b.solid_mm3, 3),
+            "readback_vs_deposit": round(rb.volume_mm3 / b.deposit_mm3 - 1, 6),
+            "max_flow_mm3_per_s": round(flow, 4),
+            "flow_limit_mm3_per_s": mat.print.max_volumetric_flow_mm3_per_s,
+            "print_time_feed_only_s": round(float(
+                (tp.lengths_mm() / tp.speed_mm_per_s).sum()), 1),
+        }
+    net = results["net"]
+    report = {"benchmark": "bench_gcode", "python": sys.version.split()[0],
+              "goal_s": GOAL_S, "net_gcode_s": net["gcode_total_s"],
+              "goal_met": net["gcode_total_s"] < GOAL_S, "repeat": repeat, "parts": results}
+    write_text(out_dir / "bench_gcode.json", json.dumps(report, indent=1) + "\n")
+    return report
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", required=True, type=Path, help="folder for G-code and JSON")
+    ap.add_argument("--repeat", type=int, default=5, help="timing repeats (best is kept)")
+    a = ap.parse_args(argv)
+    report = run(a.out, a.repeat)
+    print(json.dumps(report, indent=1))
+    return 0 if report["goal_met"] else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
