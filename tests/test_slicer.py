@@ -145,10 +145,12 @@ def _run(script, stl, cfg, tmp_path, *args):
     return r.returncode, r.stdout.strip().splitlines()[-1] if r.stdout.strip() else r.stderr
 
 
-def test_prusaslicer_slices_a_generated_net_with_one_bead_per_strand(design_1_40, tmp_path):
+@pytest.mark.parametrize("size_mm", [(40.0, 60.0), (330.0, 100.0)], ids=["reduced", "full"])
+def test_prusaslicer_slices_a_generated_net_with_one_bead_per_strand(design_1_40, tmp_path,
+                                                                     size_mm):
     require_tool("prusa-slicer")
     script = require_shared("tools/gcode/slice_check.sh")
-    net = dataclasses.replace(design_1_40.net, width_mm=40.0, height_mm=60.0)  # reduced panel
+    net = dataclasses.replace(design_1_40.net, width_mm=size_mm[0], height_mm=size_mm[1])
     printer, style, material = _setup(design_1_40, net)
     ini = write_prusa_ini(tmp_path / "net.ini", "net", net, printer, style, material)
     stl = _net_stl(net, tmp_path / "net.stl")
