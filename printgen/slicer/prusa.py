@@ -52,53 +52,65 @@ def prusa_settings(part_kind: str, design_part: NetDesign | CableDesign, printer
         raise PrintabilityError(
             f"{part_kind}: layer heights {heights} mm vary above the first layer; PrusaSlicer "
             "prints one layer_height: use equal heights after the first")
-    width = style.slicer_width_factor * sec.bead_width_mm
-    min_bead = style.slicer_min_bead_factor * sec.bead_width_mm
+    s = {**_printer(printer, material), **_filament(printer, material),
+         **_layers(part_kind, design_part, style, heights), **_speeds(printer, material)}
+    unknown = sorted(set(s) - allowed_prusa_keys())
+    if unknown:
+        raise ProfileError(f"PrusaSlicer keys {unknown} are not in prusa_keys.txt; add them "
+                           "after checking `prusa-slicer --help-fff`")
+    return s
+
+
+def _filament(printer: Printer, material: Material) -> dict[str, str]:
     p = material.print
-    flow = p.max_volumetric_flow_mm3_per_s
-    s: dict[str, str] = {}
-    s |= _printer(printer, material)
-    s |= {
+    flow = f"{p.max_volumetric_flow_mm3_per_s:g}"
+    return {
         "filament_type": p.filament_type, "filament_diameter": f"{printer.filament_diameter_mm:g}",
         "filament_density": f"{material.density / 1000:g}", "extrusion_multiplier": "1",
         "temperature": f"{p.nozzle_temperature_deg_c:g}",
         "first_layer_temperature": f"{p.first_layer_nozzle_temperature_deg_c:g}",
         "bed_temperature": f"{p.bed_temperature_deg_c:g}",
         "first_layer_bed_temperature": f"{p.first_layer_bed_temperature_deg_c:g}",
-        "filament_max_volumetric_speed": f"{flow:g}", "max_volumetric_speed": f"{flow:g}",
+        "filament_max_volumetric_speed": flow, "max_volumetric_speed": flow,
         "cooling": "1", "fan_always_on": "1", "min_fan_speed": f"{p.fan_min_percent:g}",
         "max_fan_speed": f"{p.fan_max_percent:g}", "bridge_fan_speed": "100",
         "disable_fan_first_layers": "1", "slowdown_below_layer_time": "5",
         "min_print_speed": "2",
-        "retract_length": f"{p.retract_length_mm:g}", "retract_speed": f"{p.retract_speed_mm_per_s:g}",
+        "retract_length": f"{p.retract_length_mm:g}",
+        "retract_speed": f"{p.retract_speed_mm_per_s:g}",
         "deretract_speed": f"{p.retract_speed_mm_per_s:g}",
     }
-    s |= {
+
+
+def _layers(part_kind: str, part: NetDesign | CableDesign, style: PrintStyle,
+            heights: tuple[float, ...]) -> dict[str, str]:
+    """Layer heights and Arachne widths: min_bead < strand bead < extrusion width."""
+    bead = part_section(part_kind, part).bead_width_mm
+    width = f"{style.slicer_width_factor * bead:.4g}"
+    s = {
         "layer_height": f"{(heights[1] if len(heights) > 1 else heights[0]):g}",
         "first_layer_height": f"{heights[0]:g}",
-        "perimeters": str(wall_loops(part_kind, design_part)),
+        "perimeters": str(wall_loops(part_kind, part)),
         "perimeter_generator": "arachne", "thin_walls": "1",
-        "min_bead_width": f"{min_bead:.4g}", "min_feature_size": "25%",
-    }
-    for k in ("extrusion_width", "perimeter_extrusion_width", "external_perimeter_extrusion_width",
-              "first_layer_extrusion_width", "infill_extrusion_width",
-              "solid_infill_extrusion_width", "top_infill_extrusion_width"):
-        s[k] = f"{width:.4g}"
-    v, v0 = p.print_speed_mm_per_s, p.first_layer_speed_mm_per_s
-    s |= {
+        "min_bead_width": f"{style.slicer_min_bead_factor * bead:.4g}", "min_feature_size": "25%",
         "fill_density": "0%", "top_solid_layers": "0", "bottom_solid_layers": "0",
         "gap_fill_enabled": "0", "extra_perimeters": "0", "ensure_vertical_shell_thickness": "0",
         "overhangs": "0", "skirts": "1", "skirt_distance": f"{SKIRT_DISTANCE_MM:g}",
-        "brim_width": "0", "perimeter_speed": f"{v:g}", "external_perimeter_speed": f"{v:g}",
-        "small_perimeter_speed": f"{v:g}", "first_layer_speed": f"{v0:g}",
-        "gap_fill_speed": f"{v0:g}", "travel_speed": f"{printer.travel_speed_mm_per_s:g}",
-        "avoid_crossing_perimeters": "0", "seam_position": "aligned",
+        "brim_width": "0", "avoid_crossing_perimeters": "0", "seam_position": "aligned",
     }
-    unknown = sorted(set(s) - allowed_prusa_keys())
-    if unknown:
-        raise ProfileError(f"PrusaSlicer keys {unknown} are not in prusa_keys.txt; add them "
-                           "after checking `prusa-slicer --help-fff`")
+    # first_layer_extrusion_width overrides every width on layer 1 (slicers.md pitfall 3)
+    for k in ("extrusion_width", "perimeter_extrusion_width", "external_perimeter_extrusion_width",
+              "first_layer_extrusion_width", "infill_extrusion_width",
+              "solid_infill_extrusion_width", "top_infill_extrusion_width"):
+        s[k] = width
     return s
+
+
+def _speeds(printer: Printer, material: Material) -> dict[str, str]:
+    v, v0 = material.print.print_speed_mm_per_s, material.print.first_layer_speed_mm_per_s
+    return {"perimeter_speed": f"{v:g}", "external_perimeter_speed": f"{v:g}",
+            "small_perimeter_speed": f"{v:g}", "first_layer_speed": f"{v0:g}",
+            "gap_fill_speed": f"{v0:g}", "travel_speed": f"{printer.travel_speed_mm_per_s:g}"}
 
 
 def _printer(printer: Printer, material: Material) -> dict[str, str]:
