@@ -259,3 +259,18 @@ def test_benchmark_writes_json_and_meets_the_goal(tmp_path):
     for part in report["parts"].values():
         assert abs(part["readback_vs_deposit"]) < VOLUME_TOL
         assert part["max_flow_mm3_per_s"] <= part["flow_limit_mm3_per_s"]
+
+
+def test_strands_of_two_beads_side_by_side(net_setup):
+    net, printer, style, material = net_setup
+    net = dataclasses.replace(net, width_mm=40.0, height_mm=60.0,
+                              strand=Section(0.6, 2, (0.35, 0.3)))
+    g = diamond_net(net.width_mm, net.height_mm, net.mesh_x_mm, net.mesh_y_mm)
+    for f in (1.0, 0.5):
+        tp = net_toolpath(net, printer, style, material, crossing_flow_factor=f)
+        budget = net_volume_budget(net, style, crossing_flow_factor=f)
+        assert abs(tp.volume_mm3 / budget.deposit_mm3 - 1) < VOLUME_TOL
+    tp = net_toolpath(net, printer, style, material, crossing_flow_factor=1.0)
+    strand = np.isin(tp.kind, (STRAND_PLUS, STRAND_MINUS))
+    assert np.sum(strand & (tp.layer == 0)) == 2 * len(g.strands)  # passes = 2 beads x 2 layers
+    assert len(tp.layer_z_mm) == 2
