@@ -193,3 +193,30 @@ def test_curaengine_slices_a_cable(design_1_40, tmp_path):
                        "--max-flow", f"{material.print.max_volumetric_flow_mm3_per_s:g}")
     assert rc == 0, summary
     assert summary.startswith("SLICE-CHECK OK slicer=CuraEngine-4.13")
+
+
+def _cura_keys(node: dict) -> set[str]:
+    keys = set()
+    for k, v in node.items():
+        keys.add(k)
+        keys |= _cura_keys(v.get("children", {}))
+    return keys
+
+
+def test_cura_keys_exist_in_the_definitions(design_1_40):
+    from printgen.slicer.cura import find_definitions
+
+    require_tool("CuraEngine")
+    defs = find_definitions()
+    if defs is None:  # same rule as the slicers: skip locally, fail in CI
+        msg = "fdmprinter.def.json not found (bash scripts/setup.sh --with-slicers extracts it)"
+        if os.environ.get("PRINTGEN_REQUIRE_SLICERS") or os.environ.get("CI"):
+            pytest.fail(msg)
+        pytest.skip(msg)
+    known = set()
+    for name in ("fdmprinter.def.json", "fdmextruder.def.json"):
+        known |= _cura_keys(json.loads((defs / name).read_text())["settings"])
+    assert len(known) > 400  # the whole tree was read
+    cable = design_1_40.cables[2]
+    s = cura_settings("cable", cable, *_setup(design_1_40, cable))
+    assert sorted(set(s) - known) == []

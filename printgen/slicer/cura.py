@@ -49,8 +49,14 @@ def cura_settings(part_kind: str, design_part: NetDesign | CableDesign, printer:
     # the volumetric limit caps the speed (Cura has no max_volumetric_speed)
     v = min(p.print_speed_mm_per_s, p.max_volumetric_flow_mm3_per_s / (w * max(heights)))
     v0 = min(p.first_layer_speed_mm_per_s, p.max_volumetric_flow_mm3_per_s / (w * heights[0]))
+    s = {**_machine(printer, material), **_layers(heights, w, walls),
+         **_material(material), **_speeds(printer, v, v0)}
+    return s
+
+
+def _machine(printer: Printer, material: Material) -> dict[str, str]:
     vals = placeholder_values(printer, material)
-    s = {
+    return {
         "machine_width": f"{printer.bed_x_mm:g}", "machine_depth": f"{printer.bed_y_mm:g}",
         "machine_height": f"{printer.max_height_mm:g}", "machine_heated_bed": "true",
         "machine_center_is_zero": "false", "machine_gcode_flavor": "RepRap (Marlin/Sprinter)",
@@ -61,6 +67,12 @@ def cura_settings(part_kind: str, design_part: NetDesign | CableDesign, printer:
         "relative_extrusion": "true", "center_object": "true",
         "machine_nozzle_size": f"{printer.nozzle_diameter_mm:g}",
         "material_diameter": f"{printer.filament_diameter_mm:g}", "material_flow": "100",
+        "adhesion_type": "skirt", "skirt_line_count": "1", "skirt_gap": f"{SKIRT_GAP_MM:g}",
+    }
+
+
+def _layers(heights: tuple[float, ...], w: float, walls: int) -> dict[str, str]:
+    return {
         "layer_height": f"{(heights[1] if len(heights) > 1 else heights[0]):g}",
         "layer_height_0": f"{heights[0]:g}",
         **{k: f"{w:.4g}" for k in LINE_WIDTH_KEYS},
@@ -69,6 +81,12 @@ def cura_settings(part_kind: str, design_part: NetDesign | CableDesign, printer:
         "infill_sparse_density": "0", "top_layers": "0", "bottom_layers": "0",
         "top_bottom_thickness": "0", "fill_outline_gaps": "true", "fill_perimeter_gaps": "nowhere",
         "filter_out_tiny_gaps": "false",
+    }
+
+
+def _material(material: Material) -> dict[str, str]:
+    p = material.print
+    return {
         "material_print_temperature": f"{p.nozzle_temperature_deg_c:g}",
         "material_print_temperature_layer_0": f"{p.first_layer_nozzle_temperature_deg_c:g}",
         "material_initial_print_temperature": f"{p.nozzle_temperature_deg_c:g}",
@@ -79,18 +97,21 @@ def cura_settings(part_kind: str, design_part: NetDesign | CableDesign, printer:
         "cool_fan_speed_min": f"{p.fan_min_percent:g}",
         "cool_fan_speed_max": f"{p.fan_max_percent:g}", "cool_fan_full_layer": "2",
         "cool_min_layer_time": "5",
+        "retraction_enable": "true", "retraction_amount": f"{p.retract_length_mm:g}",
+        "retraction_speed": f"{p.retract_speed_mm_per_s:g}",
+        "retraction_retract_speed": f"{p.retract_speed_mm_per_s:g}",
+        "retraction_prime_speed": f"{p.retract_speed_mm_per_s:g}",
+    }
+
+
+def _speeds(printer: Printer, v: float, v0: float) -> dict[str, str]:
+    return {
         **{k: f"{v:.4g}" for k in SPEED_KEYS},
         "speed_layer_0": f"{v0:.4g}", "speed_print_layer_0": f"{v0:.4g}",
         "skirt_brim_speed": f"{v0:.4g}",
         "speed_travel": f"{printer.travel_speed_mm_per_s:g}",
         "speed_travel_layer_0": f"{printer.travel_speed_mm_per_s / 2:g}",
-        "retraction_enable": "true", "retraction_amount": f"{p.retract_length_mm:g}",
-        "retraction_speed": f"{p.retract_speed_mm_per_s:g}",
-        "retraction_retract_speed": f"{p.retract_speed_mm_per_s:g}",
-        "retraction_prime_speed": f"{p.retract_speed_mm_per_s:g}",
-        "adhesion_type": "skirt", "skirt_line_count": "1", "skirt_gap": f"{SKIRT_GAP_MM:g}",
     }
-    return s
 
 
 def cura_cfg_text(part_kind: str, design_part: NetDesign | CableDesign, printer: Printer,
