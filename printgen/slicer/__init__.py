@@ -1,5 +1,6 @@
 """Slicer profiles: PrusaSlicer .ini and CuraEngine settings for the printed parts."""
 
+from printgen.slicer.cura import cura_cfg_text, cura_engine_args, cura_settings, write_cura_cfg
 from printgen.slicer.prusa import (
     allowed_prusa_keys,
     prusa_ini_text,
@@ -7,4 +8,5 @@ from printgen.slicer.prusa import (
     write_prusa_ini,
 )
 
-__all__ = ["allowed_prusa_keys", "prusa_ini_text", "prusa_settings", "write_prusa_ini"]
+__all__ = ["allowed_prusa_keys", "cura_cfg_text", "cura_engine_args", "cura_settings",
+           "prusa_ini_text", "prusa_settings", "write_cura_cfg", "write_prusa_ini"]
