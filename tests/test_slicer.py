@@ -193,6 +193,20 @@ def test_curaengine_slices_a_cable(design_1_40, tmp_path):
                        "--max-flow", f"{material.print.max_volumetric_flow_mm3_per_s:g}")
     assert rc == 0, summary
     assert summary.startswith("SLICE-CHECK OK slicer=CuraEngine-4.13")
+    # printgen's own CuraEngine command line gives the same print as the shared script
+    from printgen.slicer.cura import cura_engine_args, find_definitions
+
+    defs = find_definitions()
+    out = tmp_path / "own.gcode"
+    env = dict(os.environ, CURA_ENGINE_SEARCH_PATH=f"{defs}:{defs.parent / 'extruders'}")
+    args = cura_engine_args(cura_settings("cable", cable, printer, style, material),
+                            tmp_path / "cable.stl", out, defs)
+    subprocess.run(args, env=env, capture_output=True, timeout=SLICE_TIMEOUT_S, check=True)
+    mine = read_gcode(out, filament_diameter_mm=printer.filament_diameter_mm)
+    theirs = read_gcode(tmp_path / "cable.cura.gcode",
+                        filament_diameter_mm=printer.filament_diameter_mm)
+    assert_allclose(mine.volume_per_layer_mm3, theirs.volume_per_layer_mm3, rtol=1e-9)
+    assert len(mine.layer_z_mm) == len(cable.section.layer_heights_mm)
 
 
 def _cura_keys(node: dict) -> set[str]:
