@@ -14,7 +14,7 @@ h1 { font-size: 1.6em; border-bottom: 2px solid #2a6; padding-bottom: .2em; }
 h2 { font-size: 1.25em; margin-top: 1.8em; color: #164; }
 table { border-collapse: collapse; margin: .8em 0; font-size: .92em; }
 th, td { border: 1px solid #ccc; padding: .25em .6em; text-align: right; }
-th { background: #eef5f0; } td:first-child, th:first-child { text-align: left; }
+th { background: #eef5f0; } td.t { text-align: left; } td:first-child, th:first-child { text-align: left; }
 .pass { color: #fff; background: #2a6; padding: .1em .5em; border-radius: .3em; }
 .fail { color: #fff; background: #c33; padding: .1em .5em; border-radius: .3em; }
 .note { color: #555; font-size: .9em; }
@@ -43,8 +43,7 @@ class Report:
 
     def table(self, columns: list[str], rows: list[list[str]]) -> None:
         head = "".join(f"<th>{html.escape(c)}</th>" for c in columns)
-        body = "".join("<tr>" + "".join(f"<td>{html.escape(str(v))}</td>" for v in r) + "</tr>"
-                       for r in rows)
+        body = "".join("<tr>" + "".join(_cell(v) for v in r) + "</tr>" for r in rows)
         self.blocks.append(f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
 
     def figure(self, png: bytes, caption: str) -> None:
@@ -58,3 +57,15 @@ class Report:
         return (f"<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
                 f"<title>{html.escape(self.title)}</title><style>{CSS}</style></head>\n"
                 f"<body><h1>{html.escape(self.title)}</h1>\n{body}\n</body></html>\n")
+
+
+def _cell(v: object) -> str:
+    """A table cell; text that is not a number is left-aligned."""
+    text = str(v)
+    numeric = text.replace("%", "").replace("+", "").replace("x", "").strip()
+    try:
+        float(numeric.split()[0] if numeric else "")
+        cls = ""
+    except ValueError:
+        cls = ' class="t"'
+    return f"<td{cls}>{html.escape(text)}</td>"
