@@ -1,0 +1,156 @@
+"""Internal forces and tangent stiffness of strands and sliding cables, vectorised, in the
+solver's nondimensional units (lengths / L_ref, forces / S_ref).
+
+Strain is computed stably as eps = (l^2 - L0^2) / (L0 (l + L0)) with
+l^2 - L0^2 = (|D0|^2 - L0^2) + 2 D0.du + |du|^2, D0 the initial node-to-node vector and du the
+difference of the displacements: no cancellation in l - L0 even when strains are 1e-9 of the
+node coordinates (lambda = 100, stiff strands).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from solver.laws import Law
+
+
+@dataclass(frozen=True)
+class Bars:
+    """Two-node tension-only strands: i, j (m,), D0 (m, 3), rest L0 (m,), c = |D0|^2 - L0^2."""
+
+    i: np.ndarray
+    j: np.ndarray
+    d0: np.ndarray
+    rest: np.ndarray
+    c: np.ndarray
+    law_index: np.ndarray
+    laws: list[Law]
+
+
+@dataclass(frozen=True)
+class Cable:
+    """Sliding cable: nodes (k,), segment vectors D0 (k-1, 3), |D0|, rest length of the whole."""
+
+    nodes: np.ndarray
+    d0: np.ndarray
+    l0: np.ndarray
+    rest: float
+    law: Law
+
+
+def make_bars(x0: np.ndarray, elements: np.ndarray, rest: np.ndarray, law_index: np.ndarray,
+              laws: list[Law]) -> Bars:
+    i, j = elements[:, 0], elements[:, 1]
+    d0 = x0[j] - x0[i]
+    return Bars(i, j, d0, rest, np.einsum("ij,ij->i", d0, d0) - rest**2, law_index, laws)
+
+
+def make_cable(x0: np.ndarray, nodes: np.ndarray, rest: float, law: Law) -> Cable:
+    d0 = np.diff(x0[nodes], axis=0)
+    return Cable(nodes, d0, np.linalg.norm(d0, axis=1), rest, law)
+
+
+def _law_eval(laws: list[Law], index: np.ndarray, eps: np.ndarray):
+    force, tangent = np.zeros_like(eps), np.zeros_like(eps)
+    for k, law in enumerate(laws):
+        sel = index == k
+        if sel.any():
+            force[sel], tangent[sel] = law.force_and_tangent(eps[sel])
+    return force, tangent
+
+
+def bar_state(b: Bars, u: np.ndarray):
+    """(strain, force, tangent, current vector d, length l) of every strand."""
+    du = u[b.j] - u[b.i]
+    d = b.d0 + du
+    l = np.linalg.norm(d, axis=1)
+    dl2 = b.c + 2 * np.einsum("ij,ij->i", b.d0, du) + np.einsum("ij,ij->i", du, du)
+    eps = dl2 / (b.rest * (l + b.rest))
+    force, tangent = _law_eval(b.laws, b.law_index, eps)
+    return eps, force, tangent, d, l
+
+
+def cable_state(c: Cable, u: np.ndarray):
+    """(strain, tension, tangent, unit vectors (k-1, 3), segment lengths) of a sliding cable."""
+    du = np.diff(u[c.nodes], axis=0)
+    d = c.d0 + du
+    l = np.linalg.norm(d, axis=1)
+    stretch = (2 * np.einsum("ij,ij->i", c.d0, du) + np.einsum("ij,ij->i", du, du)) / (l + c.l0)
+    eps = (stretch.sum() + (c.l0.sum() - c.rest)) / c.rest
+    t, kt = c.law.force_and_tangent(np.array([eps]))
+    return float(eps), float(t[0]), float(kt[0]), d / l[:, None], l
+
+
+def _block_entries(rows, cols, blocks):
+    """COO entries of (k, 3, 3) blocks at node pairs (rows, cols)."""
+    r = (3 * rows[:, None, None] + np.arange(3)[None, :, None]).repeat(3, axis=2)
+    c = (3 * cols[:, None, None] + np.arange(3)[None, None, :]).repeat(3, axis=1)
+    return r.ravel(), c.ravel(), blocks.ravel()
+
+
+def internal(bars: Bars, cables: list[Cable], u: np.ndarray, n_nodes: int, *,
+             with_tangent: bool = True):
+    """Resisting forces g (n, 3) and, when asked, the tangent K (3n x 3n, CSR)."""
+    g = np.zeros((n_nodes, 3))
+    rows, cols, vals = [], [], []
+    _, force, tangent, d, l = bar_state(bars, u)
+    taut = force > 0
+    n = d / l[:, None]
+    fn = force[:, None] * n
+    np.add.at(g, bars.i, -fn)
+    np.add.at(g, bars.j, fn)
+    if with_tangent and taut.any():
+        nn = np.einsum("ki,kj->kij", n[taut], n[taut])
+        geo = (force[taut] / l[taut])[:, None, None]
+        mat = (tangent[taut] / bars.rest[taut])[:, None, None]
+        k = geo * (np.eye(3)[None] - nn) + mat * nn
+        i, j = bars.i[taut], bars.j[taut]
+        for a, b, s in ((i, i, 1), (j, j, 1), (i, j, -1), (j, i, -1)):
+            r, c, v = _block_entries(a, b, s * k)
+            rows.append(r), cols.append(c), vals.append(v)
+    for cab in cables:
+        _, t, kt, nvec, ls = cable_state(cab, u)
+        if t <= 0:
+            continue
+        grad = np.zeros((len(cab.nodes), 3))
+        grad[:-1] -= nvec
+        grad[1:] += nvec
+        np.add.at(g, cab.nodes, t * grad)
+        if not with_tangent:
+            continue
+        nn = np.einsum("ki,kj->kij", nvec, nvec)
+        k = (t / ls)[:, None, None] * (np.eye(3)[None] - nn)
+        a, b = cab.nodes[:-1], cab.nodes[1:]
+        for p, q, s in ((a, a, 1), (b, b, 1), (a, b, -1), (b, a, -1)):
+            r, c, v = _block_entries(p, q, s * k)
+            rows.append(r), cols.append(c), vals.append(v)
+        # all nodes of a cable share its tension: rank-one coupling kt/L0 grad grad^T
+        dof = (3 * cab.nodes[:, None] + np.arange(3)).ravel()
+        gv = grad.ravel()
+        rows.append(np.repeat(dof, len(dof))), cols.append(np.tile(dof, len(dof)))
+        vals.append((kt / cab.rest) * np.outer(gv, gv).ravel())
+    if not with_tangent:
+        return g, None
+    size = 3 * n_nodes
+    if rows:
+        K = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                          shape=(size, size))
+    else:
+        K = sp.csr_matrix((size, size))
+    return g, K
+
+
+def strain_energy(bars: Bars, cables: list[Cable], u: np.ndarray) -> float:
+    """Total strain energy of strands and cables (nondimensional)."""
+    eps = bar_state(bars, u)[0]
+    total = 0.0
+    for k, law in enumerate(bars.laws):
+        sel = bars.law_index == k
+        if sel.any():
+            total += float((bars.rest[sel] * law.energy(eps[sel])).sum())
+    for c in cables:
+        total += c.rest * float(c.law.energy(np.array([cable_state(c, u)[0]]))[0])
+    return total

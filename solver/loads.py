@@ -1,0 +1,86 @@
+"""Loads as functions of the node positions: point loads, hydrostatic pressure, drag.
+
+Each load returns, for the current positions x (n, 3) m, the node indices it acts on, the
+forces (k, 3) N, and the derivative of those forces with respect to each node's own height z
+(k, 3) N/m (the hydrostatic load is rho g (h - z) A*: it falls as the node rises).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+RHO_WATER = 1000.0  # kg/m^3
+G = 9.81  # m/s^2
+
+
+@dataclass(frozen=True)
+class PointLoads:
+    """Constant forces (k, 3) N on nodes (k,), e.g. the 1 N pull of an extension sensor."""
+
+    nodes: np.ndarray
+    forces: np.ndarray
+
+    def evaluate(self, x: np.ndarray):
+        f = np.asarray(self.forces, dtype=float).reshape(-1, 3)
+        return np.asarray(self.nodes, dtype=int), f, np.zeros_like(f)
+
+
+@dataclass(frozen=True)
+class Hydrostatic:
+    """F = rho g (level - z) A* along `direction` on nodes below the water level (z from the
+    bed). `current=True` evaluates z at the current positions, else at the initial ones."""
+
+    nodes: np.ndarray
+    areas: np.ndarray | float
+    level: float
+    direction: tuple[float, float, float] = (0.0, 1.0, 0.0)
+    rho: float = RHO_WATER
+    g: float = G
+    initial_z: np.ndarray | None = None
+
+    def evaluate(self, x: np.ndarray):
+        idx = np.asarray(self.nodes, dtype=int)
+        z = x[idx, 2] if self.initial_z is None else np.asarray(self.initial_z)
+        head = np.maximum(self.level - z, 0.0)
+        area = np.broadcast_to(np.asarray(self.areas, dtype=float), idx.shape)
+        d = np.asarray(self.direction, dtype=float)
+        f = (self.rho * self.g * head * area)[:, None] * d
+        dfdz = np.zeros_like(f)
+        if self.initial_z is None:
+            wet = (self.level - z) > 0
+            dfdz = (-self.rho * self.g * area * wet)[:, None] * d
+        return idx, f, dfdz
+
+
+@dataclass(frozen=True)
+class Drag:
+    """0.5 rho v^2 l d along `direction` on nodes below the water level (drag coefficient 1):
+    l strand length per node (m), d strand diameter (m)."""
+
+    nodes: np.ndarray
+    length: np.ndarray | float
+    diameter: float
+    velocity: float
+    level: float
+    direction: tuple[float, float, float] = (0.0, 1.0, 0.0)
+    rho: float = RHO_WATER
+
+    def evaluate(self, x: np.ndarray):
+        idx = np.asarray(self.nodes, dtype=int)
+        wet = x[idx, 2] < self.level
+        length = np.broadcast_to(np.asarray(self.length, dtype=float), idx.shape)
+        mag = 0.5 * self.rho * self.velocity**2 * length * self.diameter * wet
+        f = mag[:, None] * np.asarray(self.direction, dtype=float)
+        return idx, f, np.zeros_like(f)
+
+
+def total_forces(loads, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Sum of all loads: forces (n, 3) N and d(force)/dz (n, 3) N/m."""
+    f, dz = np.zeros_like(x), np.zeros_like(x)
+    for load in loads:
+        idx, fl, dl = load.evaluate(x)
+        np.add.at(f, idx, fl)
+        np.add.at(dz, idx, dl)
+    return f, dz
