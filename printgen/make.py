@@ -118,6 +118,17 @@ def slicer_step(ctx: MakeContext, stage: Path) -> None:
     ctx.record["slicer_profiles"] = written
 
 
+def verify_step(ctx: MakeContext, stage: Path) -> None:
+    """Prototype vs model over the loading sweep, and the steel counter-example."""
+    from printgen.report import verification_record, verification_sections
+    from printgen.verify import steel_counterexample, verify
+
+    v = verify(ctx.prototype, ctx.design, drag=bool(ctx.options.get("drag")))
+    ce = steel_counterexample(ctx.targets.scale)
+    verification_sections(ctx.report, v, ce, ctx.targets.scale)
+    ctx.record["verification"] = verification_record(v, ce)
+
+
 def make(prototype_path: str | Path, scale: float, out: str | Path, *,
          printer: str | None = None, steps: list[tuple[str, Step]] | None = None,
          options: dict[str, Any] | None = None,
@@ -155,4 +166,5 @@ def _stable(record: dict[str, Any]) -> dict[str, Any]:
 
 
 def default_steps() -> list[tuple[str, Step]]:
-    return [("slicer profiles", slicer_step), ("direct G-code", gcode_step)]
+    return [("slicer profiles", slicer_step), ("direct G-code", gcode_step),
+            ("verification (prototype and model load sweeps)", verify_step)]

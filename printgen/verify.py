@@ -117,3 +117,32 @@ def verify(p: Prototype, d: Design, *, drag: bool = False,
     proto, model = sweep(ps, lv, **kw_p), sweep(ms, lv, **kw_m)
     mm = compare(proto.deformation, model.deformation)
     return Verification(case, proto, model, mm, explain(mm))
+
+
+@dataclass(frozen=True)
+class CounterExample:
+    """The simple barrier (scene simple-free-top, hydrostatic at h = h_B) at 1:scale: the
+    prototype, the model with E scaled by 1/lambda, and the model with steel E."""
+
+    scale: float
+    deflection: dict[str, float]  # variant -> mid-height deflection / width
+    lowering: dict[str, float]  # variant -> top-centre lowering / height
+
+
+def steel_counterexample(scale: float) -> CounterExample:
+    """Why stiffness must be scaled: steel at every scale deflects less and less as lambda
+    grows (Lambert et al. 2023, Fig. 2), while E / lambda reproduces the prototype."""
+    from solver.scenes import SIMPLE, simple_scene
+
+    variants = {"prototype (lambda = 1)": (1.0, SIMPLE["modulus"]),
+                f"1:{scale:g}, E scaled by 1/lambda": (scale, SIMPLE["modulus"] / scale),
+                f"1:{scale:g}, steel E": (scale, SIMPLE["modulus"])}
+    defl, low = {}, {}
+    for name, (lam, modulus) in variants.items():
+        sc = simple_scene(scale=lam, modulus=modulus, pinned_top=False, drag=False)
+        r = solver.solve(sc.net, sc.loads_at(1.0), tol=SOLVER_TOL)
+        if not r.converged:
+            raise SolverError(f"simple barrier {name}: {r.reason}")
+        defl[name] = float(r.displacements[sc.centre, 1] / sc.width)
+        low[name] = float(-r.displacements[sc.top_centre, 2] / sc.height)
+    return CounterExample(scale, defl, low)
