@@ -1,0 +1,88 @@
+"""Column names and units of tensile-test exports: which channel a column is, and its SI factor.
+
+A column's unit comes from its header (`Load (kN)`, `force_N`, `Strain [%]`, `Weg in mm`) or from
+a units row under the header (`(s),(mm),(N),(%),(MPa)`). Roles: time, force, displacement
+(crosshead or extension), strain (extensometer) and stress.
+"""
+
+from __future__ import annotations
+
+import re
+
+# Unit label (lower case, no brackets) -> factor to SI for each kind of quantity.
+FORCE_UNITS = {"n": 1.0, "kn": 1e3, "mn": 1e-3, "lbf": 4.4482216152605, "kgf": 9.80665}
+LENGTH_UNITS = {"mm": 1e-3, "m": 1.0, "cm": 1e-2, "um": 1e-6, "µm": 1e-6, "in": 0.0254}
+STRAIN_UNITS = {"%": 1e-2, "mm/mm": 1.0, "m/m": 1.0, "-": 1.0, "": 1.0,
+                "ue": 1e-6, "µε": 1e-6, "microstrain": 1e-6, "percent": 1e-2}
+STRESS_UNITS = {"mpa": 1e6, "n/mm2": 1e6, "n/mm²": 1e6, "n/mm^2": 1e6, "kpa": 1e3, "pa": 1.0,
+                "gpa": 1e9, "psi": 6894.757293168}
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "min": 60.0, "h": 3600.0}
+ROLE_UNITS = {"force": FORCE_UNITS, "displacement": LENGTH_UNITS, "strain": STRAIN_UNITS,
+              "stress": STRESS_UNITS, "time": TIME_UNITS}
+# The unit assumed when a column gives none.
+DEFAULT_UNIT = {"force": "n", "displacement": "mm", "strain": "", "stress": "mpa", "time": "s"}
+ROLES = tuple(ROLE_UNITS)
+
+# Name patterns per role, tried in this order (stress and strain before force and
+# displacement, so "Tensile stress" is not taken for a force column).
+_ROLE_PATTERNS = (
+    ("stress", r"stress|spannung|contrainte|sigma"),
+    ("strain", r"strain|dehnung|d[ée]formation|epsilon|extensometer"),
+    ("force", r"force|load|kraft|effort|charge"),
+    ("displacement", r"displacement|extension|elongation|crosshead|position|weg|stroke|"
+                     r"traverse|deplacement|déplacement|travel"),
+    ("time", r"time|zeit|temps"),
+)
+
+_UNIT_IN_NAME = (
+    re.compile(r"^(?P<name>.*?)\s*[\(\[](?P<unit>[^\)\]]*)[\)\]]\s*$"),  # Load (kN), Load [kN]
+    re.compile(r"^(?P<name>.*?)\s+in\s+(?P<unit>\S+)\s*$", re.I),  # Kraft in N
+    re.compile(r"^(?P<name>.*?)[_ ](?P<unit>[A-Za-z%/µ²^0-9]+)\s*$"),  # force_N, Strain %
+)
+
+
+def normalise_unit(unit: str) -> str:
+    """Lower-case unit label without brackets or spaces (`(N/mm²)` -> `n/mm²`)."""
+    return unit.strip().strip("()[]").replace(" ", "").lower()
+
+
+def split_name_unit(header: str) -> tuple[str, str | None]:
+    """(name, unit or None) from a header cell: `Load (kN)` -> ('Load', 'kn')."""
+    text = header.strip()
+    for pattern in _UNIT_IN_NAME:
+        m = pattern.match(text)
+        if m and m.group("name"):
+            unit = normalise_unit(m.group("unit"))
+            if any(unit in table for table in ROLE_UNITS.values()):
+                return m.group("name").strip(), unit
+    return text, None
+
+
+def role_of(name: str) -> str | None:
+    """The role a column name suggests, or None."""
+    low = name.lower()
+    for role, pattern in _ROLE_PATTERNS:
+        if re.search(pattern, low):
+            return role
+    return None
+
+
+def is_units_row(cells: list[str]) -> bool:
+    """True when every non-empty cell is a known unit label (a units row under the header)."""
+    labels = [normalise_unit(c) for c in cells if c.strip()]
+    known = set().union(*ROLE_UNITS.values())
+    return bool(labels) and all(lab in known for lab in labels)
+
+
+def unit_factor(role: str, unit: str | None, *, where: str) -> float:
+    """Factor converting a column of `role` in `unit` to SI (strain: to a pure number)."""
+    from printgen.errors import CalibrationError
+
+    table = ROLE_UNITS[role]
+    key = DEFAULT_UNIT[role] if unit is None else unit
+    if key not in table:
+        raise CalibrationError(
+            f"{where}: unit {unit!r} is not a {role} unit; expected one of "
+            f"{', '.join(sorted(k for k in table if k))}; fix the header or units row"
+        )
+    return table[key]
