@@ -31,7 +31,12 @@ def test_outputs_are_written(made):
 def test_report_json_schema(made):
     _, out = made
     rec = json.loads((out / "report.json").read_text())
-    assert {"targets", "selection", "design", "gcode", "files"} <= set(rec)
+    assert {"targets", "selection", "design", "gcode", "files", "verification"} <= set(rec)
+    ver = rec["verification"]
+    assert ver["verdict"] in ("PASS", "FAIL") and len(ver["prototype"]["levels"]) == 23
+    # the steel counter-example: steel at 1:40 deflects far less than the prototype
+    defl = ver["counterexample"]["deflection"]
+    assert defl["1:40, steel E"] < 0.5 * defl["prototype (lambda = 1)"]
     assert rec["design"]["net"]["material"] == "tpe"
     assert rec["selection"]["cable"]["ranked"][0]["material"] == "petg"
     READBACK = 0.02  # issue 5: G-code deposits the designed volume within 2 %
@@ -48,14 +53,15 @@ def test_same_input_gives_byte_identical_json(made, tmp_path):
 
 def test_failed_step_leaves_previous_outputs_intact(made, tmp_path, monkeypatch):
     out = tmp_path / "out"
-    make_mod.make(REALISTIC, 40, out)
+    fast = [s for s in make_mod.default_steps() if not s[0].startswith("verification")]
+    make_mod.make(REALISTIC, 40, out, steps=fast)
     before = {p.name: p.read_bytes() for p in out.iterdir()}
 
     def broken(ctx, stage):
         (stage / "half-written.gcode").write_text("G1 X1")
         raise PrintgenError("forced failure")
 
-    steps = [*make_mod.default_steps(), ("broken", broken)]
+    steps = [*fast, ("broken", broken)]
     with pytest.raises(PrintgenError, match="forced failure"):
         make_mod.make(REALISTIC, 40, out, steps=steps)
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
