@@ -1,0 +1,67 @@
+"""Statistics over samples: mean, sample standard deviation (ddof = 1), count, outliers.
+
+Outliers are flagged (not removed) with the modified z-score of Iglewicz and Hoaglin,
+|0.6745 (x - median) / MAD| > 3.5; fewer than `MIN_SAMPLES` samples give a warning.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+log = logging.getLogger(__name__)
+
+MIN_SAMPLES = 5  # ISO 527-1 asks for at least five specimens per direction
+OUTLIER_Z = 3.5  # modified z-score above which a sample is flagged (Iglewicz & Hoaglin 1993)
+MAD_SCALE = 0.6745  # makes the median absolute deviation consistent with a normal SD
+
+
+@dataclass(frozen=True)
+class Stats:
+    """mean and sd (ddof = 1; None for one sample) of `values`; outliers are indices."""
+
+    mean: float
+    sd: float | None
+    n: int
+    values: tuple[float, ...]
+    outliers: tuple[int, ...]
+    warnings: tuple[str, ...]
+
+    @property
+    def cv(self) -> float | None:
+        return None if self.sd is None or self.mean == 0 else self.sd / abs(self.mean)
+
+
+def summarise(values: list[float] | np.ndarray, *, what: str = "value",
+              labels: list[str] | None = None) -> Stats:
+    """Mean, SD, count and flagged outliers of one measured quantity."""
+    v = np.asarray(values, dtype=float)
+    if v.size == 0:
+        raise ValueError(f"no samples of {what}")
+    sd = float(np.std(v, ddof=1)) if v.size > 1 else None
+    out = outliers(v)
+    warns = []
+    if v.size < MIN_SAMPLES:
+        warns.append(f"{what}: only {v.size} sample(s); at least {MIN_SAMPLES} are needed for a "
+                     "reliable mean and SD")
+    for i in out:
+        name = labels[i] if labels else f"sample {i + 1}"
+        warns.append(f"{what}: {name} = {v[i]:.4g} is an outlier (modified z-score > "
+                     f"{OUTLIER_Z:g}); check the specimen")
+    for w in warns:
+        log.warning(w)
+    return Stats(float(v.mean()), sd, int(v.size), tuple(float(x) for x in v), out, tuple(warns))
+
+
+def outliers(v: np.ndarray) -> tuple[int, ...]:
+    """Indices whose modified z-score exceeds OUTLIER_Z (none when the MAD is zero)."""
+    if v.size < 3:
+        return ()
+    med = np.median(v)
+    mad = np.median(np.abs(v - med))
+    if mad == 0:
+        return ()
+    z = MAD_SCALE * (v - med) / mad
+    return tuple(int(i) for i in np.nonzero(np.abs(z) > OUTLIER_Z)[0])
