@@ -35,7 +35,7 @@ class Stats:
 
 
 def summarise(values: list[float] | np.ndarray, *, what: str = "value",
-              labels: list[str] | None = None) -> Stats:
+              labels: list[str] | None = None, quiet: bool = False) -> Stats:
     """Mean, SD, count and flagged outliers of one measured quantity."""
     v = np.asarray(values, dtype=float)
     if v.size == 0:
@@ -50,7 +50,7 @@ def summarise(values: list[float] | np.ndarray, *, what: str = "value",
         name = labels[i] if labels else f"sample {i + 1}"
         warns.append(f"{what}: {name} = {v[i]:.4g} is an outlier (modified z-score > "
                      f"{OUTLIER_Z:g}); check the specimen")
-    for w in warns:
+    for w in [] if quiet else warns:
         log.warning(w)
     return Stats(float(v.mean()), sd, int(v.size), tuple(float(x) for x in v), out, tuple(warns))
 

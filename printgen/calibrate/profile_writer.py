@@ -1,0 +1,155 @@
+"""Write or update a material profile's `[measured]` tables from a calibration.
+
+The profile goes to `<dir>/materials/<name>.toml` (dir: --out, else the first PRINTGEN_PROFILES
+entry). A new profile `inherits` a bundled one so datasheet and print settings carry over; an
+existing one keeps everything but the tables this calibration measured. Before the file is
+replaced atomically, the staged profile is loaded with `load_material` to prove it reads back.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import datetime as dt
+import os
+import tempfile
+import tomllib
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import tomli_w
+
+from printgen import atomic
+from printgen.calibrate.pipeline import Calibration
+from printgen.errors import CalibrationError, PrintgenError
+from printgen.materials import Material, load_material
+
+SOURCE = "printgen calibrate: tensile tests"
+SIG = 6  # significant digits written for measured values
+
+
+def output_dir(out: str | Path | None) -> Path:
+    """--out, else the first PRINTGEN_PROFILES directory."""
+    if out is not None:
+        return Path(out)
+    env = [p for p in os.environ.get("PRINTGEN_PROFILES", "").split(os.pathsep) if p]
+    if not env:
+        raise CalibrationError("nowhere to write the profile: give --out DIR or set "
+                               "PRINTGEN_PROFILES (it is written as DIR/materials/NAME.toml)")
+    return Path(env[0])
+
+
+def measured_tables(cal: Calibration, *, date: str | None = None) -> dict[str, dict[str, Any]]:
+    """The `[measured.*]` tables (file units) this calibration gives."""
+    day = date or dt.date.today().isoformat()
+    prov = {"source": f"{SOURCE} ({len(cal.files)} files)", "date": day,
+            "files": [Path(f).as_posix() for f in cal.files], "conditions": _conditions(cal)}
+    out: dict[str, dict[str, Any]] = {}
+    if cal.kind != "panel" and cal.modulus is not None:
+        out["tensile_modulus"] = _value(cal.modulus, "gpa", 1e9) | prov | _fit_info(cal)
+    if cal.kind == "panel" and cal.panel is not None:
+        p = cal.panel
+        law = {"knee_strain_percent": [_r(p.knee.mean * 100)],
+               "kappa_kn_per_m_per_m": [_r(p.kappa1.mean / 1e3), _r(p.kappa2.mean / 1e3)],
+               "panel_length_mm": _r(p.panel_length * 1e3), "n_samples": p.kappa1.n}
+        if p.panel_width is not None:
+            law["panel_width_mm"] = _r(p.panel_width * 1e3)
+        out["panel_law"] = law | prov | _fit_info(cal)
+    if cal.kind != "panel" and cal.strength is not None:
+        out["failure_stress"] = _value(cal.strength, "mpa", 1e6) | prov
+    if not out:
+        raise CalibrationError("nothing measured to write (no modulus, strength or panel law)")
+    return out
+
+
+def write_profile(cal: Calibration, *, name: str, out: str | Path | None = None,
+                  inherits: str | None = None, date: str | None = None) -> tuple[Path, Material]:
+    """Write (or update) `<dir>/materials/<name>.toml`; return its path and the loaded material."""
+    root = output_dir(out)
+    path = root / "materials" / f"{name.lower()}.toml"
+    data = _existing(path)
+    if inherits is not None:
+        if inherits.lower() == name.lower():
+            raise CalibrationError(f"profile {name!r} cannot inherit itself; name the calibrated "
+                                   f"profile differently (e.g. {name}-lab --inherits {inherits})")
+        data["inherits"] = inherits
+    elif not data:
+        raise CalibrationError(f"{path} does not exist yet: give --inherits <bundled material> "
+                               "so its datasheet and print settings carry over")
+    data.setdefault("measured", {}).update(measured_tables(cal, date=date))
+    text = tomli_w.dumps(data)
+    with tempfile.TemporaryDirectory() as tmp:
+        staged = Path(tmp) / "materials" / path.name
+        staged.parent.mkdir(parents=True)
+        staged.write_text(text, encoding="utf-8")
+        with _profiles_first(Path(tmp), root):
+            try:
+                mat = load_material(name)
+            except PrintgenError as exc:
+                raise CalibrationError(f"calibrated profile {path} would not load: {exc}") from exc
+    atomic.write_text(path, text)
+    return path, mat
+
+
+def _existing(path: Path) -> dict[str, Any]:
+    if not path.is_file():
+        return {}
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise CalibrationError(f"{path}: existing profile is not valid TOML ({exc}); fix or "
+                               "remove it") from exc
+
+
+@contextlib.contextmanager
+def _profiles_first(*dirs: Path) -> Iterator[None]:
+    """Put `dirs` ahead of PRINTGEN_PROFILES while the staged profile is loaded."""
+    old = os.environ.get("PRINTGEN_PROFILES")
+    os.environ["PRINTGEN_PROFILES"] = os.pathsep.join([*map(str, dirs), *([old] if old else [])])
+    try:
+        yield
+    finally:
+        if old is None:
+            os.environ.pop("PRINTGEN_PROFILES", None)
+        else:
+            os.environ["PRINTGEN_PROFILES"] = old
+
+
+def _value(s, unit: str, factor: float) -> dict[str, Any]:
+    d: dict[str, Any] = {f"value_{unit}": _r(s.mean / factor), "n_samples": s.n}
+    if s.sd is not None and s.sd > 0:
+        d[f"sd_{unit}"] = _r(s.sd / factor)
+    return d
+
+
+def _fit_info(cal: Calibration) -> dict[str, Any]:
+    o = cal.options
+    if o.window is not None:
+        window = [_r(o.window[0] * 100), _r(o.window[1] * 100)]
+    else:
+        window = [_r(min(s.linear.lo for s in cal.samples) * 100),
+                  _r(max(s.linear.hi for s in cal.samples) * 100)]
+    corr = o.compliance.describe() if o.compliance is not None else "none"
+    return {"fit_window_percent": window, "correction": corr}
+
+
+def _conditions(cal: Calibration) -> str:
+    o = cal.options
+    parts = [cal.conditions] if cal.conditions else []
+    parts.append(f"{cal.kind} specimens")
+    if cal.samples:
+        parts.append("strain from " + "; ".join(cal.strain_sources))
+        parts.append("loading branch up to the peak")
+        parts.append("zeroed at preload %g N" % o.preload if o.preload is not None
+                     else "zeroed at the first point")
+        parts.append("linear regression over strain %g-%g %%" % (o.window[0] * 100,
+                                                                 o.window[1] * 100)
+                     if o.window is not None else
+                     f"automatic steepest window ({o.auto_span:.0%} of the rise to the peak)")
+    else:
+        parts.append("force only: strength = peak force / nominal cross-section")
+    return "; ".join(parts)
+
+
+def _r(v: float) -> float:
+    return float(f"{v:.{SIG}g}")
