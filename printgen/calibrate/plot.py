@@ -1,0 +1,64 @@
+"""One PNG per material: every loading branch with its fits and the chosen window.
+
+Left: whole loading branches with the bilinear fits. Right: the region of the modulus window,
+with each regression line drawn over the strains it used. matplotlib is imported here only.
+"""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import numpy as np
+
+from printgen import atomic
+from printgen.calibrate.pipeline import Calibration
+from printgen.errors import CalibrationError
+
+ZOOM_MARGIN = 1.5  # right panel shows strains up to this factor times the window's upper end
+
+
+def plot_calibration(cal: Calibration, path: str | Path) -> Path:
+    """Write the calibration plot to `path` (PNG) atomically; return the path."""
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError as exc:  # pragma: no cover - depends on the install
+        raise CalibrationError("plots need matplotlib: pip install 'printgen[plot]'") from exc
+    if not cal.samples:
+        raise CalibrationError("nothing to plot: no curves were fitted (force-only files)")
+    panel = cal.kind == "panel"
+    scale, ylab = (1e-3, "force per width F/w (kN/m)") if panel else (1e-6, "stress (MPa)")
+    fig, (ax_all, ax_win) = plt.subplots(1, 2, figsize=(12, 5), constrained_layout=True)
+    hi = max(s.linear.hi for s in cal.samples) * ZOOM_MARGIN
+    for i, s in enumerate(cal.samples):
+        color = f"C{i % 10}"
+        label = Path(s.path.split(":")[-1]).name
+        ax_all.plot(s.x * 100, s.y * scale, color=color, lw=1, label=label)
+        if s.bilinear is not None:
+            ax_all.plot(s.x * 100, s.bilinear(s.x) * scale, color=color, lw=1, ls="--")
+        m = s.x <= hi
+        ax_win.plot(s.x[m] * 100, s.y[m] * scale, ".", color=color, ms=3)
+        xs = np.array([s.linear.lo, s.linear.hi])
+        ax_win.plot(xs * 100, (s.linear.slope * xs + s.linear.intercept) * scale, color=color,
+                    lw=2)
+    o = cal.options
+    if o.window is not None:
+        for ax in (ax_all, ax_win):
+            ax.axvspan(o.window[0] * 100, o.window[1] * 100, color="0.85", zorder=0,
+                       label="fit window")
+    win = (f"window {o.window[0] * 100:g}-{o.window[1] * 100:g} %" if o.window is not None
+           else f"automatic steepest window ({o.auto_span:.0%} of the rise)")
+    ax_all.set_title(f"{cal.material}: loading branches, bilinear fits (dashed)")
+    ax_win.set_title(f"modulus fits, {win}")
+    for ax in (ax_all, ax_win):
+        ax.set_xlabel("strain (%)")
+        ax.set_ylabel(ylab)
+        ax.grid(alpha=0.3)
+    ax_all.legend(fontsize=7, loc="lower right")
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    plt.close(fig)
+    return atomic.write_bytes(path, buf.getvalue())

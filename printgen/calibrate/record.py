@@ -1,0 +1,77 @@
+"""A calibration as plain data in file units (GPa, MPa, %, kN/m/m) for --json and tables."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from printgen.calibrate.aggregate import Stats
+from printgen.calibrate.pipeline import Calibration
+from printgen.calibrate.sample import SampleFit
+
+
+def stats_record(s: Stats | None, factor: float) -> dict[str, Any] | None:
+    """mean, sd, n, values divided by `factor`; outliers as indices."""
+    if s is None:
+        return None
+    return {"mean": s.mean / factor, "sd": None if s.sd is None else s.sd / factor, "n": s.n,
+            "values": [v / factor for v in s.values], "outliers": list(s.outliers)}
+
+
+def units(cal: Calibration) -> tuple[str, float, str, float]:
+    """(modulus unit, factor, strength unit, factor): GPa/MPa, or kN/m per unit strain and
+    kN/m for panels (force per width)."""
+    if cal.kind == "panel":
+        return "kN/m", 1e3, "kN/m", 1e3
+    return "GPa", 1e9, "MPa", 1e6
+
+
+def sample_record(s: SampleFit, cal: Calibration) -> dict[str, Any]:
+    mu, mf, su, sf = units(cal)
+    b = s.bilinear
+    rec: dict[str, Any] = {
+        "file": s.path, "strain_source": s.strain_source,
+        f"modulus_{mu}": s.modulus / mf, "window_percent": [s.linear.lo * 100, s.linear.hi * 100],
+        "window_mode": s.linear.mode, "points": s.linear.n, "r2": s.linear.r2,
+        "bilinear": None if b is None else {f"slope1_{mu}": b.slope1 / mf,
+                                            f"slope2_{mu}": b.slope2 / mf,
+                                            "knee_percent": b.knee * 100},
+        "secant": {f"{e * 100:g}%": (None if v is None else v / mf) for e, v in s.secants.items()},
+        "peak_force_n": s.peak_force, f"strength_{su}": None if s.strength is None
+        else s.strength / sf,
+        "specimen": {k: v for k, v in vars(s.specimen).items() if v is not None},
+    }
+    if s.kappa is not None:
+        rec["kappa_kn_per_m_per_m"] = s.kappa / 1e3
+    if s.machine_modulus is not None:
+        rec[f"machine_modulus_{mu}"] = s.machine_modulus / mf
+        rec["difference_percent"] = (s.modulus / s.machine_modulus - 1) * 100
+    return rec
+
+
+def calibration_record(cal: Calibration) -> dict[str, Any]:
+    """Everything the calibration found, in file units."""
+    mu, mf, su, sf = units(cal)
+    o = cal.options
+    out: dict[str, Any] = {
+        "material": cal.material, "kind": cal.kind,
+        "options": {"window_percent": None if o.window is None else [w * 100 for w in o.window],
+                    "auto_span": o.auto_span, "preload_n": o.preload,
+                    "strain_source": o.strain_source,
+                    "compliance": None if o.compliance is None else o.compliance.describe()},
+        "samples": [sample_record(s, cal) for s in cal.samples],
+        "strength_samples": [{"file": s.path, "peak_force_n": s.peak_force,
+                              f"strength_{su}": None if s.strength is None else s.strength / sf}
+                             for s in cal.strength_samples],
+        f"modulus_{mu}": stats_record(cal.modulus, mf),
+        f"strength_{su}": stats_record(cal.strength, sf),
+        "warnings": list(cal.warnings),
+    }
+    if cal.panel is not None:
+        p = cal.panel
+        out["panel_law"] = {"kappa_kn_per_m_per_m": [stats_record(p.kappa1, 1e3),
+                                                     stats_record(p.kappa2, 1e3)],
+                            "knee_strain_percent": stats_record(p.knee, 1e-2),
+                            "panel_length_mm": p.panel_length * 1e3,
+                            "panel_width_mm": None if p.panel_width is None
+                            else p.panel_width * 1e3}
+    return out

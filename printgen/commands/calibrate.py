@@ -1,0 +1,187 @@
+"""`printgen calibrate`: material profiles from tensile-test exports.
+
+    printgen calibrate FILE... --material petg-lab [--kind cable|dogbone|panel]
+        [--width-mm W --thickness-mm T | --area-mm2 A] [--gauge-length-mm L]
+        [--grip-distance-mm L] [--specimen SIDECAR.toml] [--column ROLE=NAME] [--unit ROLE=UNIT]
+        [--window 0.05,0.25 | --window auto] [--preload N] [--secant 0.5,1]
+        [--strain-source auto|extensometer|crosshead]
+        [--machine-stiffness N_PER_MM | --compliance-curve FILE]
+        [--strength-only] [--save [--out DIR] [--inherits petg]] [--plot DIR] [--json]
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from printgen.calibrate.compliance import from_curve, from_stiffness
+from printgen.calibrate.fit import ISO_WINDOW
+from printgen.calibrate.pipeline import Calibration, calibrate
+from printgen.calibrate.record import calibration_record, units
+from printgen.calibrate.sample import DEFAULT_SECANTS, FitOptions
+from printgen.calibrate.specimen import KINDS
+from printgen.commands.common import add_json_arg, console, emit_json, fmt, table
+from printgen.errors import CalibrationError
+
+DIMENSION_OPTIONS = (("width_mm", "width", 1e-3), ("thickness_mm", "thickness", 1e-3),
+                     ("area_mm2", "area", 1e-6), ("gauge_length_mm", "gauge_length", 1e-3),
+                     ("grip_distance_mm", "grip_distance", 1e-3))
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("calibrate", help="fit moduli, strength and panel laws from tensile tests")
+    p.add_argument("files", nargs="+", help="tensile-test exports (CSV/TXT, or a zip of one)")
+    p.add_argument("--material", required=True, help="profile name to write (e.g. petg-lab)")
+    p.add_argument("--kind", choices=KINDS, help="specimen type (default: sidecar, else cable)")
+    for opt, _, _ in DIMENSION_OPTIONS:
+        p.add_argument("--" + opt.replace("_", "-"), type=float, dest=opt, metavar="X",
+                       help=f"specimen {opt.rsplit('_', 1)[0].replace('_', ' ')} "
+                            f"({opt.rsplit('_', 1)[1]}), when the file does not give it")
+    p.add_argument("--specimen", metavar="TOML", help="specimen sidecar (default: <file>.toml "
+                   "or specimen.toml beside each export)")
+    p.add_argument("--column", action="append", default=[], metavar="ROLE=NAME",
+                   help="choose a column by header name or 1-based index; roles: time, force, "
+                        "displacement, strain, stress")
+    p.add_argument("--unit", action="append", default=[], metavar="ROLE=UNIT",
+                   help="unit of a column when the file does not say (e.g. force=kN)")
+    p.add_argument("--delimiter", choices=[",", ";", "tab"], help="override detection")
+    p.add_argument("--decimal", choices=[".", ","], help="override detection")
+    p.add_argument("--window", default=None, metavar="LO,HI|auto",
+                   help="modulus strain window in %% (default 0.05,0.25 as ISO 527-1), or 'auto' "
+                        "for the steepest window as test-machine software does")
+    p.add_argument("--auto-span", type=float, default=FitOptions.auto_span,
+                   help="auto window: fraction of the rise to the peak it spans (default 0.15)")
+    p.add_argument("--preload", type=float, metavar="N", help="zero strain at this force (N)")
+    p.add_argument("--secant", default=",".join(f"{e * 100:g}" for e in DEFAULT_SECANTS),
+                   metavar="E1,E2", help="strains (%%) for secant moduli (default 0.5,1)")
+    p.add_argument("--strain-source", choices=("auto", "extensometer", "crosshead"),
+                   default="auto", help="strain channel (auto: extensometer when present)")
+    comp = p.add_mutually_exclusive_group()
+    comp.add_argument("--machine-stiffness", type=float, metavar="N_PER_MM",
+                      help="constant machine stiffness for the compliance correction")
+    comp.add_argument("--compliance-curve", metavar="FILE",
+                      help="force-displacement export of a rigid-bar test (system compliance)")
+    p.add_argument("--strength-only", action="store_true",
+                   help="force-only files: strength = peak force / cross-section, no modulus")
+    p.add_argument("--conditions", default="", help="test conditions to record in the profile")
+    p.add_argument("--save", action="store_true",
+                   help="write DIR/materials/<material>.toml (DIR: --out or $PRINTGEN_PROFILES)")
+    p.add_argument("--out", metavar="DIR", help="profile root to write into (implies --save)")
+    p.add_argument("--inherits", metavar="NAME",
+                   help="bundled profile the new one inherits (datasheet, print settings)")
+    p.add_argument("--date", help="test date to record (default: today, ISO format)")
+    p.add_argument("--plot", metavar="DIR", help="write DIR/<material>.png")
+    add_json_arg(p)
+    p.set_defaults(func=run)
+
+
+def options_from(args: argparse.Namespace) -> FitOptions:
+    """FitOptions from the command line."""
+    if args.window is None:
+        window: tuple[float, float] | None = ISO_WINDOW
+    elif args.window.strip().lower() == "auto":
+        window = None
+    else:
+        lo, hi = _floats(args.window, "--window", 2)
+        window = (lo / 100, hi / 100)
+    compliance = None
+    if args.machine_stiffness is not None:
+        compliance = from_stiffness(args.machine_stiffness)
+    elif args.compliance_curve is not None:
+        compliance = from_curve(args.compliance_curve)
+    if not 0 < args.auto_span < 1:
+        raise CalibrationError(f"--auto-span {args.auto_span:g} must be between 0 and 1")
+    return FitOptions(window=window, auto_span=args.auto_span, preload=args.preload,
+                      secant_strains=tuple(e / 100 for e in _floats(args.secant, "--secant")),
+                      strain_source=args.strain_source, compliance=compliance)
+
+
+def run(args: argparse.Namespace) -> int:
+    spec = {name: getattr(args, opt) * f for opt, name, f in DIMENSION_OPTIONS
+            if getattr(args, opt) is not None}
+    if args.kind:
+        spec["kind"] = args.kind
+    cal = calibrate(
+        args.files, material=args.material, options=options_from(args), specimen=spec,
+        specimen_file=args.specimen, columns=_pairs(args.column, "--column"),
+        units=_pairs(args.unit, "--unit"),
+        delimiter="\t" if args.delimiter == "tab" else args.delimiter, decimal=args.decimal,
+        strength_only=args.strength_only, conditions=args.conditions)
+    written = {}
+    if args.save or args.out:
+        from printgen.calibrate.profile_writer import write_profile
+
+        path, mat = write_profile(cal, name=args.material, out=args.out, inherits=args.inherits,
+                                  date=args.date)
+        e, source = mat.modulus()
+        written = {"profile": str(path), "modulus_gpa": e / 1e9, "modulus_source": source}
+    if args.plot:
+        from printgen.calibrate.plot import plot_calibration
+
+        written["plot"] = str(plot_calibration(cal, Path(args.plot) / f"{args.material}.png"))
+    if args.json:
+        emit_json({**calibration_record(cal), "written": written})
+        return 0
+    show(cal, written)
+    return 0
+
+
+def show(cal: Calibration, written: dict) -> None:
+    out = console()
+    mu, mf, su, sf = units(cal)
+    if cal.samples:
+        cols = ["file", f"E {mu}", "window %", "r2", f"E1/E2 {mu}", "knee %",
+                *[f"sec {e * 100:g}%" for e in cal.options.secant_strains],
+                f"max {su}", f"machine {mu}", "diff"]
+        rows = []
+        for s in cal.samples:
+            b, m = s.bilinear, s.machine_modulus
+            rows.append([Path(s.path).name, fmt(s.modulus / mf),
+                         f"{s.linear.lo * 100:.3f}-{s.linear.hi * 100:.3f}", f"{s.linear.r2:.4f}",
+                         "-" if b is None else f"{b.slope1 / mf:.4g}/{b.slope2 / mf:.4g}",
+                         "-" if b is None else f"{b.knee * 100:.3g}",
+                         *[fmt(None if v is None else v / mf) for v in s.secants.values()],
+                         fmt(None if s.strength is None else s.strength / sf),
+                         fmt(None if m is None else m / mf),
+                         "-" if m is None else f"{s.modulus / m - 1:+.1%}"])
+        out.print(table(f"{cal.material}: {cal.kind} specimens, strain from "
+                        f"{'; '.join(cal.strain_sources)}", cols, rows))
+    elif cal.strength_samples:
+        rows = [[Path(s.path).name, f"{s.peak_force:.2f}",
+                 fmt(None if s.strength is None else s.strength / sf)]
+                for s in cal.strength_samples]
+        out.print(table(f"{cal.material}: strength only (force-only files)",
+                        ["file", "peak N", f"strength {su}"], rows))
+    for what, st, f, u in (("modulus", cal.modulus, mf, mu), ("strength", cal.strength, sf, su)):
+        if st is not None:
+            sd = "-" if st.sd is None else f"{st.sd / f:.4g}"
+            out.print(f"[bold]{what}[/]: {st.mean / f:.4g} ± {sd} {u} (n = {st.n})")
+    if cal.panel is not None:
+        p = cal.panel
+        out.print(f"[bold]panel law[/]: kappa {p.kappa1.mean / 1e3:.4g} kN/m/m up to "
+                  f"{p.knee.mean * 100:.3g} % strain, then {p.kappa2.mean / 1e3:.4g} kN/m/m "
+                  f"(panel {p.panel_length * 1e3:g} mm long, n = {p.kappa1.n})")
+    for w in cal.warnings:
+        out.print(f"[yellow]warning:[/] {w}")
+    for k, v in written.items():
+        out.print(f"{k}: {v}")
+
+
+def _floats(text: str, opt: str, n: int | None = None) -> list[float]:
+    try:
+        vals = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError as exc:
+        raise CalibrationError(f"{opt} {text!r}: expected comma-separated numbers") from exc
+    if n is not None and len(vals) != n:
+        raise CalibrationError(f"{opt} {text!r}: expected {n} numbers (e.g. 0.05,0.25)")
+    return vals
+
+
+def _pairs(items: list[str], opt: str) -> dict[str, str]:
+    out = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip() or not value.strip():
+            raise CalibrationError(f"{opt} {item!r}: expected ROLE=VALUE, e.g. force=Kraft")
+        out[key.strip().lower()] = value.strip()
+    return out
