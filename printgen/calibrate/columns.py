@@ -22,6 +22,7 @@ ROLE_UNITS = {"force": FORCE_UNITS, "displacement": LENGTH_UNITS, "strain": STRA
 # The unit assumed when a column gives none.
 DEFAULT_UNIT = {"force": "n", "displacement": "mm", "strain": "", "stress": "mpa", "time": "s"}
 ROLES = tuple(ROLE_UNITS)
+MAX_UNIT_LEN = 8  # a bracketed header word longer than this is taken as part of the name
 
 # Name patterns per role, tried in this order (stress and strain before force and
 # displacement, so "Tensile stress" is not taken for a force column).
@@ -49,12 +50,14 @@ def normalise_unit(unit: str) -> str:
 def split_name_unit(header: str) -> tuple[str, str | None]:
     """(name, unit or None) from a header cell: `Load (kN)` -> ('Load', 'kn')."""
     text = header.strip()
-    for pattern in _UNIT_IN_NAME:
+    for k, pattern in enumerate(_UNIT_IN_NAME):
         m = pattern.match(text)
         if m and m.group("name"):
             unit = normalise_unit(m.group("unit"))
             if any(unit in table for table in ROLE_UNITS.values()):
                 return m.group("name").strip(), unit
+            if k == 0 and " " not in m.group("unit").strip() and len(unit) <= MAX_UNIT_LEN:
+                return m.group("name").strip(), unit  # bracketed and unit-like: check it later
     return text, None
 
 

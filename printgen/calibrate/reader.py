@@ -32,7 +32,7 @@ from printgen.errors import CalibrationError
 log = logging.getLogger(__name__)
 
 DELIMITERS = (";", "\t", ",")  # preferred first: a decimal comma would split a ',' file
-SNIFF_ROWS = 40  # rows from the table's end used to choose the delimiter and decimal
+SNIFF_ROWS = 40  # rows from the table's end used to choose the decimal separator
 TEXT_SUFFIXES = (".csv", ".txt", ".tsv", ".dat")
 
 
@@ -124,14 +124,19 @@ def read_export(path: str | Path, *, columns: Mapping[str, str] | None = None,
 
 
 def _sniff_delimiter(lines: list[str], where: str) -> str:
-    body = [ln for ln in lines if ln.strip()][-SNIFF_ROWS:]
+    """The first of DELIMITERS that splits most lines into the same number (>= 2) of fields."""
+    body = [ln for ln in lines if ln.strip()]
     for d in DELIMITERS:
-        counts = {len(next(csv.reader([ln], delimiter=d))) for ln in body}
-        if len(counts) == 1 and counts.pop() >= 2:
+        counts = np.array([len(next(csv.reader([ln], delimiter=d))) for ln in body])
+        if counts.size == 0:
+            break
+        values, freq = np.unique(counts, return_counts=True)
+        mode = values[np.argmax(freq)]
+        if mode >= 2 and freq.max() * 2 >= counts.size:
             return d
     raise CalibrationError(
         f"{where}: no table found; expected rows of at least 2 values separated by ',', ';' "
-        "or tab, the same number on every row (give --delimiter if the file uses another)"
+        "or tab, the same number on most rows (give --delimiter if the file uses another)"
     )
 
 
