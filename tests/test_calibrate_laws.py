@@ -1,0 +1,170 @@
+"""Synthetic exports from known laws, in every CSV variant, are recovered to 0.5 %.
+
+Each law gives stress (or panel force per width) against specimen strain; the files carry
+crosshead displacement (optionally with machine deflection added) or extensometer strain,
+small seeded noise and a post-failure drop that the fit must ignore.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+from test_calibrate_files import VARIANTS, write_export
+
+from printgen.calibrate.aggregate import summarise
+from printgen.calibrate.compliance import from_curve, from_stiffness
+from printgen.calibrate.pipeline import calibrate
+from printgen.calibrate.sample import FitOptions
+from printgen.errors import CalibrationError
+
+RECOVERY_RTOL = 0.005  # the issue's requirement: known laws recovered to 0.5 %
+NOISE = 2e-4  # force noise, fraction of the peak force (seeded), so fits are not exact
+UNCORRECTED_MIN_ERROR = 0.02  # a skipped correction must visibly bias the modulus (> 2 %)
+
+E = 2.0e9  # Pa, a printed PETG-like cable
+WIDTH, THICK, GRIP = 2.0e-3, 1.0e-3, 50.0e-3  # m
+AREA = WIDTH * THICK
+N_POINTS = 1500
+STRAIN_MAX = 0.03
+
+
+def _noisy(force: np.ndarray, seed: int) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    return force + NOISE * force.max() * rng.standard_normal(force.size)
+
+
+def _with_failure(strain: np.ndarray, force: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Append a post-failure drop (strain keeps rising, force falls) the fit must ignore."""
+    tail = np.linspace(0, 1, 40)[1:]
+    s = np.concatenate([strain, strain[-1] + 0.002 * tail])
+    f = np.concatenate([force, force[-1] * (1 - 0.9 * tail)])
+    return s, f
+
+
+def _write(tmp_path, name, strain, stress, variant, *, machine=None, extensometer=False, seed=0):
+    strain, force = _with_failure(strain, _noisy(stress * AREA, seed))
+    disp = strain * GRIP + (machine(force) if machine else 0.0)
+    ch = {"time": np.arange(force.size) * 0.1, "force": force, "displacement": disp}
+    if extensometer:
+        ch["strain"] = strain
+    return write_export(tmp_path / name, ch, variant)
+
+
+def _cal(paths, **kw):
+    spec = {"width": WIDTH, "thickness": THICK, "grip_distance": GRIP}
+    return calibrate(paths, material="synthetic", specimen=spec, **kw)
+
+
+@pytest.mark.parametrize("variant", sorted(VARIANTS))
+def test_linear_law_every_variant(tmp_path, variant):
+    eps = np.linspace(0, STRAIN_MAX, N_POINTS)
+    p = _write(tmp_path, "lin", eps, E * eps, variant, seed=1)
+    cal = _cal([p])
+    assert_allclose(cal.modulus.mean, E, rtol=RECOVERY_RTOL)
+    assert_allclose(cal.strength.mean, E * STRAIN_MAX, rtol=RECOVERY_RTOL)
+    secant = cal.samples[0].secants[0.01]
+    assert_allclose(secant, E, rtol=RECOVERY_RTOL)
+
+
+@pytest.mark.parametrize("variant", sorted(VARIANTS))
+def test_bilinear_law_every_variant(tmp_path, variant):
+    e1, e2, knee = E, 0.25 * E, 0.01
+    eps = np.linspace(0, STRAIN_MAX, N_POINTS)
+    sigma = e1 * eps + (e2 - e1) * np.maximum(eps - knee, 0)
+    cal = _cal([_write(tmp_path, "bil", eps, sigma, variant, extensometer=True, seed=2)])
+    b = cal.samples[0].bilinear
+    assert cal.samples[0].strain_source.startswith("extensometer")
+    assert_allclose([b.slope1, b.slope2, b.knee], [e1, e2, knee], rtol=RECOVERY_RTOL)
+    assert_allclose(cal.modulus.mean, e1, rtol=RECOVERY_RTOL)
+
+
+@pytest.mark.parametrize("variant", sorted(VARIANTS))
+def test_toe_region_zeroed_at_preload(tmp_path, variant):
+    """Slack toe: quadratic up to 2 e_t, then E (e - e_t); zeroing at a preload past the toe
+    puts the ISO window on the linear part."""
+    e_t = 0.002
+    eps = np.linspace(0, STRAIN_MAX, N_POINTS)
+    sigma = np.where(eps < 2 * e_t, E * eps**2 / (4 * e_t), E * (eps - e_t))
+    p = _write(tmp_path, "toe", eps, sigma, variant, seed=3)
+    preload = E * 0.003 * AREA  # N, at strain 0.5 %: past the toe
+    cal = _cal([p], options=FitOptions(preload=preload))
+    assert_allclose(cal.modulus.mean, E, rtol=RECOVERY_RTOL)
+    no_preload = _cal([p]).modulus.mean
+    assert abs(no_preload / E - 1) > UNCORRECTED_MIN_ERROR  # the toe biases an unzeroed fit
+
+
+@pytest.mark.parametrize("variant", sorted(VARIANTS))
+def test_constant_machine_stiffness_corrected(tmp_path, variant):
+    k = 2000e3  # N/m (2000 N/mm); the specimen's own E A / L is 80 N/mm
+    eps = np.linspace(0, STRAIN_MAX, N_POINTS)
+    p = _write(tmp_path, "mc", eps, E * eps, variant, machine=lambda f: f / k, seed=4)
+    cal = _cal([p], options=FitOptions(compliance=from_stiffness(k / 1e3)))
+    assert_allclose(cal.modulus.mean, E, rtol=RECOVERY_RTOL)
+    assert "constant stiffness 2000 N/mm" in cal.samples[0].strain_source
+    assert _cal([p]).modulus.mean < E * (1 - UNCORRECTED_MIN_ERROR)
+
+
+@pytest.mark.parametrize("variant", sorted(VARIANTS))
+def test_measured_compliance_curve_subtracted_point_by_point(tmp_path, variant):
+    """Nonlinear system compliance (seating then stiffening), measured on a rigid bar."""
+    def system(f):
+        return f / 1500e3 + 2e-6 * (1 - np.exp(-f / 5.0))  # m: linear + seating term
+
+    bar_force = np.linspace(0, 80.0, 400)
+    curve = write_export(tmp_path / "rigid_bar", {"force": bar_force,
+                                                 "displacement": system(bar_force)}, variant)
+    eps = np.linspace(0, STRAIN_MAX, N_POINTS)
+    p = _write(tmp_path, "cc", eps, E * eps, variant, machine=system, seed=5)
+    cal = _cal([p], options=FitOptions(compliance=from_curve(curve)))
+    assert_allclose(cal.modulus.mean, E, rtol=RECOVERY_RTOL)
+    assert _cal([p]).modulus.mean < E * (1 - UNCORRECTED_MIN_ERROR)
+
+
+@pytest.mark.parametrize("variant", sorted(VARIANTS))
+def test_tpe_panel_law_recovered(tmp_path, variant):
+    """Net panel softening from 30 to 6 kN/m/m at 40 % strain (Lambert et al. 2023):
+    kappa = (F / w) / dl, on a 43 mm long, 23 mm wide panel."""
+    k1, k2, knee, length, width = 30e3, 6e3, 0.40, 43e-3, 23e-3
+    eps = np.linspace(0, 0.8, N_POINTS)
+    fw = k1 * length * eps + (k2 - k1) * length * np.maximum(eps - knee, 0)
+    strain, force = _with_failure(eps, _noisy(fw * width, 6))
+    p = write_export(tmp_path / "panel", {"force": force, "displacement": strain * length},
+                     variant)
+    cal = calibrate([p], material="tpe-lab", options=FitOptions(window=(0.02, 0.2)),
+                    specimen={"kind": "panel", "width": width, "gauge_length": length})
+    law = cal.panel
+    assert_allclose([law.kappa1.mean, law.kappa2.mean, law.knee.mean], [k1, k2, knee],
+                    rtol=RECOVERY_RTOL)
+    assert_allclose(cal.samples[0].kappa, k1, rtol=RECOVERY_RTOL)
+
+
+def test_stats_over_samples_and_outlier_flag(tmp_path):
+    """Five specimens: mean and sample SD of the fitted moduli; a sixth, 30 % stiffer, flagged."""
+    moduli = E * np.array([0.97, 1.0, 1.02, 0.99, 1.01, 1.3])
+    eps = np.linspace(0, STRAIN_MAX, N_POINTS)
+    paths = [_write(tmp_path, f"s{i}", eps, m * eps, "comma", seed=10 + i)
+             for i, m in enumerate(moduli)]
+    cal = _cal(paths)
+    assert cal.modulus.n == 6
+    assert_allclose(cal.modulus.mean, moduli.mean(), rtol=RECOVERY_RTOL)
+    assert_allclose(cal.modulus.sd, np.std(moduli, ddof=1), rtol=RECOVERY_RTOL * 10)
+    assert cal.modulus.outliers == (5,)
+    assert any("s5.csv" in w and "outlier" in w for w in cal.warnings)
+    few = _cal(paths[:3])
+    assert any("only 3 sample" in w for w in few.warnings)
+
+
+def test_summarise_basic():
+    s = summarise([1.0, 2.0, 3.0, 4.0, 5.0])
+    assert (s.mean, s.n, s.outliers, s.warnings) == (3.0, 5, (), ())
+    assert_allclose(s.sd, np.sqrt(2.5), rtol=1e-12)  # exact sample SD; only round-off
+
+
+def test_window_beyond_the_curve_and_missing_grip_fail_clearly(tmp_path):
+    eps = np.linspace(0, 0.002, 300)
+    p = _write(tmp_path, "short", eps, E * eps, "comma")
+    with pytest.raises(CalibrationError, match=r"only \d+ points in the strain window 0.3-0.5 %"):
+        _cal([p], options=FitOptions(window=(0.003, 0.005)))
+    with pytest.raises(CalibrationError, match="needs the grip distance"):
+        calibrate([p], material="x", specimen={"width": WIDTH, "thickness": THICK})
