@@ -33,8 +33,7 @@ ISO_BELOW = 0.10  # the ISO window passes the knee: at least 10 % below the mach
 SUMMARY_FORCE_ATOL = 0.01  # N: summary.txt rounds the peak forces to 0.01 N
 # README: only PA6-GF25 Gray xy trials 1-4 disagree with their summary (shifted by two trials).
 KNOWN_SUMMARY_MISMATCHES = 4
-# Trials whose last summary block lists as many trials as there are zips (294 of 329 today).
-MIN_CHECKED = 290
+MIN_CHECKED = 322  # README: the last blocks describe 322 of the 329 zipped trials
 STRENGTH_RTOL = 5e-4  # summaries round strength to 0.01 MPa (about 2e-4 of 45 MPa)
 
 
@@ -84,14 +83,23 @@ def test_force_only_files_refuse_a_modulus_but_give_strength(tmp_path, capsys):
 
 
 def _last_blocks(summary: Path) -> dict[str, tuple[float, list[float]]]:
-    """axis -> (area mm^2, trial peak forces N) from the last summary block of each axis."""
+    """axis -> (area mm^2, trial peak forces N) from the last summary block of each axis.
+
+    Older blocks give no area: it is then average force / tensile strength."""
     out = {}
     for block in summary.read_text(encoding="utf-8").split("=== Test Summary ===")[1:]:
         axis = re.search(r"Axis: (\w+)", block)
         area = re.search(r"Cross-section area: ([\d.]+)", block)
-        if axis and area:
-            trials = [float(v) for v in re.findall(r"Trial \d+: ([\d.]+) N", block)]
+        force = re.search(r"Average max force.*?: ([\d.]+) N", block)
+        strength = re.search(r"Tensile strength.*?: ([\d.]+) MPa", block)
+        trials = [float(v) for v in re.findall(r"Trial \d+: ([\d.]+) N", block)]
+        if not (axis and trials):
+            continue
+        if area:
             out[axis.group(1)] = (float(area.group(1)), trials)
+        elif force and strength:
+            out[axis.group(1)] = (round(float(force.group(1)) / float(strength.group(1))),
+                                  trials)
     return out
 
 
@@ -101,17 +109,15 @@ def test_every_force_only_record_matches_its_summary():
     checked = mismatched = 0
     for folder in sorted(p for p in root.iterdir() if p.is_dir()):
         for axis, (area, trials) in _last_blocks(folder / "summary.txt").items():
-            files = sorted(folder.glob(f"{axis}-trial-*.csv.zip"))
-            if len(files) != len(trials):
-                continue
+            files = sorted(folder.glob(f"{axis}-trial-*.csv.zip"))[: len(trials)]
             cal = calibrate(files, material=folder.name, specimen={"area": area * 1e-6},
                             strength_only=True)
             peaks = np.array([s.peak_force for s in cal.strength_samples])
-            bad = np.abs(peaks - trials) > SUMMARY_FORCE_ATOL
+            bad = np.abs(peaks - trials[: len(files)]) > SUMMARY_FORCE_ATOL
             mismatched += int(bad.sum())
             checked += len(files)
-            if not bad.any():
+            if not bad.any() and len(files) == len(trials):
                 assert_allclose(cal.strength.mean, np.mean(trials) / area * 1e6,
                                 rtol=STRENGTH_RTOL)
-    assert checked >= MIN_CHECKED
+    assert checked >= MIN_CHECKED, checked
     assert mismatched == KNOWN_SUMMARY_MISMATCHES
