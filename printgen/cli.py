@@ -20,6 +20,7 @@ COMMAND_MODULES = (
     "printgen.commands.select",
     "printgen.commands.profiles",
     "printgen.commands.make",
+    "printgen.commands.bench",
     "printgen.commands.calibrate",
 )
 

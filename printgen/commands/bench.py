@@ -1,0 +1,31 @@
+"""`printgen bench solver|gcode|parts --out DIR`: run a benchmark of benchmarks/ (a source
+checkout) and write its JSON/PNG into DIR."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from pathlib import Path
+
+from printgen.errors import InputError
+
+ROOT = Path(__file__).resolve().parents[2]
+BENCHES = ("solver", "gcode", "parts")
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("bench", help="run a benchmark (speed against error) into a folder")
+    p.add_argument("name", choices=BENCHES)
+    p.add_argument("--out", type=Path, default=Path("benchmarks/results"))
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if not (ROOT / "benchmarks" / f"bench_{args.name}.py").is_file():
+        raise InputError(f"benchmarks/bench_{args.name}.py not found under {ROOT}; the "
+                         "benchmarks live in a source checkout of printgen")
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    module = importlib.import_module(f"benchmarks.bench_{args.name}")
+    return int(module.main(["--out", str(args.out)]) or 0)
