@@ -30,14 +30,14 @@ _ROLE_PATTERNS = (
     ("stress", r"stress|spannung|contrainte|sigma"),
     ("strain", r"strain|dehnung|d[ée]formation|epsilon|extensometer"),
     ("force", r"force|load|kraft|effort|charge"),
-    ("displacement", r"displacement|extension|elongation|crosshead|position|weg|stroke|"
-                     r"traverse|deplacement|déplacement|travel"),
+    ("displacement", (r"displacement|extension|elongation|crosshead|position|weg|stroke|"
+                      r"traverse|deplacement|déplacement|travel")),
     ("time", r"time|zeit|temps"),
 )
 
 _UNIT_IN_NAME = (
     re.compile(r"^(?P<name>.*?)\s*[\(\[](?P<unit>[^\)\]]*)[\)\]]\s*$"),  # Load (kN), Load [kN]
-    re.compile(r"^(?P<name>.*?)\s+in\s+(?P<unit>\S+)\s*$", re.I),  # Kraft in N
+    re.compile(r"^(?P<name>.*?)\s+in\s+(?P<unit>\S+)\s*$", re.IGNORECASE),  # Kraft in N
     re.compile(r"^(?P<name>.*?)[_ ](?P<unit>[A-Za-z%/µ²^0-9]+)\s*$"),  # force_N, Strain %
 )
 

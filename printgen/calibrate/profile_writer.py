@@ -140,10 +140,9 @@ def _conditions(cal: Calibration) -> str:
     if cal.samples:
         parts.append("strain from " + "; ".join(cal.strain_sources))
         parts.append("loading branch up to the peak")
-        parts.append("zeroed at preload %g N" % o.preload if o.preload is not None
+        parts.append(f"zeroed at preload {o.preload:g} N" if o.preload is not None
                      else "zeroed at the first point")
-        parts.append("linear regression over strain %g-%g %%" % (o.window[0] * 100,
-                                                                 o.window[1] * 100)
+        parts.append(f"linear regression over strain {o.window[0] * 100:g}-{o.window[1] * 100:g} %"
                      if o.window is not None else
                      f"automatic steepest window ({o.auto_span:.0%} of the rise to the peak)")
     else:

@@ -9,7 +9,6 @@ file, the line and what was expected.
 from __future__ import annotations
 
 import csv
-import io
 import logging
 import zipfile
 from collections.abc import Mapping

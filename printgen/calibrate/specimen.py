@@ -94,9 +94,9 @@ def from_metadata(meta: tuple[MetaItem, ...], where: str) -> dict[str, float]:
 def machine_modulus(meta: tuple[MetaItem, ...]) -> float | None:
     """The machine software's own modulus (Pa) from the metadata, if written."""
     for m in meta:
-        if m.number is not None and re.search(r"modul|young", m.key.lower()):
-            if m.unit in _MODULUS:
-                return m.number * _MODULUS[m.unit]
+        if (m.number is not None and re.search(r"modul|young", m.key.lower())
+                and m.unit in _MODULUS):
+            return m.number * _MODULUS[m.unit]
     return None
 
 
