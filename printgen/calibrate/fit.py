@@ -59,21 +59,25 @@ def loading_branch(y: np.ndarray) -> int:
     return int(np.argmax(y))
 
 
-def zero_at_preload(x: np.ndarray, y: np.ndarray, preload: float | None
-                    ) -> tuple[np.ndarray, np.ndarray]:
-    """Keep the points from where y first reaches `preload` and put x = 0 there (linear
-    interpolation between the two points around the crossing). None: zero at the first point."""
+def zero_at_preload(x: np.ndarray, y: np.ndarray, preload: float | None,
+                    force: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Keep the points from where `force` (default: y) first reaches `preload` and put x = 0
+    there, interpolating x and y between the two points around the crossing.
+    None: zero at the first point."""
     if preload is None:
         return x - x[0], y
-    above = np.nonzero(y >= preload)[0]
+    ref = y if force is None else force
+    above = np.nonzero(ref >= preload)[0]
     if above.size == 0:
-        raise CalibrationError(f"preload {preload:g} never reached (peak {y.max():g})")
+        raise CalibrationError(f"preload {preload:g} N never reached (peak {ref.max():.4g} N); "
+                               "lower --preload")
     k = int(above[0])
     if k == 0:
         return x - x[0], y
-    t = (preload - y[k - 1]) / (y[k] - y[k - 1])
+    t = (preload - ref[k - 1]) / (ref[k] - ref[k - 1])
     x0 = x[k - 1] + t * (x[k] - x[k - 1])
-    return np.concatenate([[0.0], x[k:] - x0]), np.concatenate([[preload], y[k:]])
+    y0 = y[k - 1] + t * (y[k] - y[k - 1])
+    return np.concatenate([[0.0], x[k:] - x0]), np.concatenate([[y0], y[k:]])
 
 
 def linear_fit(x: np.ndarray, y: np.ndarray, lo: float, hi: float) -> LinearFit:

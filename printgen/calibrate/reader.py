@@ -104,6 +104,10 @@ def read_export(path: str | Path, *, columns: Mapping[str, str] | None = None,
     ncols = len(rows[start][1])
     headers, unit_row, meta_end = _header(rows, start, ncols)
     data, line_no = _body(rows[start:], ncols, dec, where, headers, delim)
+    unknown = sorted(set(units or {}) - set(ROLES))
+    if unknown:
+        raise CalibrationError(f"unknown column role {unknown[0]!r} in the units; roles: "
+                               f"{', '.join(ROLES)}")
     roles = _assign(headers, columns or {}, where)
     channels, names = {}, {}
     for role, j in roles.items():

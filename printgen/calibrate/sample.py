@@ -90,14 +90,14 @@ def analyse(rec: TestRecord, spec: Specimen, opt: FitOptions) -> SampleFit:
     x, y, source = _curve(rec, spec, opt)
     p = loading_branch(y)
     preload = opt.preload
-    if preload is not None and spec.kind != "panel" and not rec.has("force"):
+    if preload is not None and not rec.has("force"):
         raise CalibrationError(f"{rec.path}: --preload is a force but the file has no force "
                                "column")
-    yref = _force_like(rec, spec)[: p + 1]
-    if preload is not None:
-        x_branch, y_branch = _zero_by_force(x[: p + 1], y[: p + 1], yref, preload, rec.path)
-    else:
-        x_branch, y_branch = zero_at_preload(x[: p + 1], y[: p + 1], None)
+    force = rec.channels["force"][: p + 1] if preload is not None else None
+    try:
+        x_branch, y_branch = zero_at_preload(x[: p + 1], y[: p + 1], preload, force)
+    except CalibrationError as exc:
+        raise CalibrationError(f"{rec.path}: {exc}") from exc
     if opt.window is None:
         lin = steepest_fit(x_branch, y_branch, opt.auto_span)
     else:
@@ -107,24 +107,6 @@ def analyse(rec: TestRecord, spec: Specimen, opt: FitOptions) -> SampleFit:
     peak, strength = peak_and_strength(rec, spec)
     return SampleFit(rec.path, spec, source, lin, bil, secants, peak, strength,
                      machine_modulus(rec.metadata), x_branch, y_branch)
-
-
-def _force_like(rec: TestRecord, spec: Specimen) -> np.ndarray:
-    return rec.channels["force"] if rec.has("force") else rec.channels["stress"]
-
-
-def _zero_by_force(x, y, force, preload, where):
-    above = np.nonzero(force >= preload)[0]
-    if above.size == 0:
-        raise CalibrationError(f"{where}: preload {preload:g} N never reached "
-                               f"(peak {force.max():.4g} N); lower --preload")
-    k = int(above[0])
-    if k > 0:
-        t = (preload - force[k - 1]) / (force[k] - force[k - 1])
-        x0 = x[k - 1] + t * (x[k] - x[k - 1])
-        y0 = y[k - 1] + t * (y[k] - y[k - 1])
-        return np.concatenate([[0.0], x[k:] - x0]), np.concatenate([[y0], y[k:]])
-    return x - x[0], y
 
 
 def _curve(rec: TestRecord, spec: Specimen, opt: FitOptions) -> tuple[np.ndarray, np.ndarray, str]:
