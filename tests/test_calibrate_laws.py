@@ -168,3 +168,12 @@ def test_window_beyond_the_curve_and_missing_grip_fail_clearly(tmp_path):
         _cal([p], options=FitOptions(window=(0.003, 0.005)))
     with pytest.raises(CalibrationError, match="needs the grip distance"):
         calibrate([p], material="x", specimen={"width": WIDTH, "thickness": THICK})
+
+
+def test_preload_not_reached_and_unknown_roles_fail_clearly(tmp_path):
+    eps = np.linspace(0, STRAIN_MAX, N_POINTS)
+    p = _write(tmp_path, "lin", eps, E * eps, "comma")
+    with pytest.raises(CalibrationError, match=r"lin\.csv: preload 1e\+06 N never reached"):
+        _cal([p], options=FitOptions(preload=1e6))
+    with pytest.raises(CalibrationError, match="unknown column role 'torque'"):
+        _cal([p], units={"torque": "Nm"})

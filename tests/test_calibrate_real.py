@@ -2,8 +2,8 @@
 
 Bluehill (Instron) files: the automatic steepest-window modulus lands within a few per cent of
 the machine software's own value in each header; the ISO 527-1 window (0.05-0.25 %) lies past
-the end of the linear part in these composites (yield knee at about 0.02 % strain in
-Tens_Yield, about 0.15 % in Tens_No_Yield) and comes out far lower: the difference is the window.
+the end of the linear part in these composites (knee at about 0.03 % strain in Tens_Yield,
+0.15-0.19 % in Tens_No_Yield) and comes out 93 % and 14-43 % lower: the difference is the window.
 Force-only files (joshcarter/tensile_test): modulus refused with a clear message; strength
 mean +- SD reproduces the tester's own summaries.
 """
@@ -26,7 +26,8 @@ from printgen.errors import CalibrationError
 BLUEHILL = "data/tensile/pymechtest-bluehill"
 JOSH = "data/tensile/joshcarter-tensile_test/data"
 # Automatic window (15 % of the rise) vs the machine's "Automatic Young's": measured worst file
-# +4.4 % (Tens_Yield 9), all others within 2.1 %; the machine's own window is not stated.
+# +4.4 % (Tens_Yield Specimen_RawData_8), all others +0.2 to +2.1 %; set means +1.0 % and
+# +1.2 %. The machine's own window rule is not stated; ours is slightly steeper.
 MACHINE_FILE_RTOL = 0.05
 MACHINE_MEAN_RTOL = 0.02  # mean over the 10 specimens of a set
 ISO_BELOW = 0.10  # the ISO window passes the knee: at least 10 % below the machine value
