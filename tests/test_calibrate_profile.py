@@ -64,11 +64,12 @@ def test_update_keeps_the_rest_and_refuses_bad_targets(tmp_path, cable_files, mo
     cal = calibrate(cable_files, material="petg-lab", specimen=_spec())
     out = tmp_path / "p"
     path, _ = write_profile(cal, name="petg-lab", out=out, inherits="petg")
-    path.write_text('description = "kept"\n' + path.read_text())
+    path.write_text("density_g_per_cm3 = 1.31\n" + path.read_text())  # a lab's own edit
     two = calibrate(cable_files[:2], material="petg-lab", specimen=_spec())
     write_profile(two, name="petg-lab", out=out)
     data = tomllib.loads(path.read_text())
-    assert data["inherits"] == "petg" and data["description"] == "kept"
+    assert data["inherits"] == "petg" and data["density_g_per_cm3"] == 1.31
+    assert data["name"] == "petg-lab"
     assert data["measured"]["tensile_modulus"]["n_samples"] == 2
     with pytest.raises(CalibrationError, match="cannot inherit itself"):
         write_profile(cal, name="petg", out=out, inherits="petg")

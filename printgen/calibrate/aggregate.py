@@ -1,7 +1,7 @@
 """Statistics over samples: mean, sample standard deviation (ddof = 1), count, outliers.
 
 Outliers are flagged (not removed) with the modified z-score of Iglewicz and Hoaglin,
-|0.6745 (x - median) / MAD| > 3.5; fewer than `MIN_SAMPLES` samples give a warning.
+|0.6745 (x - median) / MAD| > 3.5, when also more than 1 % from the median; fewer than `MIN_SAMPLES` samples give a warning.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ log = logging.getLogger(__name__)
 MIN_SAMPLES = 5  # ISO 527-1 asks for at least five specimens per direction
 OUTLIER_Z = 3.5  # modified z-score above which a sample is flagged (Iglewicz & Hoaglin 1993)
 MAD_SCALE = 0.6745  # makes the median absolute deviation consistent with a normal SD
+OUTLIER_MIN_REL = 0.01  # never flag a sample within 1 % of the median (round-off, tight sets)
 
 
 @dataclass(frozen=True)
@@ -64,4 +65,5 @@ def outliers(v: np.ndarray) -> tuple[int, ...]:
     if mad == 0:
         return ()
     z = MAD_SCALE * (v - med) / mad
-    return tuple(int(i) for i in np.nonzero(np.abs(z) > OUTLIER_Z)[0])
+    far = np.abs(v - med) > OUTLIER_MIN_REL * abs(med)
+    return tuple(int(i) for i in np.nonzero((np.abs(z) > OUTLIER_Z) & far)[0])

@@ -52,7 +52,7 @@ def plot_calibration(cal: Calibration, path: str | Path) -> Path:
     win = (f"window {o.window[0] * 100:g}-{o.window[1] * 100:g} %" if o.window is not None
            else f"automatic steepest window ({o.auto_span:.0%} of the rise)")
     ax_all.set_title(f"{cal.material}: loading branches, bilinear fits (dashed)")
-    ax_win.set_title(f"modulus fits, {win}")
+    ax_win.set_title(f"{'stiffness' if panel else 'modulus'} fits, {win}")
     for ax in (ax_all, ax_win):
         ax.set_xlabel("strain (%)")
         ax.set_ylabel(ylab)

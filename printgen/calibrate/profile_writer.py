@@ -76,6 +76,11 @@ def write_profile(cal: Calibration, *, name: str, out: str | Path | None = None,
     elif not data:
         raise CalibrationError(f"{path} does not exist yet: give --inherits <bundled material> "
                                "so its datasheet and print settings carry over")
+    if "name" not in data:
+        data["name"] = name
+        data["description"] = (f"{name}: calibrated with printgen calibrate from "
+                               f"{len(cal.files)} tensile tests"
+                               + (f", inheriting {inherits}" if inherits else ""))
     data.setdefault("measured", {}).update(measured_tables(cal, date=date))
     text = tomli_w.dumps(data)
     with tempfile.TemporaryDirectory() as tmp:

@@ -115,6 +115,10 @@ def run(args: argparse.Namespace) -> int:
                                   date=args.date)
         e, source = mat.modulus()
         written = {"profile": str(path), "modulus_gpa": e / 1e9, "modulus_source": source}
+        if cal.kind == "panel" and mat.panel_law is not None:
+            written["panel_law_kappa_kn_per_m_per_m"] = [k / 1e3 for k in mat.panel_law.kappas]
+            written["panel_law_knee_strain_percent"] = [k * 100 for k in
+                                                        mat.panel_law.knee_strains]
     if args.plot:
         from printgen.calibrate.plot import plot_calibration
 
@@ -128,9 +132,14 @@ def run(args: argparse.Namespace) -> int:
 
 def show(cal: Calibration, written: dict) -> None:
     out = console()
-    mu, mf, su, sf = units(cal)
+    _, mf, su, sf = units(cal)
+    panel = cal.kind == "panel"
+    mu = "kN/m/m" if panel else "GPa"  # panels: kappa = slope of F/w over strain / length
+    if panel and cal.samples:
+        mf = 1e3 * cal.samples[0].specimen.strain_length()
     if cal.samples:
-        cols = ["file", f"E {mu}", "window %", "r2", f"E1/E2 {mu}", "knee %",
+        cols = ["file", f"{'kappa' if panel else 'E'} {mu}", "window %", "r2",
+                f"{'k1/k2' if panel else 'E1/E2'} {mu}", "knee %",
                 *[f"sec {e * 100:g}%" for e in cal.options.secant_strains],
                 f"max {su}", f"machine {mu}", "diff"]
         rows = []
@@ -152,7 +161,8 @@ def show(cal: Calibration, written: dict) -> None:
                 for s in cal.strength_samples]
         out.print(table(f"{cal.material}: strength only (force-only files)",
                         ["file", "peak N", f"strength {su}"], rows))
-    for what, st, f, u in (("modulus", cal.modulus, mf, mu), ("strength", cal.strength, sf, su)):
+    for what, st, f, u in (("kappa (window)" if panel else "modulus", cal.modulus, mf, mu),
+                           ("strength", cal.strength, sf, su)):
         if st is not None:
             sd = "-" if st.sd is None else f"{st.sd / f:.4g}"
             out.print(f"[bold]{what}[/]: {st.mean / f:.4g} ± {sd} {u} (n = {st.n})")
