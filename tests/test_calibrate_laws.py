@@ -159,6 +159,9 @@ def test_summarise_basic():
     s = summarise([1.0, 2.0, 3.0, 4.0, 5.0])
     assert (s.mean, s.n, s.outliers, s.warnings) == (3.0, 5, (), ())
     assert_allclose(s.sd, np.sqrt(2.5), rtol=1e-12)  # exact sample SD; only round-off
+    # Round-off scatter is not an outlier, however small the MAD.
+    assert summarise([0.4, 0.4 + 1e-12, 0.4 - 1e-12, 0.4 + 2e-12, 0.4001]).outliers == ()
+    assert summarise([1.0, 1.01, 0.99, 1.0, 1.5]).outliers == (4,)
 
 
 def test_window_beyond_the_curve_and_missing_grip_fail_clearly(tmp_path):
