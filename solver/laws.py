@@ -25,25 +25,33 @@ class Law:
             raise ValueError(f"knees must be positive and increasing, got {self.knees}")
         if any(not np.isfinite(s) or s <= 0 for s in self.slopes):
             raise ValueError(f"slopes must be positive and finite, got {self.slopes}")
+        lo = np.array([0.0, *self.knees])
+        width = np.append(np.diff(lo), np.inf)
+        slopes = np.asarray(self.slopes, dtype=float)
+        # arrays reused by every evaluation (the dataclass is frozen: set them once here)
+        object.__setattr__(self, "_lo", lo)
+        object.__setattr__(self, "_width", width)
+        object.__setattr__(self, "_slopes", slopes)
+        object.__setattr__(self, "_knees", np.asarray(self.knees, dtype=float))
+        object.__setattr__(self, "_before", np.concatenate(
+            [[0.0], np.cumsum(slopes[:-1] * width[:-1])]))
 
     def force_and_tangent(self, eps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(force N, tangent dF/deps N) at each strain; both zero when eps <= 0."""
         e = np.maximum(eps, 0.0)
-        lo = np.array([0.0, *self.knees])
-        width = np.append(np.diff(lo), np.inf)
-        slopes = np.asarray(self.slopes)
-        force = np.clip(e[..., None] - lo, 0.0, width) @ slopes
-        tangent = slopes[np.searchsorted(np.asarray(self.knees), e, side="right")]
+        if not self.knees:  # linear: the common case, no segments to walk
+            return self._slopes[0] * e, np.where(eps > 0, self._slopes[0], 0.0)
+        force = np.clip(e[..., None] - self._lo, 0.0, self._width) @ self._slopes
+        tangent = self._slopes[np.searchsorted(self._knees, e, side="right")]
         return force, np.where(eps > 0, tangent, 0.0)
 
     def energy(self, eps: np.ndarray) -> np.ndarray:
         """Strain energy per unit rest length, integral of the force from 0 to eps (N)."""
         e = np.maximum(eps, 0.0)
-        lo = np.array([0.0, *self.knees])
-        width = np.append(np.diff(lo), np.inf)
-        seg = np.clip(e[..., None] - lo, 0.0, width)  # strain spent on each segment
-        before = np.concatenate([[0.0], np.cumsum(np.asarray(self.slopes[:-1]) * width[:-1])])
-        return (np.asarray(self.slopes) * 0.5 * seg**2 + before * seg).sum(axis=-1)
+        if not self.knees:
+            return 0.5 * self._slopes[0] * e * e
+        seg = np.clip(e[..., None] - self._lo, 0.0, self._width)  # strain on each segment
+        return (self._slopes * 0.5 * seg**2 + self._before * seg).sum(axis=-1)
 
     def scaled(self, factor: float) -> Law:
         return Law(self.knees, tuple(s * factor for s in self.slopes))
