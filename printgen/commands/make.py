@@ -22,6 +22,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", "-o", type=Path, help="output directory")
     p.add_argument("--drag", action="store_true",
                    help="also verify under hydrostatic + drag at the Froude-scaled velocity")
+    p.add_argument("--step", action="store_true", help="also write STEP files (needs cadquery)")
     add_json_arg(p)
     p.set_defaults(func=run)
 
@@ -32,7 +33,7 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     with err.status("planning") as status:
         ctx = make(args.prototype, args.scale, out, printer=args.printer,
-                   options={"drag": args.drag},
+                   options={"drag": args.drag, "step": args.step},
                    progress=lambda label: status.update(f"{label} ..."))
     seconds = time.perf_counter() - t0
     if args.json:
