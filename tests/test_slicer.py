@@ -15,7 +15,6 @@ from numpy.testing import assert_allclose
 from printgen.design import Section
 from printgen.errors import PrintabilityError
 from printgen.gcode import read_gcode
-from printgen.geometry.net import diamond_net
 from printgen.materials import load_material
 from printgen.printers import load_print_style, load_printer
 from printgen.slicer import allowed_prusa_keys, prusa_ini_text, prusa_settings, write_prusa_ini
@@ -101,41 +100,21 @@ def test_bad_designs_fail_before_any_profile_is_written(design_1_40, tmp_path, c
 
 
 # ----------------------------------------------------------------------------- slicing
-def _extrude(polys, thickness, path):
-    trimesh = pytest.importorskip("trimesh")
-    mesh = trimesh.creation.extrude_polygon(polys, thickness)
-    assert mesh.is_watertight
-    mesh.export(path)
+def _net_stl(net, path):
+    """The net's mesh (printgen.geometry.solid), as the lab would slice it."""
+    pytest.importorskip("manifold3d")
+    from printgen.geometry.solid import net_solid
+
+    net_solid(net).export(path)
     return path
 
 
-def _net_stl(net, path):
-    """A reduced net's solid: union of the strand beads and the border ring, extruded."""
-    shapely = pytest.importorskip("shapely")
-    from shapely.geometry import LineString, box
-
-    g = diamond_net(net.width_mm, net.height_mm, net.mesh_x_mm, net.mesh_y_mm)
-    sx, sy = g.size_mm
-    bw, w = net.border_width_mm, net.strand.width_mm
-    parts = [LineString(g.nodes_mm[[s[0], s[-1]]]).buffer(w / 2, cap_style="flat")
-             for s in g.strands]
-    parts.append(box(-bw / 2, -bw / 2, sx + bw / 2, sy + bw / 2).difference(
-        box(bw / 2, bw / 2, sx - bw / 2, sy - bw / 2)))
-    return _extrude(shapely.unary_union(parts), net.strand.thickness_mm, path)
-
-
 def _cable_stl(cable, path):
-    shapely = pytest.importorskip("shapely")
-    from shapely.geometry import Point, box
+    pytest.importorskip("manifold3d")
+    from printgen.geometry.solid import cable_solid
 
-    half, w = cable.length_mm / 2, cable.section.width_mm
-    ends = (-half, half)
-    outline = shapely.unary_union([box(-half, -w / 2, half, w / 2)]
-                                  + [Point(x, 0).buffer(cable.eyelet_outer_mm / 2, 128)
-                                     for x in ends])
-    holes = shapely.unary_union([Point(x, 0).buffer(cable.eyelet_inner_mm / 2, 128)
-                                 for x in ends])
-    return _extrude(outline.difference(holes), cable.section.thickness_mm, path)
+    cable_solid(cable).export(path)
+    return path
 
 
 def _run(script, stl, cfg, tmp_path, *args):
