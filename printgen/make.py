@@ -175,10 +175,11 @@ def part_thickness(kind: str, part) -> float:
 def verify_step(ctx: MakeContext, stage: Path) -> None:
     """Prototype vs model over the loading sweep, and the steel counter-example."""
     from printgen.report import verification_record, verification_sections
-    from printgen.verify import steel_counterexample, verify
+    from printgen.verify import verify
 
-    v = verify(ctx.prototype, ctx.design, drag=bool(ctx.options.get("drag")))
-    ce = steel_counterexample(ctx.targets.scale)
+    v = verify(ctx.prototype, ctx.design, drag=bool(ctx.options.get("drag")),
+               counterexample=True)
+    ce = v.counterexample
     verification_sections(ctx.report, v, ce, ctx.targets.scale)
     ctx.record["verification"] = verification_record(v, ce)
 

@@ -7,7 +7,10 @@ Also the counter-example the report warns about: the simple barrier with steel a
 
 from __future__ import annotations
 
+import multiprocessing
+import os
 import time
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -97,14 +100,15 @@ class Verification:
     model: Run
     mismatches: list[Mismatch]
     reasons: list[str]
+    counterexample: "CounterExample | None" = None
 
     @property
     def ok(self) -> bool:
         return all(m.ok for m in self.mismatches)
 
 
-def verify(p: Prototype, d: Design, *, drag: bool = False,
-           lv: np.ndarray | None = None) -> Verification:
+def verify(p: Prototype, d: Design, *, drag: bool = False, lv: np.ndarray | None = None,
+           counterexample: bool = False) -> Verification:
     """Sweep both barriers under the same relative loading and compare them."""
     lv = levels() if lv is None else np.asarray(lv, dtype=float)
     ps, ms = prototype_scene(p), model_scene(d)
@@ -114,9 +118,25 @@ def verify(p: Prototype, d: Design, *, drag: bool = False,
         kw_m = {"velocity": p.velocity / np.sqrt(d.scale),
                 "strand_diameter": d.net.strand.width_mm * 1e-3}
         case = "hydrostatic + drag at the Froude-scaled velocity"
-    proto, model = sweep(ps, lv, **kw_p), sweep(ms, lv, **kw_m)
+    jobs = [(sweep, (ms, lv), kw_m), (sweep, (ps, lv), kw_p)]  # the longest first
+    if counterexample:
+        jobs.append((steel_counterexample, (d.scale,), {}))
+    model, proto, *ce = run_jobs(jobs)
     mm = compare(proto.deformation, model.deformation)
-    return Verification(case, proto, model, mm, explain(mm))
+    return Verification(case, proto, model, mm, explain(mm), ce[0] if ce else None)
+
+
+def run_jobs(jobs: list[tuple]) -> list:
+    """Run each (fn, args, kwargs) and return the results in order: in worker processes when
+    the machine has two cores or more (the jobs are independent; the results are identical
+    either way), else one after the other. PRINTGEN_SERIAL=1 forces serial runs."""
+    workers = min(len(jobs), os.cpu_count() or 1)
+    if workers < 2 or os.environ.get("PRINTGEN_SERIAL"):
+        return [fn(*args, **kw) for fn, args, kw in jobs]
+    ctx = multiprocessing.get_context("fork")
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+        futures = [pool.submit(fn, *args, **kw) for fn, args, kw in jobs]
+        return [f.result() for f in futures]
 
 
 @dataclass(frozen=True)
