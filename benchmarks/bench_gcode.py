@@ -11,20 +11,13 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-import time
 from functools import partial
 from pathlib import Path
 
+from benchmarks.timing import best_of
+
 GOAL_S = 1.0  # the brief: G-code for the 330 mm net in under a second
 
-
-def _best(fn, repeat: int):
-    best, out = float("inf"), None
-    for _ in range(repeat):
-        t = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t)
-    return best, out
 
 
 def run(out_dir: Path, repeat: int = 5) -> dict:
@@ -53,9 +46,9 @@ def run(out_dir: Path, repeat: int = 5) -> dict:
     results = {}
     for name, part, build, budget in parts:
         style, mat = load_print_style(part.print_style), load_material(part.material)
-        t_path, tp = _best(partial(build, part, printer, style, mat), repeat)
-        t_text, text = _best(partial(gcode_text, tp, printer, mat), repeat)
-        t_read, rb = _best(partial(read_gcode_text, text,
+        t_path, tp = best_of(partial(build, part, printer, style, mat), repeat)
+        t_text, text = best_of(partial(gcode_text, tp, printer, mat), repeat)
+        t_read, rb = best_of(partial(read_gcode_text, text,
                                    filament_diameter_mm=printer.filament_diameter_mm), repeat)
         write_text(out_dir / f"{name}.gcode", text)
         b = budget(part, style)

@@ -11,19 +11,12 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-import time
 from pathlib import Path
+
+from benchmarks.timing import best_of
 
 GOAL_S = 5.0  # issue 5: the 330 mm net's mesh in under five seconds
 
-
-def _best(fn, repeat: int):
-    best, out = float("inf"), None
-    for _ in range(repeat):
-        t = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t)
-    return best, out
 
 
 def run(out_dir: Path, repeat: int = 3) -> dict:
@@ -40,9 +33,9 @@ def run(out_dir: Path, repeat: int = 3) -> dict:
               for c in d.cables]
     results = {}
     for name, build, analytic in parts:
-        t_mesh, mesh = _best(build, repeat)
-        t_stl, stl = _best(lambda mesh=mesh: stl_bytes(mesh), repeat)
-        t_3mf, _ = _best(lambda mesh=mesh, name=name: threemf_bytes([(name, mesh)]), repeat)
+        t_mesh, mesh = best_of(build, repeat)
+        t_stl, stl = best_of(lambda mesh=mesh: stl_bytes(mesh), repeat)
+        t_3mf, _ = best_of(lambda mesh=mesh, name=name: threemf_bytes([(name, mesh)]), repeat)
         results[name] = {"mesh_s": round(t_mesh, 4), "stl_s": round(t_stl, 4),
                          "threemf_s": round(t_3mf, 4), "triangles": len(mesh.faces),
                          "volume_mm3": round(float(mesh.volume), 3),

@@ -16,8 +16,6 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
 from solver import solve
 from solver.loads import total_forces
 from solver.scenes import simple_scene
@@ -52,8 +50,9 @@ def bench_size(refine: int) -> dict:
 
 def _opensees(sc, d_ref: float) -> dict:
     try:
-        from benchmarks.opensees_net import solve_opensees
         import openseespy.opensees  # noqa: F401
+
+        from benchmarks.opensees_net import solve_opensees
     except (ImportError, RuntimeError) as exc:
         return {"tool": "OpenSeesPy", "skipped": f"not available: {exc} "
                 "(pip install 'printgen[bench]'; Debian needs libblas3 liblapack3)"}
