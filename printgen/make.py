@@ -85,7 +85,7 @@ def gcode_step(ctx: MakeContext, stage: Path) -> None:
         path.write_text(text)
         ctx.files.append(path.name)
         err = back.volume_mm3 / tp.volume_mm3 - 1
-        rec[name] = {"file": path.name, "layers": int(len(back.layer_z_mm)),
+        rec[name] = {"file": path.name, "layers": len(back.layer_z_mm),
                      "volume_mm3": tp.volume_mm3, "readback_volume_mm3": back.volume_mm3,
                      "readback_error": err, "seconds": seconds}
         rows.append([name, path.name, str(len(back.layer_z_mm)), f"{tp.volume_mm3:.1f}",
@@ -124,8 +124,8 @@ def parts_step(ctx: MakeContext, stage: Path) -> None:
     """Watertight meshes of every part: STL, a 3MF carrying its PrusaSlicer settings, and
     STEP when asked (--step, needs cadquery)."""
     from printgen.export import place_mesh, prusa_config_from_ini, stl_bytes, threemf_bytes
-    from printgen.geometry.solid import cable_outline, cable_solid, net_outline, net_solid
     from printgen.gcode.toolpath import cable_volume_budget, net_volume_budget
+    from printgen.geometry.solid import cable_outline, cable_solid, net_outline, net_solid
     from printgen.slicer.prusa import prusa_ini_text
 
     d = ctx.design

@@ -144,7 +144,7 @@ def model_scene(d: Design) -> BarrierScene:
         cable_law = ((), (load_material(c.material).modulus()[0] * area_m2(c.section),))
     s = _scene(f"printed model 1:{d.scale:g}", d.scale, g, MM, net_law, cable_law,
                ((), (border_ea,)))
-    mid = lambda row: int(row[len(row) // 2])  # noqa: E731
+    mid = lambda row: int(row[len(row) // 2])
     sensors = [(mid(s.rows["bottom"]), SENSOR_FORCE_N * FLOW),
                (mid(s.rows["top"]), SENSOR_FORCE_N * FLOW), (s.centre, SENSOR_FORCE_N * FLOW)]
     return BarrierScene(**{**s.__dict__, "sensors": sensors})

@@ -94,7 +94,7 @@ def prototype_quantities(p: Prototype) -> list[tuple[str, str, str, float, float
         q += [("strand_modulus", "net strand modulus E", "Pa", -1, p.net.strand_modulus),
               ("strand_ea", "net strand axial stiffness E*A", "N", -3, ea)]
     if p.net.panel_law is not None:
-        knees, kappas, length = p.net.panel_law
+        _knees, kappas, length = p.net.panel_law
         q.append(("panel_length", "net panel test length L_p", "m", -1, length))
         for i, k in enumerate(kappas):
             q.append((f"kappa_{i}", f"net panel stiffness kappa, segment {i + 1}", "N/m/m", -1, k))

@@ -30,7 +30,7 @@ SOLVER_TOL = 1e-7  # out-of-balance force / load: far below what a flume measure
 
 def levels(step: float = LEVEL_STEP, top: float = OVERFLOW) -> np.ndarray:
     """0, step, ..., top (inclusive)."""
-    n = int(round(top / step))
+    n = round(top / step)
     return np.round(np.linspace(0.0, top, n + 1), 10)
 
 
@@ -100,7 +100,7 @@ class Verification:
     model: Run
     mismatches: list[Mismatch]
     reasons: list[str]
-    counterexample: "CounterExample | None" = None
+    counterexample: CounterExample | None = None
 
     @property
     def ok(self) -> bool:

@@ -100,7 +100,6 @@ def solve(net: Net, loads: Sequence, *, u0: np.ndarray | None = None, tol: float
 
 def _iterate(prob: Problem, u: np.ndarray, tol: float, max_iter: int):
     """Regularised Newton with an energy line search (see the module docstring)."""
-    free = prob.free
     r, J, f = prob.residual(u)
     it = 0
     while True:
@@ -109,8 +108,8 @@ def _iterate(prob: Problem, u: np.ndarray, tol: float, max_iter: int):
         if r_norm <= tol * f_norm or r_norm <= ROUND_OFF:
             return u, it, True, "converged", r_norm * prob.S, f_norm * prob.S
         if it >= max_iter:
-            return (u, it, False, f"no convergence in {max_iter} iterations: max out-of-balance "
-                    f"{r_norm * prob.S:.3g} N, {r_norm / f_norm:.2g} of the load",
+            return (u, it, False, (f"no convergence in {max_iter} iterations: max out-of-balance "
+                    f"{r_norm * prob.S:.3g} N, {r_norm / f_norm:.2g} of the load"),
                     r_norm * prob.S, f_norm * prob.S)
         it += 1
         mu = max(MU_FACTOR * float(np.linalg.norm(r)), MU_MIN * _diag_max(J))
@@ -122,9 +121,9 @@ def _iterate(prob: Problem, u: np.ndarray, tol: float, max_iter: int):
                 if trial is not None:
                     break
         if trial is None:
-            return (u, it, False, f"line search failed: no step lowers the energy or the "
+            return (u, it, False, (f"line search failed: no step lowers the energy or the "
                     f"out-of-balance force ({r_norm * prob.S:.3g} N, {r_norm / f_norm:.2g} of the "
-                    "load)", r_norm * prob.S, f_norm * prob.S)
+                    "load)"), r_norm * prob.S, f_norm * prob.S)
         u = trial
         r, J, f = prob.residual(u)
 

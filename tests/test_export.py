@@ -26,7 +26,7 @@ SLICE_TIMEOUT_S = 300
 def cable_part(design_1_40):
     c = design_1_40.cables[2]
     printer = load_printer(design_1_40.printer)
-    mesh, angle = place_mesh(cable_solid(c), printer, "cable-left")
+    mesh, _angle = place_mesh(cable_solid(c), printer, "cable-left")
     ini = prusa_ini_text("cable", c, printer, load_print_style(c.print_style),
                          load_material(c.material))
     return c, printer, mesh, ini

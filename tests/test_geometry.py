@@ -63,9 +63,9 @@ def test_cable_is_one_watertight_body_with_the_analytic_volume(design_1_40):
 
 
 @pytest.mark.parametrize("change, message", [
-    (dict(eyelet_inner_mm=7.0), "need 0 < inner < outer"),
-    (dict(length_mm=5.0), "leaves no strip"),
-    (dict(eyelet_inner_mm=0.3, eyelet_outer_mm=0.8), "not narrower than the eyelet"),
+    ({"eyelet_inner_mm": 7.0}, "need 0 < inner < outer"),
+    ({"length_mm": 5.0}, "leaves no strip"),
+    ({"eyelet_inner_mm": 0.3, "eyelet_outer_mm": 0.8}, "not narrower than the eyelet"),
 ])
 def test_impossible_cables_are_rejected(design_1_40, change, message):
     with pytest.raises(GeometryError, match=message):

@@ -23,8 +23,8 @@ from printgen.prototype import load_prototype
     ({("net", "panel_law", "kappa_kn_per_m_per_m"): [250.0]}, r"one kappa per segment"),
     ({("net", "panel_law", "knee_strain_percent"): [-20.0]}, r"positive finite numbers"),
     ({("net", "panel_law"): None}, r"give strand_modulus_gpa or a \[net.panel_law\]"),
-    ({("flow", "velocity_m_per_s"): 500.0}, r"velocity_m_per_s = 500.0 is out of range: it "
-                                            r"must be <= 50 m/s"),
+    ({("flow", "velocity_m_per_s"): 500.0}, (r"velocity_m_per_s = 500.0 is out of range: it "
+                                            r"must be <= 50 m/s")),
     ({("flume", "froude_min"): True}, r"froude_min = True is not a number"),
     ({("model", "mesh_x_mm"): 0}, r"mesh_x_mm = 0 is out of range"),
 ])

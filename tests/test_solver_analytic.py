@@ -137,10 +137,10 @@ def test_bad_laws_are_rejected():
             piecewise(knees, slopes)
 
 
-@pytest.mark.parametrize("bad", [dict(slack=-0.1), dict(slack=0.01, pretension=5.0)])
+@pytest.mark.parametrize("bad", [{"slack": -0.1}, {"slack": 0.01, "pretension": 5.0}])
 def test_bad_models_are_rejected(bad):
     nodes = np.array([[0, 0, 0], [1, 0, 0]], float)
-    kw = dict(laws=[linear(1.0)])
+    kw = {"laws": [linear(1.0)]}
     kw.update(bad)
     with pytest.raises(ValueError):
         Net(nodes, np.array([True, False]), np.array([[0, 1]]), **kw)

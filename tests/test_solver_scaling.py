@@ -75,8 +75,8 @@ def test_tightening_the_tolerance_converges():
 @pytest.mark.parametrize("slack", [0.002, 0.02])
 def test_slack_nets_converge_and_stay_similar(lam, slack):
     """Every strand starts slack (the net is a mechanism); lambda = 1 and 100 agree."""
-    d, low, r = normalised(lam, SIMPLE["modulus"] / lam, slack=slack, tol=1e-10)
-    d1, low1, _ = normalised(1, SIMPLE["modulus"], slack=slack, tol=1e-10)
+    d, _low, r = normalised(lam, SIMPLE["modulus"] / lam, slack=slack, tol=1e-10)
+    d1, _low1, _ = normalised(1, SIMPLE["modulus"], slack=slack, tol=1e-10)
     assert r.converged and d > 0
     assert d == pytest.approx(d1, rel=1e-6)  # looser tolerance (1e-10) than TIGHT
 

@@ -46,13 +46,13 @@ def run(args: argparse.Namespace) -> int:
 def show_summary(ctx, out: Path, seconds: float) -> None:
     c = console()
     d = ctx.design
-    rows = [["net", f"{d.net.material.upper()} {d.net.strand.width_mm:g} x "
-             f"{d.net.strand.thickness_mm:g} mm, {d.net.strand.passes} passes",
+    rows = [["net", (f"{d.net.material.upper()} {d.net.strand.width_mm:g} x "
+             f"{d.net.strand.thickness_mm:g} mm, {d.net.strand.passes} passes"),
              f"{ctx.selection.net[0].error:+.0%} (small strain)"]]
     if ctx.selection.cables:
         cab = ctx.selection.cables[0]
-        rows.append(["cables", f"{cab.material_name} {cab.section.width_mm:g} x "
-                     f"{cab.section.thickness_mm:g} mm, {cab.section.passes} passes",
+        rows.append(["cables", (f"{cab.material_name} {cab.section.width_mm:g} x "
+                     f"{cab.section.thickness_mm:g} mm, {cab.section.passes} passes"),
                      f"{cab.error:+.1%} E*A"])
     ver = ctx.record.get("verification")
     if ver:
