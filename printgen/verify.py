@@ -48,13 +48,14 @@ def loads_function(s: BarrierScene, *, velocity: float | None = None,
     current height, drag 0.5 rho v^2 l d when a velocity is given, and the sensors' pulls."""
     free = np.flatnonzero(~s.fixed)
     strand_per_node = _strand_length(s) / len(s.nodes)
+    row_gap = float(np.diff(np.unique(np.round(s.nodes[:, 2], 12))).min())  # node rows apart
 
     def loads_at(r: float) -> list:
         out = [solver.Hydrostatic(free, s.area_per_node, r * s.height, tuple(FLOW),
                                   rho=RHO_WATER, g=G)]
         if velocity:
             out.append(solver.Drag(free, strand_per_node, strand_diameter, velocity,
-                                   r * s.height, tuple(FLOW), rho=RHO_WATER))
+                                   r * s.height, tuple(FLOW), rho=RHO_WATER, ramp=row_gap))
         if s.sensors:
             out.append(solver.PointLoads(np.array([n for n, _ in s.sensors]),
                                          np.array([f for _, f in s.sensors])))

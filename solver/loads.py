@@ -56,8 +56,10 @@ class Hydrostatic:
 
 @dataclass(frozen=True)
 class Drag:
-    """0.5 rho v^2 l d along `direction` on nodes below the water level (drag coefficient 1):
-    l strand length per node (m), d strand diameter (m)."""
+    """0.5 rho v^2 l d along `direction` on submerged nodes (drag coefficient 1): l strand
+    length per node (m), d strand diameter (m). A node's drag grows from zero as the water
+    rises from the node's height to `ramp` (m) above it (its share of the wetted net), so the
+    load does not jump when the level crosses a node; ramp = 0 gives the sharp switch."""
 
     nodes: np.ndarray
     length: np.ndarray | float
@@ -66,14 +68,20 @@ class Drag:
     level: float
     direction: tuple[float, float, float] = (0.0, 1.0, 0.0)
     rho: float = RHO_WATER
+    ramp: float = 0.0
 
     def evaluate(self, x: np.ndarray):
         idx = np.asarray(self.nodes, dtype=int)
-        wet = x[idx, 2] < self.level
+        z = x[idx, 2]
+        if self.ramp > 0:
+            wet = np.clip((self.level - z) / self.ramp, 0.0, 1.0)
+            slope = np.where((wet > 0) & (wet < 1), -1.0 / self.ramp, 0.0)
+        else:
+            wet, slope = (z < self.level).astype(float), np.zeros_like(z)
         length = np.broadcast_to(np.asarray(self.length, dtype=float), idx.shape)
-        mag = 0.5 * self.rho * self.velocity**2 * length * self.diameter * wet
-        f = mag[:, None] * np.asarray(self.direction, dtype=float)
-        return idx, f, np.zeros_like(f)
+        full = 0.5 * self.rho * self.velocity**2 * length * self.diameter
+        d = np.asarray(self.direction, dtype=float)
+        return idx, (full * wet)[:, None] * d, (full * slope)[:, None] * d
 
 
 def total_forces(loads, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

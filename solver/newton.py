@@ -40,7 +40,7 @@ ARMIJO = 1e-4  # sufficient decrease of the potential
 POTENTIAL_ROUND_OFF = 1e-11  # relative change of the potential below which it is round-off
 MAX_BACKTRACK = 40  # step halvings before a line search gives up
 MAX_STEP = 0.05  # a step moves no node more than 5 % of the net's extent
-MAX_CUTS = 10  # a failed load level is approached by at most 10 halvings
+MAX_CUTS = 6  # a failed load level is approached by at most 6 halvings
 
 
 class Problem:

@@ -75,9 +75,11 @@ def test_failed_first_run_writes_nothing(tmp_path):
 
 
 def test_cli_make_json_and_exit_codes(tmp_path, capsys):
-    assert main(["make", str(REALISTIC), "-s", "40", "--out", str(tmp_path / "o"), "--json"]) == 0
+    assert main(["make", str(REALISTIC), "-s", "40", "--out", str(tmp_path / "o"), "--json",
+                 "--drag"]) == 0
     rec = json.loads(capsys.readouterr().out)
     assert rec["targets"]["scale"] == 40
+    assert rec["verification"]["load_case"] == "hydrostatic + drag at the Froude-scaled velocity"
     assert main(["make", str(REALISTIC), "-s", "40", "--printer", "prusa-mk4",
                  "--out", str(tmp_path / "bad")]) == 2
     assert "exceeds" in capsys.readouterr().err and not (tmp_path / "bad").exists()

@@ -144,3 +144,17 @@ def test_bad_models_are_rejected(bad):
     kw.update(bad)
     with pytest.raises(ValueError):
         Net(nodes, np.array([True, False]), np.array([[0, 1]]), **kw)
+
+
+def test_drag_ramps_in_as_the_water_covers_a_node():
+    """The drag of a node grows linearly from its height to `ramp` above it, and its
+    z-derivative is the slope of that ramp (what Newton needs)."""
+    from solver import Drag
+
+    full = 0.5 * 1000.0 * 2.0**2 * 0.3 * 0.01  # 0.5 rho v^2 l d
+    x = np.array([[0.0, 0.0, 1.0]])
+    for level, share in ((0.9, 0.0), (1.0, 0.0), (1.05, 0.5), (1.1, 1.0), (3.0, 1.0)):
+        _, f, dfdz = Drag(np.array([0]), 0.3, 0.01, 2.0, level, ramp=0.1).evaluate(x)
+        assert f[0, 1] == pytest.approx(full * share, rel=EXACT_FORM)
+        slope = -full / 0.1 if 0 < share < 1 else 0.0
+        assert dfdz[0, 1] == pytest.approx(slope, rel=EXACT_FORM)
