@@ -101,3 +101,10 @@ def explain(mismatches: list[Mismatch]) -> list[str]:
                    f"h/h_B = {UPPER_RANGE:g} ({way}); worst mismatch {mm.max_rel:.0%} of the "
                    f"prototype peak at h/h_B = {mm.worst_level:.2f}")
     return out
+
+
+def increments(d: Deformation) -> Deformation:
+    """The deformation counted from the first level (h / h_B = 0): what extension sensors
+    zeroed before the water arrives read."""
+    return Deformation(d.levels, {k: v - v[0] for k, v in d.values.items()},
+                       d.max_strand_tension, d.max_cable_tension)

@@ -16,7 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 import solver
-from printgen.compare import Deformation, Mismatch, compare, deformation, explain
+from printgen.compare import (Deformation, Mismatch, compare, deformation, explain,
+                              increments)
 from printgen.design import Design
 from printgen.errors import SolverError
 from printgen.prototype import Prototype
@@ -102,6 +103,7 @@ class Verification:
     mismatches: list[Mismatch]
     reasons: list[str]
     counterexample: CounterExample | None = None
+    from_start: list[Mismatch] | None = None  # the same, counted from h / h_B = 0
 
     @property
     def ok(self) -> bool:
@@ -124,7 +126,8 @@ def verify(p: Prototype, d: Design, *, drag: bool = False, lv: np.ndarray | None
         jobs.append((steel_counterexample, (d.scale,), {}))
     model, proto, *ce = run_jobs(jobs)
     mm = compare(proto.deformation, model.deformation)
-    return Verification(case, proto, model, mm, explain(mm), ce[0] if ce else None)
+    start = compare(increments(proto.deformation), increments(model.deformation))
+    return Verification(case, proto, model, mm, explain(mm), ce[0] if ce else None, start)
 
 
 def run_jobs(jobs: list[tuple]) -> list:
