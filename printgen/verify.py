@@ -16,8 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 import solver
-from printgen.compare import (Deformation, Mismatch, compare, deformation, explain,
-                              increments)
+from printgen.compare import Deformation, Mismatch, compare, deformation, explain, increments
 from printgen.design import Design
 from printgen.errors import SolverError
 from printgen.prototype import Prototype
