@@ -83,3 +83,12 @@ def test_cli_make_json_and_exit_codes(tmp_path, capsys):
     assert main(["make", str(REALISTIC), "-s", "40", "--printer", "prusa-mk4",
                  "--out", str(tmp_path / "bad")]) == 2
     assert "exceeds" in capsys.readouterr().err and not (tmp_path / "bad").exists()
+
+
+def test_report_html_has_the_verification_and_its_figures(made):
+    _, out = made
+    html = (out / "report.html").read_text()
+    assert "Pre-print verification" in html and "steel at every scale" in html
+    assert html.count("data:image/png;base64,") >= 1
+    assert ("<span class=\"pass\">PASS</span>" in html) or ("<span class=\"fail\">FAIL</span>"
+                                                          in html)
