@@ -168,3 +168,17 @@ def test_impossible_nets_are_rejected(design, change, message):
 def test_impossible_corner_eyelets_are_rejected(design, eyelets, message):
     with pytest.raises(GeometryError, match=message):
         net_solid(design.net, eyelets)
+
+
+def test_a_corner_eyelet_touching_the_corner_strand_is_rejected(design):
+    """A 0.8 mm border puts the 6 mm ring 0.27 mm from the corner node, inside the 0.6 mm
+    strand's half width: the strand would fuse into the ring."""
+    net = dataclasses.replace(design.net, border_width_mm=0.8)
+    net_solid(net)  # the net alone is fine
+    with pytest.raises(GeometryError, match="within the 0.6 mm strand"):
+        net_solid(net, corner_eyelets_for(design))
+
+
+def test_corner_eyelets_need_cables_to_size_them(design):
+    with pytest.raises(GeometryError, match="pass CornerEyelets"):
+        corner_eyelets_for(dataclasses.replace(design, cables=()))

@@ -15,7 +15,7 @@ import numpy as np
 
 from printgen.atomic import write_bytes
 from printgen.errors import GeometryError, InputError
-from printgen.export.layout import layout_parts
+from printgen.export.layout import Placement, layout_parts
 from printgen.export.stl import check_mesh
 from printgen.printers import Printer
 
@@ -116,7 +116,7 @@ def write_3mf(path: str | Path, parts: list[tuple[str, trimesh.Trimesh]],
 
 
 def write_plate(path: str | Path, parts: list[tuple[str, trimesh.Trimesh]], printer: Printer,
-                prusa_config: str | None = None) -> list:
+                prusa_config: str | None = None) -> list[Placement]:
     """Lay the parts out on the printer's bed (`layout_parts`) and write one 3MF with them.
 
     Returns the `Placement`s (name, placed mesh, angle); PrintabilityError, before anything
