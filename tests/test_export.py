@@ -245,6 +245,34 @@ def test_prusaslicer_slices_the_cable_plate_alone_with_its_settings(plate, tmp_p
         assert f"; printing object {p.name}" in text, p.name
 
 
+def test_prusaslicer_slices_the_net_with_corner_eyelets_from_its_3mf(tmp_path):
+    """The 1:40 net with its corner rings (340.4 mm wide: turned on the 340 mm usable bed)
+    slices alone with its TPE settings."""
+    from conftest import reference_design_1_40
+
+    from printgen.geometry.solid import corner_eyelets_for
+
+    exe = require_tool("prusa-slicer")
+    d = reference_design_1_40()
+    printer = load_printer(d.printer)
+    ini = prusa_ini_text("net", d.net, printer, load_print_style(d.net.print_style),
+                         load_material(d.net.material))
+    path = tmp_path / "net.3mf"
+    (placed,) = write_plate(path, [("net", net_solid(d.net, corner_eyelets_for(d)))], printer,
+                            ini)
+    assert placed.angle_deg > 0  # too wide by 0.4 mm for the bed straight
+    out = tmp_path / "net.gcode"
+    r = subprocess.run([exe, "--export-gcode", "--output", str(out), str(path)],
+                       capture_output=True, text=True, timeout=SLICE_TIMEOUT_S, check=False)
+    assert r.returncode == 0, r.stderr[-500:]
+    text = out.read_text()
+    assert "; printing object net" in text
+    for key in ("temperature", "filament_type", "layer_height", "first_layer_height"):
+        value = next(ln.split("=", 1)[1].strip() for ln in ini.splitlines()
+                     if ln.split("=", 1)[0].strip() == key)
+        assert f"; {key} = {value}\n" in text, key
+
+
 def test_step_needs_cadquery_or_says_how(cables, tmp_path):
     from printgen.geometry.cad import write_step
 
