@@ -123,17 +123,17 @@ def slicer_step(ctx: MakeContext, stage: Path) -> None:
 def parts_step(ctx: MakeContext, stage: Path) -> None:
     """Watertight meshes of every part: STL, a 3MF carrying its PrusaSlicer settings, and
     STEP when asked (--step, needs cadquery)."""
-    from printgen.export import place_mesh, prusa_config_from_ini, stl_bytes, threemf_bytes
-    from printgen.gcode.toolpath import cable_volume_budget, net_volume_budget
-    from printgen.geometry.solid import cable_outline, cable_solid, net_outline, net_solid
+    from printgen.export import (layout_parts, place_mesh, prusa_config_from_ini, stl_bytes,
+                                 threemf_bytes)
+    from printgen.geometry.solid import (analytic_cable_volume, analytic_net_volume,
+                                         cable_outline, cable_solid, net_outline, net_solid)
     from printgen.slicer.prusa import prusa_ini_text
 
     d = ctx.design
     printer = load_printer(d.printer)
-    parts = [("net", "net", d.net, net_solid, net_outline,
-              lambda p, s: net_volume_budget(p, s).solid_mm3)]
-    parts += [(f"cable-{c.name}", "cable", c, cable_solid, cable_outline,
-               lambda p, s: cable_volume_budget(p).solid_mm3) for c in d.cables]
+    parts = [("net", "net", d.net, net_solid, net_outline, analytic_net_volume)]
+    parts += [(f"cable-{c.name}", "cable", c, cable_solid, cable_outline, analytic_cable_volume)
+              for c in d.cables]
     rows, rec = [], {}
     for name, kind, part, solid, outline, analytic in parts:
         mat, style = load_material(part.material), load_print_style(part.print_style)
@@ -150,7 +150,7 @@ def parts_step(ctx: MakeContext, stage: Path) -> None:
                                                             part_thickness(kind, part)))
             files.append(f"{name}.step")
         ctx.files += files
-        expected = analytic(part, style)
+        expected = analytic(part)
         size = mesh.bounds[1] - mesh.bounds[0]
         rec[name] = {"files": files, "volume_mm3": float(mesh.volume),
                      "analytic_volume_mm3": expected,
@@ -160,6 +160,16 @@ def parts_step(ctx: MakeContext, stage: Path) -> None:
         rows.append([name, f"{size[0]:.1f} x {size[1]:.1f} x {size[2]:.2f}",
                      f"{mesh.volume:.1f}", f"{float(mesh.volume) / expected - 1:+.2%}",
                      str(len(mesh.faces)), f"{angle:g}"])
+    if d.cables:  # every cable on one plate: one print job, with the cables' settings
+        c = d.cables[0]
+        ini = prusa_ini_text("cable", c, printer, load_print_style(c.print_style),
+                             load_material(c.material))
+        placed = layout_parts([(f"cable-{c.name}", cable_solid(c)) for c in d.cables], printer)
+        (stage / "cables-plate.3mf").write_bytes(threemf_bytes(
+            [(p.name, p.mesh) for p in placed], prusa_config_from_ini(ini)))
+        ctx.files.append("cables-plate.3mf")
+        rec["cables-plate"] = {"files": ["cables-plate.3mf"],
+                               "parts": {p.name: p.angle_deg for p in placed}}
     ctx.record["parts"] = rec
     ctx.report.heading("Meshes")
     ctx.report.paragraph("One watertight body per part (STL, and a 3MF that opens in "
