@@ -20,7 +20,9 @@ if [[ "${1:-}" == "--with-slicers" ]]; then
   # CuraEngine's printer definitions live in the big 'cura' package: take only its files.
   if [[ ! -f /opt/cura-pkg/usr/share/cura/resources/definitions/fdmprinter.def.json ]]; then
     tmp=$(mktemp -d)
-    (cd "$tmp" && apt-get download cura >/dev/null && dpkg-deb -x cura_*_all.deb /opt/cura-pkg)
+    (cd "$tmp" && { apt-get download cura >/dev/null 2>&1 \
+        || { apt-get update -qq && apt-get download cura >/dev/null; }; } \
+        && dpkg-deb -x cura_*_all.deb /opt/cura-pkg)
     rm -rf "$tmp"
   fi
 fi
