@@ -69,13 +69,22 @@ def design_record(proto: Prototype, t: ScaledTargets, sel: Selection,
             "design": design.to_dict()}
 
 
-def verification_sections(rep: Report, v: Verification, ce: CounterExample | None,
-                          scale: float) -> None:
+def verification_sections(rep: Report, v: Verification | None, ce: CounterExample | None,
+                          scale: float, note: str = "") -> None:
     """The pre-print check: verdict, side-by-side table, figure, counter-example."""
+    rep.heading("Pre-print verification: prototype vs printed model")
+    if v is None:
+        rep.verdict(False, f"Verification {note}")
+    else:
+        _sweep_sections(rep, v, scale)
+    if ce is not None:
+        _counterexample_section(rep, ce)
+
+
+def _sweep_sections(rep: Report, v: Verification, scale: float) -> None:
     from printgen.compare import METRICS, TOLERANCE
     from printgen.plots import verification_figure
 
-    rep.heading("Pre-print verification: prototype vs printed model")
     rep.paragraph(
         f"Both barriers are solved as tension-only cable nets (solver/) under the same relative "
         f"loading, {v.load_case}, h / h_B = 0 to 1.1 in steps of 0.05 (the reference's loading "
@@ -92,6 +101,10 @@ def verification_sections(rep: Report, v: Verification, ce: CounterExample | Non
                 f"mismatch above {TOLERANCE:.0%} of the prototype's peak:")
     for reason in v.reasons:
         rep.paragraph(reason)
+    for who, run in (("prototype", v.prototype), ("model", v.model)):
+        for level, why in run.failed.items():
+            rep.verdict(False, f"{who}: no converged state at h/h_B = {level:g}, left out of the "
+                               f"comparison: {why}")
     p, m = v.prototype.deformation, v.model.deformation
     idx = [int(np.argmin(np.abs(p.levels - x))) for x in (0.5, 1.0, 1.1)]
     rows = []
@@ -120,9 +133,10 @@ def verification_sections(rep: Report, v: Verification, ce: CounterExample | Non
                                    "loading"), "Prototype (black) and printed model (orange).")
     rep.paragraph(f"Solver: {sum(v.prototype.iterations)} + {sum(v.model.iterations)} Newton "
                   f"iterations over {len(p.levels)} load levels, {v.prototype.seconds:.1f} s + "
-                  f"{v.model.seconds:.1f} s; every level converged.", "note")
-    if ce is None:
-        return
+                  f"{v.model.seconds:.1f} s.", "note")
+
+
+def _counterexample_section(rep: Report, ce: CounterExample) -> None:
     rep.heading("Why stiffness is scaled: steel at every scale")
     rep.paragraph(
         "The simple barrier (12 x 4 m, square 0.2 m mesh of 10 mm steel strands, bottom and "
@@ -149,5 +163,6 @@ def verification_record(v: Verification, ce: CounterExample | None) -> dict[str,
         "mismatches_from_start": v.from_start,
         "prototype": dump(v.prototype.deformation), "model": dump(v.model.deformation),
         "iterations": {"prototype": v.prototype.iterations, "model": v.model.iterations},
+        "not_converged": {"prototype": v.prototype.failed, "model": v.model.failed},
         "counterexample": ce,
     }

@@ -101,21 +101,38 @@ def _scene(name: str, scale: float, g: NetGraph, to_m: float, net_law: Law,
         elements = np.vstack([elements, g.segments[~diag]])
         element_law = np.concatenate([element_law, np.ones(int((~diag).sum()), int)])
         laws.append(border_law)
-    corners = [edges["bottom"][0], edges["bottom"][-1], edges["top"][0], edges["top"][-1]]
     fixed = np.zeros(len(nodes), dtype=bool)
-    fixed[corners] = True
     cables = {}
-    if cable_law is not None:
+    if cable_law is not None:  # four corner anchors, cables sliding along the edges
+        fixed[[edges["bottom"][0], edges["bottom"][-1], edges["top"][0], edges["top"][-1]]] = True
         cables = {side: (edges[side], cable_law) for side in ("bottom", "top", "left", "right")}
+    else:  # no border cables: anchored on the bed and the banks, top free (simple-free-top)
+        fixed[np.concatenate([edges["bottom"], edges["left"], edges["right"]])] = True
     w, h = float(nodes[:, 0].max()), float(nodes[:, 2].max())
     return BarrierScene(name, scale, w, h, nodes, fixed, elements, element_law, laws, cables,
                         {k: edges[k] for k in ("bottom", "top", "mid")}, centre, top_centre,
                         w * h / len(nodes))
 
 
+def square_graph(width_mm: float, height_mm: float, mesh_mm: float) -> NetGraph:
+    """A square-mesh net (strands across and up) as a NetGraph, for square prototypes."""
+    nx, ny = round(width_mm / mesh_mm), round(height_mm / mesh_mm)
+    ii, jj = np.meshgrid(np.arange(nx + 1), np.arange(ny + 1), indexing="ij")
+    nodes = np.column_stack([ii.ravel() * mesh_mm, jj.ravel() * mesh_mm]).astype(float)
+    idx = np.arange((nx + 1) * (ny + 1)).reshape(nx + 1, ny + 1)
+    segs = np.vstack([np.column_stack([idx[:-1].ravel(), idx[1:].ravel()]),
+                      np.column_stack([idx[:, :-1].ravel(), idx[:, 1:].ravel()])])
+    ring = np.concatenate([idx[:, 0], idx[-1, 1:], idx[-2::-1, -1], idx[0, -2:0:-1]])
+    return NetGraph(nodes, segs, np.ones(len(segs), int), [], ring,
+                    (2.0 * mesh_mm, 2.0 * mesh_mm), (2 * nx, 2 * ny))
+
+
 def prototype_scene(p: Prototype) -> BarrierScene:
     """The prototype: net with its panel law (or linear strands), sliding border cables."""
-    g = diamond_net(p.width / MM, p.height / MM, p.net.mesh_x / MM, p.net.mesh_y / MM)
+    if p.net.pattern == "square":
+        g = square_graph(p.width / MM, p.height / MM, p.net.mesh_x / MM)
+    else:
+        g = diamond_net(p.width / MM, p.height / MM, p.net.mesh_x / MM, p.net.mesh_y / MM)
     if p.net.panel_law is not None:
         knees, kappas, length = p.net.panel_law
         net_law = strand_law_from_membrane(knees, tuple(k * length for k in kappas),
@@ -144,7 +161,12 @@ def model_scene(d: Design) -> BarrierScene:
         cable_law = ((), (load_material(c.material).modulus()[0] * area_m2(c.section),))
     s = _scene(f"printed model 1:{d.scale:g}", d.scale, g, MM, net_law, cable_law,
                ((), (border_ea,)))
-    mid = lambda row: int(row[len(row) // 2])
-    sensors = [(mid(s.rows["bottom"]), SENSOR_FORCE_N * FLOW),
-               (mid(s.rows["top"]), SENSOR_FORCE_N * FLOW), (s.centre, SENSOR_FORCE_N * FLOW)]
+    if not d.cables:  # the three sensors belong to the realistic barrier's flume setup
+        return s
+    sensors = [(_middle(s.rows["bottom"]), SENSOR_FORCE_N * FLOW),
+               (_middle(s.rows["top"]), SENSOR_FORCE_N * FLOW), (s.centre, SENSOR_FORCE_N * FLOW)]
     return BarrierScene(**{**s.__dict__, "sensors": sensors})
+
+
+def _middle(row: np.ndarray) -> int:
+    return int(row[len(row) // 2])

@@ -194,11 +194,12 @@ def _result(prob: Problem, u: np.ndarray, r_norm: float, f_norm: float, iters: i
 
 def solve_path(net: Net, loads_at: Callable[[float], Sequence], levels: Sequence[float], *,
                tol: float = TOL_FORCE, max_iter: int = MAX_ITER, strict: bool = False,
-               max_cuts: int = MAX_CUTS) -> list[Result]:
+               max_cuts: int = MAX_CUTS, skip_failed: bool = False) -> list[Result]:
     """Solve at each level in order, warm-started; a failing level is reached by sub-steps.
 
-    Returns one Result per level; after the first level that cannot be reached the remaining
-    ones are not attempted (strict raises SolverError instead).
+    Returns one Result per level. A level that cannot be reached stops the path (strict
+    raises SolverError instead); with `skip_failed` its unconverged Result (converged=False,
+    with the reason) is kept and the next level starts from the last converged state.
     """
     out: list[Result] = []
     u = None
@@ -223,6 +224,8 @@ def solve_path(net: Net, loads_at: Callable[[float], Sequence], levels: Sequence
             if strict:
                 raise SolverError(msg)
             out.append(Result(**{**res.__dict__, "reason": msg, "level": level}))
-            return out
+            if not skip_failed:
+                return out
+            continue
         out.append(res)
     return out

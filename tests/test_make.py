@@ -92,3 +92,12 @@ def test_report_html_has_the_verification_and_its_figures(made):
     assert html.count("data:image/png;base64,") >= 1
     assert ("<span class=\"pass\">PASS</span>" in html) or ("<span class=\"fail\">FAIL</span>"
                                                           in html)
+
+
+def test_barrier_without_cables_says_why_the_sweep_is_not_run(tmp_path):
+    from proto_files import SIMPLE
+
+    ctx = make_mod.make(SIMPLE, 40, tmp_path / "simple")
+    ver = ctx.record["verification"]
+    assert ver["verdict"] == "NOT RUN" and "border cables" in ver["summary"]
+    assert "Verification not run" in (tmp_path / "simple" / "report.html").read_text()

@@ -158,3 +158,25 @@ def test_drag_ramps_in_as_the_water_covers_a_node():
         assert f[0, 1] == pytest.approx(full * share, rel=EXACT_FORM)
         slope = -full / 0.1 if 0 < share < 1 else 0.0
         assert dfdz[0, 1] == pytest.approx(slope, rel=EXACT_FORM)
+
+
+def test_a_path_reports_unreachable_levels_and_can_go_on():
+    """With too few iterations allowed every level fails: the path stops at the first one,
+    or with skip_failed keeps going, each failure converged=False with its reason."""
+    from solver import solve_path
+
+    nodes = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0]], float)
+    net = Net(nodes, _fixed_ends(3), np.array([[0, 1], [1, 2]]), [linear(1e5)])
+
+    def loads_at(level):
+        return [PointLoads(np.array([1]), np.array([[0, 100.0 * level, 0]]))]
+
+    stopped = solve_path(net, loads_at, [0.5, 1.0], max_iter=1, max_cuts=1)
+    assert len(stopped) == 1 and not stopped[0].converged
+    assert "load level 0.5" in stopped[0].reason
+    went_on = solve_path(net, loads_at, [0.5, 1.0], max_iter=1, max_cuts=1, skip_failed=True)
+    assert [r.converged for r in went_on] == [False, False]
+    with pytest.raises(SolverError, match="load level 0.5"):
+        solve_path(net, loads_at, [0.5, 1.0], max_iter=1, max_cuts=1, strict=True)
+    ok = solve_path(net, loads_at, [0.5, 1.0])
+    assert all(r.converged for r in ok) and ok[1].tensions[0] > ok[0].tensions[0]
