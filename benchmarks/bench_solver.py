@@ -16,6 +16,8 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 from solver import solve
 from solver.loads import total_forces
 from solver.scenes import simple_scene
@@ -23,6 +25,35 @@ from solver.scenes import simple_scene
 REFERENCE_TOL = 1e-13  # the reference solve: round-off level
 TOLERANCES = (1e-4, 1e-6, 1e-8)  # printgen's runs: out-of-balance force / load
 SIZES = {1: "61 x 21", 2: "121 x 41", 4: "241 x 81"}
+
+
+def strand_state(net, disp: np.ndarray) -> tuple[float, float]:
+    """(max strand strain, max tension N) of a displacement field, from the geometry."""
+    x = net.nodes + disp
+    i, j = net.elements[:, 0], net.elements[:, 1]
+    length0 = np.linalg.norm(net.nodes[j] - net.nodes[i], axis=1)
+    eps = np.linalg.norm(x[j] - x[i], axis=1) / length0 - 1
+    return float(eps.max()), float(net.laws[0].slopes[0] * max(eps.max(), 0.0))
+
+
+def robustness() -> list[dict]:
+    """The hard cases of issue 4, each from the flat start with default settings."""
+    cases = [("zero pretension, steel, 61 x 21", {}),
+             ("very soft strands (0.5 GPa, ~40 % strain)", {"modulus": 5e8}),
+             ("lambda = 100, E / lambda", {"scale": 100, "modulus": 1e9}),
+             ("slack 0.2 %, lambda = 1", {"slack": 0.002}),
+             ("slack 2 %, lambda = 1", {"slack": 0.02}),
+             ("slack 0.2 %, lambda = 100", {"slack": 0.002, "scale": 100, "modulus": 1e9}),
+             ("slack 2 %, lambda = 100", {"slack": 0.02, "scale": 100, "modulus": 1e9})]
+    out = []
+    for name, kw in cases:
+        for level in (1.0, 1.1):
+            sc = simple_scene(**kw)
+            r = solve(sc.net, sc.loads_at(level))
+            out.append({"case": name, "relative_loading": level, "converged": r.converged,
+                        "iterations": r.iterations, "time_s": r.seconds,
+                        "max_strain": float(r.strains.max()), "reason": r.reason})
+    return out
 
 
 def bench_size(refine: int) -> dict:
@@ -33,6 +64,7 @@ def bench_size(refine: int) -> dict:
     for tol in TOLERANCES:
         r = solve(sc.net, sc.loads_at(1.0), tol=tol)
         runs.append({"tool": "printgen", "tol": tol, "converged": r.converged,
+                     "max_strain": float(r.strains.max()), "max_tension_n": float(r.tensions.max()),
                      "iterations": r.iterations, "time_s": r.seconds,
                      "deflection_m": float(r.displacements[sc.centre, 1]),
                      "error": abs(float(r.displacements[sc.centre, 1]) / d_ref - 1)})
@@ -61,7 +93,9 @@ def _opensees(sc, d_ref: float) -> dict:
     disp, seconds, ok, note = solve_opensees(net.nodes, net.fixed, net.elements,
                                              net.laws[0].slopes[0], loads)
     d = float(disp[sc.centre, 1])
+    strain, tension = strand_state(net, disp)
     return {"tool": "OpenSeesPy", "converged": ok, "time_s": seconds, "note": note,
+            "max_strain": strain, "max_tension_n": tension,
             "deflection_m": d, "error": abs(d / d_ref - 1) if ok else None}
 
 
@@ -95,7 +129,7 @@ def run(out: Path, sizes: list[int]) -> dict:
     results = [bench_size(s) for s in sizes]
     report = {"benchmark": "bench_solver", "scene": "simple-pinned",
               "load": "hydrostatic at h = h_B + drag at 6 m/s, at the initial node height",
-              "reference_tol": REFERENCE_TOL, "sizes": results,
+              "reference_tol": REFERENCE_TOL, "sizes": results, "robustness": robustness(),
               "total_s": time.perf_counter() - t0}
     (out / "bench_solver.json").write_text(json.dumps(report, indent=1) + "\n")
     figure(results, out / "bench_solver.png")
