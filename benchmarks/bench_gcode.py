@@ -8,13 +8,12 @@ Times toolpath building, G-code writing and read-back (best of N), writes the G-
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 from functools import partial
 from pathlib import Path
 
-from benchmarks.timing import best_of
+from benchmarks.timing import best_of, goal_main
 
 GOAL_S = 1.0  # the brief: G-code for the 330 mm net in under a second
 
@@ -76,13 +75,7 @@ def run(out_dir: Path, repeat: int = 5) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", required=True, type=Path, help="folder for G-code and JSON")
-    ap.add_argument("--repeat", type=int, default=5, help="timing repeats (best is kept)")
-    a = ap.parse_args(argv)
-    report = run(a.out, a.repeat)
-    print(json.dumps(report, indent=1))
-    return 0 if report["goal_met"] else 1
+    return goal_main(run, __doc__, argv, repeat=5)
 
 
 if __name__ == "__main__":

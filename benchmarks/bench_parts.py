@@ -9,12 +9,11 @@ the analytic ones. Goal: the net mesh in under 5 s. Writes DIR/bench_parts.json.
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 from pathlib import Path
 
-from benchmarks.timing import best_of
+from benchmarks.timing import best_of, goal_main
 
 GOAL_S = 5.0  # issue 5: the 330 mm net's mesh in under five seconds
 
@@ -78,13 +77,7 @@ def run(out_dir: Path, repeat: int = 3) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", required=True, type=Path)
-    ap.add_argument("--repeat", type=int, default=3)
-    a = ap.parse_args(argv)
-    report = run(a.out, a.repeat)
-    print(json.dumps(report, indent=1))
-    return 0 if report["goal_met"] else 1
+    return goal_main(run, __doc__, argv, repeat=3)
 
 
 if __name__ == "__main__":

@@ -13,3 +13,19 @@ def best_of(fn, repeat: int):
         out = fn()
         best = min(best, time.perf_counter() - t)
     return best, out
+
+
+def goal_main(run, doc: str, argv: list[str] | None, repeat: int) -> int:
+    """Command line of a goal benchmark: --out DIR [--repeat N]; prints the JSON report and
+    exits 0 when its goal is met, else 1."""
+    import argparse
+    import json
+    from pathlib import Path
+
+    ap = argparse.ArgumentParser(description=doc.splitlines()[0])
+    ap.add_argument("--out", required=True, type=Path, help="folder for the outputs and JSON")
+    ap.add_argument("--repeat", type=int, default=repeat, help="timing repeats (best is kept)")
+    a = ap.parse_args(argv)
+    report = run(a.out, a.repeat)
+    print(json.dumps(report, indent=1))
+    return 0 if report["goal_met"] else 1
