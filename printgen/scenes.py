@@ -20,7 +20,7 @@ from printgen.design import Design
 from printgen.geometry.net import NetGraph, diamond_net
 from printgen.materials import load_material
 from printgen.prototype import Prototype
-from printgen.section import area_m2, diamond_factor, net_membrane_law
+from printgen.section import area_m2, diamond_factor, diamond_sin, net_membrane_law
 from printgen.units import MM
 
 SENSOR_FORCE_N = 1.0  # retraction force of each cable extension sensor (reference, section 4)
@@ -64,7 +64,7 @@ def strand_law_from_membrane(knees: tuple[float, ...], slopes: tuple[float, ...]
     strands carry N = (2 / a_across) F sin(theta) per unit width; so the strand law has knees
     eps_k sin^2(theta) and slopes N' a_across / (2 sin^3(theta)).
     """
-    sin = (mesh_along / 2) / math.hypot(mesh_along / 2, mesh_across / 2)
+    sin = diamond_sin(mesh_along, mesh_across)
     f = 1.0 / (diamond_factor(mesh_along, mesh_across))
     return tuple(k * sin * sin for k in knees), tuple(s * f for s in slopes)
 

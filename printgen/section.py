@@ -28,9 +28,14 @@ def equal_area_diameter(section: Section) -> float:
     return math.sqrt(4 * area_m2(section) / math.pi)
 
 
+def diamond_sin(mesh_along: float, mesh_across: float) -> float:
+    """sin(theta) of a diamond strand, theta its angle to the cross direction."""
+    return (mesh_along / 2) / math.hypot(mesh_along / 2, mesh_across / 2)
+
+
 def diamond_factor(mesh_along: float, mesh_across: float) -> float:
     """2 sin^3(theta) / a_across (1/m) of a diamond net loaded along `mesh_along`."""
-    sin = (mesh_along / 2) / math.hypot(mesh_along / 2, mesh_across / 2)
+    sin = diamond_sin(mesh_along, mesh_across)
     return 2 * sin**3 / mesh_across
 
 

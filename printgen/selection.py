@@ -24,6 +24,7 @@ from printgen.prototype import Prototype
 from printgen.section import (
     area_m2,
     diamond_factor,
+    diamond_sin,
     equal_area_diameter,
     net_membrane_law,
     square_factor,
@@ -139,7 +140,7 @@ def peak_strand_force(t: ScaledTargets, mesh_across: float, mesh_along: float) -
     s = ASSUMED_SAG_RATIO
     h_b = t["height"]
     n = 1000.0 * G * OVERFLOW * h_b * h_b / (8 * s) * math.sqrt(1 + 16 * s * s)
-    sin = (mesh_along / 2) / math.hypot(mesh_along / 2, mesh_across / 2)
+    sin = diamond_sin(mesh_along, mesh_across)
     return n * mesh_across / (2 * sin)
 
 
