@@ -20,8 +20,10 @@ GOAL_S = 1.0  # the brief: G-code for the 330 mm net in under a second
 
 
 def run(out_dir: Path, repeat: int = 5) -> dict:
-    from printgen.atomic import write_text
-    from printgen.gcode import (
+    from printgen.inputs.materials import load_material
+    from printgen.inputs.printers import load_print_style, load_printer
+    from printgen.outputs import write_text
+    from printgen.parts.gcode import (
         cable_toolpath,
         cable_volume_budget,
         gcode_text,
@@ -29,8 +31,6 @@ def run(out_dir: Path, repeat: int = 5) -> dict:
         net_volume_budget,
         read_gcode_text,
     )
-    from printgen.materials import load_material
-    from printgen.printers import load_print_style, load_printer
     from tests.conftest import reference_design_1_40
 
     d = reference_design_1_40()

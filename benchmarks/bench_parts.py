@@ -19,7 +19,7 @@ GOAL_S = 5.0  # issue 5: the 330 mm net's mesh in under five seconds
 
 
 def _part_record(name, build, analytic, printer, repeat: int) -> tuple[dict, object]:
-    from printgen.export import place_mesh, stl_bytes, threemf_bytes
+    from printgen.parts.export import place_mesh, stl_bytes, threemf_bytes
 
     t_mesh, mesh = best_of(build, repeat)
     t_place, (placed, angle) = best_of(lambda: place_mesh(mesh, printer, name), repeat)
@@ -38,16 +38,16 @@ def _part_record(name, build, analytic, printer, repeat: int) -> tuple[dict, obj
 
 
 def run(out_dir: Path, repeat: int = 3) -> dict:
-    from printgen.atomic import write_text
-    from printgen.export import layout_parts, threemf_bytes
-    from printgen.geometry.solid import (
+    from printgen.inputs.printers import load_printer
+    from printgen.outputs import write_text
+    from printgen.parts.export import layout_parts, threemf_bytes
+    from printgen.parts.geometry.solid import (
         analytic_cable_volume,
         analytic_net_volume,
         cable_solid,
         corner_eyelets_for,
         net_solid,
     )
-    from printgen.printers import load_printer
     from tests.conftest import reference_design_1_40
 
     d = reference_design_1_40()

@@ -12,11 +12,11 @@ from pathlib import Path
 
 import numpy as np
 
-from printgen.plan import make_design
-from printgen.prototype import load_prototype
-from printgen.selection import select
-from printgen.similitude import scale_targets
-from printgen.verify import Verification, verify
+from printgen.check.verify import Verification, verify
+from printgen.design.plan import make_design
+from printgen.design.selection import select
+from printgen.design.similitude import scale_targets
+from printgen.inputs.prototype import load_prototype
 
 HERE = Path(__file__).resolve().parent
 
@@ -44,9 +44,9 @@ def run() -> Verification:
 
 
 if __name__ == "__main__":
-    from printgen.atomic import write_bytes, write_text
-    from printgen.jsonout import dumps
-    from printgen.plots import verification_figure
+    from printgen.outputs import write_bytes, write_text
+    from printgen.report.jsonout import dumps
+    from printgen.report.plots import verification_figure
 
     out = Path(sys.argv[1] if len(sys.argv) > 1 else "out/examples")
     v = run()

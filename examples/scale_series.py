@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from printgen.materials import load_material
+from printgen.inputs.materials import load_material
 from solver import solve
 from solver.scenes import SIMPLE, simple_scene
 
@@ -52,9 +52,9 @@ def run() -> dict[str, dict[str, np.ndarray]]:
 
 
 if __name__ == "__main__":
-    from printgen.atomic import write_bytes, write_text
-    from printgen.jsonout import dumps
-    from printgen.plots import series_figure
+    from printgen.outputs import write_bytes, write_text
+    from printgen.report.jsonout import dumps
+    from printgen.report.plots import series_figure
 
     out = Path(sys.argv[1] if len(sys.argv) > 1 else "out/examples")
     curves = run()

@@ -18,7 +18,7 @@ from printgen.calibrate.sample import FitOptions
 from printgen.calibrate.specimen import find_sidecar, read_sidecar
 from printgen.cli import main
 from printgen.errors import CalibrationError
-from printgen.materials import load_material
+from printgen.inputs.materials import load_material
 
 FIT_RTOL = 0.005  # fitted values vs the law that generated the files (issue: 0.5 %)
 TOML_RTOL = 1e-5  # values are written with 6 significant digits

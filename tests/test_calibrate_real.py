@@ -122,3 +122,23 @@ def test_every_force_only_record_matches_its_summary():
                                 rtol=STRENGTH_RTOL)
     assert checked >= MIN_CHECKED, checked
     assert mismatched == KNOWN_SUMMARY_MISMATCHES
+
+
+def test_require_shared_skips_without_shared_and_fails_when_required(monkeypatch, tmp_path):
+    """A clone with nothing beside it skips; PRINTGEN_REQUIRE_SHARED=1 (CI) turns it into a
+    failure, so a CI run that lost ../shared cannot pass by skipping."""
+    import conftest
+
+    monkeypatch.setattr(conftest, "SHARED", tmp_path / "no-shared")
+    for value in (None, "", "0"):
+        if value is None:
+            monkeypatch.delenv("PRINTGEN_REQUIRE_SHARED", raising=False)
+        else:
+            monkeypatch.setenv("PRINTGEN_REQUIRE_SHARED", value)
+        with pytest.raises(pytest.skip.Exception, match="no-shared/data/tensile not found"):
+            conftest.require_shared("data/tensile")
+    monkeypatch.setenv("PRINTGEN_REQUIRE_SHARED", "1")
+    with pytest.raises(pytest.fail.Exception, match="PRINTGEN_REQUIRE_SHARED=1 makes"):
+        conftest.require_shared("data/tensile")
+    (tmp_path / "no-shared" / "data" / "tensile").mkdir(parents=True)
+    assert conftest.require_shared("data/tensile") == tmp_path / "no-shared" / "data" / "tensile"

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from printgen.compare import METRICS, Deformation, compare, explain, row_strain
+from printgen.check.compare import METRICS, Deformation, compare, explain, row_strain
 
 EXACT = 1e-12  # closed-form geometry, round-off only
 

@@ -13,9 +13,11 @@ import numpy as np
 import pytest
 from conftest import require_tool
 
-from printgen.design import Section
+from printgen.design.record import Section
 from printgen.errors import GeometryError, InputError, PrintabilityError
-from printgen.export import (
+from printgen.inputs.materials import load_material
+from printgen.inputs.printers import load_print_style, load_printer
+from printgen.parts.export import (
     layout_parts,
     place_mesh,
     prusa_config_from_ini,
@@ -26,12 +28,10 @@ from printgen.export import (
     write_plate,
     write_stl,
 )
-from printgen.export.layout import ANGLE_STEP_DEG, PART_GAP_MM
-from printgen.geometry.cable import CIRCLE_SEGMENTS, circle_scale
-from printgen.geometry.solid import cable_outline, cable_solid, net_solid
-from printgen.materials import load_material
-from printgen.printers import load_print_style, load_printer
-from printgen.slicer.prusa import prusa_ini_text
+from printgen.parts.export.layout import ANGLE_STEP_DEG, PART_GAP_MM
+from printgen.parts.geometry.cable import CIRCLE_SEGMENTS, circle_scale
+from printgen.parts.geometry.solid import cable_outline, cable_solid, net_solid
+from printgen.parts.slicer.prusa import prusa_ini_text
 
 trimesh = pytest.importorskip("trimesh")
 
@@ -250,7 +250,7 @@ def test_prusaslicer_slices_the_net_with_corner_eyelets_from_its_3mf(tmp_path):
     slices alone with its TPE settings."""
     from conftest import reference_design_1_40
 
-    from printgen.geometry.solid import corner_eyelets_for
+    from printgen.parts.geometry.solid import corner_eyelets_for
 
     exe = require_tool("prusa-slicer")
     d = reference_design_1_40()
@@ -274,7 +274,7 @@ def test_prusaslicer_slices_the_net_with_corner_eyelets_from_its_3mf(tmp_path):
 
 
 def test_step_needs_cadquery_or_says_how(cables, tmp_path):
-    from printgen.geometry.cad import write_step
+    from printgen.parts.geometry.cad import write_step
 
     outline = cable_outline(cables[0])
     try:
@@ -289,7 +289,7 @@ def test_step_needs_cadquery_or_says_how(cables, tmp_path):
 
 
 def test_step_rejects_a_flat_part_before_cadquery(cables, tmp_path):
-    from printgen.geometry.cad import write_step
+    from printgen.parts.geometry.cad import write_step
 
     with pytest.raises(GeometryError, match="thickness = 0.0 mm"):
         write_step(tmp_path / "flat.step", cable_outline(cables[0]), 0.0)

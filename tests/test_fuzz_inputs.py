@@ -8,10 +8,10 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from proto_files import write_variant
 
+from printgen.design.selection import select
+from printgen.design.similitude import scale_targets
 from printgen.errors import PrintgenError
-from printgen.prototype import load_prototype
-from printgen.selection import select
-from printgen.similitude import scale_targets
+from printgen.inputs.prototype import load_prototype
 
 KEYS = [("barrier", "width_m"), ("barrier", "height_m"), ("barrier", "anchors"),
         ("net", "mesh_x_m"), ("net", "mesh_y_m"), ("net", "strand_diameter_mm"),

@@ -13,9 +13,11 @@ import pytest
 from conftest import ROOT, require_shared
 from numpy.testing import assert_allclose
 
-from printgen.design import Section
+from printgen.design.record import Section
 from printgen.errors import PrintabilityError
-from printgen.gcode import (
+from printgen.inputs.materials import load_material
+from printgen.inputs.printers import load_print_style, load_printer
+from printgen.parts.gcode import (
     cable_toolpath,
     cable_volume_budget,
     gcode_text,
@@ -24,10 +26,8 @@ from printgen.gcode import (
     read_gcode_text,
     write_gcode,
 )
-from printgen.gcode.toolpath import BORDER, STRAND_MINUS, STRAND_PLUS, TRAVEL
-from printgen.geometry.net import diamond_net
-from printgen.materials import load_material
-from printgen.printers import load_print_style, load_printer
+from printgen.parts.gcode.toolpath import BORDER, STRAND_MINUS, STRAND_PLUS, TRAVEL
+from printgen.parts.geometry.net import diamond_net
 
 VOLUME_TOL = 0.02  # the brief: read-back volume within 2 % of the design
 E_ROUND_REL = 1e-4  # E written with 5 decimals: relative rounding error of a volume sum

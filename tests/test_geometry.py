@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 from conftest import reference_design_1_40
 
-from printgen.design import Section
+from printgen.design.record import Section
 from printgen.errors import GeometryError
-from printgen.geometry.cable import CIRCLE_SEGMENTS, circle_scale
-from printgen.geometry.net import diamond_net
-from printgen.geometry.solid import (
+from printgen.parts.geometry.cable import CIRCLE_SEGMENTS, circle_scale
+from printgen.parts.geometry.net import diamond_net
+from printgen.parts.geometry.solid import (
     CornerEyelets,
     analytic_cable_volume,
     analytic_net_volume,

@@ -6,9 +6,9 @@ import pytest
 from proto_files import REALISTIC, write_variant
 
 from printgen.errors import InputError, ProfileError
-from printgen.materials import load_material
-from printgen.printers import load_printer
-from printgen.prototype import load_prototype
+from printgen.inputs.materials import load_material
+from printgen.inputs.printers import load_printer
+from printgen.inputs.prototype import load_prototype
 
 
 @pytest.mark.parametrize("edit, message", [
@@ -71,7 +71,7 @@ def test_inheritance_cycle_is_an_error(tmp_path, monkeypatch):
     (d / "a.toml").write_text('inherits = "b"\n')
     (d / "b.toml").write_text('inherits = "a"\n')
     monkeypatch.setenv("PRINTGEN_PROFILES", str(tmp_path))
-    from printgen.printers import load_print_style
+    from printgen.inputs.printers import load_print_style
     with pytest.raises(ProfileError):
         load_print_style("a")
 

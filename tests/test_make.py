@@ -7,7 +7,7 @@ import json
 import pytest
 from proto_files import REALISTIC
 
-import printgen.make as make_mod
+import printgen.run.make as make_mod
 from printgen.cli import main
 from printgen.errors import PrintgenError
 

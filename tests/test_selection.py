@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 from proto_files import REALISTIC, SIMPLE, write_variant
 
-from printgen.design import Section
+from printgen.design.record import Section
+from printgen.design.section import area_m2, diamond_factor, net_membrane_law
+from printgen.design.selection import SCORE_DIGITS, select
+from printgen.design.similitude import scale_targets
 from printgen.errors import PrintabilityError
-from printgen.materials import load_material
-from printgen.prototype import load_prototype
-from printgen.section import area_m2, diamond_factor, net_membrane_law
-from printgen.selection import SCORE_DIGITS, select
-from printgen.similitude import scale_targets
+from printgen.inputs.materials import load_material
+from printgen.inputs.prototype import load_prototype
 
 EXACT = 1e-12  # closed-form arithmetic, round-off only
 

@@ -12,13 +12,18 @@ import pytest
 from conftest import require_shared, require_tool
 from numpy.testing import assert_allclose
 
-from printgen.design import Section
+from printgen.design.record import Section
 from printgen.errors import PrintabilityError
-from printgen.gcode import read_gcode
-from printgen.materials import load_material
-from printgen.printers import load_print_style, load_printer
-from printgen.slicer import allowed_prusa_keys, prusa_ini_text, prusa_settings, write_prusa_ini
-from printgen.slicer.cura import cura_cfg_text, cura_settings, write_cura_cfg
+from printgen.inputs.materials import load_material
+from printgen.inputs.printers import load_print_style, load_printer
+from printgen.parts.gcode import read_gcode
+from printgen.parts.slicer import (
+    allowed_prusa_keys,
+    prusa_ini_text,
+    prusa_settings,
+    write_prusa_ini,
+)
+from printgen.parts.slicer.cura import cura_cfg_text, cura_settings, write_cura_cfg
 
 READBACK_VS_CHECKER_TOL = 1e-3  # two parsers of the same file: only E rounding differs
 SLICE_TIMEOUT_S = 120
@@ -101,9 +106,9 @@ def test_bad_designs_fail_before_any_profile_is_written(design_1_40, tmp_path, c
 
 # ----------------------------------------------------------------------------- slicing
 def _net_stl(net, path):
-    """The net's mesh (printgen.geometry.solid), as the lab would slice it."""
+    """The net's mesh (printgen.parts.geometry.solid), as the lab would slice it."""
     pytest.importorskip("manifold3d")
-    from printgen.geometry.solid import net_solid
+    from printgen.parts.geometry.solid import net_solid
 
     net_solid(net).export(path)
     return path
@@ -111,7 +116,7 @@ def _net_stl(net, path):
 
 def _cable_stl(cable, path):
     pytest.importorskip("manifold3d")
-    from printgen.geometry.solid import cable_solid
+    from printgen.parts.geometry.solid import cable_solid
 
     cable_solid(cable).export(path)
     return path
@@ -173,7 +178,7 @@ def test_curaengine_slices_a_cable(design_1_40, tmp_path):
     assert rc == 0, summary
     assert summary.startswith("SLICE-CHECK OK slicer=CuraEngine-4.13")
     # printgen's own CuraEngine command line gives the same print as the shared script
-    from printgen.slicer.cura import cura_engine_args, find_definitions
+    from printgen.parts.slicer.cura import cura_engine_args, find_definitions
 
     defs = find_definitions()
     out = tmp_path / "own.gcode"
@@ -197,7 +202,7 @@ def _cura_keys(node: dict) -> set[str]:
 
 
 def test_cura_keys_exist_in_the_definitions(design_1_40):
-    from printgen.slicer.cura import find_definitions
+    from printgen.parts.slicer.cura import find_definitions
 
     require_tool("CuraEngine")
     defs = find_definitions()

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from printgen.design import Section
-from printgen.laws import piecewise_linear
-from printgen.section import area_m2, diamond_factor, equal_area_diameter, square_factor
+from printgen.design.record import Section
+from printgen.design.section import area_m2, diamond_factor, equal_area_diameter, square_factor
+from printgen.inputs.laws import piecewise_linear
 from printgen.units import GPA, MM, m_to_mm, mm_to_m, split_unit_key
 
 EXACT = 1e-12  # closed-form arithmetic, round-off only

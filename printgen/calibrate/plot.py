@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from printgen import atomic
+from printgen import outputs
 from printgen.calibrate.pipeline import Calibration
 from printgen.errors import CalibrationError
 
@@ -61,4 +61,4 @@ def plot_calibration(cal: Calibration, path: str | Path) -> Path:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110)
     plt.close(fig)
-    return atomic.write_bytes(path, buf.getvalue())
+    return outputs.write_bytes(path, buf.getvalue())

@@ -19,10 +19,10 @@ from typing import Any
 
 import tomli_w
 
-from printgen import atomic
+from printgen import outputs
 from printgen.calibrate.pipeline import Calibration
 from printgen.errors import CalibrationError, PrintgenError
-from printgen.materials import Material, load_material
+from printgen.inputs.materials import Material, load_material
 
 SOURCE = "printgen calibrate: tensile tests"
 SIG = 6  # significant digits written for measured values
@@ -92,7 +92,7 @@ def write_profile(cal: Calibration, *, name: str, out: str | Path | None = None,
                 mat = load_material(name)
             except PrintgenError as exc:
                 raise CalibrationError(f"calibrated profile {path} would not load: {exc}") from exc
-    atomic.write_text(path, text)
+    outputs.write_text(path, text)
     return path, mat
 
 

@@ -16,7 +16,7 @@ from typing import Any
 
 from printgen.calibrate.reader import MetaItem
 from printgen.errors import CalibrationError
-from printgen.schema import Field, load_toml, positive, read_table
+from printgen.inputs.schema import Field, load_toml, positive, read_table
 
 log = logging.getLogger(__name__)
 

@@ -9,7 +9,7 @@ from typing import Any
 from rich.console import Console
 from rich.table import Table
 
-from printgen.jsonout import dumps
+from printgen.report.jsonout import dumps
 
 
 def add_prototype_args(p: argparse.ArgumentParser) -> None:

@@ -11,7 +11,7 @@ from pathlib import Path
 from rich.console import Console
 
 from printgen.commands.common import add_json_arg, add_prototype_args, console, emit_json, table
-from printgen.make import make
+from printgen.run.make import make
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -6,10 +6,10 @@ import argparse
 
 from printgen.commands.common import add_json_arg, console, emit_json, table
 from printgen.errors import ProfileError
-from printgen.jsonout import jsonable
-from printgen.materials import load_material
-from printgen.printers import load_print_style, load_printer
-from printgen.profiles import KINDS, list_profiles, profile_path
+from printgen.inputs.materials import load_material
+from printgen.inputs.printers import load_print_style, load_printer
+from printgen.inputs.profiles import KINDS, list_profiles, profile_path
+from printgen.report.jsonout import jsonable
 
 LOADERS = {"materials": load_material, "printers": load_printer, "prints": load_print_style}
 

@@ -12,9 +12,9 @@ from printgen.commands.common import (
     fmt,
     table,
 )
-from printgen.prototype import load_prototype
-from printgen.selection import Candidate, Selection, select, selection_record
-from printgen.similitude import scale_targets
+from printgen.design.selection import Candidate, Selection, select, selection_record
+from printgen.design.similitude import scale_targets
+from printgen.inputs.prototype import load_prototype
 
 SHOW = 8  # candidates shown per component in the table (all are in --json)
 

@@ -12,8 +12,8 @@ from printgen.commands.common import (
     fmt,
     table,
 )
-from printgen.prototype import load_prototype
-from printgen.similitude import ScaledTargets, scale_targets, targets_record
+from printgen.design.similitude import ScaledTargets, scale_targets, targets_record
+from printgen.inputs.prototype import load_prototype
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -1,0 +1,1 @@
+"""Check: solver scenes of prototype and model, load sweeps, and their comparison."""

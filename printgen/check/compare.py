@@ -1,0 +1,110 @@
+"""Normalised deformations of a barrier along a load path, and prototype-vs-model mismatch
+(barrier-physics.md, section 6: deformation normalised by each barrier's own dimensions,
+compared over the whole loading range, not at one point)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from printgen.check.scenes import BarrierScene
+
+# Normalised quantities compared between prototype and model, with their labels.
+METRICS = {
+    "deflection": "mid-height deflection / width",
+    "lowering": "top-centre lowering / height",
+    "strain_bottom": "bottom cable elongation (strain)",
+    "strain_top": "top cable elongation (strain)",
+    "strain_mid": "elongation at mid-height (strain)",
+}
+TOLERANCE = 0.25  # max mismatch / prototype peak allowed: the paper's model matched to ~25 %
+UPPER_RANGE = 0.8  # relative loading above which a mismatch is reported as "at high loading"
+
+
+@dataclass(frozen=True)
+class Deformation:
+    """Normalised deformations at each relative loading (levels: (k,) h / h_B)."""
+
+    levels: np.ndarray
+    values: dict[str, np.ndarray]  # METRICS key -> (k,)
+    max_strand_tension: np.ndarray  # (k,) N
+    max_cable_tension: np.ndarray  # (k,) N
+
+
+def row_strain(x0: np.ndarray, x: np.ndarray) -> float:
+    """Elongation of the polyline through a row of nodes: length / initial length - 1."""
+    def length(p: np.ndarray) -> float:
+        return float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
+    return length(x) / length(x0) - 1.0
+
+
+def deformation(scene: BarrierScene, levels: np.ndarray, positions: list[np.ndarray],
+                strand_tension: list[np.ndarray], cable_tension: list[np.ndarray]) -> Deformation:
+    """Normalised deformation of `scene` for each solved state (positions (n, 3) m)."""
+    x0 = scene.nodes
+    vals: dict[str, list[float]] = {k: [] for k in METRICS}
+    for x in positions:
+        vals["deflection"].append((x[scene.centre, 1] - x0[scene.centre, 1]) / scene.width)
+        vals["lowering"].append(-(x[scene.top_centre, 2] - x0[scene.top_centre, 2]) / scene.height)
+        for row in ("bottom", "top", "mid"):
+            r = scene.rows[row]
+            vals[f"strain_{row}"].append(row_strain(x0[r], x[r]))
+    return Deformation(np.asarray(levels, float), {k: np.array(v) for k, v in vals.items()},
+                       np.array([t.max() if t.size else 0.0 for t in strand_tension]),
+                       np.array([t.max() if t.size else 0.0 for t in cable_tension]))
+
+
+@dataclass(frozen=True)
+class Mismatch:
+    """Model vs prototype for one metric, relative to the prototype's peak value."""
+
+    metric: str
+    max_rel: float
+    rms_rel: float
+    worst_level: float
+    ratio_high: float  # model / prototype, mean over relative loading >= UPPER_RANGE
+    ok: bool
+
+
+def compare(proto: Deformation, model: Deformation, *, tolerance: float = TOLERANCE
+            ) -> list[Mismatch]:
+    """Mismatch of every metric over the whole loading range."""
+    if not np.allclose(proto.levels, model.levels):
+        raise ValueError("prototype and model were solved at different relative loadings")
+    out = []
+    for key in METRICS:
+        p, m = proto.values[key], model.values[key]
+        peak = float(np.abs(p).max())
+        if peak == 0.0:
+            continue
+        diff = np.abs(m - p) / peak
+        high = proto.levels >= UPPER_RANGE - 1e-12
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = float(np.nanmean(m[high] / p[high])) if high.any() else float("nan")
+        out.append(Mismatch(key, float(diff.max()), float(np.sqrt(np.mean(diff**2))),
+                            float(proto.levels[int(diff.argmax())]), ratio,
+                            bool(diff.max() <= tolerance)))
+    return out
+
+
+def explain(mismatches: list[Mismatch]) -> list[str]:
+    """One sentence per failing metric: how far off, where, and which way."""
+    out = []
+    for mm in mismatches:
+        if mm.ok:
+            continue
+        way = "too stiff" if mm.metric != "lowering" and mm.ratio_high < 1 else "too soft"
+        if mm.metric == "lowering":
+            way = "lowers too little" if mm.ratio_high < 1 else "lowers too much"
+        out.append(f"{METRICS[mm.metric]}: model {mm.ratio_high:.2f}x the prototype above "
+                   f"h/h_B = {UPPER_RANGE:g} ({way}); worst mismatch {mm.max_rel:.0%} of the "
+                   f"prototype peak at h/h_B = {mm.worst_level:.2f}")
+    return out
+
+
+def increments(d: Deformation) -> Deformation:
+    """The deformation counted from the first level (h / h_B = 0): what extension sensors
+    zeroed before the water arrives read."""
+    return Deformation(d.levels, {k: v - v[0] for k, v in d.values.items()},
+                       d.max_strand_tension, d.max_cable_tension)

@@ -1,0 +1,187 @@
+"""Pre-print verification: the prototype and the printed model, each as a tension-only net
+(`printgen.check.scenes`), loaded hydrostatically from h / h_B = 0 to 1.1 (the reference's loading
+test: water raised behind a folded film), optionally with drag at the Froude-scaled velocity,
+and compared by their normalised deformations over the whole range (printgen.check.compare).
+Also the counter-example the report warns about: the simple barrier with steel at every scale.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+
+import solver
+from printgen.check.compare import Deformation, Mismatch, compare, deformation, explain, increments
+from printgen.check.scenes import FLOW, BarrierScene, model_scene, prototype_scene
+from printgen.design.record import Design
+from printgen.errors import SolverError
+from printgen.inputs.prototype import Prototype
+from printgen.units import RHO_WATER, G
+
+LEVEL_STEP = 0.05  # relative loading step of the sweep (issue: at most 0.05)
+OVERFLOW = 1.1  # last relative loading h / h_B
+PATH_CUTS = 2  # halvings tried before a load level is reported as not converged
+MAX_FAILED_FRACTION = 0.25  # more unconverged levels than this and the sweep is an error
+SOLVER_TOL = 1e-7  # out-of-balance force / load: far below what a flume measures (~1e-2)
+
+
+def levels(step: float = LEVEL_STEP, top: float = OVERFLOW) -> np.ndarray:
+    """0, step, ..., top (inclusive)."""
+    n = round(top / step)
+    return np.round(np.linspace(0.0, top, n + 1), 10)
+
+
+def solver_net(s: BarrierScene) -> solver.Net:
+    laws = [solver.piecewise(k, sl) for k, sl in s.laws]
+    cables = [solver.SlidingCable(nodes, solver.piecewise(*law))
+              for nodes, law in s.cables.values()]
+    return solver.Net(s.nodes, s.fixed, s.elements, laws, element_law=s.element_law,
+                      cables=cables)
+
+
+def loads_function(s: BarrierScene, *, velocity: float | None = None,
+                   strand_diameter: float = 0.0):
+    """Loads at relative loading r: hydrostatic rho g (r h_B - z) A* on the free nodes at their
+    current height, drag 0.5 rho v^2 l d when a velocity is given, and the sensors' pulls."""
+    free = np.flatnonzero(~s.fixed)
+    strand_per_node = _strand_length(s) / len(s.nodes)
+    row_gap = float(np.diff(np.unique(np.round(s.nodes[:, 2], 12))).min())  # node rows apart
+
+    def loads_at(r: float) -> list:
+        out = [solver.Hydrostatic(free, s.area_per_node, r * s.height, tuple(FLOW),
+                                  rho=RHO_WATER, g=G)]
+        if velocity:
+            out.append(solver.Drag(free, strand_per_node, strand_diameter, velocity,
+                                   r * s.height, tuple(FLOW), rho=RHO_WATER, ramp=row_gap))
+        if s.sensors:
+            out.append(solver.PointLoads(np.array([n for n, _ in s.sensors]),
+                                         np.array([f for _, f in s.sensors])))
+        return out
+
+    return loads_at
+
+
+def _strand_length(s: BarrierScene) -> float:
+    d = s.nodes[s.elements[:, 1]] - s.nodes[s.elements[:, 0]]
+    return float(np.linalg.norm(d, axis=1).sum())
+
+
+@dataclass(frozen=True)
+class Run:
+    """One barrier's sweep: its deformation and solver statistics."""
+
+    scene: BarrierScene
+    deformation: Deformation
+    iterations: list[int]
+    seconds: float
+    failed: dict[float, str]  # load levels that did not converge -> the solver's reason
+
+
+def sweep(s: BarrierScene, lv: np.ndarray, **load_kw) -> Run:
+    """Solve the load path; raise SolverError when a level cannot be reached."""
+    t0 = time.perf_counter()
+    results = solver.solve_path(solver_net(s), loads_function(s, **load_kw), lv, tol=SOLVER_TOL,
+                                max_cuts=PATH_CUTS, skip_failed=True)
+    failed = {float(r.level): r.reason for r in results if not r.converged}
+    if len(failed) > MAX_FAILED_FRACTION * len(lv):
+        raise SolverError(f"{s.name}: {len(failed)} of {len(lv)} load levels did not converge; "
+                          f"first: {next(iter(failed.values()))}")
+    d = deformation(s, lv, [r.positions for r in results], [r.tensions for r in results],
+                    [r.cable_tensions for r in results])
+    return Run(s, d, [r.iterations for r in results], time.perf_counter() - t0, failed)
+
+
+@dataclass(frozen=True)
+class Verification:
+    """Prototype vs printed model over the loading sweep."""
+
+    load_case: str
+    prototype: Run
+    model: Run
+    mismatches: list[Mismatch]
+    reasons: list[str]
+    counterexample: CounterExample | None = None
+    from_start: list[Mismatch] | None = None  # the same, counted from h / h_B = 0
+
+    @property
+    def ok(self) -> bool:
+        return all(m.ok for m in self.mismatches)
+
+
+def verify(p: Prototype, d: Design, *, drag: bool = False, lv: np.ndarray | None = None,
+           counterexample: bool = False) -> Verification:
+    """Sweep both barriers under the same relative loading and compare them."""
+    lv = levels() if lv is None else np.asarray(lv, dtype=float)
+    ps, ms = prototype_scene(p), model_scene(d)
+    kw_p, kw_m, case = {}, {}, "hydrostatic (z at the current node height)"
+    if drag:
+        kw_p = {"velocity": p.velocity, "strand_diameter": p.net.strand_diameter}
+        kw_m = {"velocity": p.velocity / np.sqrt(d.scale),
+                "strand_diameter": d.net.strand.width_mm * 1e-3}
+        case = "hydrostatic + drag at the Froude-scaled velocity"
+    jobs = [(sweep, (ms, lv), kw_m), (sweep, (ps, lv), kw_p)]  # the longest first
+    if counterexample:
+        jobs.append((steel_counterexample, (d.scale,), {}))
+    model, proto, *ce = run_jobs(jobs)
+    bad = set(proto.failed) | set(model.failed)
+    if bad:  # compare only where both barriers converged
+        keep = np.array([lvl not in bad for lvl in lv])
+        proto = _only(proto, keep)
+        model = _only(model, keep)
+    mm = compare(proto.deformation, model.deformation)
+    start = compare(increments(proto.deformation), increments(model.deformation))
+    return Verification(case, proto, model, mm, explain(mm), ce[0] if ce else None, start)
+
+
+def run_jobs(jobs: list[tuple]) -> list:
+    """Run each (fn, args, kwargs) and return the results in order: in worker processes when
+    the machine has two cores or more (the jobs are independent; the results are identical
+    either way), else one after the other. PRINTGEN_SERIAL=1 forces serial runs."""
+    workers = min(len(jobs), os.cpu_count() or 1)
+    if workers < 2 or os.environ.get("PRINTGEN_SERIAL"):
+        return [fn(*args, **kw) for fn, args, kw in jobs]
+    ctx = multiprocessing.get_context("fork")
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+        futures = [pool.submit(fn, *args, **kw) for fn, args, kw in jobs]
+        return [f.result() for f in futures]
+
+
+def _only(run: Run, keep: np.ndarray) -> Run:
+    d = run.deformation
+    dd = Deformation(d.levels[keep], {k: v[keep] for k, v in d.values.items()},
+                     d.max_strand_tension[keep], d.max_cable_tension[keep])
+    return Run(run.scene, dd, run.iterations, run.seconds, run.failed)
+
+
+@dataclass(frozen=True)
+class CounterExample:
+    """The simple barrier (scene simple-free-top, hydrostatic at h = h_B) at 1:scale: the
+    prototype, the model with E scaled by 1/lambda, and the model with steel E."""
+
+    scale: float
+    deflection: dict[str, float]  # variant -> mid-height deflection / width
+    lowering: dict[str, float]  # variant -> top-centre lowering / height
+
+
+def steel_counterexample(scale: float) -> CounterExample:
+    """Why stiffness must be scaled: steel at every scale deflects less and less as lambda
+    grows (Lambert et al. 2023, Fig. 2), while E / lambda reproduces the prototype."""
+    from solver.scenes import SIMPLE, simple_scene
+
+    variants = {"prototype (lambda = 1)": (1.0, SIMPLE["modulus"]),
+                f"1:{scale:g}, E scaled by 1/lambda": (scale, SIMPLE["modulus"] / scale),
+                f"1:{scale:g}, steel E": (scale, SIMPLE["modulus"])}
+    defl, low = {}, {}
+    for name, (lam, modulus) in variants.items():
+        sc = simple_scene(scale=lam, modulus=modulus, pinned_top=False, drag=False)
+        r = solver.solve(sc.net, sc.loads_at(1.0), tol=SOLVER_TOL)
+        if not r.converged:
+            raise SolverError(f"simple barrier {name}: {r.reason}")
+        defl[name] = float(r.displacements[sc.centre, 1] / sc.width)
+        low[name] = float(-r.displacements[sc.top_centre, 2] / sc.height)
+    return CounterExample(scale, defl, low)

@@ -1,0 +1,1 @@
+"""Design: similitude targets, section and material selection, the printable Design record."""

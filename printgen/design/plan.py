@@ -1,0 +1,46 @@
+"""From the selection's winners to a printable `Design` (mm): net panel, strand, cables."""
+
+from __future__ import annotations
+
+from printgen.design.record import CableDesign, Design, NetDesign
+from printgen.design.selection import Selection, model_mesh
+from printgen.design.similitude import ScaledTargets
+from printgen.errors import DesignError
+from printgen.inputs.prototype import Prototype
+
+EYELET_INNER_MM = 3.2  # clearance for the M3 screws that hold the cables on the flume anchors
+EYELET_RING_BEADS = 4  # the eyelet ring is 4 cable beads wide (1.8 mm at 0.45 mm beads)
+BORDER_BEADS = 2  # the net's border frame is two beads wide: the cables thread along it
+
+
+def make_design(prototype: Prototype, targets: ScaledTargets, selection: Selection) -> Design:
+    """The Design of the winners of `selection` at the targets' scale (mm).
+
+    Net: the barrier's model width x height, the model mesh, the winning strand section and
+    a border frame of BORDER_BEADS beads. Cables (when the prototype has a border): top and
+    bottom span the width anchor to anchor, the lateral ones the height.
+    """
+    net_c = selection.net[0]
+    if not net_c.feasible:
+        raise DesignError(f"no printable net: {net_c.reasons[0]}")
+    mesh_x, mesh_y = model_mesh(prototype, targets)
+    width, height = targets["width"] * 1e3, targets["height"] * 1e3
+    net = NetDesign(material=net_c.material, print_style=selection.net_print,
+                    width_mm=round(width, 6), height_mm=round(height, 6),
+                    mesh_x_mm=round(mesh_x * 1e3, 6), mesh_y_mm=round(mesh_y * 1e3, 6),
+                    strand=net_c.section,
+                    border_width_mm=BORDER_BEADS * net_c.section.bead_width_mm)
+    cables: tuple[CableDesign, ...] = ()
+    if selection.cables:
+        c = selection.cables[0]
+        if not c.feasible:
+            raise DesignError(f"no printable border cable: {c.reasons[0]}")
+        cables = tuple(
+            CableDesign(name=name, material=c.material, print_style=selection.cable_print,
+                        length_mm=round(length, 6), section=c.section,
+                        eyelet_inner_mm=EYELET_INNER_MM,
+                        eyelet_outer_mm=round(EYELET_INNER_MM + 2 * EYELET_RING_BEADS
+                                              * c.section.bead_width_mm, 6))
+            for name, length in (("top", width), ("bottom", width), ("left", height),
+                                 ("right", height)))
+    return Design(scale=targets.scale, printer=selection.printer, net=net, cables=cables)

@@ -1,0 +1,307 @@
+"""Choose a polymer and pass layout for the border cables (axial stiffness E*A) and for the net
+(membrane law from the diamond geometry) against the similitude targets.
+
+Every material x layout (beads side by side x stacked layers of the print style) is a
+candidate. Each gets its stiffness error, the Pi3 deviation of its equivalent section, a
+strength safety factor under the peak scaled load, its flow-limited print speed, and the
+reasons it cannot be printed, if any. Measured printed moduli are preferred over datasheet ones.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from printgen.design.record import Section
+from printgen.design.section import (
+    area_m2,
+    diamond_factor,
+    diamond_sin,
+    equal_area_diameter,
+    net_membrane_law,
+    square_factor,
+)
+from printgen.design.similitude import ScaledTargets
+from printgen.errors import InputError, PrintabilityError
+from printgen.inputs.laws import piecewise_linear
+from printgen.inputs.materials import Material, load_material
+from printgen.inputs.printers import Printer, PrintStyle, check_pass, load_print_style, load_printer
+from printgen.inputs.profiles import list_profiles
+from printgen.inputs.prototype import Prototype
+from printgen.units import MM, G
+
+DEFAULT_PRINTER = "generic-350"
+DEFAULT_NET_PRINT = "net-3pass"
+DEFAULT_CABLE_PRINT = "cable-4pass"
+
+MAX_BEADS_ACROSS = {"cable": 6, "net": 2}  # wider strands are no longer "strands"
+MAX_LAYERS = {"cable": 6, "net": 5}
+MIN_SAFETY_FACTOR = 1.5  # peak-load estimate is rough: keep margin
+DATASHEET_PENALTY = 0.10  # score added when only a datasheet modulus exists (~10 % error)
+PASS_PENALTY = 0.002  # per pass: prefer shorter prints among equals
+SCORE_DIGITS = 9  # scores equal to 1e-9 are ties (same E*A, different layout)
+MIN_SPEED_MM_S = 2.0  # slower than this, the flow limit makes the print impractical
+ASSUMED_SAG_RATIO = 0.2  # peak-force estimate: sag / span of a loaded cable or net strip
+OVERFLOW = 1.1  # peak relative loading h / h_B of the loading test
+NET_STRAINS = np.linspace(0.01, 0.40, 40)  # strain range over which net laws are compared
+CHECK_STRAINS = (0.05, 0.30)  # net law errors reported at low and high strain
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One material x pass layout. Errors are signed relative (cable: E*A; net: law at
+    CHECK_STRAINS) plus, for nets, the RMS log error over NET_STRAINS."""
+
+    component: str
+    material: str
+    material_name: str
+    modulus: float  # Pa, the one used
+    modulus_source: str
+    section: Section
+    stiffness: float  # cable: E*A (N); net: initial membrane stiffness (N/m)
+    target: float
+    error: float
+    error_low: float
+    error_high: float
+    error_rms: float
+    pi3_deviation: float  # equal-area diameter / target diameter - 1
+    peak_force: float  # N, per cable or per strand
+    safety_factor: float
+    speed_mm_per_s: float
+    reasons: tuple[str, ...]
+    score: float
+
+    @property
+    def feasible(self) -> bool:
+        return not self.reasons
+
+
+@dataclass(frozen=True)
+class Selection:
+    """Ranked candidates (best first) and the rationale for each winner."""
+
+    cables: tuple[Candidate, ...]
+    net: tuple[Candidate, ...]
+    cable_rationale: str
+    net_rationale: str
+    printer: str
+    net_print: str
+    cable_print: str
+
+    @property
+    def cable(self) -> Candidate | None:
+        return self.cables[0] if self.cables and self.cables[0].feasible else None
+
+    @property
+    def net_choice(self) -> Candidate:
+        return self.net[0]
+
+
+def layouts(style: PrintStyle, component: str) -> list[Section]:
+    """Every beads-across x layers section of this print style."""
+    return [Section(style.bead_width_mm, n, tuple(style.layer_heights_mm(m)))
+            for n in range(1, MAX_BEADS_ACROSS[component] + 1)
+            for m in range(1, MAX_LAYERS[component] + 1)]
+
+
+def print_limits(section: Section, material: Material, printer: Printer,
+                 where: str) -> tuple[float, list[str]]:
+    """(flow-limited speed mm/s, reasons it cannot be printed)."""
+    reasons = []
+    for h in set(section.layer_heights_mm):
+        try:
+            check_pass(printer, section.bead_width_mm, h, where=where)
+        except PrintabilityError as exc:
+            reasons.append(str(exc))
+    bead_mm2 = section.bead_width_mm * max(section.layer_heights_mm)
+    speed = min(material.print.print_speed_mm_per_s,
+                material.print.max_volumetric_flow_mm3_per_s / bead_mm2)
+    if speed < MIN_SPEED_MM_S:
+        reasons.append(f"{where}: flow limit {material.print.max_volumetric_flow_mm3_per_s:g} "
+                       f"mm^3/s allows only {speed:.2f} mm/s (< {MIN_SPEED_MM_S:g} mm/s)")
+    return speed, reasons
+
+
+def peak_cable_force(t: ScaledTargets) -> float:
+    """Estimated peak border-cable tension (N) at overflow: top and bottom cables carry the
+    net's load as parabolic cables of sag ratio ASSUMED_SAG_RATIO."""
+    s = ASSUMED_SAG_RATIO
+    h_b, w_b = t["height"], t["width"]
+    total = 1000.0 * G * w_b * h_b**2 * (OVERFLOW - 0.5)
+    q = total / (2 * w_b)
+    return q * w_b / (8 * s) * math.sqrt(1 + 16 * s * s)
+
+
+def peak_strand_force(t: ScaledTargets, mesh_across: float, mesh_along: float) -> float:
+    """Estimated peak net-strand tension (N): a vertical net strip of span h_B under the
+    bottom pressure at overflow, sag ratio ASSUMED_SAG_RATIO, shared by 2 / a strands."""
+    s = ASSUMED_SAG_RATIO
+    h_b = t["height"]
+    n = 1000.0 * G * OVERFLOW * h_b * h_b / (8 * s) * math.sqrt(1 + 16 * s * s)
+    sin = diamond_sin(mesh_along, mesh_across)
+    return n * mesh_across / (2 * sin)
+
+
+def cable_candidate(t: ScaledTargets, m: Material, sec: Section, printer: Printer) -> Candidate:
+    modulus, source = m.modulus()
+    ea, target = modulus * area_m2(sec), t["cable_ea"]
+    speed, reasons = print_limits(sec, m, printer, f"cable {m.name} {sec.beads_across}x"
+                                  f"{len(sec.layer_heights_mm)}")
+    force = peak_cable_force(t)
+    sf = m.failure_stress()[0] * area_m2(sec) / force
+    if sf < MIN_SAFETY_FACTOR:
+        reasons.append(f"safety factor {sf:.2f} below {MIN_SAFETY_FACTOR} at {force:.2f} N")
+    err = ea / target - 1
+    score = (abs(math.log(ea / target)) + DATASHEET_PENALTY * (source == "datasheet")
+             + PASS_PENALTY * sec.passes)
+    return Candidate("cable", m.key, m.name, modulus, source, sec, ea, target, err, err, err,
+                     abs(math.log(ea / target)), equal_area_diameter(sec) / t["cable_d"] - 1,
+                     force, sf, speed, tuple(reasons), score)
+
+
+def target_net_law(p: Prototype, t: ScaledTargets) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """(knee strains, membrane slopes N/m) of the model net's target force-per-width law.
+
+    From the prototype's panel law (kappa * L_p scaled by lambda^-2), else from its strand E*A
+    and mesh geometry (square: one strand per mesh across; diamond: `diamond_factor`).
+    """
+    if p.net.panel_law is not None:
+        knees, kappas = p.net.panel_law[0], p.net.panel_law[1]
+        return tuple(knees), tuple(t[f"membrane_{i}"] for i in range(len(kappas)))
+    if p.net.pattern == "square":
+        factor = square_factor(t["mesh_x"])
+    else:
+        factor = diamond_factor(t["mesh_y"], t["mesh_x"])
+    return (), (t["strand_ea"] * factor,)
+
+
+def model_mesh(p: Prototype, t: ScaledTargets) -> tuple[float, float]:
+    """(mesh_x, mesh_y) of the printed net in m: the lab's choice, else the scaled mesh."""
+    m = p.model
+    if m.mesh_x_mm is not None and m.mesh_y_mm is not None:
+        return m.mesh_x_mm * MM, m.mesh_y_mm * MM
+    return t["mesh_x"], t["mesh_y"]
+
+
+def net_candidate(p: Prototype, t: ScaledTargets, m: Material, sec: Section,
+                  printer: Printer) -> Candidate:
+    """Score one net candidate: its membrane law (diamond geometry) against the target law."""
+    mesh_x, mesh_y = model_mesh(p, t)
+    knees, slopes, source = net_membrane_law(m, sec, mesh_y, mesh_x)
+    t_knees, t_slopes = target_net_law(p, t)
+    got = piecewise_linear(NET_STRAINS, knees, slopes)
+    want = piecewise_linear(NET_STRAINS, t_knees, t_slopes)
+    log_ratio = np.log(got / want)
+    low, high = (float(np.interp(s, NET_STRAINS, got / want) - 1) for s in CHECK_STRAINS)
+    speed, reasons = print_limits(sec, m, printer, f"net {m.name} strand "
+                                  f"{sec.width_mm:g}x{sec.thickness_mm:g} mm")
+    force = peak_strand_force(t, mesh_x, mesh_y)
+    sf = m.failure_stress()[0] * area_m2(sec) / force
+    if sf < MIN_SAFETY_FACTOR:
+        reasons.append(f"safety factor {sf:.2f} below {MIN_SAFETY_FACTOR} at {force:.3g} N")
+    rms = float(np.sqrt(np.mean(log_ratio**2)))
+    modulus, mod_source = m.modulus()
+    measured = "measured" if source == "measured panel law" else mod_source
+    score = rms + DATASHEET_PENALTY * (measured == "datasheet") + PASS_PENALTY * sec.passes
+    return Candidate("net", m.key, m.name, modulus, source, sec, slopes[0], t_slopes[0],
+                     float(got[0] / want[0] - 1), low, high, rms,
+                     equal_area_diameter(sec) / t["strand_d"] - 1, force, sf, speed,
+                     tuple(reasons), score)
+
+
+def select(p: Prototype, t: ScaledTargets, *, printer: str | None = None,
+           materials: tuple[str, ...] | None = None) -> Selection:
+    """Rank every material x layout for cables and net; best feasible first."""
+    printer_obj = load_printer(printer or p.model.printer or DEFAULT_PRINTER)
+    names = materials or p.model.materials or tuple(list_profiles("materials"))
+    mats = [load_material(n) for n in names]
+    net_style = load_print_style(p.model.net_print or DEFAULT_NET_PRINT)
+    cable_style = load_print_style(p.model.cable_print or DEFAULT_CABLE_PRINT)
+    for style, comp in ((net_style, "net"), (cable_style, "cable")):
+        if style.component != comp:
+            raise InputError(f"print style {style.key!r} is for {style.component}s, not {comp}s; "
+                             f"pick a {comp} style (printgen profiles list)")
+    nets = [net_candidate(p, t, m, s, printer_obj) for m in mats
+            for s in layouts(net_style, "net")]
+    cables = []
+    if p.border is not None:
+        cables = [cable_candidate(t, m, s, printer_obj) for m in mats
+                  for s in layouts(cable_style, "cable")]
+    cables, nets = _rank(cables), _rank(nets)
+    if not any(c.feasible for c in nets):
+        raise PrintabilityError(f"no material and pass layout can print the net on "
+                                f"{printer_obj.key}: {nets[0].reasons[0]}")
+    return Selection(tuple(cables), tuple(nets), _rationale(cables, "cable"),
+                     _rationale(nets, "net"), printer_obj.key, net_style.key, cable_style.key)
+
+
+def _rank(cands: list[Candidate]) -> list[Candidate]:
+    # ties (same material, same passes) go to the squarest section: closest to a round cable
+    def aspect(c: Candidate) -> float:
+        w, t = c.section.width_mm, c.section.thickness_mm
+        return max(w / t, t / w)
+
+    return sorted(cands, key=lambda c: (not c.feasible, round(c.score, SCORE_DIGITS), aspect(c),
+                                        c.material, c.section.passes))
+
+
+def _rationale(ranked: list[Candidate], what: str) -> str:
+    """One paragraph explaining the winner against the runner-up."""
+    if not ranked:
+        return f"The prototype has no border cables: no {what} to select."
+    best = ranked[0]
+    if not best.feasible:
+        return f"No {what} can be printed: {best.reasons[0]}"
+    sec = best.section
+    layout = (f"{sec.beads_across} bead(s) of {sec.bead_width_mm:g} mm across x "
+              f"{len(sec.layer_heights_mm)} layer(s) = {sec.width_mm:g} x {sec.thickness_mm:g} mm, "
+              f"{sec.passes} passes")
+    if what == "cable":
+        fit = (f"E*A = {best.stiffness:.4g} N against the target {best.target:.4g} N "
+               f"({best.error:+.1%})")
+    else:
+        fit = (f"membrane stiffness {best.stiffness:.4g} N/m against {best.target:.4g} N/m at "
+               f"small strain ({best.error:+.1%}), {best.error_low:+.0%} at "
+               f"{CHECK_STRAINS[0]:.0%} and {best.error_high:+.0%} at {CHECK_STRAINS[1]:.0%} "
+               f"strain (RMS log error {best.error_rms:.2f} over 1-40 %)")
+    basis = ("a measured printed value" if "measured" in best.modulus_source else
+             "only a DATASHEET modulus (printed parts are often 2x softer: calibrate it)")
+    others = [c for c in ranked[1:] if c.feasible and c.material != best.material]
+    vs = (f" The best other material, {others[0].material_name}, scores {others[0].score:.3f} "
+          f"against {best.score:.3f} ({others[0].error:+.1%})." if others else "")
+    return (f"{best.material_name}, {layout}: {fit}, based on {basis} "
+            f"({best.modulus_source}). Its equal-area diameter breaks Pi3 (d / h_B) by "
+            f"{best.pi3_deviation:+.0%}: the section is an equivalent one that keeps the "
+            f"stiffness, not the geometric diameter. Safety factor {best.safety_factor:.1f} "
+            f"against failure at the estimated peak force {best.peak_force:.3g} N (overflow "
+            f"{OVERFLOW:.0%}); flow-limited speed {best.speed_mm_per_s:.3g} mm/s.{vs}")
+
+
+def candidate_record(c: Candidate) -> dict:
+    """JSON-ready record of one candidate (stable keys)."""
+    s = c.section
+    return {
+        "material": c.material, "material_name": c.material_name,
+        "modulus_pa": c.modulus, "modulus_source": c.modulus_source,
+        "section": {"bead_width_mm": s.bead_width_mm, "beads_across": s.beads_across,
+                    "layer_heights_mm": list(s.layer_heights_mm), "width_mm": s.width_mm,
+                    "thickness_mm": s.thickness_mm, "passes": s.passes},
+        "stiffness": c.stiffness, "target": c.target, "error": c.error,
+        "error_low_strain": c.error_low, "error_high_strain": c.error_high,
+        "error_rms_log": c.error_rms, "pi3_deviation": c.pi3_deviation,
+        "peak_force_n": c.peak_force, "safety_factor": c.safety_factor,
+        "speed_mm_per_s": c.speed_mm_per_s, "feasible": c.feasible,
+        "reasons": list(c.reasons), "score": c.score,
+    }
+
+
+def selection_record(s: Selection) -> dict:
+    """JSON-ready record of the ranked selection (stable keys)."""
+    return {
+        "printer": s.printer, "net_print": s.net_print, "cable_print": s.cable_print,
+        "cable": {"rationale": s.cable_rationale,
+                  "ranked": [candidate_record(c) for c in s.cables]},
+        "net": {"rationale": s.net_rationale, "ranked": [candidate_record(c) for c in s.net]},
+    }

@@ -1,0 +1,171 @@
+"""Similitude targets of the model at scale 1/lambda (Lambert et al. 2023, section 2 of the
+printgen reference): Froude scaling in the same fluid, with stiffness scaled too.
+
+Every quantity q of the model is q_prototype * lambda**exponent; the exponents are those of the
+reference's scaling table. Reynolds number: Re = v R_h / nu with the hydraulic radius of the
+approach section R_h = w h / (w + 2 h) (the standard open-channel definition; the paper's
+v w_B h / nu is not dimensionless).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from printgen.errors import InputError
+from printgen.inputs.prototype import Prototype
+from printgen.units import NU_WATER, G
+
+RE_TURBULENT = 2500.0  # model flow must stay turbulent (reference, section 2)
+
+
+@dataclass(frozen=True)
+class TargetRow:
+    """One quantity of the scaling table: prototype and model values in `unit` (SI)."""
+
+    key: str
+    label: str
+    unit: str
+    exponent: float
+    prototype: float
+    model: float
+
+
+@dataclass(frozen=True)
+class FlowCheck:
+    """The model flow: Froude and Reynolds numbers, discharge, and warnings."""
+
+    velocity: float  # m/s
+    depth: float  # m
+    channel_width: float  # m
+    hydraulic_radius: float  # m
+    froude: float
+    reynolds: float
+    discharge: float  # m^3/s over the channel width
+    warnings: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class ScaledTargets:
+    """Targets of the model at 1/scale; `rows` keyed by `TargetRow.key` in `values`."""
+
+    scale: float
+    rows: tuple[TargetRow, ...]
+    pi_prototype: dict[str, float]
+    pi_model: dict[str, float]
+    flow: FlowCheck
+    values: dict[str, float] = field(repr=False)
+
+    def __getitem__(self, key: str) -> float:
+        return self.values[key]
+
+
+def check_scale(scale: float) -> float:
+    """Return scale as float; raise InputError unless it is finite and >= 1."""
+    if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not math.isfinite(scale):
+        raise InputError(f"scale = {scale!r} is not a finite number; give lambda >= 1, e.g. 40")
+    if scale < 1:
+        raise InputError(f"scale = {scale:g} is below 1; lambda is prototype / model "
+                         "(1:40 -> --scale 40), so it must be >= 1")
+    return float(scale)
+
+
+def prototype_quantities(p: Prototype) -> list[tuple[str, str, str, float, float]]:
+    """(key, label, unit, exponent, prototype value) of every scaled quantity."""
+    rho = p.density
+    q = [
+        ("width", "barrier width w_B", "m", -1, p.width),
+        ("height", "barrier height h_B", "m", -1, p.height),
+        ("mesh_x", "mesh diagonal across a_x", "m", -1, p.net.mesh_x),
+        ("mesh_y", "mesh diagonal up a_y", "m", -1, p.net.mesh_y),
+        ("strand_d", "net strand diameter d", "m", -1, p.net.strand_diameter),
+        ("strand_area", "net strand section A", "m^2", -2, math.pi / 4 * p.net.strand_diameter**2),
+        ("depth", "flow depth h", "m", -1, p.depth),
+        ("velocity", "flow velocity v_f", "m/s", -0.5, p.velocity),
+        ("time", "time", "s", -0.5, 1.0),
+        ("hydrostatic_force", "hydrostatic resultant at h = h_B", "N", -3,
+         0.5 * rho * G * p.height**2 * p.width),
+        ("drag_per_length", "drag per strand length", "N/m", -2,
+         0.5 * rho * p.velocity**2 * p.net.strand_diameter),
+        ("strain", "strain", "-", 0, 1.0),
+    ]
+    if p.net.strand_modulus is not None:
+        ea = p.net.strand_modulus * math.pi / 4 * p.net.strand_diameter**2
+        q += [("strand_modulus", "net strand modulus E", "Pa", -1, p.net.strand_modulus),
+              ("strand_ea", "net strand axial stiffness E*A", "N", -3, ea)]
+    if p.net.panel_law is not None:
+        _knees, kappas, length = p.net.panel_law
+        q.append(("panel_length", "net panel test length L_p", "m", -1, length))
+        for i, k in enumerate(kappas):
+            q.append((f"kappa_{i}", f"net panel stiffness kappa, segment {i + 1}", "N/m/m", -1, k))
+            q.append((f"membrane_{i}", f"membrane stiffness kappa*L_p, segment {i + 1}", "N/m",
+                      -2, k * length))
+    if p.border is not None:
+        area = math.pi / 4 * p.border.diameter**2
+        q += [("cable_d", "border cable diameter", "m", -1, p.border.diameter),
+              ("cable_area", "border cable section A", "m^2", -2, area),
+              ("cable_modulus", "border cable modulus E", "Pa", -1, p.border.modulus),
+              ("cable_ea", "border cable axial stiffness E*A", "N", -3, p.border.modulus * area)]
+    return q
+
+
+def scale_targets(p: Prototype, scale: float) -> ScaledTargets:
+    """Model targets at 1/scale, the five Pi groups of both, and the model flow check."""
+    lam = check_scale(scale)
+    rows = tuple(TargetRow(k, label, unit, e, v, v * lam**e if e else v)
+                 for k, label, unit, e, v in prototype_quantities(p))
+    values = {r.key: r.model for r in rows}
+    proto = {r.key: r.prototype for r in rows}
+    return ScaledTargets(lam, rows, pi_groups(proto, p), pi_groups(values, p),
+                         flow_check(p, values, lam), values)
+
+
+def pi_groups(v: dict[str, float], p: Prototype) -> dict[str, float]:
+    """Pi1..Pi5 of one scale. Pi5 uses the net strand modulus, else the border cable's."""
+    modulus = v.get("strand_modulus", v.get("cable_modulus", math.nan))
+    return {
+        "pi1_width_over_height": v["width"] / v["height"],
+        "pi2_mesh_over_height": v["mesh_x"] / v["height"],
+        "pi3_strand_d_over_height": v["strand_d"] / v["height"],
+        "pi4_froude": v["velocity"] / math.sqrt(G * v["height"]),
+        "pi5_modulus_over_dynamic_pressure": modulus / (p.density * v["velocity"] ** 2),
+    }
+
+
+def flow_check(p: Prototype, v: dict[str, float], lam: float) -> FlowCheck:
+    """Froude, Reynolds (hydraulic radius) and flume fit of the model flow."""
+    width = p.flume.width if p.flume else v["width"]
+    h, u = v["depth"], v["velocity"]
+    r_h = width * h / (width + 2 * h)
+    froude, reynolds = u / math.sqrt(G * h), u * r_h / NU_WATER
+    discharge = u * h * width
+    warn = []
+    if reynolds < RE_TURBULENT:
+        warn.append(f"model flow Re = {reynolds:.0f} is below {RE_TURBULENT:.0f}: not turbulent; "
+                    "use a smaller scale (lambda) or a faster, deeper flow")
+    if p.flume:
+        f = p.flume
+        if v["width"] > f.width:
+            warn.append(f"model barrier width {v['width'] * 1e3:.0f} mm exceeds the flume width "
+                        f"{f.width * 1e3:.0f} mm; use a larger lambda or a wider flume")
+        if discharge > f.max_discharge:
+            warn.append(f"model discharge {discharge * 1e3:.2f} L/s exceeds the flume's "
+                        f"{f.max_discharge * 1e3:.2f} L/s; lower the prototype velocity or depth "
+                        "or use a larger lambda")
+        if not f.froude_min <= froude <= f.froude_max:
+            warn.append(f"model Froude {froude:.2f} is outside the flume's range "
+                        f"{f.froude_min:g}-{f.froude_max:g}")
+    return FlowCheck(u, h, width, r_h, froude, reynolds, discharge, tuple(warn))
+
+
+def targets_record(t: ScaledTargets, name: str) -> dict:
+    """JSON-ready record of the targets (stable keys)."""
+    return {
+        "prototype": name,
+        "scale": t.scale,
+        "targets": {r.key: {"label": r.label, "unit": r.unit, "exponent": r.exponent,
+                            "prototype": r.prototype, "model": r.model} for r in t.rows},
+        "pi_groups": {"prototype": t.pi_prototype, "model": t.pi_model},
+        "flow": t.flow,
+        "warnings": list(t.flow.warnings),
+    }

@@ -1,0 +1,1 @@
+"""Inputs: the prototype file, its schema, and the profiles (materials, printers, print styles)."""

@@ -1,0 +1,156 @@
+"""Prototype barrier input files (TOML in `examples/`): geometry, net, border cables, flow, flume.
+
+Every key names its unit; unknown keys are errors listing the allowed keys; every value is
+range-checked where it is read. Values are SI in the dataclasses. An optional `[model]` table
+holds the lab's choices for the printed model (mesh, printer, print styles, materials).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from printgen.errors import InputError
+from printgen.inputs.schema import Field, load_toml, positive, read_table
+
+TOP = [Field("name", str), Field("description", str, required=False, default=""),
+       Field("barrier", dict), Field("net", dict), Field("border", dict, required=False),
+       Field("flow", dict), Field("flume", dict, required=False),
+       Field("model", dict, required=False, default={})]
+BARRIER = [positive("width_m", 1000.0), positive("height_m", 100.0),
+           Field("anchors", int, lo=0, hi=64, required=False, default=0)]
+NET = [
+    Field("pattern", str, choices=("square", "diamond", "water-drop")),
+    positive("mesh_x_m", 10.0, help="mesh diagonal (or square side) across the barrier"),
+    positive("mesh_y_m", 10.0, help="mesh diagonal (or square side) up the barrier"),
+    positive("strand_diameter_mm", 1000.0),
+    positive("strand_modulus_gpa", 500.0, required=False),
+    Field("pretension_n", float, lo=0.0, hi=1e9, required=False, default=0.0),
+    Field("panel_law", dict, required=False),
+]
+PANEL_LAW = [Field("knee_strain_percent", list, required=False, default=[]),
+             Field("kappa_kn_per_m_per_m", list), positive("panel_length_m", 100.0),
+             Field("source", str, required=False, default="")]
+BORDER = [positive("diameter_mm", 1000.0), positive("modulus_gpa", 500.0),
+          Field("sliding", bool, required=False, default=True),
+          Field("pretension_n", float, lo=0.0, hi=1e9, required=False, default=0.0)]
+FLOW = [positive("velocity_m_per_s", 50.0), positive("depth_m", 100.0, required=False),
+        positive("density_kg_per_m3", 3000.0, required=False, default=1000.0, si=False)]
+FLUME = [positive("width_m", 10.0), positive("max_discharge_l_per_s", 1e5),
+         positive("free_section_m", 10.0, required=False),
+         positive("froude_min", 10.0, si=False), positive("froude_max", 10.0, si=False)]
+MODEL = [positive("mesh_x_mm", 1000.0, si=False), positive("mesh_y_mm", 1000.0, si=False),
+         Field("printer", str, required=False), Field("net_print", str, required=False),
+         Field("cable_print", str, required=False),
+         Field("materials", list, required=False, default=[])]
+
+
+@dataclass(frozen=True)
+class NetSpec:
+    """Prototype net (SI). panel_law: (knee strains, kappas N/m/m, panel length m) or None."""
+
+    pattern: str
+    mesh_x: float
+    mesh_y: float
+    strand_diameter: float
+    strand_modulus: float | None
+    pretension: float
+    panel_law: tuple[tuple[float, ...], tuple[float, ...], float] | None
+
+
+@dataclass(frozen=True)
+class BorderSpec:
+    diameter: float
+    modulus: float
+    sliding: bool
+    pretension: float
+
+
+@dataclass(frozen=True)
+class FlumeSpec:
+    width: float
+    max_discharge: float  # m^3/s
+    free_section: float | None
+    froude_min: float
+    froude_max: float
+
+
+@dataclass(frozen=True)
+class ModelPrefs:
+    """The lab's choices for the printed model; None means: let printgen choose."""
+
+    mesh_x_mm: float | None = None
+    mesh_y_mm: float | None = None
+    printer: str | None = None
+    net_print: str | None = None
+    cable_print: str | None = None
+    materials: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Prototype:
+    """A full-scale barrier and its flow (SI)."""
+
+    name: str
+    description: str
+    width: float
+    height: float
+    anchors: int
+    net: NetSpec
+    border: BorderSpec | None
+    velocity: float
+    depth: float  # flow depth, = height unless given
+    density: float
+    flume: FlumeSpec | None
+    model: ModelPrefs = field(default_factory=ModelPrefs)
+    path: Path | None = None
+
+
+def load_prototype(path: str | Path) -> Prototype:
+    """Read and validate a prototype TOML file."""
+    p = Path(path)
+    where = str(p)
+    top = read_table(load_toml(p), TOP, where=where)
+    bar = read_table(top["barrier"], BARRIER, where=f"{where} [barrier]")
+    net = read_table(top["net"], NET, where=f"{where} [net]")
+    flow = read_table(top["flow"], FLOW, where=f"{where} [flow]")
+    law = _panel_law(net["panel_law"], f"{where} [net.panel_law]")
+    if law is None and net["strand_modulus"] is None:
+        raise InputError(f"{where} [net]: give strand_modulus_gpa or a [net.panel_law] table; "
+                         "the net's stiffness is otherwise unknown")
+    border = top["border"] and BorderSpec(**read_table(top["border"], BORDER,
+                                                       where=f"{where} [border]"))
+    flume = top["flume"] and FlumeSpec(**read_table(top["flume"], FLUME, where=f"{where} [flume]"))
+    model = read_table(top["model"], MODEL, where=f"{where} [model]") if top["model"] else {}
+    depth = flow["depth"] if flow["depth"] is not None else bar["height"]
+    for label, mesh in (("mesh_x_m", net["mesh_x"]), ("mesh_y_m", net["mesh_y"])):
+        limit = bar["width"] if label == "mesh_x_m" else bar["height"]
+        if mesh > limit / 2:
+            raise InputError(f"{where} [net]: {label} = {mesh:g} m exceeds half the barrier "
+                             f"({limit / 2:g} m); a net needs at least two meshes each way")
+    return Prototype(
+        name=top["name"], description=top["description"], width=bar["width"],
+        height=bar["height"], anchors=bar["anchors"],
+        net=NetSpec(net["pattern"], net["mesh_x"], net["mesh_y"], net["strand_diameter"],
+                    net["strand_modulus"], net["pretension"], law),
+        border=border or None, velocity=flow["velocity"], depth=depth,
+        density=flow["density_kg_per_m3"], flume=flume or None,
+        model=ModelPrefs(**{**model, "materials": tuple(model.get("materials") or ())}),
+        path=p,
+    )
+
+
+def _panel_law(raw: dict | None, where: str):
+    if raw is None:
+        return None
+    t = read_table(raw, PANEL_LAW, where=where)
+    knees, kappas = t["knee_strain_percent"], t["kappa_kn_per_m_per_m"]
+    values = [*knees, *kappas]
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) and v > 0 and v < 1e9
+               for v in values):
+        raise InputError(f"{where}: knee_strain_percent and kappa_kn_per_m_per_m must hold "
+                         "positive finite numbers")
+    if len(kappas) != len(knees) + 1 or sorted(knees) != list(knees):
+        raise InputError(f"{where}: give increasing knees and one kappa per segment "
+                         f"(got {len(knees)} knees, {len(kappas)} kappas)")
+    return (tuple(k / 100 for k in knees), tuple(k * 1e3 for k in kappas), t["panel_length"])

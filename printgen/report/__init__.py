@@ -1,0 +1,1 @@
+"""Report: JSON records, plots and the HTML report."""

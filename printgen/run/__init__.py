@@ -1,0 +1,1 @@
+"""Run: the `make` pipeline, step by step, into one output folder."""

@@ -1,0 +1,260 @@
+"""`printgen make`: prototype + lambda -> targets, selection, design, printable parts, slicer
+profiles, direct G-code, verification, report; every file staged and moved into the output
+directory only when every step succeeded (a failed run leaves the previous outputs intact).
+
+Steps are plain functions `step(ctx, stage)` run in order; each adds files under `stage` and
+numbers to `ctx.record`.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from printgen.design.plan import make_design
+from printgen.design.record import Design
+from printgen.design.selection import Selection, select
+from printgen.design.similitude import ScaledTargets, scale_targets
+from printgen.inputs.materials import load_material
+from printgen.inputs.printers import load_print_style, load_printer
+from printgen.inputs.prototype import Prototype, load_prototype
+from printgen.outputs import staged_dir
+from printgen.report.html import Report
+from printgen.report.jsonout import dumps
+from printgen.report.report import design_record, design_sections
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class MakeContext:
+    """What the steps share: inputs, the chosen design, the report being built."""
+
+    prototype: Prototype
+    targets: ScaledTargets
+    selection: Selection
+    design: Design
+    report: Report
+    options: dict[str, Any]
+    record: dict[str, Any] = field(default_factory=dict)
+    files: list[str] = field(default_factory=list)
+
+
+Step = Callable[[MakeContext, Path], None]
+
+
+def plan(prototype_path: str | Path, scale: float, *, printer: str | None = None,
+         options: dict[str, Any] | None = None) -> MakeContext:
+    """Targets, selection and design: the fast, file-free part of `make`."""
+    proto = load_prototype(prototype_path)
+    t = scale_targets(proto, scale)
+    sel = select(proto, t, printer=printer)
+    design = make_design(proto, t, sel)
+    rep = Report(f"printgen: {proto.name} at 1:{t.scale:g}")
+    design_sections(rep, proto, t, sel, design)
+    ctx = MakeContext(proto, t, sel, design, rep, options or {})
+    ctx.record.update(design_record(proto, t, sel, design))
+    return ctx
+
+
+def gcode_step(ctx: MakeContext, stage: Path) -> None:
+    """Direct G-code for the net and each cable, checked by read-back against the design."""
+    from printgen.parts.gcode.readback import read_gcode_text
+    from printgen.parts.gcode.toolpath import cable_toolpath, net_toolpath
+    from printgen.parts.gcode.writer import gcode_text
+
+    d = ctx.design
+    printer = load_printer(d.printer)
+    parts = [("net", d.net, net_toolpath)] + [(f"cable-{c.name}", c, cable_toolpath)
+                                              for c in d.cables]
+    rows, rec = [], {}
+    for name, part, build in parts:
+        mat, style = load_material(part.material), load_print_style(part.print_style)
+        t0 = time.perf_counter()
+        tp = build(part, printer, style, mat)
+        text = gcode_text(tp, printer, mat, title=f"{name}, 1:{d.scale:g}")
+        back = read_gcode_text(text, filament_diameter_mm=printer.filament_diameter_mm)
+        seconds = time.perf_counter() - t0
+        path = stage / f"{name}.gcode"
+        path.write_text(text)
+        ctx.files.append(path.name)
+        err = back.volume_mm3 / tp.volume_mm3 - 1
+        rec[name] = {"file": path.name, "layers": len(back.layer_z_mm),
+                     "volume_mm3": tp.volume_mm3, "readback_volume_mm3": back.volume_mm3,
+                     "readback_error": err, "seconds": seconds}
+        rows.append([name, path.name, str(len(back.layer_z_mm)), f"{tp.volume_mm3:.1f}",
+                     f"{err:+.2%}", f"{seconds:.2f}"])
+    ctx.record["gcode"] = rec
+    ctx.report.heading("Direct G-code")
+    ctx.report.paragraph("Every net strand is one straight extrusion through the crossings, the "
+                         "strand families alternate per pass; the G-code is read back and its "
+                         "extruded volume compared with the toolpath's.")
+    ctx.report.table(["part", "file", "layers", "volume mm^3", "read-back error", "time s"], rows)
+
+
+def slicer_step(ctx: MakeContext, stage: Path) -> None:
+    """PrusaSlicer .ini for every part and CuraEngine settings for the cables."""
+    from printgen.parts.slicer.cura import cura_cfg_text
+    from printgen.parts.slicer.prusa import prusa_ini_text
+
+    d = ctx.design
+    printer = load_printer(d.printer)
+    written = []
+    for kind, name, part in [("net", "net", d.net)] + [("cable", f"cable-{c.name}", c)
+                                                       for c in d.cables]:
+        mat, style = load_material(part.material), load_print_style(part.print_style)
+        ini = stage / f"{name}.prusa.ini"
+        ini.write_text(prusa_ini_text(kind, part, printer, style, mat))
+        written.append(ini.name)
+        if kind == "cable":
+            cfg = stage / f"{name}.cura.cfg"
+            cfg.write_text(cura_cfg_text(kind, part, printer, style, mat))
+            written.append(cfg.name)
+    ctx.files += written
+    ctx.record["slicer_profiles"] = written
+
+
+def parts_step(ctx: MakeContext, stage: Path) -> None:
+    """Watertight meshes of every part: STL, a 3MF carrying its PrusaSlicer settings, and
+    STEP when asked (--step, needs cadquery)."""
+    from printgen.parts.export import (
+        layout_parts,
+        place_mesh,
+        prusa_config_from_ini,
+        stl_bytes,
+        threemf_bytes,
+    )
+    from printgen.parts.geometry.solid import (
+        analytic_cable_volume,
+        analytic_net_volume,
+        cable_outline,
+        cable_solid,
+        net_outline,
+        net_solid,
+    )
+    from printgen.parts.slicer.prusa import prusa_ini_text
+
+    d = ctx.design
+    printer = load_printer(d.printer)
+    parts = [("net", "net", d.net, net_solid, net_outline, analytic_net_volume)]
+    parts += [(f"cable-{c.name}", "cable", c, cable_solid, cable_outline, analytic_cable_volume)
+              for c in d.cables]
+    rows, rec = [], {}
+    for name, kind, part, solid, outline, analytic in parts:
+        mat, style = load_material(part.material), load_print_style(part.print_style)
+        mesh, angle = place_mesh(solid(part), printer, name)
+        ini = prusa_ini_text(kind, part, printer, style, mat)
+        (stage / f"{name}.stl").write_bytes(stl_bytes(mesh))
+        (stage / f"{name}.3mf").write_bytes(threemf_bytes([(name, mesh)],
+                                                           prusa_config_from_ini(ini)))
+        files = [f"{name}.stl", f"{name}.3mf"]
+        if ctx.options.get("step"):
+            from printgen.parts.geometry.cad import step_bytes
+
+            (stage / f"{name}.step").write_bytes(step_bytes(outline(part),
+                                                            part_thickness(kind, part)))
+            files.append(f"{name}.step")
+        ctx.files += files
+        expected = analytic(part)
+        size = mesh.bounds[1] - mesh.bounds[0]
+        rec[name] = {"files": files, "volume_mm3": float(mesh.volume),
+                     "analytic_volume_mm3": expected,
+                     "volume_error": float(mesh.volume) / expected - 1,
+                     "size_mm": np.round(size, 4), "triangles": len(mesh.faces),
+                     "watertight": bool(mesh.is_watertight), "bed_angle_deg": angle}
+        rows.append([name, f"{size[0]:.1f} x {size[1]:.1f} x {size[2]:.2f}",
+                     f"{mesh.volume:.1f}", f"{float(mesh.volume) / expected - 1:+.2%}",
+                     str(len(mesh.faces)), f"{angle:g}"])
+    if d.cables:  # every cable on one plate: one print job, with the cables' settings
+        c = d.cables[0]
+        ini = prusa_ini_text("cable", c, printer, load_print_style(c.print_style),
+                             load_material(c.material))
+        placed = layout_parts([(f"cable-{c.name}", cable_solid(c)) for c in d.cables], printer)
+        (stage / "cables-plate.3mf").write_bytes(threemf_bytes(
+            [(p.name, p.mesh) for p in placed], prusa_config_from_ini(ini)))
+        ctx.files.append("cables-plate.3mf")
+        rec["cables-plate"] = {"files": ["cables-plate.3mf"],
+                               "parts": {p.name: p.angle_deg for p in placed}}
+    ctx.record["parts"] = rec
+    ctx.report.heading("Meshes")
+    ctx.report.paragraph("One watertight body per part (STL, and a 3MF that opens in "
+                         "PrusaSlicer with the part's settings), placed on the printer bed.")
+    ctx.report.table(["part", "size on bed (mm)", "volume mm^3", "vs analytic", "triangles",
+                      "turned (deg)"], rows)
+
+
+def part_thickness(kind: str, part) -> float:
+    return (part.strand if kind == "net" else part.section).thickness_mm
+
+
+def verify_step(ctx: MakeContext, stage: Path) -> None:
+    """Prototype vs model over the loading sweep, and the steel counter-example.
+
+    The sweep is the scene realistic-1:40 (barrier-physics.md, section 7): it needs border
+    cables. A barrier without them gets the counter-example and a note saying so.
+    """
+    from printgen.check.verify import steel_counterexample, verify
+    from printgen.report.report import verification_record, verification_sections
+
+    if not ctx.design.cables:
+        ce = steel_counterexample(ctx.targets.scale)
+        note = ("not run: the prototype-vs-model sweep is defined for barriers with border "
+                "cables (scene realistic-1:40); a net anchored along its bed and banks with no "
+                "pretension is degenerate at low water levels and printgen's solver does not "
+                "converge there. Use examples/scale_series.py for such barriers.")
+        verification_sections(ctx.report, None, ce, ctx.targets.scale, note=note)
+        ctx.record["verification"] = {"verdict": "NOT RUN", "summary": note,
+                                      "counterexample": ce}
+        return
+    v = verify(ctx.prototype, ctx.design, drag=bool(ctx.options.get("drag")),
+               counterexample=True)
+    verification_sections(ctx.report, v, v.counterexample, ctx.targets.scale)
+    ctx.record["verification"] = verification_record(v, v.counterexample)
+
+
+def make(prototype_path: str | Path, scale: float, out: str | Path, *,
+         printer: str | None = None, steps: list[tuple[str, Step]] | None = None,
+         options: dict[str, Any] | None = None,
+         progress: Callable[[str], None] | None = None) -> MakeContext:
+    """Run every step into a staging directory; move the files into `out` at the end."""
+    t0 = time.perf_counter()
+    ctx = plan(prototype_path, scale, printer=printer, options=options)
+    with staged_dir(out) as stage:
+        for label, step in steps if steps is not None else default_steps():
+            if progress:
+                progress(label)
+            t = time.perf_counter()
+            step(ctx, stage)
+            ctx.record.setdefault("timings_s", {})[label] = time.perf_counter() - t
+        ctx.record["files"] = sorted([*ctx.files, "report.html", "report.json", "design.json"])
+        (stage / "design.json").write_text(dumps(ctx.design.to_dict()))
+        (stage / "report.json").write_text(dumps(_stable(ctx.record)))
+        (stage / "report.html").write_text(ctx.report.html())
+    log.info("make finished in %.2f s", time.perf_counter() - t0)
+    return ctx
+
+
+def _stable(record: dict[str, Any]) -> dict[str, Any]:
+    """The record without wall-clock times, so the same input gives byte-identical JSON."""
+    drop = {"timings_s", "seconds", "time_s"}
+
+    def clean(v: Any) -> Any:
+        if isinstance(v, dict):
+            return {k: clean(x) for k, x in v.items() if k not in drop}
+        if isinstance(v, list):
+            return [clean(x) for x in v]
+        return v
+
+    return clean(record)
+
+
+def default_steps() -> list[tuple[str, Step]]:
+    return [("meshes (STL, 3MF)", parts_step), ("slicer profiles", slicer_step),
+            ("direct G-code", gcode_step),
+            ("verification (prototype and model load sweeps)", verify_step)]
