@@ -4,4 +4,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh --with-slicers
 export PRINTGEN_REQUIRE_SLICERS=1   # slicer tests fail, not skip, when a slicer is missing
+# ../shared tests (G-code checker, tensile exports) fail, not skip, when ../shared sits beside the
+# clone or PRINTGEN_REQUIRE_SHARED=1 is given (.ci/run); a clone with nothing beside it skips them.
+export PRINTGEN_REQUIRE_SHARED="${PRINTGEN_REQUIRE_SHARED:-$([[ -d ../shared ]] && echo 1 || echo 0)}"
 exec .venv/bin/python -m pytest -n auto --dist loadfile "$@"
