@@ -2,6 +2,37 @@
 
 Based on Lambert et al., "Small-Scale Modeling of Flexible Barriers. I: Mechanical Similitude
 of the Structure", J. Hydraul. Eng. 149(3), 2023, doi:10.1061/JHEND8.HYENG-13070.
+
+The public verbs (`printgen.run.api`), imported on first use so `import printgen` stays fast:
+
+- ``targets(prototype, scale)`` -> `ScaledTargets`
+- ``select(prototype, scale)`` -> `Selection`
+- ``plan(prototype, scale)`` -> `Design` (the printable design `make` writes)
+- ``make(prototype, scale, out)`` -> `MakeContext` (files in `out`)
+- ``verify(prototype, scale, design=None)`` -> `Verification`
+- ``calibrate(paths, material=...)`` -> `Calibration`
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
 __version__ = "0.1.0"
+
+VERBS = ("targets", "select", "plan", "make", "verify", "calibrate")
+__all__ = ["__version__", "calibrate", "make", "plan", "select", "targets", "verify"]
+
+if TYPE_CHECKING:
+    from printgen.run.api import calibrate, make, plan, select, targets, verify
+
+
+def __getattr__(name: str) -> Any:
+    if name in VERBS:
+        from printgen.run import api
+
+        return getattr(api, name)
+    raise AttributeError(f"module 'printgen' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), *VERBS])

@@ -11,7 +11,7 @@ from pathlib import Path
 from rich.console import Console
 
 from printgen.commands.common import add_json_arg, add_prototype_args, console, emit_json, table
-from printgen.run.make import make
+from printgen.run import api
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -32,9 +32,8 @@ def run(args: argparse.Namespace) -> int:
     err = Console(stderr=True, highlight=False)
     t0 = time.perf_counter()
     with err.status("planning") as status:
-        ctx = make(args.prototype, args.scale, out, printer=args.printer,
-                   options={"drag": args.drag, "step": args.step},
-                   progress=lambda label: status.update(f"{label} ..."))
+        ctx = api.make(args.prototype, args.scale, out, printer=args.printer, drag=args.drag,
+                       step=args.step, progress=lambda label: status.update(f"{label} ..."))
     seconds = time.perf_counter() - t0
     if args.json:
         emit_json(ctx.record)

@@ -12,9 +12,9 @@ from printgen.commands.common import (
     fmt,
     table,
 )
-from printgen.design.selection import Candidate, Selection, select, selection_record
-from printgen.design.similitude import scale_targets
+from printgen.design.selection import Candidate, Selection
 from printgen.inputs.prototype import load_prototype
+from printgen.run import api
 
 SHOW = 8  # candidates shown per component in the table (all are in --json)
 
@@ -32,11 +32,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     proto = load_prototype(args.prototype)
-    t = scale_targets(proto, args.scale)
-    s = select(proto, t, printer=args.printer,
-               materials=tuple(args.materials) if args.materials else None)
+    s = api.select(proto, args.scale, printer=args.printer, materials=args.materials)
     if args.json:
-        emit_json({"prototype": proto.name, "scale": t.scale, **selection_record(s)})
+        emit_json({"prototype": proto.name, "scale": args.scale, **s.to_record()})
         return 0
     show_selection(s, None if args.all else SHOW)
     return 0

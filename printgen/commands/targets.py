@@ -12,8 +12,8 @@ from printgen.commands.common import (
     fmt,
     table,
 )
-from printgen.design.similitude import ScaledTargets, scale_targets, targets_record
-from printgen.inputs.prototype import load_prototype
+from printgen.design.similitude import ScaledTargets
+from printgen.run import api
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -24,12 +24,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    proto = load_prototype(args.prototype)
-    t = scale_targets(proto, args.scale)
+    t = api.targets(args.prototype, args.scale)
     if args.json:
-        emit_json(targets_record(t, proto.name))
+        emit_json(t.to_record())
         return 0
-    show_targets(proto.name, t)
+    show_targets(t.prototype, t)
     return 0
 
 

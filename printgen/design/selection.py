@@ -73,6 +73,23 @@ class Candidate:
     reasons: tuple[str, ...]
     score: float
 
+    def to_record(self) -> dict:
+        """JSON-ready record of this candidate (stable keys)."""
+        s = self.section
+        return {
+            "material": self.material, "material_name": self.material_name,
+            "modulus_pa": self.modulus, "modulus_source": self.modulus_source,
+            "section": {"bead_width_mm": s.bead_width_mm, "beads_across": s.beads_across,
+                        "layer_heights_mm": list(s.layer_heights_mm), "width_mm": s.width_mm,
+                        "thickness_mm": s.thickness_mm, "passes": s.passes},
+            "stiffness": self.stiffness, "target": self.target, "error": self.error,
+            "error_low_strain": self.error_low, "error_high_strain": self.error_high,
+            "error_rms_log": self.error_rms, "pi3_deviation": self.pi3_deviation,
+            "peak_force_n": self.peak_force, "safety_factor": self.safety_factor,
+            "speed_mm_per_s": self.speed_mm_per_s, "feasible": self.feasible,
+            "reasons": list(self.reasons), "score": self.score,
+        }
+
     @property
     def feasible(self) -> bool:
         return not self.reasons
@@ -97,6 +114,15 @@ class Selection:
     @property
     def net_choice(self) -> Candidate:
         return self.net[0]
+
+    def to_record(self) -> dict:
+        """JSON-ready record of the ranked selection (stable keys)."""
+        return {
+            "printer": self.printer, "net_print": self.net_print, "cable_print": self.cable_print,
+            "cable": {"rationale": self.cable_rationale,
+                      "ranked": [c.to_record() for c in self.cables]},
+            "net": {"rationale": self.net_rationale, "ranked": [c.to_record() for c in self.net]},
+        }
 
 
 def layouts(style: PrintStyle, component: str) -> list[Section]:
@@ -277,31 +303,3 @@ def _rationale(ranked: list[Candidate], what: str) -> str:
             f"stiffness, not the geometric diameter. Safety factor {best.safety_factor:.1f} "
             f"against failure at the estimated peak force {best.peak_force:.3g} N (overflow "
             f"{OVERFLOW:.0%}); flow-limited speed {best.speed_mm_per_s:.3g} mm/s.{vs}")
-
-
-def candidate_record(c: Candidate) -> dict:
-    """JSON-ready record of one candidate (stable keys)."""
-    s = c.section
-    return {
-        "material": c.material, "material_name": c.material_name,
-        "modulus_pa": c.modulus, "modulus_source": c.modulus_source,
-        "section": {"bead_width_mm": s.bead_width_mm, "beads_across": s.beads_across,
-                    "layer_heights_mm": list(s.layer_heights_mm), "width_mm": s.width_mm,
-                    "thickness_mm": s.thickness_mm, "passes": s.passes},
-        "stiffness": c.stiffness, "target": c.target, "error": c.error,
-        "error_low_strain": c.error_low, "error_high_strain": c.error_high,
-        "error_rms_log": c.error_rms, "pi3_deviation": c.pi3_deviation,
-        "peak_force_n": c.peak_force, "safety_factor": c.safety_factor,
-        "speed_mm_per_s": c.speed_mm_per_s, "feasible": c.feasible,
-        "reasons": list(c.reasons), "score": c.score,
-    }
-
-
-def selection_record(s: Selection) -> dict:
-    """JSON-ready record of the ranked selection (stable keys)."""
-    return {
-        "printer": s.printer, "net_print": s.net_print, "cable_print": s.cable_print,
-        "cable": {"rationale": s.cable_rationale,
-                  "ranked": [candidate_record(c) for c in s.cables]},
-        "net": {"rationale": s.net_rationale, "ranked": [candidate_record(c) for c in s.net]},
-    }

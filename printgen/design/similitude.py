@@ -55,9 +55,22 @@ class ScaledTargets:
     pi_model: dict[str, float]
     flow: FlowCheck
     values: dict[str, float] = field(repr=False)
+    prototype: str = ""  # the prototype's name
 
     def __getitem__(self, key: str) -> float:
         return self.values[key]
+
+    def to_record(self) -> dict:
+        """JSON-ready record of the targets (stable keys)."""
+        return {
+            "prototype": self.prototype,
+            "scale": self.scale,
+            "targets": {r.key: {"label": r.label, "unit": r.unit, "exponent": r.exponent,
+                                "prototype": r.prototype, "model": r.model} for r in self.rows},
+            "pi_groups": {"prototype": self.pi_prototype, "model": self.pi_model},
+            "flow": self.flow,
+            "warnings": list(self.flow.warnings),
+        }
 
 
 def check_scale(scale: float) -> float:
@@ -117,7 +130,7 @@ def scale_targets(p: Prototype, scale: float) -> ScaledTargets:
     values = {r.key: r.model for r in rows}
     proto = {r.key: r.prototype for r in rows}
     return ScaledTargets(lam, rows, pi_groups(proto, p), pi_groups(values, p),
-                         flow_check(p, values, lam), values)
+                         flow_check(p, values, lam), values, p.name)
 
 
 def pi_groups(v: dict[str, float], p: Prototype) -> dict[str, float]:
@@ -156,16 +169,3 @@ def flow_check(p: Prototype, v: dict[str, float], lam: float) -> FlowCheck:
             warn.append(f"model Froude {froude:.2f} is outside the flume's range "
                         f"{f.froude_min:g}-{f.froude_max:g}")
     return FlowCheck(u, h, width, r_h, froude, reynolds, discharge, tuple(warn))
-
-
-def targets_record(t: ScaledTargets, name: str) -> dict:
-    """JSON-ready record of the targets (stable keys)."""
-    return {
-        "prototype": name,
-        "scale": t.scale,
-        "targets": {r.key: {"label": r.label, "unit": r.unit, "exponent": r.exponent,
-                            "prototype": r.prototype, "model": r.model} for r in t.rows},
-        "pi_groups": {"prototype": t.pi_prototype, "model": t.pi_model},
-        "flow": t.flow,
-        "warnings": list(t.flow.warnings),
-    }

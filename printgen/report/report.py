@@ -9,8 +9,8 @@ import numpy as np
 
 from printgen.check.verify import CounterExample, Verification
 from printgen.design.record import Design
-from printgen.design.selection import Candidate, Selection, selection_record
-from printgen.design.similitude import ScaledTargets, targets_record
+from printgen.design.selection import Candidate, Selection
+from printgen.design.similitude import ScaledTargets
 from printgen.inputs.prototype import Prototype
 from printgen.report.html import Report
 
@@ -65,7 +65,7 @@ def _row(rank: int, c: Candidate) -> list[str]:
 def design_record(proto: Prototype, t: ScaledTargets, sel: Selection,
                   design: Design) -> dict[str, Any]:
     """The JSON part of the report for targets, selection and design."""
-    return {"targets": targets_record(t, proto.name), "selection": selection_record(sel),
+    return {"targets": t.to_record(), "selection": sel.to_record(),
             "design": design.to_dict()}
 
 

@@ -1,0 +1,93 @@
+"""printgen's public verbs: what the CLI commands call, and what a notebook or script calls.
+
+Each verb takes a prototype (a TOML path or an already loaded `Prototype`) and the scale
+lambda, and returns the same dataclasses the CLI prints. `printgen/__init__.py` exposes them
+lazily, so `import printgen` stays fast::
+
+    import printgen
+    t = printgen.targets("examples/realistic_barrier.toml", 40)
+    s = printgen.select("examples/realistic_barrier.toml", 40)
+    v = printgen.verify("examples/realistic_barrier.toml", 40)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from printgen.design.plan import make_design
+from printgen.design.record import Design
+from printgen.design.selection import Selection
+from printgen.design.selection import select as _select
+from printgen.design.similitude import ScaledTargets, scale_targets
+from printgen.inputs.prototype import Prototype, load_prototype
+
+if TYPE_CHECKING:
+    from printgen.calibrate.pipeline import Calibration
+    from printgen.calibrate.sample import FitOptions
+    from printgen.check.verify import Verification
+    from printgen.run.make import MakeContext
+
+PrototypeLike = str | Path | Prototype
+
+
+def prototype_of(prototype: PrototypeLike) -> Prototype:
+    """A loaded prototype: `prototype` itself, or the TOML file it names."""
+    return prototype if isinstance(prototype, Prototype) else load_prototype(prototype)
+
+
+def targets(prototype: PrototypeLike, scale: float) -> ScaledTargets:
+    """Similitude targets of the model at 1:`scale` (lengths 1/lambda, forces lambda^-3, ...),
+    with the Pi groups of both barriers and the Froude/Reynolds check of the model flow."""
+    return scale_targets(prototype_of(prototype), scale)
+
+
+def select(prototype: PrototypeLike, scale: float, *, printer: str | None = None,
+           materials: Sequence[str] | None = None) -> Selection:
+    """Every material x pass layout for the border cables and the net, ranked against the
+    targets at 1:`scale`; `printer` and `materials` name profiles (default: the prototype's)."""
+    p = prototype_of(prototype)
+    return _select(p, scale_targets(p, scale), printer=printer,
+                   materials=tuple(materials) if materials else None)
+
+
+def plan(prototype: PrototypeLike, scale: float, *, printer: str | None = None) -> Design:
+    """The printable design that `make` writes: the selection's choice, sized for the model.
+    (Named `plan`, not `design`: `printgen.design` is the design stage's package.)"""
+    p = prototype_of(prototype)
+    t = scale_targets(p, scale)
+    return make_design(p, t, _select(p, t, printer=printer))
+
+
+def make(prototype: str | Path, scale: float, out: str | Path, *,
+         printer: str | None = None, drag: bool = False, step: bool = False,
+         options: dict[str, Any] | None = None,
+         progress: Callable[[str], None] | None = None) -> MakeContext:
+    """Targets, selection, parts (STL, 3MF, slicer profiles, G-code), the pre-print
+    verification and the report, written into the folder `out` as one whole run."""
+    from printgen.run.make import make as _make
+
+    opts = {"drag": drag, "step": step, **(options or {})}
+    return _make(prototype, scale, out, printer=printer, options=opts, progress=progress)
+
+
+def verify(prototype: PrototypeLike, scale: float, design_: Design | None = None, *,
+           printer: str | None = None, drag: bool = False) -> Verification:
+    """The pre-print check: prototype and printed model solved under the same relative
+    loading, h/h_B = 0 to 1.1, and compared by their normalised deformations. Without a
+    `design_`, the design `make` would print is checked."""
+    from printgen.check.verify import verify as _verify
+
+    p = prototype_of(prototype)
+    d = design_ if design_ is not None else plan(p, scale, printer=printer)
+    return _verify(p, d, drag=drag)
+
+
+def calibrate(paths: Sequence[str | Path], *, material: str,
+              options: FitOptions | None = None, **kwargs: Any) -> Calibration:
+    """Moduli, strength and panel laws of a material from tensile-test exports (see
+    `printgen.calibrate.pipeline.calibrate` for every keyword)."""
+    from printgen.calibrate.pipeline import calibrate as _calibrate
+
+    return _calibrate(paths, material=material, options=options, **kwargs)
