@@ -1,0 +1,110 @@
+"""The layout by stage (shared/design.md, README "Where things live"): data moves down the flow
+run -> report -> check -> parts -> design -> inputs -> ground floor; a lower stage never imports
+a higher one, and solver/ never imports printgen. Imports are read with `ast`, so a lazy import
+inside a function counts as much as one at the top of a module."""
+
+from __future__ import annotations
+
+import ast
+import shutil
+from pathlib import Path
+
+import pytest
+from conftest import ROOT
+
+# Rank of each part of printgen: a module may import only parts of equal or lower rank.
+RANK = {
+    "errors": 0, "units": 0, "outputs": 0, "workers": 0,  # ground floor
+    "inputs": 1,
+    "calibrate": 2,  # tensile exports -> material profiles: feeds inputs, sits beside design
+    "design": 2,
+    "parts": 3,
+    "check": 4,
+    "report": 5,
+    "run": 6,
+    "commands": 7, "cli": 7, "__main__": 7, "__init__": 7,  # the CLI and the public verbs
+}
+TOP_LEVEL_MODULES_MAX = 8  # issue 17: at most 8 modules at printgen/'s top level
+
+
+def part_of(module: str) -> str:
+    """'printgen.check.verify' -> 'check'; 'printgen' -> '__init__'."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else "__init__"
+
+
+def imported_modules(path: Path, package: str) -> list[tuple[int, str]]:
+    """(line, absolute module name) of every import in the file, relative ones resolved."""
+    tree = ast.parse(path.read_text("utf-8"), filename=str(path))
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            out += [(node.lineno, a.name) for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                anchor = package.split(".")[: len(package.split(".")) - node.level + 1]
+                base = ".".join([*anchor, base] if base else anchor)
+            out.append((node.lineno, base))
+            out += [(node.lineno, f"{base}.{a.name}") for a in node.names
+                    if base == "printgen"]  # `from printgen import outputs`
+    return out
+
+
+def layout_violations(root: Path) -> list[str]:
+    """Every import in root/printgen that runs up the flow, and any printgen import in
+    root/solver, as 'file:line: what'."""
+    bad = []
+    for path in sorted((root / "printgen").rglob("*.py")):
+        rel = path.relative_to(root)
+        module = ".".join(rel.with_suffix("").parts)
+        package = module if path.name == "__init__.py" else module.rsplit(".", 1)[0]
+        mine = part_of(module.removesuffix(".__init__"))
+        for line, name in imported_modules(path, package):
+            if name == "printgen" or not name.startswith("printgen."):
+                continue
+            theirs = part_of(name)
+            if RANK.get(theirs, 99) > RANK.get(mine, -1):
+                bad.append(f"{rel}:{line}: {mine} (rank {RANK.get(mine)}) imports {name} "
+                           f"({theirs}, rank {RANK.get(theirs)})")
+    for path in sorted((root / "solver").rglob("*.py")):
+        for line, name in imported_modules(path, "solver"):
+            if name.split(".")[0] == "printgen":
+                bad.append(f"{path.relative_to(root)}:{line}: solver imports {name}")
+    return bad
+
+
+def test_no_import_runs_up_the_flow():
+    assert layout_violations(ROOT) == []
+
+
+def test_every_part_has_a_rank():
+    """A new top-level module or folder must be placed in the flow (added to RANK)."""
+    names = {p.stem for p in (ROOT / "printgen").iterdir()
+             if (p.suffix == ".py" or (p.is_dir() and (p / "__init__.py").exists()))}
+    assert names - set(RANK) == set()
+
+
+def test_top_level_stays_small():
+    modules = sorted(p.name for p in (ROOT / "printgen").glob("*.py"))
+    assert len(modules) <= TOP_LEVEL_MODULES_MAX, modules
+
+
+@pytest.mark.parametrize(("victim", "line", "expected"), [
+    ("printgen/inputs/schema.py", "from printgen.run.make import make\n", "inputs (rank 1)"),
+    ("printgen/parts/geometry/net.py", "    from printgen.check import verify\n",
+     "printgen.check"),
+    ("solver/laws.py", "import printgen.units\n", "solver imports printgen.units"),
+])
+def test_a_wrong_import_is_caught(tmp_path, victim, line, expected):
+    """The check fails on a deliberately wrong import in a copy of the tree."""
+    for top in ("printgen", "solver"):
+        shutil.copytree(ROOT / top, tmp_path / top,
+                        ignore=shutil.ignore_patterns("__pycache__"))
+    target = tmp_path / victim
+    text = target.read_text("utf-8")
+    if line.startswith(" "):  # a lazy import inside a function body
+        line = "def _lazy():\n" + line
+    target.write_text(text + "\n\n" + line)
+    found = layout_violations(tmp_path)
+    assert len(found) == 1 and expected in found[0], found
