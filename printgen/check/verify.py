@@ -36,12 +36,14 @@ def levels(step: float = LEVEL_STEP, top: float = OVERFLOW) -> np.ndarray:
     return np.round(np.linspace(0.0, top, n + 1), 10)
 
 
-def solver_net(s: BarrierScene) -> solver.Net:
+def solver_net(s: BarrierScene, *, slack: float = 0.0) -> solver.Net:
+    """The scene as a solver net; `slack` is the relative initial slack of every strand and
+    cable (0.01 = rest lengths 1 % longer than the printed ones)."""
     laws = [solver.piecewise(k, sl) for k, sl in s.laws]
     cables = [solver.SlidingCable(nodes, solver.piecewise(*law))
               for nodes, law in s.cables.values()]
     return solver.Net(s.nodes, s.fixed, s.elements, laws, element_law=s.element_law,
-                      cables=cables)
+                      cables=cables, slack=slack)
 
 
 def loads_function(s: BarrierScene, *, velocity: float | None = None,
@@ -82,11 +84,11 @@ class Run:
     failed: dict[float, str]  # load levels that did not converge -> the solver's reason
 
 
-def sweep(s: BarrierScene, lv: np.ndarray, **load_kw) -> Run:
+def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw) -> Run:
     """Solve the load path; raise SolverError when a level cannot be reached."""
     t0 = time.perf_counter()
-    results = solver.solve_path(solver_net(s), loads_function(s, **load_kw), lv, tol=SOLVER_TOL,
-                                max_cuts=PATH_CUTS, skip_failed=True)
+    results = solver.solve_path(solver_net(s, slack=slack), loads_function(s, **load_kw), lv,
+                                tol=SOLVER_TOL, max_cuts=PATH_CUTS, skip_failed=True)
     failed = {float(r.level): r.reason for r in results if not r.converged}
     if len(failed) > MAX_FAILED_FRACTION * len(lv):
         raise SolverError(f"{s.name}: {len(failed)} of {len(lv)} load levels did not converge; "
