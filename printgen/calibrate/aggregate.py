@@ -1,17 +1,15 @@
 """Statistics over samples: mean, sample standard deviation (ddof = 1), count, outliers.
 
 Outliers are flagged (not removed) with the modified z-score of Iglewicz and Hoaglin,
-|0.6745 (x - median) / MAD| > 3.5, when also more than 1 % from the median; fewer than `MIN_SAMPLES` samples give a warning.
+|0.6745 (x - median) / MAD| > 3.5, when also more than 1 % from the median, and only from
+`MIN_SAMPLES` samples on: fewer give mean and SD only ("n = 3: spread only").
 """
 
 from __future__ import annotations
 
-import logging
 from dataclasses import dataclass
 
 import numpy as np
-
-log = logging.getLogger(__name__)
 
 MIN_SAMPLES = 5  # ISO 527-1 asks for at least five specimens per direction
 OUTLIER_Z = 3.5  # modified z-score above which a sample is flagged (Iglewicz & Hoaglin 1993)
@@ -36,24 +34,30 @@ class Stats:
 
 
 def summarise(values: list[float] | np.ndarray, *, what: str = "value",
-              labels: list[str] | None = None, quiet: bool = False) -> Stats:
-    """Mean, SD, count and flagged outliers of one measured quantity."""
+              labels: list[str] | None = None, unit: tuple[str, float] = ("", 1.0)) -> Stats:
+    """Mean, SD, count and (from MIN_SAMPLES samples on) flagged outliers of one measured
+    quantity; outlier warnings give values in `unit` (label, factor from SI)."""
     v = np.asarray(values, dtype=float)
     if v.size == 0:
         raise ValueError(f"no samples of {what}")
     sd = float(np.std(v, ddof=1)) if v.size > 1 else None
-    out = outliers(v)
+    out = outliers(v) if v.size >= MIN_SAMPLES else ()
+    label, factor = unit
     warns = []
-    if v.size < MIN_SAMPLES:
-        warns.append(f"{what}: only {v.size} sample(s); at least {MIN_SAMPLES} are needed for a "
-                     "reliable mean and SD")
     for i in out:
         name = labels[i] if labels else f"sample {i + 1}"
-        warns.append(f"{what}: {name} = {v[i]:.4g} is an outlier (modified z-score > "
-                     f"{OUTLIER_Z:g}); check the specimen")
-    for w in [] if quiet else warns:
-        log.warning(w)
+        warns.append(f"{what}: {name} = {v[i] / factor:.4g} {label}".rstrip()
+                     + f" is an outlier (modified z-score > {OUTLIER_Z:g}, median "
+                     f"{np.median(v) / factor:.4g} {label}); check the specimen")
     return Stats(float(v.mean()), sd, int(v.size), tuple(float(x) for x in v), out, tuple(warns))
+
+
+def spread_only(n: int) -> str | None:
+    """The one warning for fewer than MIN_SAMPLES samples, or None."""
+    if n >= MIN_SAMPLES:
+        return None
+    return (f"n = {n}: spread only (mean ± SD, no outlier flags); ISO 527-1 asks for at least "
+            f"{MIN_SAMPLES} specimens, and outliers are flagged from n = {MIN_SAMPLES}")
 
 
 def outliers(v: np.ndarray) -> tuple[int, ...]:

@@ -89,3 +89,40 @@ def unit_factor(role: str, unit: str | None, *, where: str) -> float:
             f"{', '.join(sorted(k for k in table if k))}; fix the header or units row"
         )
     return table[key]
+
+
+# Columns that are not physical units by their name or unit label: raw load-cell counts, ADC
+# readings, bridge voltages. They are never taken for a role unless --column names them.
+RAW_UNITS = frozenset({"counts", "count", "cnt", "raw", "adc", "digits", "digit", "bits", "lsb",
+                       "mv", "v", "mv/v"})
+_RAW_NAME = re.compile(r"(?<![a-z])(raw|counts?|cnt|adc|digits?|bits|lsb|voltage)(?![a-z])")
+# Tester flag columns (0/1 or true/false per row): step loss, end stop, overload, ...
+_FLAG_NAME = re.compile(r"flag|loss|stop|limit|error|fault|alarm|warn|overload|slip|skip|abort|"
+                        r"trip|status|event|break")
+
+
+def is_raw(name: str, unit: str | None) -> bool:
+    """True when a column is raw counts or a voltage by its name or unit label."""
+    return (unit is not None and unit in RAW_UNITS) or bool(_RAW_NAME.search(name.lower()))
+
+
+def unit_class(role: str, name: str, unit: str | None) -> tuple[int, str]:
+    """(rank, reason) of a candidate column for `role`: 0 a unit of the role, 1 no unit (the
+    default assumed), 2 another unit label (an error when used), 3 raw (never taken)."""
+    if is_raw(name, unit):
+        return 3, f"raw {'counts' if unit is None else unit}, not {DEFAULT_UNIT[role]} by its name"
+    if unit is None:
+        return 1, f"no unit: {_show_unit(DEFAULT_UNIT[role])} assumed"
+    if unit in ROLE_UNITS[role]:
+        return 0, f"unit {_show_unit(unit)}"
+    return 2, f"unit {unit!r}"
+
+
+def is_flag_name(name: str) -> bool:
+    """True when a header names a tester flag (step loss, end stop, overload, ...)."""
+    return bool(_FLAG_NAME.search(name.lower()))
+
+
+def _show_unit(unit: str) -> str:
+    return {"n": "N", "kn": "kN", "mn": "mN", "mpa": "MPa", "kpa": "kPa", "gpa": "GPa",
+            "pa": "Pa", "": "none"}.get(unit, unit)

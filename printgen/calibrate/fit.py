@@ -16,6 +16,11 @@ ISO_WINDOW = (0.0005, 0.0025)  # strain, ISO 527-1 chord window 0.05 %-0.25 %
 MIN_POINTS = 5  # fewest points a regression (or each bilinear segment) may use
 AUTO_SPAN = 0.15  # automatic window covers this fraction of the rise to the peak (y_peak - y_0)
 KNEE_GRID = 200  # candidate knees scanned before the bounded refinement
+ZERO_MODES = ("interpolate", "first")  # preload zero conventions (see zero_at_preload)
+DEFAULT_ZERO = "interpolate"
+# Break: the force falls by this fraction of its peak (a 40 % drop, as test-machine software's
+# usual break detection); the last sample before that drop gives the elongation at break.
+BREAK_DROP = 0.4
 
 
 @dataclass(frozen=True)
@@ -60,24 +65,38 @@ def loading_branch(y: np.ndarray) -> int:
 
 
 def zero_at_preload(x: np.ndarray, y: np.ndarray, preload: float | None,
-                    force: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Keep the points from where `force` (default: y) first reaches `preload` and put x = 0
-    there, interpolating x and y between the two points around the crossing.
-    None: zero at the first point."""
+                    force: np.ndarray | None = None, *, mode: str = DEFAULT_ZERO
+                    ) -> tuple[np.ndarray, np.ndarray, float]:
+    """(x, y, x0): the points from where `force` (default: y) first reaches `preload`, with
+    x0 the strain put to zero there.
+
+    mode "interpolate": x0 and the first y interpolated between the two samples around the
+    crossing (independent of the sampling rate); "first": x0 at the first sample at or above
+    the preload (as many testers' software does). None: zero at the first point."""
+    if mode not in ZERO_MODES:
+        raise CalibrationError(f"zero convention {mode!r}; expected one of {', '.join(ZERO_MODES)}")
     if preload is None:
-        return x - x[0], y
+        return x - x[0], y, float(x[0])
     ref = y if force is None else force
     above = np.nonzero(ref >= preload)[0]
     if above.size == 0:
         raise CalibrationError(f"preload {preload:g} N never reached (peak {ref.max():.4g} N); "
                                "lower --preload")
     k = int(above[0])
-    if k == 0:
-        return x - x[0], y
+    if k == 0 or mode == "first":
+        return x[k:] - x[k], y[k:], float(x[k])
     t = (preload - ref[k - 1]) / (ref[k] - ref[k - 1])
     x0 = x[k - 1] + t * (x[k] - x[k - 1])
     y0 = y[k - 1] + t * (y[k] - y[k - 1])
-    return np.concatenate([[0.0], x[k:] - x0]), np.concatenate([[y0], y[k:]])
+    return np.concatenate([[0.0], x[k:] - x0]), np.concatenate([[y0], y[k:]]), float(x0)
+
+
+def break_index(y: np.ndarray, drop: float = BREAK_DROP) -> int | None:
+    """Index of the break: the last sample before y first falls below (1 - drop) x its peak
+    after the peak; None when it never does (the test stopped before the break)."""
+    p = int(np.argmax(y))
+    below = np.nonzero(y[p:] < (1.0 - drop) * y[p])[0]
+    return None if below.size == 0 else p + int(below[0]) - 1
 
 
 def linear_fit(x: np.ndarray, y: np.ndarray, lo: float, hi: float) -> LinearFit:

@@ -10,13 +10,23 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from printgen.calibrate.aggregate import Stats, summarise
-from printgen.calibrate.reader import read_export
-from printgen.calibrate.sample import FitOptions, SampleFit, analyse, peak_and_strength
+from printgen.calibrate.aggregate import Stats, spread_only, summarise
+from printgen.calibrate.fit import BREAK_DROP
+from printgen.calibrate.inputs import expand
+from printgen.calibrate.plausible import check_stress
+from printgen.calibrate.reader import NoTableError, read_export
+from printgen.calibrate.sample import (
+    PRELOAD_STEPS,
+    FitOptions,
+    SampleFit,
+    analyse,
+    flag_notes,
+    peak_and_strength,
+)
 from printgen.calibrate.specimen import (
     KINDS,
     Specimen,
@@ -38,6 +48,9 @@ class StrengthSample:
     specimen: Specimen
     peak_force: float  # N
     strength: float | None  # Pa (panels: N/m)
+    flags: tuple[str, ...] = ()
+    columns: dict[str, str] = field(default_factory=dict)  # role -> header used
+    notes: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -66,6 +79,10 @@ class Calibration:
     panel: PanelLawFit | None = None
     conditions: str = ""
     warnings: tuple[str, ...] = ()
+    elongation: Stats | None = None  # strain at break (a number)
+    preload_change: tuple[float | None, ...] | None = None  # mean at PRELOAD_STEPS x preload
+    excluded: tuple[str, ...] = ()  # flagged files left out of the statistics
+    skipped: tuple[str, ...] = ()  # directory files that hold no table
 
     @property
     def files(self) -> tuple[str, ...]:
@@ -81,7 +98,8 @@ def calibrate(paths: Sequence[str | Path], *, material: str, options: FitOptions
               columns: Mapping[str, str] | None = None, units: Mapping[str, str] | None = None,
               delimiter: str | None = None, decimal: str | None = None,
               strength_only: bool = False, conditions: str = "") -> Calibration:
-    """Fit every export in `paths` (one material, one specimen type) and summarise.
+    """Fit every export in `paths` (files, or directories: every export in them; one
+    material, one specimen type) and summarise.
 
     specimen : dimension options in SI (width, thickness, area, gauge_length, grip_distance)
     and `kind`; they fill what the files' metadata lines do not give.
@@ -92,25 +110,43 @@ def calibrate(paths: Sequence[str | Path], *, material: str, options: FitOptions
     kind = (specimen or {}).get("kind")
     if kind is not None and kind not in KINDS:
         raise CalibrationError(f"specimen kind {kind!r}; expected one of {', '.join(KINDS)}")
+    curve = opt.compliance.source if opt.compliance and opt.compliance.force is not None else None
+    files, notes = expand(paths, exclude=[p for p in (curve, specimen_file) if p])
     fits: list[SampleFit] = []
     strengths: list[StrengthSample] = []
-    for p in paths:
-        rec, spec = _load(Path(p), specimen or {}, specimen_file, columns, units, delimiter,
-                          decimal)
+    skipped: list[str] = []
+    for path, in_dir in files:
+        try:
+            rec, spec = _load(path, specimen or {}, specimen_file, columns, units, delimiter,
+                              decimal)
+        except NoTableError:
+            if not in_dir:
+                raise
+            skipped.append(str(path))
+            continue
         if strength_only:
-            peak, strength = peak_and_strength(rec, spec)
-            if peak is None:
-                raise CalibrationError(f"{rec.path}: --strength-only needs a force column")
-            strengths.append(StrengthSample(rec.path, spec, peak, strength))
+            strengths.append(_strength_sample(rec, spec))
         else:
             fits.append(analyse(rec, spec, opt))
     kinds = {s.specimen.kind for s in (*fits, *strengths)}
+    if not kinds:
+        raise CalibrationError(f"no exports with a table among {', '.join(skipped)}")
     if len(kinds) > 1:
         raise CalibrationError(f"exports mix specimen kinds {sorted(kinds)}; calibrate one "
                                "specimen type at a time")
     cal = Calibration(material=material, kind=kinds.pop(), options=opt, samples=tuple(fits),
-                      strength_samples=tuple(strengths), conditions=conditions)
+                      strength_samples=tuple(strengths), conditions=conditions,
+                      warnings=tuple(notes), skipped=tuple(skipped))
     return _summarise(cal)
+
+
+def _strength_sample(rec, spec) -> StrengthSample:
+    peak, strength = peak_and_strength(rec, spec)
+    if peak is None:
+        raise CalibrationError(f"{rec.path}: --strength-only needs a force column")
+    check_stress(rec, spec, strength)
+    return StrengthSample(rec.path, spec, peak, strength, flag_notes(rec), dict(rec.names),
+                          rec.notes)
 
 
 def _load(path: Path, spec_opts, specimen_file, columns, units, delimiter, decimal):
@@ -125,29 +161,92 @@ def _load(path: Path, spec_opts, specimen_file, columns, units, delimiter, decim
 
 
 def _summarise(cal: Calibration) -> Calibration:
-    labels = [Path(f).name for f in cal.files]
-    warns: list[str] = []
-    mod = strength = panel = None
+    """Statistics over the samples no tester flag excludes, and the warnings, each once."""
+    keep = cal.options.keep_flagged
+    fits = [s for s in cal.samples if keep or not s.flags]
+    forces = [s for s in cal.strength_samples if keep or not s.flags]
+    flagged = [s for s in (*cal.samples, *cal.strength_samples) if s.flags]
+    if flagged and not (fits or forces):
+        raise CalibrationError(
+            f"all {len(flagged)} samples carry tester flags ({_flag_list(flagged)}); none left "
+            "for the statistics: check the tests, or keep them with --keep-flagged")
+    warns = list(cal.warnings) + _column_notes((*cal.samples, *cal.strength_samples))
+    action = "kept (--keep-flagged)" if keep else "excluded from the statistics"
+    warns += [f"{Path(s.path).name}: {'; '.join(s.flags)}: {action}" for s in flagged]
+    warns += [f"{Path(p).name}: no table of numbers, not an export: skipped" for p in cal.skipped]
+    n = len(fits) + len(forces)
+    warns += [w for w in [spread_only(n)] if w]
+    labels = [Path(s.path).name for s in (*fits, *forces)]
+    (mu, mf), (su, sf) = _units(cal)
+    mod = strength = panel = elong = change = None
     bil: dict[str, Stats] = {}
-    if cal.samples:
-        mod = summarise([s.modulus for s in cal.samples], what="modulus", labels=labels)
+    if fits:
+        mod = summarise([s.modulus for s in fits], what="modulus", labels=labels, unit=(mu, mf))
         warns += mod.warnings
-        with_bil = [s for s in cal.samples if s.bilinear is not None]
+        with_bil = [s for s in fits if s.bilinear is not None]
         if with_bil:
-            bil = {k: summarise([getattr(s.bilinear, k) for s in with_bil], what=f"bilinear {k}",
-                                 quiet=True)
+            bil = {k: summarise([getattr(s.bilinear, k) for s in with_bil], what=f"bilinear {k}")
                    for k in ("slope1", "slope2", "knee")}
         if cal.kind == "panel":
-            panel = _panel_law(cal.samples)
-    vals = [s.strength for s in (*cal.samples, *cal.strength_samples)]
+            panel = _panel_law(tuple(fits))
+        elong, change, more = _elongation_and_preload(fits, labels)
+        warns += more
+    vals = [s.strength for s in (*fits, *forces)]
     if vals and all(v is not None for v in vals):
-        strength = summarise(vals, what="strength", labels=labels)
-        warns += [w for w in strength.warnings if mod is None or "only" not in w]
+        strength = summarise(vals, what="strength", labels=labels, unit=(su, sf))
+        warns += strength.warnings
     elif vals:
         warns.append("strength not computed: cross-section (or panel width) unknown for "
                      f"{sum(v is None for v in vals)} file(s)")
-    return Calibration(cal.material, cal.kind, cal.options, cal.samples, cal.strength_samples,
-                       mod, strength, bil, panel, cal.conditions, tuple(warns))
+    return replace(cal, modulus=mod, strength=strength, bilinear=bil, panel=panel,
+                   warnings=tuple(dict.fromkeys(warns)), elongation=elong,
+                   preload_change=change, excluded=tuple(s.path for s in flagged if not keep))
+
+
+def _units(cal: Calibration) -> tuple[tuple[str, float], tuple[str, float]]:
+    """((modulus unit, factor), (strength unit, factor)) as the table shows them."""
+    if cal.kind != "panel":
+        return ("GPa", 1e9), ("MPa", 1e6)
+    lengths = {s.specimen.strain_length() for s in cal.samples}
+    length = lengths.pop() if len(lengths) == 1 else None
+    return (("kN/m/m", 1e3 * length) if length else ("kN/m", 1e3)), ("kN/m", 1e3)
+
+
+def _elongation_and_preload(fits: list[SampleFit], labels: list[str]):
+    """(elongation at break Stats or None, mean modulus change at PRELOAD_STEPS x preload or
+    None, warnings)."""
+    warns = []
+    breaks = [s.elongation_at_break for s in fits if s.elongation_at_break is not None]
+    if len(breaks) < len(fits):
+        missing = [Path(s.path).name for s in fits if s.elongation_at_break is None]
+        warns.append(f"no break found in {', '.join(missing)} (the force never fell "
+                     f"{BREAK_DROP:.0%} below its peak): elongation at break left out for them")
+    elong = summarise(breaks, what="elongation at break", unit=("%", 1e-2)) if breaks else None
+    change = None
+    if fits[0].preload_change is not None:
+        change = tuple(_mean_or_none([s.preload_change[k] for s in fits if s.preload_change])
+                       for k in range(len(PRELOAD_STEPS)))
+    return elong, change, warns
+
+
+def _mean_or_none(values: list[float | None]) -> float | None:
+    v = [x for x in values if x is not None]
+    return float(sum(v) / len(v)) if v else None
+
+
+def _flag_list(samples) -> str:
+    return "; ".join(f"{Path(s.path).name}: {', '.join(s.flags)}" for s in samples)
+
+
+def _column_notes(samples) -> list[str]:
+    """Each column-choice note once, with the files it applies to."""
+    files: dict[str, list[str]] = {}
+    for s in samples:
+        for note in s.notes:
+            files.setdefault(note, []).append(Path(s.path).name)
+    total = len(samples)
+    return [f"{note} ({'all ' + str(total) + ' files' if len(names) == total > 1 else ', '.join(names)})"
+            for note, names in files.items()]
 
 
 def _panel_law(samples: tuple[SampleFit, ...]) -> PanelLawFit:

@@ -19,10 +19,12 @@ import numpy as np
 
 from printgen.calibrate.columns import (
     ROLES,
+    is_flag_name,
     is_units_row,
     normalise_unit,
     role_of,
     split_name_unit,
+    unit_class,
     unit_factor,
 )
 from printgen.calibrate.numbers import decimal_of, parse_number
@@ -33,6 +35,11 @@ log = logging.getLogger(__name__)
 DELIMITERS = (";", "\t", ",")  # preferred first: a decimal comma would split a ',' file
 SNIFF_ROWS = 40  # rows from the table's end used to choose the decimal separator
 TEXT_SUFFIXES = (".csv", ".txt", ".tsv", ".dat")
+_BOOLEAN = {"true": 1.0, "false": 0.0}  # flag columns written as words
+
+
+class NoTableError(CalibrationError):
+    """The file holds no table of numbers (a note, a README): not an export."""
 
 
 @dataclass(frozen=True)
@@ -59,6 +66,10 @@ class TestRecord:
     decimal: str = "."
     first_data_line: int = 1
     lines: np.ndarray = field(default_factory=lambda: np.zeros(0, int))  # file line per row
+    assumed: frozenset[str] = frozenset()  # roles whose unit the file does not give
+    alternatives: dict[str, tuple[str, ...]] = field(default_factory=dict)  # role -> others
+    notes: tuple[str, ...] = ()  # how columns were chosen when several could serve a role
+    flags: dict[str, np.ndarray] = field(default_factory=dict)  # flag column -> bool per row
 
     def has(self, role: str) -> bool:
         return role in self.channels
@@ -67,6 +78,9 @@ class TestRecord:
 def read_text(path: str | Path) -> tuple[str, str]:
     """(text, display name) of an export; a zip must hold exactly one text file."""
     p = Path(path)
+    if p.is_dir():
+        raise CalibrationError(f"{p}: is a directory; pass it to `printgen calibrate` (which "
+                               "reads every export in it) or name the export file")
     if not p.is_file():
         raise CalibrationError(f"{p}: file not found; check the path")
     if p.suffix.lower() == ".zip":
@@ -108,22 +122,47 @@ def read_export(path: str | Path, *, columns: Mapping[str, str] | None = None,
     if unknown:
         raise CalibrationError(f"unknown column role {unknown[0]!r} in the units; roles: "
                                f"{', '.join(ROLES)}")
-    roles = _assign(headers, columns or {}, where)
-    channels, names = {}, {}
+    col_units = _column_units(headers, unit_row, ncols)
+    roles, alternatives, notes = _assign(headers, col_units, columns or {}, where)
+    channels, names, assumed = {}, {}, set()
     for role, j in roles.items():
         unit = (units or {}).get(role)
-        if unit is not None:
-            unit = normalise_unit(unit)
-        elif unit_row is not None and unit_row[j].strip():
-            unit = normalise_unit(unit_row[j])
-        else:
-            unit = split_name_unit(headers[j])[1] if headers else None
+        unit = normalise_unit(unit) if unit is not None else col_units[j]
+        if unit is None:
+            assumed.add(role)
         col = headers[j] if headers else f"column {j + 1}"
         channels[role] = data[:, j] * unit_factor(role, unit, where=f"{where}: column {col!r}")
         names[role] = col
     meta = tuple(m for n, r in rows[:meta_end] if (m := _meta(n, r, dec)) is not None)
     return TestRecord(where, channels, names, tuple(headers), meta, delim, dec,
-                      rows[start][0], line_no)
+                      rows[start][0], line_no, frozenset(assumed), alternatives, tuple(notes),
+                      _flags(headers, data, set(roles.values())))
+
+
+def _column_units(headers: list[str], unit_row: list[str] | None, ncols: int
+                  ) -> list[str | None]:
+    """Each column's unit label from the units row, else from its header, else None."""
+    out: list[str | None] = []
+    for j in range(ncols):
+        if unit_row is not None and unit_row[j].strip():
+            out.append(normalise_unit(unit_row[j]))
+        else:
+            out.append(split_name_unit(headers[j])[1] if headers else None)
+    return out
+
+
+def _flags(headers: list[str], data: np.ndarray, used: set[int]) -> dict[str, np.ndarray]:
+    """Tester flag columns: unused columns holding only 0 and 1 (a column of ones only counts
+    when its name says flag, stop, loss, ...: otherwise it is a constant such as a cycle)."""
+    out = {}
+    for j, h in enumerate(headers):
+        col = data[:, j] if data.size else np.zeros(0)
+        if j in used or col.size < 2 or not np.all((col == 0) | (col == 1)):
+            continue
+        if np.all(col == 1) and not is_flag_name(h):
+            continue
+        out[h] = col == 1
+    return out
 
 
 def _sniff_delimiter(lines: list[str], where: str) -> str:
@@ -137,14 +176,20 @@ def _sniff_delimiter(lines: list[str], where: str) -> str:
         mode = values[np.argmax(freq)]
         if mode >= 2 and freq.max() * 2 >= counts.size:
             return d
-    raise CalibrationError(
+    raise NoTableError(
         f"{where}: no table found; expected rows of at least 2 values separated by ',', ';' "
         "or tab, the same number on most rows (give --delimiter if the file uses another)"
     )
 
 
 def _numeric(cells: list[str], dec: str) -> bool:
-    return all(parse_number(c, dec) is not None for c in cells)
+    return all(_value(c, dec) is not None for c in cells)
+
+
+def _value(cell: str, dec: str) -> float | None:
+    """A cell's number, or 1/0 for true/false (flag columns)."""
+    v = parse_number(cell, dec)
+    return _BOOLEAN.get(cell.strip().strip('"').lower()) if v is None else v
 
 
 def _table_start(rows: list[tuple[int, list[str]]], dec: str, where: str, delim: str) -> int:
@@ -152,7 +197,7 @@ def _table_start(rows: list[tuple[int, list[str]]], dec: str, where: str, delim:
         r, nxt = rows[k][1], rows[k + 1][1]
         if len(r) >= 2 and len(nxt) == len(r) and _numeric(r, dec) and _numeric(nxt, dec):
             return k
-    raise CalibrationError(
+    raise NoTableError(
         f"{where}: no numeric table found; expected at least two rows of numbers separated by "
         f"{_show(delim)} with decimal {dec!r} (give --delimiter / --decimal if detection failed)"
     )
@@ -173,7 +218,7 @@ def _header(rows, start: int, ncols: int) -> tuple[list[str], list[str] | None, 
 def _body(rows, ncols: int, dec: str, where: str, headers: list[str], delim: str):
     out, line_no = [], []
     for idx, (n, r) in enumerate(rows):
-        vals = [parse_number(c, dec) for c in r] if len(r) == ncols else None
+        vals = [_value(c, dec) for c in r] if len(r) == ncols else None
         if vals is not None and None not in vals:
             out.append(vals)
             line_no.append(n)
@@ -191,23 +236,62 @@ def _body(rows, ncols: int, dec: str, where: str, headers: list[str], delim: str
     return np.array(out, dtype=float), np.array(line_no, dtype=int)
 
 
-def _assign(headers: list[str], chosen: Mapping[str, str], where: str) -> dict[str, int]:
-    """role -> column index, from the options first, then from the header names."""
+def _assign(headers: list[str], col_units: list[str | None], chosen: Mapping[str, str],
+            where: str) -> tuple[dict[str, int], dict[str, tuple[str, ...]], list[str]]:
+    """(role -> column index, role -> other candidate headers, notes): the options first, then
+    the header names, preferring a column whose unit belongs to the role; raw counts are never
+    taken and two unitless force columns are an error, not a guess."""
     roles: dict[str, int] = {}
     for role, key in chosen.items():
         if role not in ROLES:
             raise CalibrationError(f"unknown column role {role!r}; roles: {', '.join(ROLES)}")
         roles[role] = _find_column(headers, key, where)
+    cands: dict[str, list[int]] = {r: [] for r in ROLES}
     for j, h in enumerate(headers):
         role = role_of(split_name_unit(h)[0])
         if role is not None and role not in roles and j not in roles.values():
-            roles[role] = j
+            cands[role].append(j)
+    alternatives: dict[str, tuple[str, ...]] = {}
+    notes: list[str] = []
+    for role, js in cands.items():
+        if not js:
+            continue
+        why = {j: unit_class(role, headers[j], col_units[j]) for j in js}
+        best = min(js, key=lambda j: why[j][0])
+        _refuse_guess(role, [headers[j] for j in js if why[j][0] == why[best][0]], why[best],
+                      where)
+        if why[best][0] < 3:
+            roles[role] = best
+        others = [j for j in js if j != best or why[j][0] == 3]
+        if others:
+            alternatives[role] = tuple(headers[j] for j in others)
+            used = f"column {headers[best]!r} used ({why[best][1]})" if best in roles.values() \
+                else "no column used"
+            notes.append(f"{role}: {used}; also found "
+                         + ", ".join(f"{headers[j]!r} ({why[j][1]})" for j in others)
+                         + f"; choose another with --column {role}=NAME")
     if "force" not in roles and "stress" not in roles:
         raise CalibrationError(
             f"{where}: no force or stress column among {headers or 'the unnamed columns'}; "
             "name one with --column force=NAME (or a 1-based index)"
         )
-    return roles
+    return roles, alternatives, notes
+
+
+def _refuse_guess(role: str, best: list[str], why: tuple[int, str], where: str) -> None:
+    """A force column is never guessed: only raw counts, or several without a unit, stop."""
+    if role != "force":
+        return
+    if why[0] == 3:
+        raise CalibrationError(
+            f"{where}: force column {best[0]!r} holds {why[1]}, and no other column gives "
+            "newtons; convert it to N, or name a force column with --column force=NAME (add "
+            "--unit force=N if it is in newtons)")
+    if why[0] == 1 and len(best) > 1:
+        raise CalibrationError(
+            f"{where}: force columns {', '.join(map(repr, best))} give no unit, so which one is "
+            "in newtons cannot be told; choose with --column force=NAME (and --unit force=kN "
+            "if it is not in N)")
 
 
 def _find_column(headers: list[str], key: str, where: str) -> int:

@@ -15,26 +15,32 @@ import numpy as np
 
 from printgen.calibrate.compliance import Compliance
 from printgen.calibrate.fit import (
+    DEFAULT_ZERO,
     ISO_WINDOW,
     BilinearFit,
     LinearFit,
     bilinear_fit,
+    break_index,
     linear_fit,
     loading_branch,
     secant_moduli,
     steepest_fit,
     zero_at_preload,
 )
+from printgen.calibrate.plausible import check_modulus, check_stress
 from printgen.calibrate.reader import TestRecord
 from printgen.calibrate.specimen import Specimen, machine_modulus
 from printgen.errors import CalibrationError
 
 DEFAULT_SECANTS = (0.005, 0.01)  # strain where secant moduli are reported (0.5 %, 1 %)
+PRELOAD_STEPS = (0.9, 1.1)  # preload factors for the modulus's sensitivity (+-10 %)
 
 
 @dataclass(frozen=True)
 class FitOptions:
-    """window: strain (lo, hi) or None for the automatic (steepest) window; preload in N."""
+    """window: strain (lo, hi) or None for the automatic (steepest) window; preload in N;
+    zero: preload zero convention (fit.ZERO_MODES); keep_flagged: flagged samples stay in the
+    statistics."""
 
     window: tuple[float, float] | None = ISO_WINDOW
     auto_span: float = 0.15
@@ -43,6 +49,8 @@ class FitOptions:
     strain_source: str = "auto"  # auto, extensometer, crosshead
     compliance: Compliance | None = None
     bilinear: bool = True
+    zero: str = DEFAULT_ZERO
+    keep_flagged: bool = False
 
 
 @dataclass(frozen=True)
@@ -60,6 +68,18 @@ class SampleFit:
     machine_modulus: float | None  # Pa, from the export's header
     x: np.ndarray = field(repr=False)  # loading branch, zeroed at the preload
     y: np.ndarray = field(repr=False)
+    elongation_at_break: float | None = None  # strain from the zero to the break; None: no break
+    preload_moduli: tuple[float | None, ...] | None = None  # at PRELOAD_STEPS x the preload
+    flags: tuple[str, ...] = ()  # tester flags set during the test (see flag_notes)
+    columns: dict[str, str] = field(default_factory=dict)  # role -> header used
+    notes: tuple[str, ...] = ()  # how columns were chosen
+
+    @property
+    def preload_change(self) -> tuple[float | None, ...] | None:
+        """Relative modulus change at PRELOAD_STEPS x the preload (None without a preload)."""
+        if self.preload_moduli is None:
+            return None
+        return tuple(None if m is None else m / self.modulus - 1 for m in self.preload_moduli)
 
     @property
     def modulus(self) -> float:
@@ -86,27 +106,65 @@ def peak_and_strength(rec: TestRecord, spec: Specimen) -> tuple[float | None, fl
 
 
 def analyse(rec: TestRecord, spec: Specimen, opt: FitOptions) -> SampleFit:
-    """Every fit of one export (raises CalibrationError when it cannot give a modulus)."""
+    """Every fit of one export (raises CalibrationError when it cannot give a modulus, or
+    when the force, stress or modulus is implausible)."""
+    peak, strength = peak_and_strength(rec, spec)
+    check_stress(rec, spec, strength)
     x, y, source = _curve(rec, spec, opt)
     p = loading_branch(y)
-    preload = opt.preload
-    if preload is not None and not rec.has("force"):
+    if opt.preload is not None and not rec.has("force"):
         raise CalibrationError(f"{rec.path}: --preload is a force but the file has no force "
                                "column")
-    force = rec.channels["force"][: p + 1] if preload is not None else None
-    try:
-        x_branch, y_branch = zero_at_preload(x[: p + 1], y[: p + 1], preload, force)
-    except CalibrationError as exc:
-        raise CalibrationError(f"{rec.path}: {exc}") from exc
-    if opt.window is None:
-        lin = steepest_fit(x_branch, y_branch, opt.auto_span)
-    else:
-        lin = linear_fit(x_branch, y_branch, *opt.window)
+    force = rec.channels["force"][: p + 1] if opt.preload is not None else None
+    lin, x_branch, y_branch, x0 = _zeroed_fit(rec.path, x[: p + 1], y[: p + 1], force,
+                                              opt.preload, opt)
+    check_modulus(rec, spec, lin.slope)
+    moduli = None
+    if opt.preload is not None:
+        moduli = tuple(_modulus_or_none(rec.path, x[: p + 1], y[: p + 1], force,
+                                        opt.preload * f, opt) for f in PRELOAD_STEPS)
     bil = bilinear_fit(x_branch, y_branch) if opt.bilinear else None
     secants = secant_moduli(x_branch, y_branch, opt.secant_strains, x0=0.0, y0=float(y_branch[0]))
-    peak, strength = peak_and_strength(rec, spec)
+    k = break_index(y)
     return SampleFit(rec.path, spec, source, lin, bil, secants, peak, strength,
-                     machine_modulus(rec.metadata), x_branch, y_branch)
+                     machine_modulus(rec.metadata), x_branch, y_branch,
+                     None if k is None else float(x[k] - x0), moduli,
+                     flag_notes(rec, x - x0), dict(rec.names), rec.notes)
+
+
+def flag_notes(rec: TestRecord, strain: np.ndarray | None = None) -> tuple[str, ...]:
+    """One note per tester flag column set during the test: where it first is set."""
+    out = []
+    for name, on in rec.flags.items():
+        if not on.any():
+            continue
+        i = int(np.argmax(on))
+        at = f", {strain[i] * 100:.3g} % strain" if strain is not None else ""
+        out.append(f"{name} set at line {rec.lines[i]}{at} ({int(on.sum())} rows)")
+    return tuple(out)
+
+
+def _zeroed_fit(path: str, x: np.ndarray, y: np.ndarray, force: np.ndarray | None,
+                preload: float | None, opt: FitOptions
+                ) -> tuple[LinearFit, np.ndarray, np.ndarray, float]:
+    """(modulus line, zeroed branch x and y, strain x0 put to zero) for one preload."""
+    try:
+        xb, yb, x0 = zero_at_preload(x, y, preload, force, mode=opt.zero)
+        if opt.window is None:
+            lin = steepest_fit(xb, yb, opt.auto_span)
+        else:
+            lin = linear_fit(xb, yb, *opt.window)
+    except CalibrationError as exc:
+        raise CalibrationError(f"{path}: {exc}") from exc
+    return lin, xb, yb, x0
+
+
+def _modulus_or_none(path: str, x: np.ndarray, y: np.ndarray, force: np.ndarray | None,
+                     preload: float, opt: FitOptions) -> float | None:
+    try:
+        return _zeroed_fit(path, x, y, force, preload, opt)[0].slope
+    except CalibrationError:
+        return None
 
 
 def _curve(rec: TestRecord, spec: Specimen, opt: FitOptions) -> tuple[np.ndarray, np.ndarray, str]:
