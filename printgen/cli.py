@@ -10,9 +10,12 @@ from __future__ import annotations
 import argparse
 import importlib
 import logging
+import os
 import sys
 
 from printgen.errors import PrintgenError
+from printgen.outputs import describe_os_error, os_error_exit_code
+from printgen.workers import Interrupted, signals_raise
 
 # One entry per command module; a module may register several subcommands.
 COMMAND_MODULES = (
@@ -20,6 +23,7 @@ COMMAND_MODULES = (
     "printgen.commands.select",
     "printgen.commands.profiles",
     "printgen.commands.make",
+    "printgen.commands.check",
     "printgen.commands.bench",
     "printgen.commands.calibrate",
 )
@@ -38,15 +42,52 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+REPORT_URL = "the printgen maintainers (an issue with the command line and this line)"
+
+
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    """Run one command; return its exit code. No traceback reaches the user: bad input exits
+    2, a signal 128 + its number (130 Ctrl-C, 143 SIGTERM), anything unexpected 1 with a hint
+    to report it (PRINTGEN_DEBUG=1 re-raises it, traceback and all)."""
+    argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
+    try:
+        parser = build_parser()
+        args = parser.parse_args(argv)
+    except KeyboardInterrupt:
+        print("printgen: interrupted (Ctrl-C)", file=sys.stderr)
+        return 130
+    args.argv = ["printgen", *argv]
     logging.basicConfig(
         level=logging.INFO if args.verbose else logging.WARNING,
         format="%(levelname)s: %(message)s",
     )
+    return run_command(args, f"printgen {args.command}")
+
+
+def run_command(args: argparse.Namespace, name: str) -> int:
+    """Call the command's function and turn every way it can end into one line and a code."""
     try:
-        return int(args.func(args) or 0)
+        with signals_raise():
+            return int(args.func(args) or 0)
     except PrintgenError as exc:
-        print(f"printgen {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        return _fail(f"{name}: error: {exc}", 2)
+    except Interrupted as exc:
+        return _fail(f"{name}: stopped by {exc.name}; outputs left as they were", exc.exit_code)
+    except KeyboardInterrupt:
+        return _fail(f"{name}: stopped by SIGINT; outputs left as they were", 130)
+    except OSError as exc:
+        return _fail(f"{name}: error: {describe_os_error(exc)}", os_error_exit_code(exc))
+    except MemoryError:
+        return _fail(f"{name}: error: out of memory; use a coarser mesh or a larger machine", 1)
+    except Exception as exc:
+        if os.environ.get("PRINTGEN_DEBUG"):
+            raise
+        text = " ".join(str(exc).split())[:300]
+        return _fail(f"{name}: internal error: {type(exc).__name__}: {text}; this is a bug in "
+                     f"printgen, please report it to {REPORT_URL} "
+                     "(PRINTGEN_DEBUG=1 shows the traceback)", 1)
+
+
+def _fail(line: str, code: int) -> int:
+    print(line, file=sys.stderr)
+    return code

@@ -7,10 +7,7 @@ Also the counter-example the report warns about: the simple barrier with steel a
 
 from __future__ import annotations
 
-import multiprocessing
-import os
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,6 +19,7 @@ from printgen.design.record import Design
 from printgen.errors import SolverError
 from printgen.inputs.prototype import Prototype
 from printgen.units import RHO_WATER, G
+from printgen.workers import run_jobs  # the worker lifecycle lives on the ground floor
 
 LEVEL_STEP = 0.05  # relative loading step of the sweep (issue: at most 0.05)
 OVERFLOW = 1.1  # last relative loading h / h_B
@@ -138,19 +136,6 @@ def verify(p: Prototype, d: Design, *, drag: bool = False, lv: np.ndarray | None
     mm = compare(proto.deformation, model.deformation)
     start = compare(increments(proto.deformation), increments(model.deformation))
     return Verification(case, proto, model, mm, explain(mm), ce[0] if ce else None, start)
-
-
-def run_jobs(jobs: list[tuple]) -> list:
-    """Run each (fn, args, kwargs) and return the results in order: in worker processes when
-    the machine has two cores or more (the jobs are independent; the results are identical
-    either way), else one after the other. PRINTGEN_SERIAL=1 forces serial runs."""
-    workers = min(len(jobs), os.cpu_count() or 1)
-    if workers < 2 or os.environ.get("PRINTGEN_SERIAL"):
-        return [fn(*args, **kw) for fn, args, kw in jobs]
-    ctx = multiprocessing.get_context("fork")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
-        futures = [pool.submit(fn, *args, **kw) for fn, args, kw in jobs]
-        return [f.result() for f in futures]
 
 
 def _only(run: Run, keep: np.ndarray) -> Run:

@@ -12,6 +12,7 @@ from rich.console import Console
 
 from printgen.commands.common import add_json_arg, add_prototype_args, console, emit_json, table
 from printgen.run import api
+from printgen.run.make import json_output
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -23,6 +24,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--drag", action="store_true",
                    help="also verify under hydrostatic + drag at the Froude-scaled velocity")
     p.add_argument("--step", action="store_true", help="also write STEP files (needs cadquery)")
+    p.add_argument("--force", action="store_true",
+                   help="replace --out even when it holds files printgen did not write")
     add_json_arg(p)
     p.set_defaults(func=run)
 
@@ -33,10 +36,11 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     with err.status("planning") as status:
         ctx = api.make(args.prototype, args.scale, out, printer=args.printer, drag=args.drag,
-                       step=args.step, progress=lambda label: status.update(f"{label} ..."))
+                       step=args.step, progress=lambda label: status.update(f"{label} ..."),
+                       options={"force": args.force, "command": getattr(args, "argv", None)})
     seconds = time.perf_counter() - t0
     if args.json:
-        emit_json(ctx.record)
+        emit_json(json_output(ctx.record))
         return 0
     show_summary(ctx, out, seconds)
     return 0

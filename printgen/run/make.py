@@ -24,7 +24,7 @@ from printgen.design.similitude import ScaledTargets, scale_targets
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
 from printgen.inputs.prototype import Prototype, load_prototype
-from printgen.outputs import staged_dir
+from printgen.outputs import MANIFEST, file_digest, staged_dir
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
 from printgen.report.report import design_record, design_sections
@@ -89,13 +89,13 @@ def gcode_step(ctx: MakeContext, stage: Path) -> None:
                      "volume_mm3": tp.volume_mm3, "readback_volume_mm3": back.volume_mm3,
                      "readback_error": err, "seconds": seconds}
         rows.append([name, path.name, str(len(back.layer_z_mm)), f"{tp.volume_mm3:.1f}",
-                     f"{err:+.2%}", f"{seconds:.2f}"])
+                     f"{err:+.2%}"])  # times go to timings.json: the report is reproducible
     ctx.record["gcode"] = rec
     ctx.report.heading("Direct G-code")
     ctx.report.paragraph("Every net strand is one straight extrusion through the crossings, the "
                          "strand families alternate per pass; the G-code is read back and its "
                          "extruded volume compared with the toolpath's.")
-    ctx.report.table(["part", "file", "layers", "volume mm^3", "read-back error", "time s"], rows)
+    ctx.report.table(["part", "file", "layers", "volume mm^3", "read-back error"], rows)
 
 
 def slicer_step(ctx: MakeContext, stage: Path) -> None:
@@ -133,6 +133,7 @@ def parts_step(ctx: MakeContext, stage: Path) -> None:
     from printgen.parts.geometry.solid import (
         analytic_cable_volume,
         analytic_net_volume,
+        attachment_for,
         cable_outline,
         cable_solid,
         net_outline,
@@ -142,8 +143,12 @@ def parts_step(ctx: MakeContext, stage: Path) -> None:
 
     d = ctx.design
     printer = load_printer(d.printer)
-    parts = [("net", "net", d.net, net_solid, net_outline, analytic_net_volume)]
-    parts += [(f"cable-{c.name}", "cable", c, cable_solid, cable_outline, analytic_cable_volume)
+    comp = printer.hole_compensation_mm
+    att = attachment_for(d, hole_compensation_mm=comp) if d.cables else None
+    parts = [("net", "net", d.net, lambda p: net_solid(p, att), lambda p: net_outline(p, att),
+              lambda p: analytic_net_volume(p, att))]
+    parts += [(f"cable-{c.name}", "cable", c, lambda p: cable_solid(p, comp),
+               lambda p: cable_outline(p, comp), lambda p: analytic_cable_volume(p, comp))
               for c in d.cables]
     rows, rec = [], {}
     for name, kind, part, solid, outline, analytic in parts:
@@ -175,7 +180,8 @@ def parts_step(ctx: MakeContext, stage: Path) -> None:
         c = d.cables[0]
         ini = prusa_ini_text("cable", c, printer, load_print_style(c.print_style),
                              load_material(c.material))
-        placed = layout_parts([(f"cable-{c.name}", cable_solid(c)) for c in d.cables], printer)
+        placed = layout_parts([(f"cable-{c.name}", cable_solid(c, comp)) for c in d.cables],
+                              printer)
         (stage / "cables-plate.3mf").write_bytes(threemf_bytes(
             [(p.name, p.mesh) for p in placed], prusa_config_from_ini(ini)))
         ctx.files.append("cables-plate.3mf")
@@ -218,40 +224,111 @@ def verify_step(ctx: MakeContext, stage: Path) -> None:
     ctx.record["verification"] = verification_record(v, v.counterexample)
 
 
+TIMINGS = "timings.json"  # the one volatile file: every wall-clock time of the run
+TIME_KEYS = ("timings_s", "seconds", "time_s")  # record keys that hold wall-clock times
+
+
 def make(prototype_path: str | Path, scale: float, out: str | Path, *,
          printer: str | None = None, steps: list[tuple[str, Step]] | None = None,
          options: dict[str, Any] | None = None,
          progress: Callable[[str], None] | None = None) -> MakeContext:
-    """Run every step into a staging directory; move the files into `out` at the end."""
+    """Run every step into a stage folder and swap it in as the whole of `out`.
+
+    options: "force" (replace a folder printgen did not write), "command" (the command line,
+    recorded in the manifest), "drag", "step". `out` gets manifest.json (files, inputs,
+    version, command line) and timings.json (the only file that differs between runs).
+    """
     t0 = time.perf_counter()
     ctx = plan(prototype_path, scale, printer=printer, options=options)
-    with staged_dir(out) as stage:
+    meta: dict[str, Any] = {}
+    with staged_dir(out, force=bool(ctx.options.get("force")), meta=meta,
+                    volatile=(TIMINGS,)) as stage:
         for label, step in steps if steps is not None else default_steps():
             if progress:
                 progress(label)
             t = time.perf_counter()
             step(ctx, stage)
             ctx.record.setdefault("timings_s", {})[label] = time.perf_counter() - t
-        ctx.record["files"] = sorted([*ctx.files, "report.html", "report.json", "design.json"])
+        meta.update(provenance(ctx))
+        provenance_section(ctx.report, meta)
+        ctx.record["files"] = sorted([*ctx.files, "report.html", "report.json", "design.json",
+                                      MANIFEST, TIMINGS])
+        ctx.record.setdefault("timings_s", {})["total"] = time.perf_counter() - t0
+        stable, timings = split_timings(ctx.record)
         (stage / "design.json").write_text(dumps(ctx.design.to_dict()))
-        (stage / "report.json").write_text(dumps(_stable(ctx.record)))
+        (stage / "report.json").write_text(dumps(stable))
         (stage / "report.html").write_text(ctx.report.html())
+        (stage / TIMINGS).write_text(dumps(timings))
     log.info("make finished in %.2f s", time.perf_counter() - t0)
     return ctx
 
 
-def _stable(record: dict[str, Any]) -> dict[str, Any]:
-    """The record without wall-clock times, so the same input gives byte-identical JSON."""
-    drop = {"timings_s", "seconds", "time_s"}
+def split_timings(record: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
+    """(the record without wall-clock times, the times at the same paths).
 
-    def clean(v: Any) -> Any:
+    The first is byte-reproducible; the second is `timings.json` and `--json`'s "timings".
+    """
+    def split(v: Any) -> tuple[Any, Any]:
         if isinstance(v, dict):
-            return {k: clean(x) for k, x in v.items() if k not in drop}
+            keep, times = {}, {}
+            for k, x in v.items():
+                if k in TIME_KEYS:
+                    times[k] = x
+                    continue
+                keep[k], t = split(x)
+                if t:
+                    times[k] = t
+            return keep, times
         if isinstance(v, list):
-            return [clean(x) for x in v]
-        return v
+            parts = [split(x) for x in v]
+            times = {str(i): t for i, (_, t) in enumerate(parts) if t}
+            return [k for k, _ in parts], times
+        return v, {}
 
-    return clean(record)
+    return split(record)
+
+
+def json_output(record: dict[str, Any]) -> dict[str, Any]:
+    """What `make --json` prints: the reproducible record plus one top-level "timings" key."""
+    stable, timings = split_timings(record)
+    return {**stable, "timings": timings}
+
+
+def provenance(ctx: MakeContext) -> dict[str, Any]:
+    """Version, command line and the sha256 of every input (prototype, each profile used)."""
+    from importlib.metadata import version
+
+    from printgen.inputs.profiles import BUNDLED, load_raw
+
+    d = ctx.design
+    used = {("printers", d.printer), ("materials", d.net.material),
+            ("prints", d.net.print_style)}
+    used |= {("materials", c.material) for c in d.cables}
+    used |= {("prints", c.print_style) for c in d.cables}
+    inputs = {"prototype": _digest(ctx.prototype.path)} if ctx.prototype.path else {}
+    for kind, name in sorted(used):
+        for path in load_raw(kind, name)[1]:
+            shown = (Path("profiles") / path.relative_to(BUNDLED)
+                     if path.is_relative_to(BUNDLED) else path)
+            inputs[f"{kind}/{path.stem}"] = _digest(path, shown)
+    return {"printgen_version": version("printgen"), "command": ctx.options.get("command"),
+            "inputs": inputs}
+
+
+def _digest(path: Path, shown: Path | None = None) -> dict[str, Any]:
+    return {"path": str(shown or path), "sha256": file_digest(Path(path))["sha256"]}
+
+
+def provenance_section(rep: Report, meta: dict[str, Any]) -> None:
+    """The report's provenance: what made this folder (the manifest holds the same)."""
+    rep.heading("Provenance")
+    cmd = meta.get("command")
+    rep.paragraph(f"printgen {meta['printgen_version']}; command: "
+                  f"{' '.join(cmd) if cmd else 'printgen.make() from Python'}. Every file of "
+                  f"this folder and its sha256 are in {MANIFEST}; `printgen check FOLDER` "
+                  "verifies them.")
+    rep.table(["input", "file", "sha256"],
+              [[k, v["path"], v["sha256"]] for k, v in meta["inputs"].items()])
 
 
 def default_steps() -> list[tuple[str, Step]]:

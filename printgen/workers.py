@@ -1,0 +1,112 @@
+"""Worker processes and signals: workers die with their parent, signals end a run cleanly.
+
+`run_jobs` runs independent jobs in a process pool whose workers (Linux) ask the kernel to
+kill them when their parent dies (`prctl(PR_SET_PDEATHSIG, SIGKILL)` in the initializer), so
+a `make` killed by SIGKILL leaves no orphan. The workers ignore SIGINT, SIGTERM and SIGHUP:
+the parent handles those (`signals_raise`: they become an `Interrupted` exception), stops the
+workers, lets every `finally` remove its stage folder, and the command line prints one line and
+exits with 128 + the signal number (130 for Ctrl-C, 143 for SIGTERM). Other pools (the design
+search's Dask workers) use `init_worker` as their initializer too.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import multiprocessing
+import os
+import signal
+from collections.abc import Iterator
+from concurrent.futures import ProcessPoolExecutor
+from typing import Any
+
+PR_SET_PDEATHSIG = 1  # linux/prctl.h
+HANDLED = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+class Interrupted(BaseException):
+    """A signal asked the run to stop (a BaseException, like KeyboardInterrupt, so that no
+    `except Exception` swallows it)."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+    @property
+    def name(self) -> str:
+        return signal.Signals(self.signum).name
+
+    @property
+    def exit_code(self) -> int:
+        return 128 + self.signum
+
+
+def _raise(signum: int, _frame: Any) -> None:
+    raise Interrupted(signum)
+
+
+@contextlib.contextmanager
+def signals_raise() -> Iterator[None]:
+    """Within the block SIGINT, SIGTERM and SIGHUP raise `Interrupted` (main thread only);
+    the previous handlers come back afterwards."""
+    if multiprocessing.parent_process() is not None or not _main_thread():
+        yield
+        return
+    previous = {s: signal.signal(s, _raise) for s in HANDLED}
+    try:
+        yield
+    finally:
+        for s, h in previous.items():
+            signal.signal(s, h)
+
+
+def _main_thread() -> bool:
+    import threading
+
+    return threading.current_thread() is threading.main_thread()
+
+
+def init_worker(parent_pid: int) -> None:
+    """Pool initializer: die with the parent, leave signals to the parent."""
+    for s in HANDLED:
+        signal.signal(s, signal.SIG_IGN)
+    with contextlib.suppress(OSError, AttributeError):
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+    if os.getppid() != parent_pid:  # the parent died before prctl took effect
+        os._exit(1)
+
+
+def run_jobs(jobs: list[tuple]) -> list:
+    """Run each (fn, args, kwargs) and return the results in order: in worker processes when
+    the machine has two cores or more (the jobs are independent; the results are identical
+    either way), else one after the other. PRINTGEN_SERIAL=1 forces serial runs.
+
+    On any exception or signal in the parent the workers are killed before it propagates.
+    """
+    workers = min(len(jobs), os.cpu_count() or 1)
+    if workers < 2 or os.environ.get("PRINTGEN_SERIAL"):
+        return [fn(*args, **kw) for fn, args, kw in jobs]
+    ctx = multiprocessing.get_context("fork")
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=init_worker,
+                               initargs=(os.getpid(),))
+    try:
+        futures = [pool.submit(fn, *args, **kw) for fn, args, kw in jobs]
+        results = [f.result() for f in futures]
+    except BaseException:
+        stop(pool)
+        raise
+    pool.shutdown(wait=True)
+    return results
+
+
+def stop(pool: ProcessPoolExecutor) -> None:
+    """Kill the pool's workers now and reap them (no waiting for running jobs)."""
+    procs = list((getattr(pool, "_processes", None) or {}).values())  # no public API for this
+    for p in procs:
+        with contextlib.suppress(Exception):
+            p.kill()
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in procs:
+        with contextlib.suppress(Exception):
+            p.join(timeout=5)
