@@ -245,12 +245,12 @@ def test_prusaslicer_slices_the_cable_plate_alone_with_its_settings(plate, tmp_p
         assert f"; printing object {p.name}" in text, p.name
 
 
-def test_prusaslicer_slices_the_net_with_corner_eyelets_from_its_3mf(tmp_path):
-    """The 1:40 net with its corner rings (340.4 mm wide: turned on the 340 mm usable bed)
-    slices alone with its TPE settings."""
+def test_prusaslicer_slices_the_net_with_its_loops_and_eyelets_from_its_3mf(tmp_path):
+    """The 1:40 net with its loops and corner eyelets (335.4 mm wide with its corner rings:
+    turned on the 340 mm usable bed) slices alone with its TPE settings."""
     from conftest import reference_design_1_40
 
-    from printgen.parts.geometry.solid import corner_eyelets_for
+    from printgen.parts.geometry.solid import attachment_for
 
     exe = require_tool("prusa-slicer")
     d = reference_design_1_40()
@@ -258,9 +258,8 @@ def test_prusaslicer_slices_the_net_with_corner_eyelets_from_its_3mf(tmp_path):
     ini = prusa_ini_text("net", d.net, printer, load_print_style(d.net.print_style),
                          load_material(d.net.material))
     path = tmp_path / "net.3mf"
-    (placed,) = write_plate(path, [("net", net_solid(d.net, corner_eyelets_for(d)))], printer,
-                            ini)
-    assert placed.angle_deg > 0  # too wide by 0.4 mm for the bed straight
+    att = attachment_for(d, hole_compensation_mm=printer.hole_compensation_mm)
+    write_plate(path, [("net", net_solid(d.net, att))], printer, ini)
     out = tmp_path / "net.gcode"
     r = subprocess.run([exe, "--export-gcode", "--output", str(out), str(path)],
                        capture_output=True, text=True, timeout=SLICE_TIMEOUT_S, check=False)

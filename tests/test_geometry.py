@@ -1,6 +1,6 @@
 """Meshes of the printed parts: watertight, one body, bounds and volume against the analytic
-values (strand lengths x section minus crossing and border overlaps, plus the frame and the
-corner rings; strip plus eyelets)."""
+values (strand lengths x section minus crossing and border overlaps, plus the frame, the
+loops and corner eyelets of the attachment; strip plus eyelets)."""
 
 from __future__ import annotations
 
@@ -12,14 +12,14 @@ from conftest import reference_design_1_40
 
 from printgen.design.record import Section
 from printgen.errors import GeometryError
+from printgen.parts.geometry.attach import Attachment, holes
 from printgen.parts.geometry.cable import CIRCLE_SEGMENTS, circle_scale
 from printgen.parts.geometry.net import diamond_net
 from printgen.parts.geometry.solid import (
-    CornerEyelets,
     analytic_cable_volume,
     analytic_net_volume,
+    attachment_for,
     cable_solid,
-    corner_eyelets_for,
     net_outline,
     net_solid,
 )
@@ -27,6 +27,8 @@ from printgen.parts.geometry.solid import (
 pytest.importorskip("manifold3d")
 
 VOLUME = 0.01  # issue 5: mesh volume within 1 % of the analytic value
+RING_QUADRATURE = 1e-3  # the in-ring area integral's polar grid: well below 1e-3 of the net
+COMP_MM = 0.2  # the generic printer's hole compensation
 COORD = 1e-9  # mm: vertices are read back in float64 (to_mesh64); round-off only
 GROWTH = circle_scale(CIRCLE_SEGMENTS) - 1  # equal-area polygons reach ~2e-4 x r past the circle
 
@@ -38,9 +40,10 @@ def design():
 
 @pytest.fixture(scope="module")
 def net_meshes(design):
-    """The 1:40 net without and with corner eyelets (same anchor pins as the cables)."""
-    eyelets = corner_eyelets_for(design)
-    return {None: net_solid(design.net), eyelets: net_solid(design.net, eyelets)}
+    """The 1:40 net without and with its attachment (loops on the edge nodes, eyelets on the
+    corner nodes, sized from the cables)."""
+    att = attachment_for(design, hole_compensation_mm=COMP_MM)
+    return {None: net_solid(design.net), att: net_solid(design.net, att)}
 
 
 def _frame_extent(net):
@@ -62,25 +65,22 @@ def test_net_bounds_without_eyelets(design, net_meshes):
                                atol=COORD)
 
 
-def test_net_bounds_with_corner_eyelets(design, net_meshes):
-    """Each ring overlaps a frame arm by half the border width: its centre sits d from the
-    frame corner with sqrt(ro^2 - d^2) = d + bw/2, so it reaches d + ro past the frame."""
+def test_net_bounds_with_its_attachment(design, net_meshes):
+    """The corner eyelets are centred on the corner nodes: the net reaches the corner ring's
+    outer radius (hole + half border + one extra ring) past its corner nodes."""
     sx, sy, half = _frame_extent(design.net)
-    eyelets = corner_eyelets_for(design)
-    ro, bw = eyelets.outer_mm / 2, design.net.border_width_mm
-    d = (-bw + np.sqrt(8 * ro * ro - bw * bw)) / 4
-    assert np.sqrt(ro * ro - d * d) == pytest.approx(d + bw / 2, rel=1e-12)  # round-off
-    reach = half + d + ro
-    lo, hi = net_meshes[eyelets].bounds
+    att = attachment_for(design, hole_compensation_mm=COMP_MM)
+    ro = (3.0 + COMP_MM) / 2 + half + design.net.strand.bead_width_mm
+    lo, hi = net_meshes[att].bounds
     tol = ro * GROWTH + COORD
-    np.testing.assert_allclose(lo, [-reach, -reach, 0.0], atol=tol)
-    np.testing.assert_allclose(hi, [sx + reach, sy + reach, design.net.strand.thickness_mm],
-                               atol=tol)
+    np.testing.assert_allclose(lo, [-ro, -ro, 0.0], atol=tol)
+    np.testing.assert_allclose(hi, [sx + ro, sy + ro, design.net.strand.thickness_mm], atol=tol)
 
 
 def test_net_volume_matches_the_analytic_value(design, net_meshes):
-    for eyelets, mesh in net_meshes.items():
-        assert mesh.volume == pytest.approx(analytic_net_volume(design.net, eyelets), rel=VOLUME)
+    for att, mesh in net_meshes.items():
+        assert mesh.volume == pytest.approx(analytic_net_volume(design.net, att),
+                                            rel=RING_QUADRATURE)
     # the overlaps matter: strand lengths x section + frame alone miss by more than 1 %
     g = diamond_net(design.net.width_mm, design.net.height_mm, design.net.mesh_x_mm,
                     design.net.mesh_y_mm)
@@ -91,26 +91,32 @@ def test_net_volume_matches_the_analytic_value(design, net_meshes):
     assert abs(nominal / net_meshes[None].volume - 1) > VOLUME
 
 
-def test_corner_eyelet_holes_are_open(design, net_meshes):
-    """Each corner ring keeps its hole: the outline gains four holes of the pin's area."""
-    eyelets = corner_eyelets_for(design)
-    plain, ringed = net_outline(design.net), net_outline(design.net, eyelets)
-    assert len(ringed.interiors) == len(plain.interiors) + 4
-    pin = np.pi * (eyelets.inner_mm / 2) ** 2
-    new = sorted(h.area for h in (type(ringed)(r) for r in ringed.interiors))[:4]
-    np.testing.assert_allclose(new, pin, rtol=1e-9)  # equal-area polygons: round-off only
+def test_every_edge_node_has_a_loop_and_every_corner_an_eyelet(design, net_meshes):
+    """The outline gains one hole per border node: loops of the strip's diagonal plus the
+    clearance, corner eyelets of the pin hole, both widened by the hole compensation."""
+    att = attachment_for(design, hole_compensation_mm=COMP_MM)
+    plain, ringed = net_outline(design.net), net_outline(design.net, att)
+    g = diamond_net(design.net.width_mm, design.net.height_mm, design.net.mesh_x_mm,
+                    design.net.mesh_y_mm)
+    assert len(ringed.interiors) == len(plain.interiors) + len(g.border)
+    assert att.loop_hole_mm == pytest.approx(np.hypot(0.9, 0.6) + 2 * 0.3, rel=1e-12)
+    areas = sorted(type(ringed)(r).area for r in ringed.interiors)
+    loop = np.pi * ((att.loop_hole_mm + COMP_MM) / 2) ** 2
+    pin = np.pi * ((3.0 + COMP_MM) / 2) ** 2
+    np.testing.assert_allclose(areas[:len(g.border) - 4], loop, rtol=1e-9)  # equal-area polygons
+    assert sum(np.isclose(areas, pin, rtol=1e-9)) == 4
 
 
 def test_a_smaller_net_keeps_its_analytic_volume(design):
-    """Another mesh ratio, odd half-cell counts (corners off the strands), wider strands."""
+    """Another mesh ratio, odd half-cell counts (corner-only nodes), wider strands."""
     net = dataclasses.replace(design.net, width_mm=61.0, height_mm=47.0, mesh_x_mm=12.0,
                               mesh_y_mm=14.0, strand=Section(0.4, 2, (0.3, 0.3)),
-                              border_width_mm=1.5)
+                              border_width_mm=1.6)
     assert diamond_net(61.0, 47.0, 12.0, 14.0).half_cells == (10, 7)
-    eyelets = CornerEyelets(1.6, 4.0)
-    mesh = net_solid(net, eyelets)
+    att = Attachment(0.6, 0.4, 0.3, 1.6, COMP_MM)
+    mesh = net_solid(net, att)
     assert mesh.is_watertight and len(mesh.split(only_watertight=False)) == 1
-    assert mesh.volume == pytest.approx(analytic_net_volume(net, eyelets), rel=VOLUME)
+    assert mesh.volume == pytest.approx(analytic_net_volume(net, att), rel=RING_QUADRATURE)
 
 
 def test_cable_is_one_watertight_body_with_the_analytic_volume(design):
@@ -160,25 +166,23 @@ def test_impossible_nets_are_rejected(design, change, message):
         net_solid(dataclasses.replace(design.net, **change))
 
 
-@pytest.mark.parametrize("eyelets, message", [
-    (CornerEyelets(3.0, 2.0), "need 0 < inner < outer"),
-    (CornerEyelets(3.0, 3.5), "too thin to join"),
-    (CornerEyelets(0.0, 3.5), "inner diameter = 0.0 mm"),
+@pytest.mark.parametrize("att, message", [
+    (Attachment(0.9, 0.6, 0.3, 3.0, 1.5), "must lie in 0..1 mm"),
+    (Attachment(0.9, 0.6, 0.3, 9.0, 0.2), "less than 0.60 mm"),
+    (Attachment(6.0, 0.6, 0.3, 3.0, 0.2), "less than 0.60 mm"),
 ])
-def test_impossible_corner_eyelets_are_rejected(design, eyelets, message):
+def test_impossible_attachments_are_rejected(design, att, message):
     with pytest.raises(GeometryError, match=message):
-        net_solid(design.net, eyelets)
+        net_solid(design.net, att)
 
 
-def test_a_corner_eyelet_touching_the_corner_strand_is_rejected(design):
-    """A 0.8 mm border puts the 6 mm ring 0.27 mm from the corner node, inside the 0.6 mm
-    strand's half width: the strand would fuse into the ring."""
-    net = dataclasses.replace(design.net, border_width_mm=0.8)
-    net_solid(net)  # the net alone is fine
-    with pytest.raises(GeometryError, match="within the 0.6 mm strand"):
-        net_solid(net, corner_eyelets_for(design))
+def test_the_border_must_split_around_the_loops(design):
+    net = dataclasses.replace(design.net, border_width_mm=1.8)  # three beads
+    g = diamond_net(net.width_mm, net.height_mm, net.mesh_x_mm, net.mesh_y_mm)
+    with pytest.raises(GeometryError, match="even number of border beads"):
+        holes(net, g, attachment_for(design))
 
 
-def test_corner_eyelets_need_cables_to_size_them(design):
-    with pytest.raises(GeometryError, match="pass CornerEyelets"):
-        corner_eyelets_for(dataclasses.replace(design, cables=()))
+def test_an_attachment_needs_cables_to_size_it(design):
+    with pytest.raises(GeometryError, match="no border cables"):
+        attachment_for(dataclasses.replace(design, cables=()))

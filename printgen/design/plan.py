@@ -16,18 +16,22 @@ BORDER_BEADS = 2  # the net's border frame is two beads wide: the cables thread 
 def make_design(prototype: Prototype, targets: ScaledTargets, selection: Selection) -> Design:
     """The Design of the winners of `selection` at the targets' scale (mm).
 
-    Net: the barrier's model width x height, the model mesh, the winning strand section and
-    a border frame of BORDER_BEADS beads. Cables (when the prototype has a border): top and
-    bottom span the width anchor to anchor, the lateral ones the height.
+    Net: the barrier's model width x height rounded to whole half-meshes (the diamond
+    lattice keeps its mesh exact, `printgen.parts.geometry.net`), the model mesh, the winning
+    strand section and a border frame of BORDER_BEADS beads. Cables (when the prototype has a
+    border): top and bottom span the net's width anchor to anchor (its corner nodes sit on the
+    anchors), the lateral ones its height, so the parts meet at every scale.
     """
     net_c = selection.net[0]
     if not net_c.feasible:
         raise DesignError(f"no printable net: {net_c.reasons[0]}")
     mesh_x, mesh_y = model_mesh(prototype, targets)
-    width, height = targets["width"] * 1e3, targets["height"] * 1e3
+    mesh_x_mm, mesh_y_mm = round(mesh_x * 1e3, 6), round(mesh_y * 1e3, 6)
+    width = _lattice_span_mm(targets["width"] * 1e3, mesh_x_mm)
+    height = _lattice_span_mm(targets["height"] * 1e3, mesh_y_mm)
     net = NetDesign(material=net_c.material, print_style=selection.net_print,
                     width_mm=round(width, 6), height_mm=round(height, 6),
-                    mesh_x_mm=round(mesh_x * 1e3, 6), mesh_y_mm=round(mesh_y * 1e3, 6),
+                    mesh_x_mm=mesh_x_mm, mesh_y_mm=mesh_y_mm,
                     strand=net_c.section,
                     border_width_mm=BORDER_BEADS * net_c.section.bead_width_mm)
     cables: tuple[CableDesign, ...] = ()
@@ -44,3 +48,8 @@ def make_design(prototype: Prototype, targets: ScaledTargets, selection: Selecti
             for name, length in (("top", width), ("bottom", width), ("left", height),
                                  ("right", height)))
     return Design(scale=targets.scale, printer=selection.printer, net=net, cables=cables)
+
+
+def _lattice_span_mm(length_mm: float, diagonal_mm: float) -> float:
+    """`length_mm` rounded to whole half-diagonals (the rule of `diamond_net`), mm."""
+    return round(2 * length_mm / diagonal_mm) * diagonal_mm / 2

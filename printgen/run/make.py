@@ -9,9 +9,10 @@ numbers to `ctx.record`.
 from __future__ import annotations
 
 import logging
+import os
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -28,6 +29,7 @@ from printgen.outputs import MANIFEST, file_digest, staged_dir
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
 from printgen.report.report import design_record, design_sections
+from printgen.run.budget import DEFAULT_LIMIT_S, Estimate, check_budget
 
 log = logging.getLogger(__name__)
 
@@ -224,6 +226,7 @@ def verify_step(ctx: MakeContext, stage: Path) -> None:
     ctx.record["verification"] = verification_record(v, v.counterexample)
 
 
+LONG_RUN_S = 15.0  # runs estimated longer than this show their estimate and progress
 TIMINGS = "timings.json"  # the one volatile file: every wall-clock time of the run
 TIME_KEYS = ("timings_s", "seconds", "time_s")  # record keys that hold wall-clock times
 
@@ -240,6 +243,9 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     """
     t0 = time.perf_counter()
     ctx = plan(prototype_path, scale, printer=printer, options=options)
+    est = size_check(ctx, steps is None or any(s is verify_step for _, s in steps))
+    if progress and est.seconds > LONG_RUN_S:
+        progress(f"estimate: {est.summary()}")
     meta: dict[str, Any] = {}
     with staged_dir(out, force=bool(ctx.options.get("force")), meta=meta,
                     volatile=(TIMINGS,)) as stage:
@@ -261,6 +267,18 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
         (stage / TIMINGS).write_text(dumps(timings))
     log.info("make finished in %.2f s", time.perf_counter() - t0)
     return ctx
+
+
+def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
+    """Estimate the run before any of it is done; InputError when it is over the limit
+    (options["time_limit_s"], default about a minute on 2 cores)."""
+    cores = 1 if os.environ.get("PRINTGEN_SERIAL") else min(2, os.cpu_count() or 1)
+    limit = ctx.options.get("time_limit_s") or DEFAULT_LIMIT_S
+    d = ctx.design if verifies else replace(ctx.design, cables=())  # no sweep, no cost
+    est = check_budget(ctx.prototype, d, limit_s=float(limit), cores=cores)
+    ctx.record["size"] = est.to_record()
+    ctx.record.setdefault("timings_s", {})["estimate"] = est.seconds
+    return est
 
 
 def split_timings(record: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:

@@ -46,14 +46,17 @@ def circle_points(cx: float, cy: float, r: float, n: int = CIRCLE_SEGMENTS) -> n
     return np.column_stack([cx + rr * np.cos(t), cy + rr * np.sin(t)])
 
 
-def check_cable(cable: CableDesign) -> None:
+def check_cable(cable: CableDesign, hole_compensation_mm: float = 0.0) -> None:
     """Raise GeometryError when the cable cannot be built (with the value, limit and fix)."""
     name = f"cable {cable.name}"
+    if not (np.isfinite(hole_compensation_mm) and 0 <= hole_compensation_mm < 1.0):
+        raise GeometryError(f"hole compensation {hole_compensation_mm!r} mm must lie in 0..1 mm;"
+                            " fix hole_compensation_mm in the printer profile")
     check_positive_mm(cable.length_mm, f"{name} length")
     check_positive_mm(cable.section.width_mm, f"{name} strip width")
     check_positive_mm(cable.section.thickness_mm, f"{name} thickness")
     if not (np.isfinite(cable.eyelet_outer_mm)
-            and cable.eyelet_outer_mm > cable.eyelet_inner_mm > 0):
+            and cable.eyelet_outer_mm > cable.eyelet_inner_mm + hole_compensation_mm > 0):
         raise GeometryError(f"{name}: eyelet diameters inner {cable.eyelet_inner_mm:g} mm, "
                             f"outer {cable.eyelet_outer_mm:g} mm; need 0 < inner < outer "
                             "(fix eyelet_inner_mm / eyelet_outer_mm of the design)")
@@ -67,14 +70,15 @@ def check_cable(cable: CableDesign) -> None:
                             "eyelet centres must be more than one outer diameter apart")
 
 
-def cable_outline(cable: CableDesign):
-    """Plan view of a cable: shapely Polygon with two holes (mm, centred, along x)."""
-    check_cable(cable)
+def cable_outline(cable: CableDesign, hole_compensation_mm: float = 0.0):
+    """Plan view of a cable: shapely Polygon with two holes (mm, centred, along x); the holes
+    are `hole_compensation_mm` larger than the design's (FDM holes print small)."""
+    check_cable(cable, hole_compensation_mm)
     shapely = require_shapely()
     from shapely.geometry import Polygon, box
 
     half, w = cable.length_mm / 2, cable.section.width_mm
-    ro, ri = cable.eyelet_outer_mm / 2, cable.eyelet_inner_mm / 2
+    ro, ri = cable.eyelet_outer_mm / 2, (cable.eyelet_inner_mm + hole_compensation_mm) / 2
     ends = (-half, half)
     outline = shapely.unary_union([box(-half, -w / 2, half, w / 2)]
                                   + [Polygon(circle_points(x, 0.0, ro)) for x in ends])
@@ -82,16 +86,16 @@ def cable_outline(cable: CableDesign):
     return outline.difference(holes)
 
 
-def analytic_cable_area(cable: CableDesign) -> float:
+def analytic_cable_area(cable: CableDesign, hole_compensation_mm: float = 0.0) -> float:
     """Plan area of a cable (mm^2): two annuli plus the strip outside the two outer discs."""
-    check_cable(cable)
-    ro, ri = cable.eyelet_outer_mm / 2, cable.eyelet_inner_mm / 2
+    check_cable(cable, hole_compensation_mm)
+    ro, ri = cable.eyelet_outer_mm / 2, (cable.eyelet_inner_mm + hole_compensation_mm) / 2
     w = cable.section.width_mm
     # strip |y| <= w/2 inside one disc, on the strip's side of its centre
     in_disc = (w / 2) * np.sqrt(ro * ro - w * w / 4) + ro * ro * np.arcsin(w / (2 * ro))
     return float(2 * np.pi * (ro * ro - ri * ri) + cable.length_mm * w - 2 * in_disc)
 
 
-def analytic_cable_volume(cable: CableDesign) -> float:
+def analytic_cable_volume(cable: CableDesign, hole_compensation_mm: float = 0.0) -> float:
     """Volume of a cable (mm^3): plan area x section thickness."""
-    return analytic_cable_area(cable) * cable.section.thickness_mm
+    return analytic_cable_area(cable, hole_compensation_mm) * cable.section.thickness_mm

@@ -4,27 +4,27 @@ extruded to the section thickness (manifold3d), checked after every operation.
 Net: every diagonal strand of the `NetGraph` as one straight band of the strand width from
 border to border (rigid junctions where the bands cross), plus the border frame of
 `border_width_mm` centred on the panel edge, which the border cables thread along - the same
-layout the direct G-code lays. Optional corner eyelets (`CornerEyelets`) attach the net
-corners to the flume anchors: a ring per corner on the outward diagonal, overlapping each
-frame arm by half the border width. Cables: `printgen.parts.geometry.cable`.
+layout the direct G-code lays. With an `Attachment` (`printgen.parts.geometry.attach`) a
+loop is centred on every edge node, through which the cable strip threads, and an eyelet on
+every corner node, which goes on the flume's anchor pin. Cables:
+`printgen.parts.geometry.cable`.
 Needs the `geometry` extra (manifold3d, trimesh, shapely).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from printgen.design.record import CableDesign, Design, NetDesign
+from printgen.design.record import CableDesign, NetDesign
 from printgen.errors import GeometryError
+from printgen.parts.geometry.attach import Attachment, Hole, attachment_for, holes
 from printgen.parts.geometry.cable import (
     analytic_cable_volume,
     cable_outline,
     check_positive_mm,
     circle_points,
-    circle_scale,
     require_shapely,
 )
 from printgen.parts.geometry.net import NetGraph, diamond_net
@@ -32,30 +32,12 @@ from printgen.parts.geometry.net import NetGraph, diamond_net
 if TYPE_CHECKING:  # pragma: no cover
     import trimesh
 
-__all__ = ["CornerEyelets", "analytic_cable_volume", "analytic_net_area", "analytic_net_volume",
-           "cable_outline", "cable_solid", "corner_eyelets_for", "extrude", "net_outline",
+__all__ = ["Attachment", "analytic_cable_volume", "analytic_net_area", "analytic_net_volume",
+           "attachment_for", "cable_outline", "cable_solid", "extrude", "net_outline",
            "net_solid"]
 
 AREA_CHECK = 1e-6  # relative: manifold's cross-section area vs shapely's (same polygon)
-CORNERS = ((0, 0, -1, -1), (1, 0, 1, -1), (1, 1, 1, 1), (0, 1, -1, 1))  # (at x, at y, dir)
-
-
-@dataclass(frozen=True)
-class CornerEyelets:
-    """Eyelet rings at the four net corners (diameters, mm)."""
-
-    inner_mm: float
-    outer_mm: float
-
-
-def corner_eyelets_for(design: Design) -> CornerEyelets:
-    """Net corner eyelets that go on the same anchor pins as the cables' eyelets (the cable
-    with the largest pin hole sets both diameters)."""
-    if not design.cables:
-        raise GeometryError("the design has no cables to take the corner eyelet size from; "
-                            "pass CornerEyelets(inner_mm, outer_mm) explicitly")
-    c = max(design.cables, key=lambda c: c.eyelet_inner_mm)
-    return CornerEyelets(c.eyelet_inner_mm, c.eyelet_outer_mm)
+QUAD_RINGS, QUAD_ANGLES = 200, 720  # polar grid of the in-ring area integral (~1e-3 of it)
 
 
 def _graph(net: NetDesign) -> NetGraph:
@@ -83,64 +65,48 @@ def _graph(net: NetDesign) -> NetGraph:
     return g
 
 
-def _eyelet_offset(net: NetDesign, e: CornerEyelets) -> float:
-    """Offset (mm, along x and y) of an eyelet centre from the frame's outer corner, such
-    that the ring overlaps each frame arm by half the border width; checked."""
-    bw, w = net.border_width_mm, net.strand.width_mm
-    check_positive_mm(e.inner_mm, "net corner eyelet inner diameter")
-    if not (np.isfinite(e.outer_mm) and e.outer_mm > e.inner_mm):
-        raise GeometryError(f"net corner eyelets: inner {e.inner_mm:g} mm, outer "
-                            f"{e.outer_mm:g} mm; need 0 < inner < outer")
-    ro, ri = e.outer_mm / 2, e.inner_mm / 2
-    d = (-bw + np.sqrt(8 * ro * ro - bw * bw)) / 4  # sqrt(ro^2 - d^2) = d + bw/2
-    hole = ri * circle_scale()
-    if d <= hole:
-        need = 2 * np.sqrt(((4 * hole + bw) ** 2 + bw * bw) / 8)
-        raise GeometryError(f"net corner eyelet ring {e.outer_mm:g} mm outer, {e.inner_mm:g} mm "
-                            f"inner is too thin to join a {bw:g} mm border without its hole "
-                            f"cutting the frame; use an outer diameter above {need:.3g} mm")
-    gap = np.sqrt(2) * (bw / 2 + d) - ro  # ring to the corner node, along the diagonal
-    if gap <= w / 2:
-        raise GeometryError(f"net corner eyelet ring comes {gap:.3g} mm from the corner node, "
-                            f"within the {w:g} mm strand; widen the border or the eyelet hole")
-    return float(d)
-
-
-def net_outline(net: NetDesign, eyelets: CornerEyelets | None = None):
+def net_outline(net: NetDesign, attachment: Attachment | None = None):
     """Plan view of the net: one shapely Polygon with holes (mm, origin at the lower-left
-    node, border frame centred on the panel edge)."""
+    node, border frame centred on the panel edge), with the loops and corner eyelets of
+    `attachment` when given."""
     g = _graph(net)
-    d = None if eyelets is None else _eyelet_offset(net, eyelets)
+    hs = [] if attachment is None else holes(net, g, attachment)
     shapely = require_shapely()
-    from shapely.geometry import LineString, Polygon, box
+    from shapely.geometry import Polygon
 
-    sx, sy = g.size_mm
-    bw, w = net.border_width_mm, net.strand.width_mm
-    bands = [LineString(g.nodes_mm[[s[0], s[-1]]]).buffer(w / 2, cap_style="flat")
-             for s in g.strands]
-    frame = box(-bw / 2, -bw / 2, sx + bw / 2, sy + bw / 2).difference(
-        box(bw / 2, bw / 2, sx - bw / 2, sy - bw / 2))
-    pieces, holes = [*bands, frame], []
-    if eyelets is not None:
-        for cx, cy in _eyelet_centres(g, bw, d):
-            pieces.append(Polygon(circle_points(cx, cy, eyelets.outer_mm / 2)))
-            holes.append(Polygon(circle_points(cx, cy, eyelets.inner_mm / 2)))
+    pieces = [*_strand_bands(net, g), _frame(net, g)]
+    pieces += [Polygon(circle_points(*h.centre_mm, h.outer_r_mm)) for h in hs]
     outline = shapely.unary_union(pieces)
-    return outline.difference(shapely.unary_union(holes)) if holes else outline
+    if not hs:
+        return outline
+    return outline.difference(shapely.unary_union(
+        [Polygon(circle_points(*h.centre_mm, h.hole_r_mm)) for h in hs]))
 
 
-def _eyelet_centres(g: NetGraph, bw: float, d: float) -> list[tuple[float, float]]:
+def _strand_bands(net: NetDesign, g: NetGraph) -> list:
+    from shapely.geometry import LineString
+
+    return [LineString(g.nodes_mm[[s[0], s[-1]]]).buffer(net.strand.width_mm / 2,
+                                                          cap_style="flat")
+            for s in g.strands]
+
+
+def _frame(net: NetDesign, g: NetGraph):
+    from shapely.geometry import box
+
     sx, sy = g.size_mm
-    return [(ix * sx + ux * (bw / 2 + d), iy * sy + uy * (bw / 2 + d))
-            for ix, iy, ux, uy in CORNERS]
+    bw = net.border_width_mm
+    return box(-bw / 2, -bw / 2, sx + bw / 2, sy + bw / 2).difference(
+        box(bw / 2, bw / 2, sx - bw / 2, sy - bw / 2))
 
 
-def analytic_net_area(net: NetDesign, eyelets: CornerEyelets | None = None) -> float:
+def analytic_net_area(net: NetDesign, attachment: Attachment | None = None) -> float:
     """Plan area of the net (mm^2), from the graph alone (no shapely).
 
     Strand lengths x width, less one rhombus w^2 / sin(theta) per crossing and, per strand
     end, the w x (bw/2) / sin(phi) inside the frame (phi: strand vs the edge it meets), plus
-    the frame 2 bw (sx + sy) and the corner rings less their overlap with the frame.
+    the frame 2 bw (sx + sy). Each ring adds its disc less the frame and strands already
+    inside it (a polar-grid integral of numpy point tests) and removes its hole.
     """
     g = _graph(net)
     a, b = g.mesh_mm
@@ -155,24 +121,40 @@ def analytic_net_area(net: NetDesign, eyelets: CornerEyelets | None = None) -> f
     sin_phi = np.where(on_top_bottom, b / diag, a / diag)
     area = (length * w - n_cross * w * w / sin_theta - float(np.sum(bw / 2 / sin_phi)) * w
             + 2 * bw * (sx + sy))
-    if eyelets is not None:
-        d = _eyelet_offset(net, eyelets)
-        ro, ri = eyelets.outer_mm / 2, eyelets.inner_mm / 2
-        area += 4 * (np.pi * (ro * ro - ri * ri) - _disc_in_quadrant(ro, d))
+    if attachment is not None:
+        for h in holes(net, g, attachment):
+            area += np.pi * (h.outer_r_mm**2 - h.hole_r_mm**2) - _base_in_disc(net, g, h)
     return float(area)
 
 
-def _disc_in_quadrant(r: float, d: float) -> float:
-    """Area of a disc of radius r (centre 0) in {x >= d, y >= d}, for 0 <= d, 2 d^2 < r^2."""
-    def f(x: float) -> float:
-        return 0.5 * (x * np.sqrt(r * r - x * x) + r * r * np.arcsin(x / r)) - d * x
+def _base_in_disc(net: NetDesign, g: NetGraph, h: Hole) -> float:
+    """Area (mm^2) of frame and strands within a ring's outer radius (hole included)."""
+    r = h.outer_r_mm * (np.arange(QUAD_RINGS) + 0.5) / QUAD_RINGS
+    t = (np.arange(QUAD_ANGLES) + 0.5) * (2 * np.pi / QUAD_ANGLES)
+    rr, tt = np.meshgrid(r, t, indexing="ij")
+    p = h.centre_mm + np.stack([rr * np.cos(tt), rr * np.sin(tt)], axis=-1)
+    sx, sy = g.size_mm
+    half = net.border_width_mm / 2
+    x, y = p[..., 0], p[..., 1]
+    outer = (x >= -half) & (x <= sx + half) & (y >= -half) & (y <= sy + half)
+    inner = (x > half) & (x < sx - half) & (y > half) & (y < sy - half)
+    inside = outer & ~inner
+    for s in g.strands:
+        p0, p1 = g.nodes_mm[s[0]], g.nodes_mm[s[-1]]
+        d = p1 - p0
+        length = float(np.hypot(*d))
+        u = d / length
+        rel = p - p0
+        along = rel @ u
+        across = np.abs(rel @ np.array([-u[1], u[0]]))
+        inside |= (along >= 0) & (along <= length) & (across <= net.strand.width_mm / 2)
+    cell = h.outer_r_mm / QUAD_RINGS * (2 * np.pi / QUAD_ANGLES) * rr
+    return float(np.sum(cell * inside))
 
-    return float(f(np.sqrt(r * r - d * d)) - f(d))
 
-
-def analytic_net_volume(net: NetDesign, eyelets: CornerEyelets | None = None) -> float:
+def analytic_net_volume(net: NetDesign, attachment: Attachment | None = None) -> float:
     """Volume of the net (mm^3): plan area x strand thickness."""
-    return analytic_net_area(net, eyelets) * net.strand.thickness_mm
+    return analytic_net_area(net, attachment) * net.strand.thickness_mm
 
 
 def extrude(outline, thickness_mm: float, name: str) -> trimesh.Trimesh:
@@ -207,11 +189,12 @@ def extrude(outline, thickness_mm: float, name: str) -> trimesh.Trimesh:
     return mesh
 
 
-def net_solid(net: NetDesign, eyelets: CornerEyelets | None = None) -> trimesh.Trimesh:
+def net_solid(net: NetDesign, attachment: Attachment | None = None) -> trimesh.Trimesh:
     """The net as one watertight trimesh (mm, z from 0 to the strand thickness)."""
-    return extrude(net_outline(net, eyelets), net.strand.thickness_mm, "net")
+    return extrude(net_outline(net, attachment), net.strand.thickness_mm, "net")
 
 
-def cable_solid(cable: CableDesign) -> trimesh.Trimesh:
+def cable_solid(cable: CableDesign, hole_compensation_mm: float = 0.0) -> trimesh.Trimesh:
     """A cable as one watertight trimesh (mm, centred on the origin, along x)."""
-    return extrude(cable_outline(cable), cable.section.thickness_mm, f"cable {cable.name}")
+    return extrude(cable_outline(cable, hole_compensation_mm), cable.section.thickness_mm,
+                   f"cable {cable.name}")
