@@ -1,0 +1,277 @@
+"""A lab's loading test brought back to the pre-print check: read its CSV, compare it with the
+predicted curves, and fit the one factor of the printed net that best explains it (issue 10).
+
+The CSV (`,` or `;` separated; with `;`, decimal commas are accepted; lines starting with `#`
+are comments) has a column `h_over_hb` and any of the columns in `COLUMNS`. Elongations are
+read as what the extension sensors record: counted from h / h_B = 0 (sensors zeroed before
+the water arrives), so they are compared with the predicted curves counted from there too.
+An empty cell is a reading that was not taken.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from printgen.check.bands import Band, Variant, curves, run_variant
+from printgen.design.record import Design
+from printgen.errors import InputError
+
+LEVEL_COLUMN = "h_over_hb"
+# CSV column -> (METRICS key of printgen.check.compare, factor from the CSV unit to the key's)
+COLUMNS = {
+    "bottom_cable_elongation_pct": ("strain_bottom", 0.01),
+    "top_cable_elongation_pct": ("strain_top", 0.01),
+    "mid_height_elongation_pct": ("strain_mid", 0.01),
+    "deflection_over_width": ("deflection", 1.0),
+}
+MAX_LEVEL = 1.1  # the sweep's last relative loading (overflow): no prediction beyond it
+LIMITS = {  # plausible range of each column (CSV units): beyond it the unit is wrong
+    "bottom_cable_elongation_pct": (-100.0, 100.0),
+    "top_cable_elongation_pct": (-100.0, 100.0),
+    "mid_height_elongation_pct": (-100.0, 100.0),
+    "deflection_over_width": (-2.0, 2.0),
+}
+
+
+class MeasurementError(InputError):
+    """A measured-data file cannot be read (bad column, number, range, or no data)."""
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """A lab's loading test: levels (k,) h / h_B; values : METRICS key -> (k,) in the model's
+    units (strain, deflection / width), NaN where the cell was empty; columns : CSV names."""
+
+    path: str
+    levels: np.ndarray
+    values: dict[str, np.ndarray]
+    columns: dict[str, str]  # METRICS key -> CSV column
+
+
+def read_measured(path: str | Path) -> Measurement:
+    """Read and check a measured loading test (see the module docstring for the format)."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise MeasurementError(f"{p}: cannot read the measured data: {exc}") from exc
+    lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines())
+             if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        raise MeasurementError(f"{p}: empty file; give a header line with {LEVEL_COLUMN} and "
+                               f"any of {', '.join(COLUMNS)}, then one line per level")
+    sep = ";" if ";" in lines[0][1] else ","
+    header = [h.strip().lower() for h in lines[0][1].split(sep)]
+    _check_header(p, header)
+    rows = lines[1:]
+    if not rows:
+        raise MeasurementError(f"{p}: a header but no data lines; give one line per level")
+    table = np.array([_row(p, n, ln, sep, header) for n, ln in rows])
+    data = dict(zip(header, table.T, strict=True))
+    _check_ranges(p, data, [n for n, _ in rows])
+    keys = {COLUMNS[c][0]: c for c in header if c != LEVEL_COLUMN}
+    values = {COLUMNS[c][0]: data[c] * COLUMNS[c][1] for c in header if c != LEVEL_COLUMN}
+    return Measurement(str(p), data[LEVEL_COLUMN], values, keys)
+
+
+def _check_header(p: Path, header: list[str]) -> None:
+    allowed = [LEVEL_COLUMN, *COLUMNS]
+    for h in header:
+        if h not in allowed:
+            raise MeasurementError(f"{p}: unknown column {h!r}; allowed: {', '.join(allowed)}")
+    dup = sorted({h for h in header if header.count(h) > 1})
+    if dup:
+        raise MeasurementError(f"{p}: column {dup[0]!r} appears twice; keep one")
+    if LEVEL_COLUMN not in header:
+        raise MeasurementError(f"{p}: missing column {LEVEL_COLUMN!r} (relative loading "
+                               f"h / h_B); columns found: {', '.join(header)}")
+    if len(header) < 2:
+        raise MeasurementError(f"{p}: no measured column; add any of {', '.join(COLUMNS)}")
+
+
+def _row(p: Path, n: int, line: str, sep: str, header: list[str]) -> list[float]:
+    cells = [c.strip() for c in line.split(sep)]
+    if len(cells) != len(header):
+        raise MeasurementError(f"{p}, line {n}: {len(cells)} cells for {len(header)} columns "
+                               f"({', '.join(header)})")
+    out = []
+    for col, cell in zip(header, cells, strict=True):
+        if cell == "" and col != LEVEL_COLUMN:
+            out.append(math.nan)  # a reading that was not taken
+            continue
+        text = cell.replace(",", ".") if sep == ";" else cell
+        try:
+            v = float(text)
+        except ValueError:
+            v = math.nan
+        if not math.isfinite(v):
+            raise MeasurementError(f"{p}, line {n}, column {col!r}: {cell!r} is not a finite "
+                                   "number")
+        out.append(v)
+    return out
+
+
+def _check_ranges(p: Path, data: dict[str, np.ndarray], line_numbers: list[int]) -> None:
+    lv = data[LEVEL_COLUMN]
+    bad = np.flatnonzero((lv < 0) | (lv > MAX_LEVEL))
+    if bad.size:
+        i = int(bad[0])
+        raise MeasurementError(f"{p}, line {line_numbers[i]}: {LEVEL_COLUMN} = {lv[i]:g} outside "
+                               f"0 to {MAX_LEVEL:g} (the predicted range; h / h_B, not mm)")
+    for col, (lo, hi) in LIMITS.items():
+        if col not in data:
+            continue
+        v = data[col]
+        bad = np.flatnonzero((v < lo) | (v > hi))
+        if bad.size:
+            i = int(bad[0])
+            raise MeasurementError(f"{p}, line {line_numbers[i]}, column {col!r}: {v[i]:g} "
+                                   f"outside {lo:g} to {hi:g}; check the unit of the column")
+        if np.all(np.isnan(v)):
+            raise MeasurementError(f"{p}: column {col!r} holds no value; fill or remove it")
+
+
+@dataclass(frozen=True)
+class Mismatch:
+    """Measured vs predicted for one column: RMS of the difference (model units), and the
+    same relative to the measured peak; inside : points within the predicted band."""
+
+    metric: str
+    column: str
+    rms: float
+    rms_rel: float
+    points: int
+    inside: int
+
+
+def mismatch(m: Measurement, predicted: dict[str, np.ndarray],
+             lo: dict[str, np.ndarray] | None = None, hi: dict[str, np.ndarray] | None = None
+             ) -> list[Mismatch]:
+    """Mismatch of every measured column against `predicted` (METRICS key -> values at the
+    measured levels), and how many points fall inside the band [lo, hi] when one is given."""
+    out = []
+    for key, col in m.columns.items():
+        meas, pred = m.values[key], predicted[key]
+        ok = ~np.isnan(meas) & ~np.isnan(pred)
+        diff = meas[ok] - pred[ok]
+        rms = float(np.sqrt(np.mean(diff**2))) if ok.any() else math.nan
+        peak = float(np.abs(meas[ok]).max()) if ok.any() else 0.0
+        inside = 0
+        if lo is not None and hi is not None:
+            inside = int(np.sum((meas[ok] >= lo[key][ok] - 1e-12)
+                                & (meas[ok] <= hi[key][ok] + 1e-12)))
+        out.append(Mismatch(key, col, rms, rms / peak if peak > 0 else math.nan, int(ok.sum()),
+                            inside))
+    return out
+
+
+def objective(m: Measurement, predicted: dict[str, np.ndarray]) -> float:
+    """Mean over columns of the squared RMS mismatch relative to each column's measured peak
+    (columns of different units weigh the same)."""
+    return float(np.nanmean([mm.rms_rel**2 for mm in mismatch(m, predicted)]))
+
+
+Predictor = Callable[[float], dict[str, np.ndarray]]
+FIT_KINDS = ("stiffness", "slack")
+STIFFNESS_RANGE = (0.2, 5.0)  # net stiffness factors searched: a printed net 5x off is a misprint
+SLACK_RANGE = (0.0, 0.03)  # initial slack searched: 3 % sags visibly, a lab would see it
+XTOL_LOG = 0.005  # stiffness factor known to 0.5 % (bounded Brent on log factor)
+XTOL_SLACK = 1e-4  # slack known to 0.01 %
+AT_BOUND = 0.01  # a result this close to a range end (fraction of the range) is "at the bound"
+
+
+@dataclass(frozen=True)
+class Fit:
+    """The factor of the printed net that best explains the measurement.
+
+    kind : "stiffness" (multiplier on the net's force law) or "slack" (relative initial
+    slack); value : the fitted factor; before, after : mismatches at the nominal (1 or 0) and
+    at the fitted value; predicted : METRICS key -> (k,) at the measured levels, fitted;
+    evaluations : solver sweeps run; at_bound : the best value is at the searched range's end.
+    """
+
+    kind: str
+    value: float
+    before: list[Mismatch]
+    after: list[Mismatch]
+    predicted: dict[str, np.ndarray]
+    evaluations: int
+    at_bound: bool
+
+
+def fit_factor(m: Measurement, predict: Predictor, kind: str = "stiffness") -> Fit:
+    """Minimise the measured-vs-predicted mismatch (`objective`) over one factor:
+    scipy's bounded Brent search on log(factor) for stiffness, on the slack itself for slack.
+    `predict(value)` returns the predicted curves at the measured levels (from h / h_B = 0)."""
+    from scipy.optimize import minimize_scalar
+
+    if kind not in FIT_KINDS:
+        raise InputError(f"fit {kind!r} unknown; choose one of {', '.join(FIT_KINDS)}")
+    cache: dict[float, dict[str, np.ndarray]] = {}
+
+    def curves_at(value: float) -> dict[str, np.ndarray]:
+        if value not in cache:
+            cache[value] = predict(value)
+        return cache[value]
+
+    if kind == "stiffness":
+        lo, hi = (math.log(v) for v in STIFFNESS_RANGE)
+        to_value, nominal, xtol = math.exp, 1.0, XTOL_LOG
+    else:
+        (lo, hi), to_value, nominal, xtol = SLACK_RANGE, float, 0.0, XTOL_SLACK
+    res = minimize_scalar(lambda x: objective(m, curves_at(to_value(x))), bounds=(lo, hi),
+                          method="bounded", options={"xatol": xtol})
+    value = to_value(float(res.x))
+    edge = AT_BOUND * (hi - lo)
+    return Fit(kind, value, mismatch(m, curves_at(nominal)), mismatch(m, curves_at(value)),
+               curves_at(value), len(cache), bool(res.x - lo < edge or hi - res.x < edge))
+
+
+def fitted_profile(material: str, kind: str, value: float, *, panel_kappas: tuple | None,
+                   modulus_gpa: float | None, source: str) -> str:
+    """TOML text of a material profile that feeds a fitted stiffness factor back: it inherits
+    `material` and scales its panel law (or its measured modulus). None for a slack fit."""
+    if kind != "stiffness":
+        return ""
+    lines = [f'# The printed net of {source}, fitted by printgen verify --measured:',
+             f"# effective stiffness {value:.3f} x the '{material}' profile.",
+             f'inherits = "{material}"', ""]
+    cond = f"effective law of the printed net fitted to the loading test {source}"
+    if panel_kappas:
+        kappas = ", ".join(f"{k * value / 1e3:.4g}" for k in panel_kappas)
+        lines += ["[measured.panel_law]", f"kappa_kn_per_m_per_m = [{kappas}]",
+                  f'source = "printgen verify --measured {source}"', f'conditions = "{cond}"']
+    else:
+        lines += ["[measured.tensile_modulus]", f"value_gpa = {modulus_gpa * value:.4g}",
+                  f'source = "printgen verify --measured {source}"', f'conditions = "{cond}"']
+    return "\n".join(lines) + "\n"
+
+
+def model_predictor(d: Design, band: Band, m: Measurement, kind: str = "stiffness", *,
+                    load_kw: dict | None = None) -> Predictor:
+    """`predict(value)` for `fit_factor`: the printed model swept with the net's stiffness
+    times `value` (or `value` initial slack) up to the highest measured level, on the band's
+    solver net (a coarse net adds its change to the nominal curves, as the band does), counted
+    from h / h_B = 0 and interpolated at the measured levels."""
+    top = float(m.levels.max())
+    above = np.flatnonzero(band.levels >= top - 1e-9)
+    n = int(above[0]) + 1 if above.size else len(band.levels)
+    lv, k = band.levels[:n], band.coarsen
+    base = curves(run_variant(d, Variant(), lv, k, load_kw)) if k > 1 else None
+
+    def predict(value: float) -> dict[str, np.ndarray]:
+        v = (Variant("fit", net_factor=value, frame_factor=value) if kind == "stiffness"
+             else Variant("fit", slack=value))
+        c = curves(run_variant(d, v, lv, k, load_kw))
+        out = {}
+        for key in m.values:
+            y = c[key] if base is None else band.nominal[key][:n] + c[key] - base[key]
+            out[key] = np.interp(m.levels, lv, y - y[0])
+        return out
+
+    return predict
