@@ -95,6 +95,9 @@ def unit_factor(role: str, unit: str | None, *, where: str) -> float:
 # readings, bridge voltages. They are never taken for a role unless --column names them.
 RAW_UNITS = frozenset({"counts", "count", "cnt", "raw", "adc", "digits", "digit", "bits", "lsb",
                        "mv", "v", "mv/v"})
+# An unlabelled force column of whole numbers reaching this is load-cell counts, not newtons: a
+# printed specimen breaks far below 10 kN, and a tester's newtons carry decimals.
+RAW_COUNTS_MIN = 1e4
 _RAW_NAME = re.compile(r"(?<![a-z])(raw|counts?|cnt|adc|digits?|bits|lsb|voltage)(?![a-z])")
 # Tester flag columns (0/1 or true/false per row): step loss, end stop, overload, ...
 _FLAG_NAME = re.compile(r"flag|loss|stop|limit|error|fault|alarm|warn|overload|slip|skip|abort|"
@@ -106,11 +109,18 @@ def is_raw(name: str, unit: str | None) -> bool:
     return (unit is not None and unit in RAW_UNITS) or bool(_RAW_NAME.search(name.lower()))
 
 
-def unit_class(role: str, name: str, unit: str | None) -> tuple[int, str]:
+def unit_class(role: str, name: str, unit: str | None, values=None) -> tuple[int, str]:
     """(rank, reason) of a candidate column for `role`: 0 a unit of the role, 1 no unit (the
-    default assumed), 2 another unit label (an error when used), 3 raw (never taken)."""
+    default assumed), 2 another unit label (an error when used), 3 raw (never taken): raw by
+    its name or unit label, or an unlabelled force column of whole numbers reaching
+    RAW_COUNTS_MIN (load-cell counts by their magnitude)."""
     if is_raw(name, unit):
-        return 3, f"raw {'counts' if unit is None else unit}, not {DEFAULT_UNIT[role]} by its name"
+        kind = "counts" if unit is None else unit
+        return 3, f"raw {kind}, not {_show_unit(DEFAULT_UNIT[role])} by its name"
+    if unit is None and role == "force" and values is not None and values.size:
+        top = float(abs(values).max())
+        if top >= RAW_COUNTS_MIN and bool((values == values.round()).all()):
+            return 3, f"whole numbers up to {top:.6g}: raw counts by magnitude, not N"
     if unit is None:
         return 1, f"no unit: {_show_unit(DEFAULT_UNIT[role])} assumed"
     if unit in ROLE_UNITS[role]:

@@ -123,7 +123,7 @@ def read_export(path: str | Path, *, columns: Mapping[str, str] | None = None,
         raise CalibrationError(f"unknown column role {unknown[0]!r} in the units; roles: "
                                f"{', '.join(ROLES)}")
     col_units = _column_units(headers, unit_row, ncols)
-    roles, alternatives, notes = _assign(headers, col_units, columns or {}, where)
+    roles, alternatives, notes = _assign(headers, col_units, data, columns or {}, where)
     channels, names, assumed = {}, {}, set()
     for role, j in roles.items():
         unit = (units or {}).get(role)
@@ -236,8 +236,8 @@ def _body(rows, ncols: int, dec: str, where: str, headers: list[str], delim: str
     return np.array(out, dtype=float), np.array(line_no, dtype=int)
 
 
-def _assign(headers: list[str], col_units: list[str | None], chosen: Mapping[str, str],
-            where: str) -> tuple[dict[str, int], dict[str, tuple[str, ...]], list[str]]:
+def _assign(headers: list[str], col_units: list[str | None], data: np.ndarray,
+            chosen: Mapping[str, str], where: str) -> tuple[dict[str, int], dict[str, tuple[str, ...]], list[str]]:
     """(role -> column index, role -> other candidate headers, notes): the options first, then
     the header names, preferring a column whose unit belongs to the role; raw counts are never
     taken and two unitless force columns are an error, not a guess."""
@@ -256,7 +256,7 @@ def _assign(headers: list[str], col_units: list[str | None], chosen: Mapping[str
     for role, js in cands.items():
         if not js:
             continue
-        why = {j: unit_class(role, headers[j], col_units[j]) for j in js}
+        why = {j: unit_class(role, headers[j], col_units[j], data[:, j]) for j in js}
         best = min(js, key=lambda j: why[j][0])
         _refuse_guess(role, [headers[j] for j in js if why[j][0] == why[best][0]], why[best],
                       where)

@@ -6,7 +6,26 @@ from typing import Any
 
 from printgen.calibrate.aggregate import Stats
 from printgen.calibrate.pipeline import Calibration
-from printgen.calibrate.sample import SampleFit
+from printgen.calibrate.sample import PRELOAD_STEPS, SampleFit
+
+
+def _pct(v: float | None) -> float | None:
+    return None if v is None else v * 100
+
+
+def preload_record(cal: Calibration, change: tuple[float | None, ...] | None,
+                   moduli: tuple[float | None, ...] | None = None) -> dict[str, Any] | None:
+    """Preloads at PRELOAD_STEPS x the preload, the modulus change there (%) and, for one
+    sample, the moduli; None without a preload."""
+    p = cal.options.preload
+    if p is None or change is None:
+        return None
+    out: dict[str, Any] = {"preload_n": [p * f for f in PRELOAD_STEPS],
+                           "change_percent": [_pct(c) for c in change]}
+    if moduli is not None:
+        mu, mf, _, _ = units(cal)
+        out[f"modulus_{mu}"] = [None if m is None else m / mf for m in moduli]
+    return out
 
 
 def stats_record(s: Stats | None, factor: float) -> dict[str, Any] | None:
@@ -39,6 +58,9 @@ def sample_record(s: SampleFit, cal: Calibration) -> dict[str, Any]:
         "peak_force_n": s.peak_force, f"strength_{su}": None if s.strength is None
         else s.strength / sf,
         "specimen": {k: v for k, v in vars(s.specimen).items() if v is not None},
+        "columns": s.columns, "elongation_at_break_percent": _pct(s.elongation_at_break),
+        "preload_sensitivity": preload_record(cal, s.preload_change, s.preload_moduli),
+        "flags": list(s.flags), "excluded": s.path in cal.excluded,
     }
     if s.kappa is not None:
         rec["kappa_kn_per_m_per_m"] = s.kappa / 1e3
@@ -56,14 +78,20 @@ def calibration_record(cal: Calibration) -> dict[str, Any]:
         "material": cal.material, "kind": cal.kind,
         "options": {"window_percent": None if o.window is None else [w * 100 for w in o.window],
                     "auto_span": o.auto_span, "preload_n": o.preload,
-                    "strain_source": o.strain_source,
+                    "strain_source": o.strain_source, "zero": o.zero,
+                    "keep_flagged": o.keep_flagged,
                     "compliance": None if o.compliance is None else o.compliance.describe()},
         "samples": [sample_record(s, cal) for s in cal.samples],
         "strength_samples": [{"file": s.path, "peak_force_n": s.peak_force,
-                              f"strength_{su}": None if s.strength is None else s.strength / sf}
+                              f"strength_{su}": None if s.strength is None else s.strength / sf,
+                              "columns": s.columns, "flags": list(s.flags),
+                              "excluded": s.path in cal.excluded}
                              for s in cal.strength_samples],
         f"modulus_{mu}": stats_record(cal.modulus, mf),
+        "modulus_preload_sensitivity": preload_record(cal, cal.preload_change),
         f"strength_{su}": stats_record(cal.strength, sf),
+        "elongation_at_break_percent": stats_record(cal.elongation, 1e-2),
+        "excluded": list(cal.excluded), "skipped": list(cal.skipped),
         "warnings": list(cal.warnings),
     }
     if cal.panel is not None:

@@ -1,9 +1,10 @@
 """`printgen calibrate`: material profiles from tensile-test exports.
 
-    printgen calibrate FILE... --material petg-lab [--kind cable|dogbone|panel]
+    printgen calibrate FILE|DIR... --material petg-lab [--kind cable|dogbone|panel]
         [--width-mm W --thickness-mm T | --area-mm2 A] [--gauge-length-mm L]
         [--grip-distance-mm L] [--specimen SIDECAR.toml] [--column ROLE=NAME] [--unit ROLE=UNIT]
-        [--window 0.05,0.25 | --window auto] [--preload N] [--secant 0.5,1]
+        [--window 0.05,0.25 | --window auto] [--preload N [--zero interpolate|first]]
+        [--secant 0.5,1] [--keep-flagged]
         [--strain-source auto|extensometer|crosshead]
         [--machine-stiffness N_PER_MM | --compliance-curve FILE]
         [--strength-only] [--save [--out DIR] [--inherits petg]] [--plot DIR] [--json]
@@ -14,15 +15,19 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from rich.markup import escape
+
+from printgen.calibrate.aggregate import MIN_SAMPLES
 from printgen.calibrate.compliance import from_curve, from_stiffness
-from printgen.calibrate.fit import ISO_WINDOW
+from printgen.calibrate.fit import DEFAULT_ZERO, ISO_WINDOW, ZERO_MODES
 from printgen.calibrate.pipeline import Calibration, calibrate
 from printgen.calibrate.record import calibration_record, units
-from printgen.calibrate.sample import DEFAULT_SECANTS, FitOptions
+from printgen.calibrate.sample import DEFAULT_SECANTS, PRELOAD_STEPS, FitOptions, SampleFit
 from printgen.calibrate.specimen import KINDS
 from printgen.commands.common import add_json_arg, console, emit_json, fmt, table
 from printgen.errors import CalibrationError
 
+PRELOAD_COL = "ΔE % at P∓10%"  # modulus change (%) at 0.9 and 1.1 x the preload
 DIMENSION_OPTIONS = (("width_mm", "width", 1e-3), ("thickness_mm", "thickness", 1e-3),
                      ("area_mm2", "area", 1e-6), ("gauge_length_mm", "gauge_length", 1e-3),
                      ("grip_distance_mm", "grip_distance", 1e-3))
@@ -30,7 +35,9 @@ DIMENSION_OPTIONS = (("width_mm", "width", 1e-3), ("thickness_mm", "thickness", 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("calibrate", help="fit moduli, strength and panel laws from tensile tests")
-    p.add_argument("files", nargs="+", help="tensile-test exports (CSV/TXT, or a zip of one)")
+    p.add_argument("files", nargs="+", help="tensile-test exports (.csv .txt .tsv .dat in any "
+                   "case, or a zip of one) or directories (every export in them; sidecar "
+                   ".toml files are never read as data)")
     p.add_argument("--material", required=True, help="profile name to write (e.g. petg-lab)")
     p.add_argument("--kind", choices=KINDS, help="specimen type (default: sidecar, else cable)")
     for opt, _, _ in DIMENSION_OPTIONS:
@@ -51,7 +58,14 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "for the steepest window as test-machine software does")
     p.add_argument("--auto-span", type=float, default=FitOptions.auto_span,
                    help="auto window: fraction of the rise to the peak it spans (default 0.15)")
-    p.add_argument("--preload", type=float, metavar="N", help="zero strain at this force (N)")
+    p.add_argument("--preload", type=float, metavar="N", help="zero strain at this force (N); "
+                   "the modulus at -10 %% and +10 %% of it is shown too")
+    p.add_argument("--zero", choices=ZERO_MODES, help=f"preload zero (default {DEFAULT_ZERO}): "
+                   "'interpolate' between the samples around the preload, or 'first' sample at "
+                   "or above it (as many testers' software does)")
+    p.add_argument("--keep-flagged", action="store_true",
+                   help="keep samples a tester flag column marks (step loss, end stop, ...) in "
+                        "the statistics (default: reported and left out)")
     p.add_argument("--secant", default=",".join(f"{e * 100:g}" for e in DEFAULT_SECANTS),
                    metavar="E1,E2", help="strains (%%) for secant moduli (default 0.5,1)")
     p.add_argument("--strain-source", choices=("auto", "extensometer", "crosshead"),
@@ -91,9 +105,13 @@ def options_from(args: argparse.Namespace) -> FitOptions:
         compliance = from_curve(args.compliance_curve)
     if not 0 < args.auto_span < 1:
         raise CalibrationError(f"--auto-span {args.auto_span:g} must be between 0 and 1")
+    if args.zero is not None and args.preload is None:
+        raise CalibrationError(f"--zero {args.zero} needs --preload N: without a preload, strain "
+                               "is zeroed at the first sample")
     return FitOptions(window=window, auto_span=args.auto_span, preload=args.preload,
                       secant_strains=tuple(e / 100 for e in _floats(args.secant, "--secant")),
-                      strain_source=args.strain_source, compliance=compliance)
+                      strain_source=args.strain_source, compliance=compliance,
+                      zero=args.zero or DEFAULT_ZERO, keep_flagged=args.keep_flagged)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -138,43 +156,87 @@ def show(cal: Calibration, written: dict) -> None:
     if panel and cal.samples:
         mf = 1e3 * cal.samples[0].specimen.strain_length()
     if cal.samples:
-        cols = ["file", f"{'kappa' if panel else 'E'} {mu}", "window %", "r2",
+        cols = ["file", f"{'kappa' if panel else 'E'} {mu}", PRELOAD_COL, "window %", "r2",
                 f"{'k1/k2' if panel else 'E1/E2'} {mu}", "knee %",
                 *[f"sec {e * 100:g}%" for e in cal.options.secant_strains],
-                f"max {su}", f"machine {mu}", "diff"]
-        rows = []
-        for s in cal.samples:
-            b, m = s.bilinear, s.machine_modulus
-            rows.append([Path(s.path).name, fmt(s.modulus / mf),
-                         f"{s.linear.lo * 100:.3f}-{s.linear.hi * 100:.3f}", f"{s.linear.r2:.4f}",
-                         "-" if b is None else f"{b.slope1 / mf:.4g}/{b.slope2 / mf:.4g}",
-                         "-" if b is None else f"{b.knee * 100:.3g}",
-                         *[fmt(None if v is None else v / mf) for v in s.secants.values()],
-                         fmt(None if s.strength is None else s.strength / sf),
-                         fmt(None if m is None else m / mf),
-                         "-" if m is None else f"{s.modulus / m - 1:+.1%}"])
-        out.print(table(f"{cal.material}: {cal.kind} specimens, strain from "
-                        f"{'; '.join(cal.strain_sources)}", cols, rows))
+                f"max {su}", "break %", f"machine {mu}", "diff", "flags"]
+        rows = [[escape(c) for c in _sample_row(s, cal, mf, sf)] for s in cal.samples]
+        cols, rows = _drop_empty(cols, rows, (PRELOAD_COL, f"machine {mu}", "diff", "flags"))
+        out.print(table(escape(f"{cal.material}: {cal.kind} specimens, strain from "
+                               f"{'; '.join(cal.strain_sources)}{_zero_text(cal)}"), cols, rows))
     elif cal.strength_samples:
-        rows = [[Path(s.path).name, f"{s.peak_force:.2f}",
-                 fmt(None if s.strength is None else s.strength / sf)]
-                for s in cal.strength_samples]
-        out.print(table(f"{cal.material}: strength only (force-only files)",
-                        ["file", "peak N", f"strength {su}"], rows))
+        rows = [[escape(Path(s.path).name), f"{s.peak_force:.2f}",
+                 fmt(None if s.strength is None else s.strength / sf),
+                 escape(_flag_text(s, cal))] for s in cal.strength_samples]
+        out.print(table(escape(f"{cal.material}: strength only (force-only files)"),
+                        ["file", "peak N", f"strength {su}", "flags"], rows))
     for what, st, f, u in (("kappa (window)" if panel else "modulus", cal.modulus, mf, mu),
-                           ("strength", cal.strength, sf, su)):
+                           ("strength", cal.strength, sf, su),
+                           ("elongation at break", cal.elongation, 1e-2, "%")):
         if st is not None:
             sd = "-" if st.sd is None else f"{st.sd / f:.4g}"
-            out.print(f"[bold]{what}[/]: {st.mean / f:.4g} ± {sd} {u} (n = {st.n})")
+            n = f"n = {st.n}" + (": spread only" if st.n < MIN_SAMPLES else "")
+            extra = _preload_text(cal) if st is cal.modulus else ""
+            out.print(f"[bold]{what}[/]: {st.mean / f:.4g} ± {sd} {u} ({n}){extra}")
     if cal.panel is not None:
         p = cal.panel
         out.print(f"[bold]panel law[/]: kappa {p.kappa1.mean / 1e3:.4g} kN/m/m up to "
                   f"{p.knee.mean * 100:.3g} % strain, then {p.kappa2.mean / 1e3:.4g} kN/m/m "
                   f"(panel {p.panel_length * 1e3:g} mm long, n = {p.kappa1.n})")
     for w in cal.warnings:
-        out.print(f"[yellow]warning:[/] {w}")
+        out.print(f"[yellow]warning:[/] {escape(w)}")
     for k, v in written.items():
-        out.print(f"{k}: {v}")
+        out.print(escape(f"{k}: {v}"))
+
+
+def _sample_row(s: SampleFit, cal: Calibration, mf: float, sf: float) -> list[str]:
+    b, m = s.bilinear, s.machine_modulus
+    return [Path(s.path).name, fmt(s.modulus / mf), _change_text(s.preload_change),
+            f"{s.linear.lo * 100:.3g}-{s.linear.hi * 100:.3g}", f"{s.linear.r2:.4f}",
+            "-" if b is None else f"{b.slope1 / mf:.4g}/{b.slope2 / mf:.4g}",
+            "-" if b is None else f"{b.knee * 100:.3g}",
+            *[fmt(None if v is None else v / mf) for v in s.secants.values()],
+            fmt(None if s.strength is None else s.strength / sf),
+            fmt(None if s.elongation_at_break is None else s.elongation_at_break * 100),
+            fmt(None if m is None else m / mf),
+            "-" if m is None else f"{s.modulus / m - 1:+.1%}", _flag_text(s, cal)]
+
+
+def _drop_empty(cols: list[str], rows: list[list[str]], optional: tuple[str, ...]
+                ) -> tuple[list[str], list[list[str]]]:
+    """Leave out the `optional` columns that are '-' in every row (the table stays narrow)."""
+    keep = [j for j, c in enumerate(cols) if c not in optional or any(r[j] != "-" for r in rows)]
+    return [cols[j] for j in keep], [[r[j] for j in keep] for r in rows]
+
+
+def _flag_text(s, cal: Calibration) -> str:
+    """Flag column names set in a sample, and whether it left the statistics."""
+    if not s.flags:
+        return "-"
+    names = ", ".join(f.split(" set at ")[0] for f in s.flags)
+    return f"{names}: {'out' if s.path in cal.excluded else 'kept'}"
+
+
+def _change_text(change: tuple[float | None, ...] | None) -> str:
+    """'-1.2/+0.8': modulus change (%) at -10 % and +10 % preload; '-' without a preload."""
+    if change is None:
+        return "-"
+    return "/".join("?" if c is None else f"{c * 100:+.1f}" for c in change)
+
+
+def _zero_text(cal: Calibration) -> str:
+    o = cal.options
+    if o.preload is None:
+        return "; zero at the first sample (no preload)"
+    return f"; zero at preload {o.preload:g} N ({o.zero})"
+
+
+def _preload_text(cal: Calibration) -> str:
+    if cal.preload_change is None or cal.options.preload is None:
+        return ""
+    lo, hi = (f * cal.options.preload for f in PRELOAD_STEPS)
+    return (f"; preload {lo:g} / {hi:g} N (±10 %) moves it {_change_text(cal.preload_change)} "
+            f"% (zero: {cal.options.zero})")
 
 
 def _floats(text: str, opt: str, n: int | None = None) -> list[float]:
