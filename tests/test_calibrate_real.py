@@ -19,6 +19,7 @@ from conftest import require_shared
 from numpy.testing import assert_allclose
 
 from printgen.calibrate.pipeline import calibrate
+from printgen.calibrate.reader import read_export
 from printgen.calibrate.sample import FitOptions
 from printgen.cli import main
 from printgen.errors import CalibrationError
@@ -142,3 +143,23 @@ def test_require_shared_skips_without_shared_and_fails_when_required(monkeypatch
         conftest.require_shared("data/tensile")
     (tmp_path / "no-shared" / "data" / "tensile").mkdir(parents=True)
     assert conftest.require_shared("data/tensile") == tmp_path / "no-shared" / "data" / "tensile"
+
+
+# Brittle composite: the break follows the peak within this strain (measured at most 0.023 %).
+BREAK_AFTER_PEAK = 3e-4
+
+
+@pytest.mark.parametrize("folder", ["Tens_Yield", "Tens_No_Yield"])
+def test_bluehill_elongation_at_break_after_the_peak(folder):
+    """Elongation at break lies between the machine's strain at tensile strength (header) and
+    the last strain recorded; no flag columns, no column-choice notes in these files."""
+    files = sorted(require_shared(f"{BLUEHILL}/{folder}").glob("*.csv"))
+    cal = calibrate(files, material="cf", options=FitOptions(window=None))
+    for s in cal.samples:
+        rec = read_export(s.path)
+        at_strength = next(m.number for m in rec.metadata if m.key.startswith("Tensile strain"))
+        last = rec.channels["strain"][-1] - rec.channels["strain"][0]
+        assert at_strength <= s.elongation_at_break <= last
+        assert s.elongation_at_break - at_strength < BREAK_AFTER_PEAK
+        assert (s.flags, s.notes) == ((), ())
+    assert cal.elongation.n == 10 and cal.excluded == ()
