@@ -6,7 +6,9 @@ import io
 
 import numpy as np
 
+from printgen.check.bands import Band
 from printgen.check.compare import METRICS, Deformation
+from printgen.check.measured import Fit, Measurement
 from printgen.errors import PrintgenError
 
 DPI = 110
@@ -32,11 +34,16 @@ def _png(fig) -> bytes:
 
 
 def verification_figure(proto: Deformation, model: Deformation, scale: float,
-                        title: str) -> bytes:
-    """Normalised deformations of prototype and model against relative loading, 2 x 3 panels."""
+                        title: str, *, band: Band | None = None) -> bytes:
+    """Normalised deformations of prototype and model against relative loading, 2 x 3 panels;
+    the model's uncertainty band (min/max envelope) shaded when given."""
     plt = _pyplot()
     fig, axes = plt.subplots(2, 3, figsize=(12, 6.6), constrained_layout=True)
+    lo, hi = band.envelope() if band is not None else ({}, {})
     for ax, key in zip(axes.flat, METRICS, strict=False):
+        if band is not None:
+            ax.fill_between(band.levels, lo[key], hi[key], color="C1", alpha=0.25, lw=0,
+                            label="model band")
         ax.plot(proto.levels, proto.values[key], "k-o", ms=3, label="prototype")
         ax.plot(model.levels, model.values[key], "C1-s", ms=3, label=f"model 1:{scale:g}")
         ax.set_xlabel("relative loading h / h_B")
@@ -74,4 +81,31 @@ def series_figure(lams: np.ndarray, curves: dict[str, dict[str, np.ndarray]],
         ax.grid(alpha=0.3, which="both")
     axes[0].legend(fontsize=8)
     fig.suptitle(title)
+    return _png(fig)
+
+
+def measured_figure(m: Measurement, band: Band, fit: Fit | None) -> bytes:
+    """Each measured column against relative loading: the predicted band and nominal curve
+    (counted from h / h_B = 0), the measured points, and the fitted curve when given."""
+    plt = _pyplot()
+    keys = list(m.values)
+    fig, axes = plt.subplots(1, len(keys), figsize=(4.2 * len(keys), 3.8),
+                             constrained_layout=True, squeeze=False)
+    lo, hi = band.envelope(from_start=True)
+    for ax, key in zip(axes.flat, keys, strict=True):
+        unit = 100.0 if key.startswith("strain") else 1.0
+        nominal = band.nominal[key] - band.nominal[key][0]
+        ax.fill_between(band.levels, lo[key] * unit, hi[key] * unit, color="C1", alpha=0.25,
+                        lw=0, label="predicted band")
+        ax.plot(band.levels, nominal * unit, "C1-", label="nominal")
+        ax.plot(m.levels, m.values[key] * unit, "ko", ms=4, label="measured")
+        if fit is not None:
+            order = np.argsort(m.levels)
+            ax.plot(m.levels[order], fit.predicted[key][order] * unit, "C0--",
+                    label=f"fitted {fit.kind} {fit.value:.3g}")
+        ax.set_xlabel("relative loading h / h_B")
+        ax.set_title(m.columns[key], fontsize=10)
+        ax.grid(alpha=0.3)
+    axes.flat[0].legend(fontsize=8)
+    fig.suptitle("Measured loading test against the prediction")
     return _png(fig)

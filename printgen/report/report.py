@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from printgen.check.bands import Band
 from printgen.check.verify import CounterExample, Verification
 from printgen.design.record import Design
 from printgen.design.selection import Candidate, Selection
@@ -70,18 +71,20 @@ def design_record(proto: Prototype, t: ScaledTargets, sel: Selection,
 
 
 def verification_sections(rep: Report, v: Verification | None, ce: CounterExample | None,
-                          scale: float, note: str = "") -> None:
-    """The pre-print check: verdict, side-by-side table, figure, counter-example."""
+                          scale: float, note: str = "", band: Band | None = None) -> None:
+    """The pre-print check: verdict, side-by-side table, figure (with the model's uncertainty
+    band when given), counter-example."""
     rep.heading("Pre-print verification: prototype vs printed model")
     if v is None:
         rep.verdict(False, f"Verification {note}")
     else:
-        _sweep_sections(rep, v, scale)
+        _sweep_sections(rep, v, scale, band)
     if ce is not None:
         _counterexample_section(rep, ce)
 
 
-def _sweep_sections(rep: Report, v: Verification, scale: float) -> None:
+def _sweep_sections(rep: Report, v: Verification, scale: float, band: Band | None = None
+                    ) -> None:
     from printgen.check.compare import METRICS, TOLERANCE
     from printgen.report.plots import verification_figure
 
@@ -130,7 +133,9 @@ def _sweep_sections(rep: Report, v: Verification, scale: float) -> None:
                 f"{m.max_cable_tension[-1] * scale**3 / 1e3:.1f}",
                 f"{m.max_cable_tension[-1]:.3g}"]])
     rep.figure(verification_figure(p, m, scale, "Normalised deformation against relative "
-                                   "loading"), "Prototype (black) and printed model (orange).")
+                                   "loading", band=band),
+               "Prototype (black) and printed model (orange"
+               + ("; shaded: the model's uncertainty band)." if band is not None else ")."))
     rep.paragraph(f"Solver: {sum(v.prototype.iterations)} + {sum(v.model.iterations)} Newton "
                   f"iterations over {len(p.levels)} load levels (times in timings.json).",
                   "note")

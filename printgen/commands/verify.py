@@ -1,0 +1,66 @@
+"""`printgen verify PROTOTYPE --scale 40 --design OUT/design.json [--measured FILE.csv]
+[--fit stiffness|slack] [--out DIR]`: the pre-print check of an existing design with its
+uncertainty band; with a lab's measured loading test, the mismatch and one fitted factor."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from rich.console import Console
+
+from printgen.check.measured import COLUMNS, FIT_KINDS, LEVEL_COLUMN
+from printgen.commands.common import add_json_arg, add_prototype_args, console, emit_json, table
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("verify", help="re-run the pre-print check of a design (design.json) "
+                                      "with its uncertainty band; compare a measured test")
+    add_prototype_args(p)
+    p.add_argument("--design", type=Path, required=True,
+                   help="the design.json that printgen make wrote")
+    p.add_argument("--measured", type=Path, metavar="FILE.csv",
+                   help=f"a loading test (',' or ';'): {LEVEL_COLUMN} and any of "
+                        f"{', '.join(COLUMNS)}")
+    p.add_argument("--fit", choices=FIT_KINDS, default="stiffness",
+                   help="the one factor of the printed net fitted to --measured "
+                        "(default: its effective stiffness)")
+    p.add_argument("--out", "-o", type=Path,
+                   help="output folder (default: beside the design's folder, '<name>-verify')")
+    p.add_argument("--drag", action="store_true",
+                   help="hydrostatic + drag at the Froude-scaled velocity")
+    p.add_argument("--force", action="store_true",
+                   help="replace an output folder printgen did not write")
+    add_json_arg(p)
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from printgen.run.verify import band_summary, verify_design
+
+    folder = args.design.resolve().parent
+    out = args.out or folder.with_name(f"{folder.name}-verify")
+    err = Console(stderr=True, highlight=False)
+    t0 = time.perf_counter()
+    with err.status("reading inputs") as status:
+        res = verify_design(args.prototype, args.scale, args.design, out,
+                            measured=args.measured, fit=args.fit, drag=args.drag,
+                            force=args.force, progress=lambda s: status.update(f"{s} ..."))
+    if args.json:
+        emit_json(res.record)
+        return 0
+    c = console()
+    rows = [[line.split(": ", 1)[0], line.split(": ", 1)[1]] for line in band_summary(res)]
+    c.print(table(f"printgen verify: 1:{res.design.scale:g} in {time.perf_counter() - t0:.1f} s"
+                  " (prototype vs the model's band)", ["quantity", "verdict"], rows))
+    if res.fit is not None:
+        c.print(res.record["measured"]["fit"]["sentence"])
+        if res.profile_text:
+            name = f"{res.design.net.material}-fitted.toml"
+            c.print(f"Feed it back: copy {out / name} into profiles/materials/ (or a folder in "
+                    "$PRINTGEN_PROFILES) and use it as the net's material.")
+    c.print(f"{len(res.files)} files in {out}/ ; open {out / 'report.html'}")
+    sys.stdout.flush()
+    return 0

@@ -1,0 +1,148 @@
+"""Report sections and JSON records of the model's uncertainty band and of a lab's measured
+loading test (issue 10): what varied, the band at h/h_B = 0.5, 1.0, 1.1, the band verdicts,
+and the measured points against the band with the fitted factor of the printed net."""
+
+from __future__ import annotations
+
+import html
+from typing import Any
+
+import numpy as np
+
+from printgen.check.bands import Band, BandVerdict, band_verdicts
+from printgen.check.compare import METRICS
+from printgen.check.measured import Fit, Measurement, mismatch
+from printgen.check.verify import Verification
+from printgen.report.html import Report
+
+SHOW_LEVELS = (0.5, 1.0, 1.1)  # relative loadings shown in the tables and summaries
+
+
+def _at(levels: np.ndarray, x: float) -> int | None:
+    i = int(np.argmin(np.abs(levels - x)))
+    return i if abs(levels[i] - x) < 1e-9 else None
+
+
+def band_sections(rep: Report, v: Verification, band: Band) -> None:
+    """What varied, the band at SHOW_LEVELS, and the verdict of each metric."""
+    rep.heading("Uncertainty band of the printed model")
+    runs = "; ".join(f"{label} ({src})" for label, src in band.sources.items()) or "none"
+    mesh = ("the design's own net" if band.coarsen == 1 else
+            f"a net {band.coarsen} times coarser (strands {band.coarsen} times stiffer), each "
+            "variant's change added to the nominal curves")
+    tried = ", ".join(f"x{k}: {c:.1%}" for k, c in band.refinement.items()) or "none"
+    rep.paragraph(f"The model is swept for its nominal inputs and for each uncertain input moved "
+                  f"alone: {runs}. The band is the min/max envelope of those curves (one input "
+                  f"at a time; combined extremes are not run). Variants ran on {mesh}: the "
+                  f"coarsest net whose nominal curves move by less than 1 % of their peak "
+                  f"(refinement test, largest change: {tried}).")
+    for note in band.notes:
+        rep.paragraph(f"Not in the band: {note}.", "note")
+    for label, lv in band.failed.items():
+        rep.verdict(False, f"{label}: no converged state at h/h_B = "
+                           f"{', '.join(f'{x:g}' for x in lv)}; left out of the band there")
+    lo, hi = band.envelope()
+    p = v.prototype.deformation.values
+    verdicts = {b.metric: b for b in band_verdicts(p, band)}
+    start = {b.metric: b for b in band_verdicts(p, band, from_start=True)}
+    idx = [_at(band.levels, x) for x in SHOW_LEVELS]
+    rows = []
+    for key in METRICS:
+        cells = [("-" if i is None else f"{p[key][i]:.4f} / {lo[key][i]:.4f}-{hi[key][i]:.4f}")
+                 for i in idx]
+        rows.append([METRICS[key], *cells, verdicts[key].text, start[key].text])
+    rep.table(["quantity (prototype / model band)", *(f"h/h_B = {x:g}" for x in SHOW_LEVELS),
+               "verdict", "counted from h/h_B = 0"], rows)
+
+
+def band_record(v: Verification, band: Band) -> dict[str, Any]:
+    """The band in report.json: every curve's min/max (absolute and from h/h_B = 0), the
+    variants and notes, the refinement test, and the verdicts."""
+    lo, hi = band.envelope()
+    lo0, hi0 = band.envelope(from_start=True)
+    p = v.prototype.deformation.values
+    at = {f"{x:g}": {key: {"min": lo[key][i], "max": hi[key][i], "nominal": band.nominal[key][i],
+                           "prototype": p[key][i]} for key in METRICS}
+          for x in SHOW_LEVELS if (i := _at(band.levels, x)) is not None}
+    return {
+        "levels": band.levels, "nominal": band.nominal, "min": lo, "max": hi,
+        "min_from_start": lo0, "max_from_start": hi0, "at": at,
+        "variants": band.sources, "variant_curves": band.variants, "notes": band.notes,
+        "coarsen": band.coarsen, "refinement_change": {str(k): c for k, c in
+                                                       band.refinement.items()},
+        "not_converged": band.failed,
+        "verdicts": [_verdict(b) for b in band_verdicts(p, band)],
+        "verdicts_from_start": [_verdict(b) for b in band_verdicts(p, band, from_start=True)],
+        "seconds": band.seconds,
+    }
+
+
+def _verdict(b: BandVerdict) -> dict[str, Any]:
+    return {"metric": b.metric, "kind": b.kind, "least": b.least, "most": b.most,
+            "inside_levels": b.inside_levels, "levels": b.levels, "text": b.text}
+
+
+def predicted_at(m: Measurement, band: Band) -> tuple[dict, dict, dict]:
+    """(nominal, band min, band max) counted from h/h_B = 0, at the measured levels."""
+    lo, hi = band.envelope(from_start=True)
+    nom = {k: band.nominal[k] - band.nominal[k][0] for k in METRICS}
+    return tuple({k: np.interp(m.levels, band.levels, c[k]) for k in m.values}
+                 for c in (nom, lo, hi))
+
+
+def measured_sections(rep: Report, m: Measurement, band: Band, fit: Fit | None,
+                      profile: str) -> None:
+    """Measured points against the band, their mismatch, the fitted factor and its profile."""
+    from printgen.report.plots import measured_figure
+
+    rep.heading(f"Measured loading test: {m.path}")
+    nom, lo, hi = predicted_at(m, band)
+    before = mismatch(m, nom, lo, hi)
+    after = {mm.metric: mm for mm in fit.after} if fit else {}
+    rep.paragraph("Measured values are taken as the sensors read them, counted from h/h_B = 0, "
+                  "and compared with the predicted curves counted from there.")
+    rows = [[mm.column, str(mm.points), f"{mm.inside} of {mm.points}", _fmt(mm),
+             f"{mm.rms_rel:.0%}"] + ([_fmt(after[mm.metric]), f"{after[mm.metric].rms_rel:.0%}"]
+                                     if fit else []) for mm in before]
+    cols = ["column", "points", "inside the band", "RMS mismatch (nominal)", "of measured peak"]
+    if fit:
+        cols += [f"RMS, fitted {fit.kind}", "of measured peak"]
+    rep.table(cols, rows)
+    if fit:
+        rep.paragraph(_fit_sentence(fit))
+    rep.figure(measured_figure(m, band, fit), "Measured points (black) on the predicted band "
+               "(orange: nominal line, shaded: band), counted from h/h_B = 0; dashed: fitted.")
+    if profile:
+        rep.paragraph("To feed it back, save this as profiles/materials/<name>.toml (or a folder "
+                      "in $PRINTGEN_PROFILES) and name it as the net's material:")
+        rep.blocks.append(f"<pre>{html.escape(profile)}</pre>")
+
+
+def _fmt(mm) -> str:
+    scale, unit = (100.0, " %") if mm.metric.startswith("strain") else (1.0, "")
+    return f"{mm.rms * scale:.3g}{unit}"
+
+
+def _fit_sentence(fit: Fit) -> str:
+    what = (f"net stiffness {fit.value:.3f} x its profile" if fit.kind == "stiffness"
+            else f"initial slack {fit.value:.2%} of the net")
+    edge = (" The best value is at the end of the searched range: the measurement is outside "
+            "what this factor can explain." if fit.at_bound else "")
+    return (f"The printed net behaved like a model with {what} (one-factor fit, "
+            f"{fit.evaluations} solver sweeps).{edge}")
+
+
+def measured_record(m: Measurement, band: Band, fit: Fit | None, profile: str
+                    ) -> dict[str, Any]:
+    """The measured comparison in report.json."""
+    nom, lo, hi = predicted_at(m, band)
+    rec: dict[str, Any] = {"file": m.path, "levels": m.levels, "values": m.values,
+                           "columns": m.columns, "predicted_nominal": nom,
+                           "band_min": lo, "band_max": hi,
+                           "mismatch": mismatch(m, nom, lo, hi), "fit": None}
+    if fit:
+        rec["fit"] = {"kind": fit.kind, "value": fit.value, "at_bound": fit.at_bound,
+                      "evaluations": fit.evaluations, "mismatch_nominal": fit.before,
+                      "mismatch_fitted": fit.after, "predicted": fit.predicted,
+                      "sentence": _fit_sentence(fit), "profile": profile}
+    return rec

@@ -1,0 +1,154 @@
+"""`printgen verify`: the pre-print check of an existing design (the design.json `make`
+wrote), with its uncertainty band, and optionally a lab's measured loading test compared with
+it and one factor of the printed net fitted to it. Output folder (written whole,
+`outputs.staged_dir`): report.html, report.json, timings.json, and with a stiffness fit
+`<material>-fitted.toml`, the profile that feeds the fit back.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from printgen.check.bands import Band, band_verdicts, model_band
+from printgen.check.measured import (
+    Fit,
+    Measurement,
+    fit_factor,
+    fitted_profile,
+    model_predictor,
+    read_measured,
+)
+from printgen.check.verify import Verification, verify
+from printgen.design.record import Design
+from printgen.errors import InputError
+from printgen.inputs.materials import load_material
+from printgen.inputs.prototype import Prototype, load_prototype
+from printgen.outputs import staged_dir
+from printgen.report.html import Report
+from printgen.report.jsonout import dumps
+from printgen.report.report import verification_record, verification_sections
+from printgen.report.uncertainty import (
+    band_record,
+    band_sections,
+    measured_record,
+    measured_sections,
+)
+
+SCALE_TOL = 1e-9  # relative: --scale must be the design's scale
+TIMINGS = "timings.json"  # wall-clock times, the one file that differs between identical runs
+
+
+@dataclass
+class VerifyRun:
+    """What `printgen verify` computed and wrote."""
+
+    prototype: Prototype
+    design: Design
+    verification: Verification
+    band: Band
+    measurement: Measurement | None
+    fit: Fit | None
+    profile_text: str
+    record: dict[str, Any]
+    files: list[str]
+
+
+def load_design(path: str | Path, scale: float) -> Design:
+    """The Design in `path` (make's design.json); InputError when it is unreadable or at
+    another scale than `scale`."""
+    p = Path(path)
+    try:
+        rec = json.loads(p.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise InputError(f"--design {p}: cannot read it ({exc}); give the design.json that "
+                         "printgen make wrote") from exc
+    if isinstance(rec, dict) and "design" in rec and "net" not in rec:
+        rec = rec["design"]  # a report.json holds the design under "design"
+    if not isinstance(rec, dict):
+        raise InputError(f"--design {p}: not a design record (a JSON object)")
+    d = Design.from_record(rec, where=f"--design {p}")
+    if abs(d.scale / scale - 1) > SCALE_TOL:
+        raise InputError(f"--design {p} is the design at 1:{d.scale:g}, --scale is {scale:g}; "
+                         f"give --scale {d.scale:g} or the design made at 1:{scale:g}")
+    return d
+
+
+def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
+                  out: str | Path, *, measured: str | Path | None = None,
+                  fit: str = "stiffness", drag: bool = False, force: bool = False,
+                  progress: Callable[[str], None] | None = None) -> VerifyRun:
+    """Check the design against the prototype with its band; compare and fit `measured`.
+
+    Every input is read and checked before the first solve, so a bad file costs nothing.
+    """
+    say = progress or (lambda _label: None)
+    t0 = time.perf_counter()
+    p = load_prototype(prototype)
+    d = load_design(design_path, scale)
+    m = read_measured(measured) if measured is not None else None
+    load_kw = _load_kw(p, d) if drag else None
+    say("verification (prototype and model load sweeps)")
+    v = verify(p, d, drag=drag)
+    say("uncertainty band (model variants)")
+    band = model_band(d, v.model, load_kw=load_kw)
+    result, text = None, ""
+    if m is not None:
+        say(f"fit of the net's {fit} to {Path(measured).name}")
+        result = fit_factor(m, model_predictor(d, band, m, fit, load_kw=load_kw), fit)
+        text = _profile_text(d, result, Path(measured).name)
+    rep = Report(f"printgen verify: {p.name} at 1:{d.scale:g}")
+    verification_sections(rep, v, None, d.scale, band=band)
+    band_sections(rep, v, band)
+    record = {"design": d.to_dict(), "verification": verification_record(v, None),
+              "bands": band_record(v, band)}
+    if m is not None:
+        measured_sections(rep, m, band, result, text)
+        record["measured"] = measured_record(m, band, result, text)
+    record["timings_s"] = {"total": time.perf_counter() - t0, "band": band.seconds}
+    files = _write(out, rep, record, d, text, force)
+    return VerifyRun(p, d, v, band, m, result, text, record, files)
+
+
+def _load_kw(p: Prototype, d: Design) -> dict[str, float]:
+    import math
+
+    return {"velocity": p.velocity / math.sqrt(d.scale),
+            "strand_diameter": d.net.strand.width_mm * 1e-3}
+
+
+def _profile_text(d: Design, fit: Fit, source: str) -> str:
+    mat = load_material(d.net.material)
+    law = mat.panel_law
+    kappas = law.kappas if law is not None and law.has_geometry else None
+    return fitted_profile(d.net.material, fit.kind, fit.value, panel_kappas=kappas,
+                          modulus_gpa=mat.modulus()[0] / 1e9, source=source)
+
+
+def _write(out: str | Path, rep: Report, record: dict[str, Any], d: Design, profile: str,
+           force: bool) -> list[str]:
+    timings = record.pop("timings_s")
+    files = {"report.html": rep.html(), "report.json": dumps(record),
+             TIMINGS: dumps({"timings_s": timings})}
+    if profile:
+        files[f"{d.net.material}-fitted.toml"] = profile
+    record["timings_s"] = timings
+    with staged_dir(out, force=force, volatile=(TIMINGS,)) as stage:
+        for name, text in files.items():
+            (stage / name).write_text(text)
+    return sorted(files)
+
+
+def band_summary(run: VerifyRun) -> list[str]:
+    """One line per metric: the band verdict (for the command line's summary)."""
+    from printgen.check.compare import METRICS
+
+    keep = run.band.levels
+    proto = run.verification.prototype.deformation
+    sel = [i for i, lv in enumerate(proto.levels) if any(abs(lv - k) < 1e-9 for k in keep)]
+    curves = {k: proto.values[k][sel] for k in METRICS}
+    return [f"{METRICS[b.metric]}: {b.text}" for b in band_verdicts(curves, run.band)]

@@ -1,0 +1,123 @@
+"""Uncertainty bands of the printed model: the variants, the envelope, the refinement test and
+the verdict's wording (issue 10)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from conftest import reference_design_1_40
+
+from printgen.check import bands
+from printgen.check.bands import (
+    Variant,
+    band_verdict,
+    model_band,
+    model_variants,
+    refinement_test,
+    run_variant,
+    variant_scene,
+)
+from printgen.check.compare import METRICS
+from printgen.design.record import Section
+
+COARSE = 3  # the 1:40 net with a 3x coarser mesh (50 nodes): fast sweeps
+LEVELS = np.round(np.arange(0.0, 1.11, 0.1), 10)  # 0.1 steps keep the sweeps short
+ROUND = 1e-12  # round-off allowed between a curve and the band's edge
+LEVELS_V = np.linspace(0.0, 1.1, 12)
+
+
+def coarse_design():
+    d = reference_design_1_40()
+    n = d.net
+    return dataclasses.replace(d, net=dataclasses.replace(
+        n, mesh_x_mm=n.mesh_x_mm * COARSE, mesh_y_mm=n.mesh_y_mm * COARSE))
+
+
+def test_band_contains_the_nominal_and_every_variant():
+    d = coarse_design()
+    nominal = run_variant(d, Variant(), LEVELS)
+    variants = [Variant("softer net", net_factor=0.7, frame_factor=0.7),
+                Variant("stiffer cables", cable_factor=1.3)]
+    b = model_band(d, nominal, variants=variants, notes=["a note"])
+    assert b.notes == ["a note"] and set(b.variants) == {v.label for v in variants}
+    for from_start in (False, True):
+        lo, hi = b.envelope(from_start=from_start)
+        for key in METRICS:
+            curves = [b.nominal[key], *(c[key] for c in b.variants.values())]
+            for c in curves:
+                c = c - (c[0] if from_start else 0.0)
+                assert np.all(lo[key] <= c + ROUND) and np.all(c <= hi[key] + ROUND)
+    lo, hi = b.envelope()
+    assert np.max(hi["deflection"] - lo["deflection"]) > 0  # the variants move the curve
+
+
+def test_refinement_test_keeps_the_design_net_when_coarsening_changes_the_answer(monkeypatch):
+    d = coarse_design()
+    nominal = bands.curves(run_variant(d, Variant(), LEVELS))
+    k, change = refinement_test(d, nominal, LEVELS)
+    assert list(change) == [2]  # a failing x2 stops the test: x3 is not run
+    assert change[2] >= bands.REFINE_TOL and k == 1
+    monkeypatch.setattr(bands, "REFINE_TOL", 10.0)  # any change accepted: the coarsest wins
+    k, change = refinement_test(d, nominal, LEVELS)
+    assert k == max(change) == max(bands.COARSENINGS)
+
+
+def test_coarse_variant_scene_keeps_membrane_stiffness():
+    d = coarse_design()
+    fine, coarse = variant_scene(d, Variant()), variant_scene(d, Variant(), 2)
+    assert len(coarse.nodes) < len(fine.nodes)
+    assert coarse.laws[0][1][0] == pytest.approx(2 * fine.laws[0][1][0], rel=ROUND)
+    assert coarse.laws[1] == fine.laws[1]  # the border frame is not meshed: same law
+
+
+def test_variants_of_the_1_40_design_say_what_is_left_out():
+    variants, notes = model_variants(reference_design_1_40())
+    assert [v.slack for v in variants if v.slack] == [bands.SLACK_MAX]
+    text = " ".join(notes)
+    assert "TPE (net): no SD" in text and "PETG (cables): no SD" in text
+    assert "tested net the profile assumes" in text
+
+
+def test_modulus_sd_and_panel_geometry_variants(tmp_path, monkeypatch):
+    (tmp_path / "materials").mkdir()
+    (tmp_path / "materials" / "petg-sd.toml").write_text(
+        'inherits = "petg"\n[measured.tensile_modulus]\nvalue_gpa = 1.30\nsd_gpa = 0.13\n')
+    monkeypatch.setenv("PRINTGEN_PROFILES", str(tmp_path))
+    d = reference_design_1_40()
+    d = dataclasses.replace(
+        d, cables=tuple(dataclasses.replace(c, material="petg-sd") for c in d.cables),
+        net=dataclasses.replace(d.net, strand=Section(0.6, 1, (0.35, 0.30))))
+    variants = {v.label: v for v in model_variants(d)[0]}
+    assert sorted(v.cable_factor for v in variants.values() if v.cable_factor != 1) == \
+        pytest.approx([0.9, 1.1], rel=ROUND)
+    geometry = [v for label, v in variants.items() if "panel law" in label]
+    assert len(geometry) == 1  # the tested net's strands were 0.95 mm thick, these 0.65 mm
+    assert geometry[0].net_factor == pytest.approx(0.95 / 0.65, rel=1e-9)
+
+
+VERDICTS = {  # model band (lo, hi) as multiples of the prototype curve -> (kind, text)
+    "inside": ((0.9, 1.1), "inside", "prototype inside the model band"),
+    "stiffer": ((0.5, 0.8), "stiffer", "model stiffer by at least 20% (up to 20%)"),
+    "softer": ((1.3, 1.6), "softer", "model softer by at least 30% (up to 30%)"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(VERDICTS))
+def test_band_verdict_wording(case):
+    (a, b), kind, text = VERDICTS[case]
+    p = LEVELS_V**2
+    v = band_verdict("deflection", p, a * p, b * p)
+    assert v.kind == kind and v.text == text
+
+
+def test_band_verdict_partly_inside_crossing_and_sign():
+    p = LEVELS_V**2
+    half = LEVELS_V > 0.55
+    v = band_verdict("deflection", p, np.where(half, 0.5, 0.9) * p, np.where(half, 0.8, 1.1) * p)
+    assert v.kind == "partly inside" and "model stiffer by up to 20% at the others" in v.text
+    v = band_verdict("deflection", p, np.where(half, 0.5, 1.2) * p, np.where(half, 0.8, 1.5) * p)
+    assert v.kind == "crossing"
+    neg = band_verdict("lowering", -p, -0.8 * p, -0.5 * p)  # a negative curve: magnitudes
+    assert neg.kind == "stiffer" and neg.least == pytest.approx(0.2, rel=1e-9)

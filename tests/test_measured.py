@@ -1,0 +1,138 @@
+"""A lab's measured loading test: reading the CSV, rejecting bad files, and the fit of the
+printed net's effective stiffness (issue 10)."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+from conftest import EXAMPLES, reference_design_1_40
+
+from printgen.check.bands import Band
+from printgen.check.measured import (
+    COLUMNS,
+    Measurement,
+    MeasurementError,
+    fit_factor,
+    fitted_profile,
+    mismatch,
+    model_predictor,
+    read_measured,
+)
+from printgen.cli import main
+from printgen.design.record import Design
+
+FIT_TOL = 0.05  # issue 10: the fit recovers a known stiffness factor to 5 %
+KNOWN_FACTOR = 1.6  # the "printed net" of the synthetic test: 60 % stiffer than its profile
+COARSE = 3  # the 1:40 net with a 3x coarser mesh (50 nodes): a fast, converging model
+FIT_LEVELS = np.round(np.arange(0.0, 1.01, 0.1), 10)  # 0.1 steps keep the sweeps short
+MEASURED_LEVELS = np.array([0.2, 0.4, 0.6, 0.8, 1.0])
+READ_TOL = 1e-12  # numbers read back from text written with repr()
+
+
+def coarse_design() -> Design:
+    d = reference_design_1_40()
+    n = d.net
+    return dataclasses.replace(d, net=dataclasses.replace(
+        n, mesh_x_mm=n.mesh_x_mm * COARSE, mesh_y_mm=n.mesh_y_mm * COARSE))
+
+
+def plain_band(levels: np.ndarray) -> Band:
+    """A band with no variants on the design's own net: all the predictor needs."""
+    return Band(levels, {}, {}, {}, [], 1, {})
+
+
+def write_csv(path, levels, values: dict[str, np.ndarray], sep: str = ",") -> None:
+    cols = list(values)
+    lines = [sep.join(["h_over_hb", *cols])]
+    for i, lv in enumerate(levels):
+        cells = [repr(float(lv))] + [repr(float(values[c][i])) for c in cols]
+        lines.append(sep.join(cells))
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_fit_recovers_a_known_stiffness_factor(tmp_path):
+    d = coarse_design()
+    every = {key: np.zeros(len(MEASURED_LEVELS)) for key, _ in COLUMNS.values()}
+    template = Measurement("synthetic", MEASURED_LEVELS, every,
+                           {key: col for col, (key, _) in COLUMNS.items()})
+    predict = model_predictor(d, plain_band(FIT_LEVELS), template, "stiffness")
+    truth = predict(KNOWN_FACTOR)
+    csv = tmp_path / "test.csv"
+    write_csv(csv, MEASURED_LEVELS, {col: truth[key] / unit
+                                     for col, (key, unit) in COLUMNS.items()}, sep=";")
+    m = read_measured(csv)
+    fit = fit_factor(m, model_predictor(d, plain_band(FIT_LEVELS), m, "stiffness"))
+    assert fit.value == pytest.approx(KNOWN_FACTOR, rel=FIT_TOL)
+    assert not fit.at_bound
+    assert max(mm.rms_rel for mm in fit.after) < min(mm.rms_rel for mm in fit.before)
+    text = fitted_profile("tpe", "stiffness", fit.value, panel_kappas=(30e3, 6e3),
+                          modulus_gpa=None, source="test.csv")
+    assert 'inherits = "tpe"' in text and f"{30 * fit.value:.4g}" in text
+
+
+def test_read_semicolon_decimal_comma_comments_and_blank_cells(tmp_path):
+    p = tmp_path / "lab.csv"
+    p.write_text("# loading test 2\nh_over_hb; mid_height_elongation_pct; deflection_over_width\n"
+                 "0,5; 1,25; 0,08\n1,0; ; 0,12\n")
+    m = read_measured(p)
+    np.testing.assert_allclose(m.levels, [0.5, 1.0], rtol=READ_TOL)
+    np.testing.assert_allclose(m.values["strain_mid"][:1], [0.0125], rtol=READ_TOL)
+    assert np.isnan(m.values["strain_mid"][1])
+    assert m.columns == {"strain_mid": "mid_height_elongation_pct",
+                         "deflection": "deflection_over_width"}
+    pred = {"strain_mid": np.array([0.0125, 0.02]), "deflection": np.array([0.08, 0.10])}
+    mm = {x.metric: x for x in mismatch(m, pred)}
+    assert mm["strain_mid"].rms == pytest.approx(0.0, abs=READ_TOL)
+    assert mm["strain_mid"].points == 1
+    assert mm["deflection"].rms == pytest.approx(np.sqrt(0.02**2 / 2), rel=1e-9)
+
+
+BAD = {
+    "unknown column": ("h_over_hb,mid_elongation\n0.5,1\n", "mid_elongation"),
+    "missing level column": ("mid_height_elongation_pct\n1\n", "h_over_hb"),
+    "bad number": ("h_over_hb,top_cable_elongation_pct\n0.5,1.2.3\n", "top_cable_elongation_pct"),
+    "empty": ("\n# nothing\n", "empty file"),
+    "header only": ("h_over_hb,deflection_over_width\n", "no data"),
+    "level out of range": ("h_over_hb,deflection_over_width\n1.5,0.1\n", "h_over_hb"),
+    "percent as fraction": ("h_over_hb,deflection_over_width\n0.5,12\n",
+                            "deflection_over_width"),
+    "short row": ("h_over_hb,deflection_over_width\n0.5\n", "cells"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD))
+def test_bad_csv_is_refused_naming_the_problem(tmp_path, case):
+    text, named = BAD[case]
+    p = tmp_path / "bad.csv"
+    p.write_text(text)
+    with pytest.raises(MeasurementError, match=named):
+        read_measured(p)
+
+
+@pytest.mark.parametrize("case", ["unknown column", "bad number"])
+def test_verify_command_exits_2_on_a_bad_csv(tmp_path, capsys, case):
+    text, named = BAD[case]
+    csv = tmp_path / "bad.csv"
+    csv.write_text(text)
+    design = tmp_path / "design.json"
+    design.write_text(json.dumps(reference_design_1_40().to_dict()))
+    code = main(["verify", str(EXAMPLES / "realistic_barrier.toml"), "--scale", "40",
+                 "--design", str(design), "--measured", str(csv), "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert named in err
+    if case == "unknown column":  # the allowed columns are listed
+        assert all(c in err for c in COLUMNS)
+    assert not (tmp_path / "o").exists()
+
+
+def test_design_record_round_trip_and_errors():
+    d = reference_design_1_40()
+    assert Design.from_record(json.loads(json.dumps(d.to_dict()))) == d
+    from printgen.errors import InputError
+
+    with pytest.raises(InputError, match="'net'"):
+        Design.from_record({"scale": 40, "printer": "generic-350", "cables": []})
