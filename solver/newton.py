@@ -1,4 +1,5 @@
-"""Equilibrium of a tension-only net by a regularised (Levenberg-Marquardt) Newton method.
+"""Equilibrium of a tension-only net by a regularised (Levenberg-Marquardt) Newton method:
+the reference path (method="reference"; `solver.fast` computes the same more cheaply).
 
 Why not plain Newton: a flat net without pretension has no out-of-plane stiffness at the
 start (every strand at exactly its rest length: zero tension, zero geometric stiffness), and a
@@ -20,7 +21,7 @@ fails is approached through halved sub-steps (automatic step cutting).
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 
 import numpy as np
 import scipy.sparse as sp
@@ -190,42 +191,3 @@ def _result(prob: Problem, u: np.ndarray, r_norm: float, f_norm: float, iters: i
     return Result(prob.x0 + disp, disp, eps, force * prob.S, force <= 0,
                   np.array([c[0] for c in cab]), np.array([c[1] * prob.S for c in cab]),
                   r_norm, f_norm, iters, ok, reason, seconds, level)
-
-
-def solve_path(net: Net, loads_at: Callable[[float], Sequence], levels: Sequence[float], *,
-               tol: float = TOL_FORCE, max_iter: int = MAX_ITER, strict: bool = False,
-               max_cuts: int = MAX_CUTS, skip_failed: bool = False) -> list[Result]:
-    """Solve at each level in order, warm-started; a failing level is reached by sub-steps.
-
-    Returns one Result per level. A level that cannot be reached stops the path (strict
-    raises SolverError instead); with `skip_failed` its unconverged Result (converged=False,
-    with the reason) is kept and the next level starts from the last converged state.
-    """
-    out: list[Result] = []
-    u = None
-    done = 0.0
-    for level in levels:
-        res, cuts, start = None, 0, done
-        target = level
-        while True:
-            res = solve(net, loads_at(target), u0=u, tol=tol, max_iter=max_iter, level=target)
-            if res.converged:
-                u, done = res.displacements, target
-                if target == level:
-                    break
-                target = level
-                continue
-            if cuts >= max_cuts:
-                break
-            cuts += 1
-            target = start + 0.5 * (target - start)
-        if not res.converged:
-            msg = f"load level {level:g}: {res.reason} (after {cuts} step cuts)"
-            if strict:
-                raise SolverError(msg)
-            out.append(Result(**{**res.__dict__, "reason": msg, "level": level}))
-            if not skip_failed:
-                return out
-            continue
-        out.append(res)
-    return out

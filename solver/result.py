@@ -16,7 +16,8 @@ class Result:
     """positions, displacements : (n, 3) m; strains, tensions : (m,) of the strands (N);
     slack : (m,) bool, strands carrying no force; cable_strains, cable_tensions : (c,) of the
     sliding cables; residual : max out-of-balance force on a free node (N); load_norm : max
-    applied force (N); converged with `reason`; iterations; seconds."""
+    applied force (N); converged with `reason`; iterations (Newton and chord steps);
+    seconds; level of a load path; factorizations of the tangent (the main cost)."""
 
     positions: np.ndarray
     displacements: np.ndarray
@@ -32,3 +33,4 @@ class Result:
     reason: str
     seconds: float
     level: float | None = None
+    factorizations: int = 0

@@ -1,0 +1,138 @@
+"""Public entry points: `solve` one load case, `solve_path` a sequence of load levels.
+
+method="fast" (default) runs `solver.fast`; method="reference" runs the plain regularised
+Newton method of `solver.newton` (COO assembly and SuperLU at every step), kept as the
+reference the fast path is tested against. Both return converged=False with the reason (or
+raise SolverError when `strict`) instead of an unconverged answer.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from solver import newton
+from solver.fast import Stepper, best_start, iterate, membrane_start
+from solver.model import Net
+from solver.newton import MAX_CUTS, MAX_ITER, TOL_FORCE
+from solver.result import Result, SolverError
+from solver.state import NetSystem, State, _bar_pass, cable_state, evaluate
+
+METHODS = ("fast", "reference")
+
+
+class FastSolver:
+    """One net's fast solves: its pattern, ordering and factorization reused across loads."""
+
+    def __init__(self, net: Net, backend: str | None = None) -> None:
+        self.ns = NetSystem(net)
+        self.stepper = Stepper(self.ns, backend)
+
+    def solve(self, loads: Sequence, starts: list[np.ndarray], tol: float, max_iter: int,
+              level: float | None = None) -> Result:
+        """Equilibrium under `loads` from the best of `starts` (m; none or all zero: rest)."""
+        t0, f0 = time.perf_counter(), self.stepper.factorizations
+        ns = self.ns
+        ns.loads = list(loads)
+        if starts and any(np.any(u) for u in starts):
+            st = best_start(ns, [np.asarray(u, dtype=float) / ns.L for u in starts])
+        else:
+            st = membrane_start(ns, evaluate(ns, np.zeros_like(ns.x0)), self.stepper)
+        st, iters, ok, reason = iterate(ns, st, tol, max_iter, self.stepper)
+        return _result(ns, st, iters, ok, reason, time.perf_counter() - t0, level,
+                       self.stepper.factorizations - f0)
+
+
+def _result(ns: NetSystem, st: State, iters: int, ok: bool, reason: str, seconds: float,
+            level: float | None, factorizations: int) -> Result:
+    eps, force, _, _, _ = _bar_pass(ns.bars, st.u)
+    cab = [cable_state(c, st.u) for c in ns.cables]
+    disp = st.u * ns.L
+    return Result(ns.x0 + disp, disp, eps, force * ns.S, force <= 0,
+                  np.array([c[0] for c in cab]), np.array([c[1] * ns.S for c in cab]),
+                  st.r_norm * ns.S, st.f_norm * ns.S, iters, ok, reason, seconds, level,
+                  factorizations)
+
+
+def _check(method: str) -> None:
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+
+
+def solve(net: Net, loads: Sequence, *, u0: np.ndarray | None = None, tol: float = TOL_FORCE,
+          max_iter: int = MAX_ITER, strict: bool = False, level: float | None = None,
+          method: str = "fast") -> Result:
+    """Equilibrium of `net` under `loads` from displacements `u0` (m; default: rest).
+
+    Returns a Result with converged=False and the reason when it fails; raises SolverError
+    instead when `strict`.
+    """
+    _check(method)
+    if method == "reference":
+        return newton.solve(net, loads, u0=u0, tol=tol, max_iter=max_iter, strict=strict,
+                            level=level)
+    res = FastSolver(net).solve(loads, [] if u0 is None else [u0], tol, max_iter, level)
+    if strict and not res.converged:
+        raise SolverError(res.reason)
+    return res
+
+
+def _starts(history: list[tuple[float, np.ndarray]], target: float) -> list[np.ndarray]:
+    """Warm starts for a level: the last converged state, and its extrapolation from the two
+    last converged levels (a secant predictor)."""
+    if not history:
+        return []
+    (l2, u2) = history[-1]
+    if len(history) < 2 or history[-2][0] == l2:
+        return [u2]
+    l1, u1 = history[-2]
+    return [u2, u2 + (u2 - u1) * ((target - l2) / (l2 - l1))]
+
+
+def solve_path(net: Net, loads_at: Callable[[float], Sequence], levels: Sequence[float], *,
+               tol: float = TOL_FORCE, max_iter: int = MAX_ITER, strict: bool = False,
+               max_cuts: int = MAX_CUTS, skip_failed: bool = False,
+               method: str = "fast") -> list[Result]:
+    """Solve at each level in order, warm-started; a failing level is reached by sub-steps.
+
+    Returns one Result per level. A level that cannot be reached stops the path (strict
+    raises SolverError instead); with `skip_failed` its unconverged Result (converged=False,
+    with the reason) is kept and the next level starts from the last converged state.
+    """
+    _check(method)
+    fast = FastSolver(net) if method == "fast" else None
+    out: list[Result] = []
+    history: list[tuple[float, np.ndarray]] = []
+    done = 0.0
+    for level in levels:
+        res, cuts, start, target = None, 0, done, level
+        while True:
+            if fast is not None:
+                res = fast.solve(loads_at(target), _starts(history, target), tol, max_iter,
+                                 target)
+            else:
+                res = newton.solve(net, loads_at(target), u0=history[-1][1] if history else None,
+                                   tol=tol, max_iter=max_iter, level=target)
+            if res.converged:
+                history.append((target, res.displacements))
+                done = target
+                if target == level:
+                    break
+                target = level
+                continue
+            if cuts >= max_cuts:
+                break
+            cuts += 1
+            target = start + 0.5 * (target - start)
+        if not res.converged:
+            msg = f"load level {level:g}: {res.reason} (after {cuts} step cuts)"
+            if strict:
+                raise SolverError(msg)
+            out.append(Result(**{**res.__dict__, "reason": msg, "level": level}))
+            if not skip_failed:
+                return out
+            continue
+        out.append(res)
+    return out

@@ -1,0 +1,172 @@
+"""The fast path: the same regularised Newton method as `solver.newton` (same convergence
+test, same energy line search, same step cap), computed with less work per step and fewer
+steps:
+
+- one strand pass per trial state (`solver.state`), the tangent scattered into a pattern
+  fixed per net (`solver.pattern`), factorized by a sparse LDL^T whose ordering is reused
+  (`solver.linsolve`; SuperLU when `qdldl` is not installed);
+- steps damped by mu D (D: the net's stiffness under unit force density) instead of mu I;
+- a membrane start from rest: the shape of the net under unit force density, scaled to the
+  lowest potential along it, instead of the flat net;
+- chord steps: after a full Newton step the same factorization is tried once more, and kept
+  while it at least halves the out-of-balance force (modified Newton);
+- along load paths, a start extrapolated from the last two converged levels when its
+  potential is lower than the last level's state.
+
+The answer is the same (R = 0 to the same tolerance): only the path to it differs.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from solver.linsolve import Factorization, ldl_available
+from solver.newton import (
+    ARMIJO,
+    MAX_BACKTRACK,
+    MAX_STEP,
+    MU_FACTOR,
+    MU_MIN,
+    POTENTIAL_ROUND_OFF,
+    ROUND_OFF,
+)
+from solver.state import NetSystem, State, evaluate, potential, tangent_values
+
+FORCING = 0.1  # inexact Newton: linear solves to min(FORCING, |R| / force scale), relative
+MU_GROWTH = 10.0  # mu grows by this factor when no damped step descends
+MU_RETRIES = 6  # ... at most this many times in one iteration
+CHORD_RATE = 0.5  # a chord step is kept when it at least halves the out-of-balance force
+START_SPAN = (-6.0, 0.0)  # log10 of the membrane start's largest displacement / net extent
+START_GRID = 13  # potentials sampled over START_SPAN before the scalar minimisation
+START_XTOL = 0.01  # log10 resolution of the membrane start's scale
+
+
+class Stepper:
+    """Factorizations of one net, reusing the LDL^T ordering; counts what it does."""
+
+    def __init__(self, ns: NetSystem, backend: str | None = None) -> None:
+        self.ns = ns
+        self.backend = backend or ("ldl" if ldl_available() else "lu")
+        self.ldl = None
+        self.factorizations = 0
+
+    def factor(self, data: np.ndarray) -> Factorization:
+        fact = Factorization(self.ns.pattern, data, self.backend, self.ldl)
+        self.ldl = fact.ldl  # None after a failed LDL^T: a fresh one next time
+        self.factorizations += 1
+        return fact
+
+    def newton(self, st: State, boost: float = 1.0) -> Factorization:
+        """Factorization of J + mu D at `st`, mu = MU_FACTOR |R| x boost (floored)."""
+        data = tangent_values(self.ns, st)
+        diag = float(np.abs(data[self.ns.pattern.diagonal]).max()) if data.size else 0.0
+        mu = max(MU_FACTOR * float(np.linalg.norm(st.r)), MU_MIN * max(diag, 1e-300))
+        return self.factor(data + boost * mu * self.ns.damping)
+
+
+def iterate(ns: NetSystem, st: State, tol: float, max_iter: int, stepper: Stepper):
+    """(state, iterations, converged, reason) from state `st` (chord steps count too)."""
+    it, chord = 0, None
+    while True:
+        if st.r_norm <= tol * st.f_norm or st.r_norm <= ROUND_OFF:
+            return st, it, True, "converged"
+        if it >= max_iter:
+            return st, it, False, (f"no convergence in {max_iter} iterations: max out-of-balance "
+                                   f"{st.r_norm * ns.S:.3g} N, {st.r_norm / st.f_norm:.2g} of "
+                                   "the load")
+        it += 1
+        if chord is not None:
+            trial = _chord_step(ns, st, chord)
+            if trial is not None:
+                st = trial
+                continue
+        fact, found = _newton_step(ns, st, stepper)
+        if found is None:
+            return st, it, False, (f"line search failed: no step lowers the energy or the "
+                                   f"out-of-balance force ({st.r_norm * ns.S:.3g} N, "
+                                   f"{st.r_norm / st.f_norm:.2g} of the load)")
+        st, full = found
+        chord = fact if full else None
+
+
+def _newton_step(ns: NetSystem, st: State, stepper: Stepper):
+    """(factorization, (state, full step) or None): the damped Newton step, then the step on
+    its symmetric part; when neither lowers the potential (the follower load can make the
+    damped tangent indefinite) mu grows tenfold, at most MU_RETRIES times."""
+    forcing = min(FORCING, st.r_norm / st.f_norm)
+    for attempt in range(MU_RETRIES + 1):
+        fact = stepper.newton(st, MU_GROWTH**attempt)
+        for step in (fact.solve(-st.r, forcing), fact.symmetric_solve(-st.r)):
+            found = None if step is None else _line_search(ns, st, step)
+            if found is not None:
+                return fact, found
+    return fact, None
+
+
+def _chord_step(ns: NetSystem, st: State, fact: Factorization) -> State | None:
+    step = fact.solve(-st.r, min(FORCING, st.r_norm / st.f_norm))
+    if step is None or float(np.abs(step).max()) > MAX_STEP:
+        return None
+    trial = evaluate(ns, _moved(ns, st.u, step))
+    pi0, pi = st.potential(st.f), trial.potential(st.f)
+    if trial.r_norm <= CHORD_RATE * st.r_norm and pi <= pi0 + POTENTIAL_ROUND_OFF * abs(pi0):
+        return trial
+    return None
+
+
+def _moved(ns: NetSystem, u: np.ndarray, step: np.ndarray) -> np.ndarray:
+    out = u.copy()
+    out.ravel()[ns.free] += step
+    return out
+
+
+def _line_search(ns: NetSystem, st: State, step: np.ndarray):
+    """(state, full step taken) from backtracking as in `solver.newton._line_search`."""
+    alpha = min(1.0, MAX_STEP / max(float(np.abs(step).max()), 1e-300))
+    slope = float(st.r @ step)
+    if slope >= 0:
+        return None
+    pi0 = st.potential(st.f)
+    for _ in range(MAX_BACKTRACK):
+        trial = evaluate(ns, _moved(ns, st.u, alpha * step))
+        pi = trial.potential(st.f)
+        if pi <= pi0 + ARMIJO * alpha * slope:
+            return trial, alpha == 1.0
+        if (abs(alpha * slope) < POTENTIAL_ROUND_OFF * max(abs(pi0), abs(pi), 1e-300)
+                and trial.r_norm < st.r_norm):
+            return trial, alpha == 1.0
+        alpha *= 0.5
+    return None
+
+
+def membrane_start(ns: NetSystem, st: State, stepper: Stepper) -> State:
+    """From rest: solve D v = F (the net under unit force density), then scale v to the
+    lowest potential along it. Returns `st` unchanged when that does not lower it."""
+    if not st.r.size or st.r_norm == 0.0:
+        return st
+    v = stepper.factor(ns.damping.copy()).solve(-st.r)
+    if v is None or not np.any(v):
+        return st
+    v = v / float(np.abs(v).max())
+
+    def pot(log_s: float) -> float:
+        return potential(ns, _moved(ns, st.u, 10.0**log_s * v), st.f)
+
+    grid = np.linspace(*START_SPAN, START_GRID)
+    values = [pot(x) for x in grid]
+    k = int(np.argmin(values))
+    lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
+    best = minimize_scalar(pot, bounds=(lo, hi), method="bounded",
+                           options={"xatol": START_XTOL})
+    log_s = float(best.x) if best.fun < values[k] else float(grid[k])
+    if min(best.fun, values[k]) >= st.potential(st.f):
+        return st
+    return evaluate(ns, _moved(ns, st.u, 10.0**log_s * v))
+
+
+def best_start(ns: NetSystem, candidates: list[np.ndarray]) -> State:
+    """The candidate start of lowest potential (loads frozen at the first candidate)."""
+    states = [evaluate(ns, u) for u in candidates]
+    f = states[0].f
+    return min(states, key=lambda s: s.potential(f))

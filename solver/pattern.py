@@ -1,0 +1,89 @@
+"""A fixed sparse pattern of the tangent on the free degrees of freedom, computed once per net.
+
+Every Newton step has the same non-zero positions: the 3 x 3 node blocks of each strand and
+each sliding-cable segment, the dense block of each cable (all its nodes share one tension),
+and the diagonal block of every node (the hydrostatic load's z-derivative). The pattern keeps,
+for every value a step produces (in a fixed order), its position in the CSR data array, so a
+step assembles its matrix with one `np.bincount`: no COO -> CSR conversion, no sorting.
+Slack strands simply contribute zeros. The pattern is symmetric, so the symmetric part of a
+matrix is a permutation of its data, and its upper triangle (what an LDL^T factorization
+reads) a fixed selection.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+
+def block_rows_cols(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Dof rows and columns (k, 3, 3) of the 3 x 3 blocks at node pairs (a, b)."""
+    r = 3 * a[:, None, None] + np.arange(3)[None, :, None]
+    c = 3 * b[:, None, None] + np.arange(3)[None, None, :]
+    return np.broadcast_to(r, (len(a), 3, 3)), np.broadcast_to(c, (len(a), 3, 3))
+
+
+def pair_rows_cols(i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rows and columns (k, 4, 3, 3) of the blocks ii, jj, ij, ji of two-node members."""
+    rc = [block_rows_cols(a, b) for a, b in ((i, i), (j, j), (i, j), (j, i))]
+    return np.stack([r for r, _ in rc], axis=1), np.stack([c for _, c in rc], axis=1)
+
+
+def pair_values(k: np.ndarray) -> np.ndarray:
+    """Values (k, 4, 3, 3) of a two-node member of stiffness block k (k, 3, 3): +k, +k, -k, -k."""
+    return np.stack([k, k, -k, -k], axis=1)
+
+
+class Pattern:
+    """CSR structure of the free-dof tangent and the scatter map of every value slot.
+
+    Slots, in this order: strands (m x 36), then per cable its segments (x 36) and its dense
+    block ((3 k)^2), then the diagonal block of every node (n x 9).
+    """
+
+    def __init__(self, n_nodes: int, free: np.ndarray, bar_i: np.ndarray, bar_j: np.ndarray,
+                 cable_nodes: list[np.ndarray]) -> None:
+        rows, cols = [], []
+        r, c = pair_rows_cols(bar_i, bar_j)
+        rows.append(r.ravel()), cols.append(c.ravel())
+        for nodes in cable_nodes:
+            r, c = pair_rows_cols(nodes[:-1], nodes[1:])
+            rows.append(r.ravel()), cols.append(c.ravel())
+            dof = (3 * nodes[:, None] + np.arange(3)).ravel()
+            rows.append(np.repeat(dof, len(dof))), cols.append(np.tile(dof, len(dof)))
+        every = np.arange(n_nodes)
+        r, c = block_rows_cols(every, every)
+        rows.append(r.ravel()), cols.append(c.ravel())
+        rows, cols = np.concatenate(rows), np.concatenate(cols)
+        index = np.full(3 * n_nodes, -1)
+        index[free] = np.arange(int(free.sum()))
+        fr, fc = index[rows], index[cols]
+        self.keep = (fr >= 0) & (fc >= 0)
+        self.size = int(free.sum())
+        keys = fr[self.keep].astype(np.int64) * self.size + fc[self.keep]
+        uniq, self.slot = np.unique(keys, return_inverse=True)
+        self.nnz = len(uniq)
+        self.rows, self.cols = uniq // self.size, uniq % self.size
+        self.indptr = np.concatenate([[0], np.cumsum(np.bincount(self.rows,
+                                                                 minlength=self.size))])
+        self.transpose = np.searchsorted(uniq, self.cols * self.size + self.rows)
+        self.diagonal = np.flatnonzero(self.rows == self.cols)
+        upper = np.flatnonzero(self.rows <= self.cols)
+        order = sp.csc_matrix((np.arange(len(upper), dtype=float) + 1,
+                               (self.rows[upper], self.cols[upper])),
+                              shape=(self.size, self.size))
+        self.upper = upper[order.data.astype(np.int64) - 1]
+        self.upper_indices, self.upper_indptr = order.indices, order.indptr
+
+    def scatter(self, values: np.ndarray) -> np.ndarray:
+        """CSR data (nnz,) of all slot values (in slot order; summed where they coincide)."""
+        return np.bincount(self.slot, weights=values[self.keep], minlength=self.nnz)
+
+    def csr(self, data: np.ndarray) -> sp.csr_matrix:
+        return sp.csr_matrix((data, self.cols, self.indptr), shape=(self.size, self.size))
+
+    def symmetric_upper(self, data: np.ndarray) -> sp.csc_matrix:
+        """Upper triangle (CSC) of the symmetric part (A + A^T) / 2 of the matrix `data`."""
+        sym = 0.5 * (data + data[self.transpose])
+        return sp.csc_matrix((sym[self.upper], self.upper_indices, self.upper_indptr),
+                             shape=(self.size, self.size))

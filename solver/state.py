@@ -1,0 +1,163 @@
+"""The fast path's view of a net: built once per net (nondimensional strands and cables, the
+fixed tangent pattern, the damping matrix), evaluated in one strand pass per trial state.
+
+`evaluate` returns everything a Newton step needs at a displacement field: out-of-balance
+force, force scale, strain energy, and the per-strand quantities from which `tangent_values`
+assembles the tangent without a second pass.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.assemble import Bars, _law_eval, cable_state, make_bars, make_cable
+from solver.loads import total_forces
+from solver.model import Net
+from solver.pattern import Pattern, pair_values
+
+
+class NetSystem:
+    """A net in nondimensional form (x / L, F / S) with its fixed tangent pattern."""
+
+    def __init__(self, net: Net) -> None:
+        x0 = np.asarray(net.nodes, dtype=float)
+        self.net, self.x0, self.n = net, x0, len(x0)
+        self.L = float(np.linalg.norm(x0.max(axis=0) - x0.min(axis=0))) or 1.0
+        slopes = [s for law in net.laws for s in law.slopes]
+        slopes += [s for c in net.cables for s in c.law.slopes]
+        self.S = float(max(slopes))
+        scaled = [law.scaled(1 / self.S) for law in net.laws]
+        self.bars = make_bars(x0 / self.L, np.asarray(net.elements, dtype=int),
+                              net.rest_lengths() / self.L, net.law_index, scaled)
+        self.cables = [make_cable(x0 / self.L, np.asarray(c.nodes, dtype=int),
+                                  net.cable_rest_length(c) / self.L, c.law.scaled(1 / self.S))
+                       for c in net.cables]
+        self.free = ~net.fixed_dofs.ravel()
+        self.pattern = Pattern(self.n, self.free, self.bars.i, self.bars.j,
+                               [c.nodes for c in self.cables])
+        self.damping = self._damping()
+        self.loads: list = []
+
+    def _damping(self) -> np.ndarray:
+        """CSR data of D = (graph Laplacian, weights 1 / rest length) x I3, scaled to a mean
+        diagonal of 1: the stiffness of a net under unit force density. Damping a step with
+        mu D instead of mu I moves a node without stiffness with its neighbours (a membrane
+        shape), not alone along its own out-of-balance force."""
+        eye = np.eye(3)[None]
+        vals = [pair_values((1.0 / self.bars.rest)[:, None, None] * eye).ravel()]
+        for c in self.cables:
+            vals.append(pair_values((1.0 / c.l0)[:, None, None] * eye).ravel())
+            vals.append(np.zeros((3 * len(c.nodes)) ** 2))
+        vals.append(np.zeros(9 * self.n))
+        data = self.pattern.scatter(np.concatenate(vals))
+        mean = float(data[self.pattern.diagonal].mean()) if self.pattern.size else 1.0
+        return data / (mean or 1.0)
+
+    def external(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Nondimensional loads and their z-derivative at nondimensional displacements u."""
+        f, dz = total_forces(self.loads, self.x0 + u * self.L)
+        return f / self.S, dz * self.L / self.S
+
+
+@dataclass
+class State:
+    """A trial displacement field u (n, 3) and what follows from it (nondimensional)."""
+
+    u: np.ndarray
+    r: np.ndarray  # out-of-balance force on the free dofs
+    r_norm: float  # max |r|
+    f_norm: float  # force scale: max(|F_ext|, strand and cable tensions)
+    energy: float  # strain energy
+    f: np.ndarray  # external forces (n, 3)
+    dz: np.ndarray  # their z-derivative (n, 3)
+    bar: tuple  # (force, tangent, d, l) of the strands
+    cab: list  # (tension, tangent, unit vectors, lengths, grad) of each cable
+
+    def potential(self, f_frozen: np.ndarray) -> float:
+        """Total potential with the loads frozen at another state's values."""
+        return self.energy - float((f_frozen * self.u).sum())
+
+
+def _bar_pass(b: Bars, u: np.ndarray):
+    du = u[b.j] - u[b.i]
+    d = b.d0 + du
+    l = np.sqrt(np.einsum("ij,ij->i", d, d))
+    dl2 = b.c + 2 * np.einsum("ij,ij->i", b.d0, du) + np.einsum("ij,ij->i", du, du)
+    eps = dl2 / (b.rest * (l + b.rest))
+    force, tangent = _law_eval(b.laws, b.law_index, eps)
+    return eps, force, tangent, d, l
+
+
+def _bar_energy(b: Bars, eps: np.ndarray) -> float:
+    if len(b.laws) == 1:
+        return float((b.rest * b.laws[0].energy(eps)).sum())
+    total = 0.0
+    for k, law in enumerate(b.laws):
+        sel = b.law_index == k
+        if sel.any():
+            total += float((b.rest[sel] * law.energy(eps[sel])).sum())
+    return total
+
+
+def evaluate(ns: NetSystem, u: np.ndarray) -> State:
+    """Forces, energy and strand states at u, in one pass over the strands."""
+    b = ns.bars
+    eps, force, tangent, d, l = _bar_pass(b, u)
+    fn = (force / l)[:, None] * d
+    g = np.zeros((ns.n, 3))
+    for k in range(3):
+        g[:, k] = (np.bincount(b.j, fn[:, k], ns.n) - np.bincount(b.i, fn[:, k], ns.n))
+    energy = _bar_energy(b, eps)
+    cabs, scales = [], [float(force.max()) if force.size else 0.0]
+    for c in ns.cables:
+        ce, t, kt, nvec, ls = cable_state(c, u)
+        grad = np.zeros((len(c.nodes), 3))
+        grad[:-1] -= nvec
+        grad[1:] += nvec
+        if t > 0:
+            np.add.at(g, c.nodes, t * grad)
+        energy += c.rest * float(c.law.energy(np.array([ce]))[0])
+        cabs.append((t, kt, nvec, ls, grad))
+        scales.append(t)
+    f, dz = ns.external(u)
+    r = (g - f).ravel()[ns.free]
+    scales.append(float(np.abs(f).max()) if f.size else 0.0)
+    return State(u, r, float(np.abs(r).max()) if r.size else 0.0, max(max(scales), 1e-300),
+                 energy, f, dz, (force, tangent, d, l), cabs)
+
+
+def potential(ns: NetSystem, u: np.ndarray, f_frozen: np.ndarray) -> float:
+    """Strain energy minus the work of frozen loads, without forces (for scalar searches)."""
+    energy = _bar_energy(ns.bars, _bar_pass(ns.bars, u)[0])
+    for c in ns.cables:
+        energy += c.rest * float(c.law.energy(np.array([cable_state(c, u)[0]]))[0])
+    return energy - float((f_frozen * u).sum())
+
+
+def tangent_values(ns: NetSystem, st: State) -> np.ndarray:
+    """CSR data of the tangent K - dF_ext/du at a state (the pattern's slot order)."""
+    force, tangent, d, l = st.bar
+    n = d / l[:, None]
+    nn = np.einsum("ki,kj->kij", n, n)
+    geo = np.where(force > 0, force / l, 0.0)[:, None, None]
+    mat = (tangent / ns.bars.rest)[:, None, None]
+    vals = [pair_values(geo * (np.eye(3)[None] - nn) + mat * nn).ravel()]
+    for c, (t, kt, nvec, ls, grad) in zip(ns.cables, st.cab):
+        if t <= 0:
+            vals.append(np.zeros(36 * len(ls) + (3 * len(c.nodes)) ** 2))
+            continue
+        cnn = np.einsum("ki,kj->kij", nvec, nvec)
+        vals.append(pair_values((t / ls)[:, None, None] * (np.eye(3)[None] - cnn)).ravel())
+        gv = grad.ravel()
+        vals.append((kt / c.rest) * np.outer(gv, gv).ravel())
+    hyd = np.zeros((ns.n, 3, 3))
+    hyd[:, :, 2] = -st.dz
+    vals.append(hyd.ravel())
+    return ns.pattern.scatter(np.concatenate(vals))
+
+
+def set_loads(ns: NetSystem, loads: Sequence) -> None:
+    ns.loads = list(loads)
