@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import dataclasses
 import inspect
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -36,6 +37,7 @@ from printgen.design.record import Design
 from printgen.design.section import area_m2, diamond_factor
 from printgen.errors import GeometryError
 from printgen.inputs.materials import load_material
+from printgen.inputs.prototype import Prototype
 from printgen.units import MM
 
 SLACK_MAX = 0.01  # initial slack of the printed net, upper end of the range (issue 10: 0-1 %)
@@ -132,6 +134,15 @@ def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
         return []
     return [Variant(f"{mat.name} panel law: tested net = the design's net", net_factor=ratio,
                     source=f"{mat.name} profile [measured.panel_law] conditions")]
+
+
+def model_load_kw(p: Prototype, d: Design, drag: bool) -> dict[str, float] | None:
+    """The model's load keywords for `sweep`: drag at the Froude-scaled velocity, as `verify`
+    loads the model with drag; None for the hydrostatic test."""
+    if not drag:
+        return None
+    return {"velocity": p.velocity / math.sqrt(d.scale),
+            "strand_diameter": d.net.strand.width_mm * MM}
 
 
 def variant_scene(d: Design, v: Variant, coarsen: int = 1) -> BarrierScene:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from printgen.check.bands import Band, band_verdicts, model_band
+from printgen.check.bands import Band, band_verdicts, model_band, model_load_kw
 from printgen.check.measured import (
     Fit,
     Measurement,
@@ -91,7 +91,7 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     p = load_prototype(prototype)
     d = load_design(design_path, scale)
     m = read_measured(measured) if measured is not None else None
-    load_kw = _load_kw(p, d) if drag else None
+    load_kw = model_load_kw(p, d, drag)
     say("verification (prototype and model load sweeps)")
     v = verify(p, d, drag=drag)
     say("uncertainty band (model variants)")
@@ -112,13 +112,6 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     record["timings_s"] = {"total": time.perf_counter() - t0, "band": band.seconds}
     files = _write(out, rep, record, d, text, force)
     return VerifyRun(p, d, v, band, m, result, text, record, files)
-
-
-def _load_kw(p: Prototype, d: Design) -> dict[str, float]:
-    import math
-
-    return {"velocity": p.velocity / math.sqrt(d.scale),
-            "strand_diameter": d.net.strand.width_mm * 1e-3}
 
 
 def _profile_text(d: Design, fit: Fit, source: str) -> str:
