@@ -40,7 +40,9 @@ def run(out_dir: Path, repeat: int = 5) -> dict:
              ("net-crossing-flow-0.5", d.net,
               partial(net_toolpath, crossing_flow_factor=half),
               partial(net_volume_budget, crossing_flow_factor=half))]
-    parts += [(f"cable-{c.name}", c, cable_toolpath, lambda p, s: cable_volume_budget(p))
+    parts += [(f"cable-{c.name}", c, cable_toolpath,
+               lambda p, s: cable_volume_budget(p, s.crossing_flow_factor,
+                                                printer.hole_compensation_mm))
               for c in d.cables]
     results = {}
     for name, part, build, budget in parts:

@@ -3,7 +3,8 @@
 Simulates G90/G91, M82/M83 (G91 makes E relative too, as Marlin 2), G92, G20/G21 and
 G0/G1/G2/G3. A move extrudes when E grows and XY moves; its section is dE x filament area /
 XY length and its bead width is that section / layer height (rectangle model). Retractions and
-primes (E on a move without XY) are not deposits.
+primes (E on a move without XY) are not deposits, nor are moves under a `;TYPE:` of a skirt,
+brim, prime or purge line (their volume is `prime_volume_mm3`).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from printgen.parts.gcode.toolpath import TRAVEL, Toolpath
 
 EXTRUDING = 1  # kind of a read-back extrusion move
 Z_ROUND_MM = 1e-4  # extrusion Z values closer than this are one layer
+NOT_PART = re.compile(r"skirt|brim|custom|prime|purge|wipe", re.IGNORECASE)  # as check_gcode
 _WORD = re.compile(r"([A-Za-z])\s*([-+]?(?:\d+\.?\d*|\.\d+))")
 
 
@@ -39,6 +41,7 @@ class Readback:
     bounds_mm: np.ndarray
     filament_mm: float
     max_flow_mm3_per_s: float
+    prime_volume_mm3: float = 0.0
 
     @property
     def volume_mm3(self) -> float:
@@ -75,9 +78,12 @@ def read_gcode_text(text: str, *, filament_diameter_mm: float = 1.75) -> Readbac
     """Parse G-code text into moves; raises InputError when nothing is extruded."""
     fil = math.pi * filament_diameter_mm ** 2 / 4
     rows = _simulate(text)
-    if not rows:
+    all_rows = np.array(rows, dtype=float).reshape(-1, 9)
+    part = all_rows[:, 8] == 0
+    prime = float(np.sum(all_rows[~part, 3] * all_rows[~part, 6]) * fil)
+    a = all_rows[part, :8]  # x, y, z, de, lxy, feed mm/min, extruding, new_path
+    if not np.any(a[:, 6] > 0):
         raise InputError("the G-code extrudes nothing (no move with growing E and XY motion)")
-    a = np.array(rows, dtype=float)  # x, y, z, de, lxy, feed mm/min, extruding, new_path
     ext = a[:, 6] > 0
     zkey = np.round(a[:, 2] / Z_ROUND_MM) * Z_ROUND_MM
     layer_z = np.unique(zkey[ext])
@@ -99,11 +105,12 @@ def read_gcode_text(text: str, *, filament_diameter_mm: float = 1.75) -> Readbac
         bounds_mm=np.vstack([pts.min(axis=0), pts.max(axis=0)]),
         filament_mm=float(a[ext, 3].sum()),
         max_flow_mm3_per_s=float(np.max(area * speed)),
+        prime_volume_mm3=prime,
     )
 
 
 def _simulate(text: str) -> list[tuple[float, ...]]:
-    """Rows (x, y, z, dE, L_xy, feed, extruding, starts_path) for every XY move."""
+    """Rows (x, y, z, dE, L_xy, feed, extruding, starts_path, not_part) for every XY move."""
     x = y = z = 0.0
     e = 0.0
     feed = 0.0
@@ -111,7 +118,10 @@ def _simulate(text: str) -> list[tuple[float, ...]]:
     in_path = False
     last_z = None
     rows: list[tuple[float, ...]] = []
+    not_part = 0.0
     for raw in text.splitlines():
+        if raw.startswith(";TYPE:"):
+            not_part = 1.0 if NOT_PART.search(raw[6:]) else 0.0
         code = raw.split(";", 1)[0].strip()
         if not code:
             continue
@@ -141,7 +151,7 @@ def _simulate(text: str) -> list[tuple[float, ...]]:
             if lxy > 1e-9 or nz != z:
                 new_path = extruding and (not in_path or nz != last_z)
                 rows.append((nx, ny, nz, de if extruding else 0.0, lxy, feed,
-                             1.0 if extruding else 0.0, 1.0 if new_path else 0.0))
+                             1.0 if extruding else 0.0, 1.0 if new_path else 0.0, not_part))
                 in_path = extruding
                 if extruding:
                     last_z = nz

@@ -1,23 +1,15 @@
-"""Direct toolpaths for the diamond net and the eyelet cables (mm, mm/s).
+"""Toolpaths of the direct G-code (mm, mm/s): the `Toolpath` arrays, the printability checks,
+the bed placement and the move builder shared by `netpath` (the net) and `cablepath` (the
+cables).
 
 A `Toolpath` is a set of parallel arrays, one row per move, in print order: the end point,
-bead width and height, speed and flow fraction. Travel moves have width 0. `writer` turns
-it into G-code text; `readback` turns G-code back into a `Toolpath`.
-
-Net: each layer is one pass. The border (as many concentric loops as its width holds beads)
-comes first, then every diagonal strand of one family as one straight extrusion from border
-to border through the crossings, then the other family; the family order alternates from
-layer to layer ("crossed passes"). The strands laid second in a layer cross beads already
-there: over each crossing their flow is `crossing_flow_factor` (1 = full bead, the double
-deposit at crossings stays).
-
-Cable: per layer, the two eyelets as concentric rings, then the strip beads side by side
-between the eyelets' outer circles. Long parts are turned on the bed (diagonal) if needed.
+bead width and height, speed and flow fraction. Travel moves have width 0; a travel of kind
+COMB runs over beads already printed in the layer and is not retracted by the writer.
+`writer` turns it into G-code text; `readback` turns G-code back into a `Toolpath`.
 """
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,11 +18,13 @@ from printgen.design.record import CableDesign, NetDesign, Section
 from printgen.errors import PrintabilityError, ProfileError
 from printgen.inputs.materials import Material
 from printgen.inputs.printers import Printer, PrintStyle, check_pass
-from printgen.parts.geometry.net import NetGraph, diamond_net
+from printgen.parts.geometry.attach import border_beads as border_bead
+from printgen.parts.geometry.net import diamond_net
 
-TRAVEL, BORDER, STRAND_PLUS, STRAND_MINUS, CABLE_STRIP, EYELET = 0, 1, 2, 3, 4, 5
+TRAVEL, BORDER, STRAND_PLUS, STRAND_MINUS, CABLE_STRIP, EYELET, COMB = 0, 1, 2, 3, 4, 5, 6
 KIND_NAMES = {TRAVEL: "travel", BORDER: "border", STRAND_PLUS: "strand+",
-              STRAND_MINUS: "strand-", CABLE_STRIP: "strip", EYELET: "eyelet"}
+              STRAND_MINUS: "strand-", CABLE_STRIP: "strip", EYELET: "eyelet",
+              COMB: "travel over printed beads"}
 CHORD_TOL_MM = 0.01  # max distance of an eyelet polygon chord from the true circle
 SPEED_MARGIN = 0.995  # speeds stay 0.5 % below the volumetric limit (written F is rounded)
 N_ORIENTATIONS = 181  # bed placement tries angles 0..90 deg in 0.5 deg steps
@@ -94,7 +88,8 @@ class VolumeBudget:
     crossing_overlap : strand on strand at the crossings (counted twice in `nominal`)
     junction_overlap : strand ends inside the border / strip ends in the eyelets
     solid : the part itself (nominal minus overlaps) - the mesh volume
-    deposit : what the G-code lays: nominal minus the flow saved over crossings
+    deposit : what the G-code lays: nominal minus the flow saved over crossings and over
+    the junctions (laid at `overlap_flow`)
     """
 
     nominal_mm3: float
@@ -102,6 +97,7 @@ class VolumeBudget:
     junction_overlap_mm3: float
     crossing_flow_factor: float
     crossings_per_layer: int
+    overlap_flow: float = 1.0
 
     @property
     def solid_mm3(self) -> float:
@@ -109,7 +105,8 @@ class VolumeBudget:
 
     @property
     def deposit_mm3(self) -> float:
-        return self.nominal_mm3 - (1.0 - self.crossing_flow_factor) * self.crossing_overlap_mm3
+        return (self.nominal_mm3 - (1.0 - self.crossing_flow_factor) * self.crossing_overlap_mm3
+                - (1.0 - self.overlap_flow) * self.junction_overlap_mm3)
 
 
 # ----------------------------------------------------------------------------- checks
@@ -123,11 +120,12 @@ def part_section(part_kind: str, part: NetDesign | CableDesign) -> Section:
 
 
 def check_part(part_kind: str, part: NetDesign | CableDesign, printer: Printer,
-               style: PrintStyle) -> tuple[float, np.ndarray]:
+               style: PrintStyle, *, reach_mm: float = 0.0) -> tuple[float, np.ndarray]:
     """Raise a PrintabilityError for a part that cannot be printed; else return its placement.
 
     Checks passes (>= 1), every bead against the nozzle, layer heights, the part height and
-    its footprint on the bed. Returns (angle_rad, centre_xy_mm) of the placement on the bed.
+    its footprint on the bed (a net reaching `reach_mm` past its corner nodes: its loops and
+    corner eyelets). Returns (angle_rad, centre_xy_mm) of the placement on the bed.
     """
     sec = part_section(part_kind, part)
     where = f"{part_kind} {getattr(part, 'name', '')}".rstrip()
@@ -147,11 +145,12 @@ def check_part(part_kind: str, part: NetDesign | CableDesign, printer: Printer,
         raise PrintabilityError(f"{where}: thickness {sec.thickness_mm:g} mm exceeds the "
                                 f"{printer.max_height_mm:g} mm build height of {printer.key}")
     if part_kind == "net":
-        check_pass(printer, _border_bead(part)[1], sec.layer_heights_mm[0], where=f"{where} border")
+        check_pass(printer, border_bead(part)[1], sec.layer_heights_mm[0], where=f"{where} border")
         size = np.array(diamond_net(part.width_mm, part.height_mm, part.mesh_x_mm,
-                                    part.mesh_y_mm).size_mm) + part.border_width_mm
+                                    part.mesh_y_mm).size_mm) \
+            + 2 * max(part.border_width_mm / 2, reach_mm)
     else:
-        ring_w = _ring_layout(part)[1]
+        ring_w = ring_layout(part, printer.hole_compensation_mm)[1]
         check_pass(printer, ring_w, sec.layer_heights_mm[0], where=f"{where} eyelet ring")
         if sec.width_mm >= part.eyelet_outer_mm:
             raise PrintabilityError(
@@ -179,21 +178,16 @@ def place_on_bed(size_mm: np.ndarray, printer: Printer, *, where: str) -> tuple[
 def wall_loops(part_kind: str, part: NetDesign | CableDesign) -> int:
     """Perimeter loops a slicer needs to fill the widest band of the part (2 beads a loop)."""
     if part_kind == "net":
-        beads = max(part.strand.beads_across, _border_bead(part)[0])
+        beads = max(part.strand.beads_across, border_bead(part)[0])
     else:
-        beads = max(part.section.beads_across, _ring_layout(part)[0])
+        beads = max(part.section.beads_across, ring_layout(part)[0])
     return max(1, -(-beads // 2))
 
 
-def _border_bead(net: NetDesign) -> tuple[int, float]:
-    """(loops, bead width mm) of the border: whole strand beads across its width."""
-    n = max(1, round(net.border_width_mm / net.strand.bead_width_mm))
-    return n, net.border_width_mm / n
-
-
-def _ring_layout(cable: CableDesign) -> tuple[int, float]:
-    """(rings, bead width mm) filling the eyelet annulus with beads near the section's."""
-    band = (cable.eyelet_outer_mm - cable.eyelet_inner_mm) / 2
+def ring_layout(cable: CableDesign, hole_compensation_mm: float = 0.0) -> tuple[int, float]:
+    """(rings, bead width mm) filling the eyelet annulus (hole widened by the compensation)
+    with beads near the section's."""
+    band = (cable.eyelet_outer_mm - cable.eyelet_inner_mm - hole_compensation_mm) / 2
     if band <= 0:
         raise PrintabilityError(f"cable {cable.name}: eyelet outer {cable.eyelet_outer_mm:g} mm "
                                 f"is not larger than inner {cable.eyelet_inner_mm:g} mm")
@@ -201,7 +195,7 @@ def _ring_layout(cable: CableDesign) -> tuple[int, float]:
     return n, band / n
 
 
-def _speeds(material: Material, widths: list[float], heights: list[float]) -> list[float]:
+def speeds(material: Material, widths: list[float], heights: list[float]) -> list[float]:
     """Speed per layer (mm/s): the material's speed, capped by its volumetric flow limit."""
     p = material.print
     out = []
@@ -213,7 +207,7 @@ def _speeds(material: Material, widths: list[float], heights: list[float]) -> li
 
 
 # ----------------------------------------------------------------------------- builder
-class _Builder:
+class Builder:
     def __init__(self, angle: float, centre: np.ndarray, offset: np.ndarray) -> None:
         c, s = np.cos(angle), np.sin(angle)
         self.rot = np.array([[c, -s], [s, c]])
@@ -225,6 +219,7 @@ class _Builder:
         return self.rot @ np.asarray(p, dtype=float) + self.shift
 
     def line(self, p0, p1, z, w, h, v, flow, layer, kind, travel_speed) -> None:
+        """An extrusion from p0 to p1 (part coordinates), after a travel when not there."""
         a, b = self._xy(p0), self._xy(p1)
         start = (float(a[0]), float(a[1]), z)
         if self.pos is None or np.hypot(self.pos[0] - start[0], self.pos[1] - start[1]) > 1e-6 \
@@ -233,6 +228,18 @@ class _Builder:
         self.rows.append((float(b[0]), float(b[1]), z, w, h, v, flow, layer, kind))
         self.pos = (float(b[0]), float(b[1]), z)
 
+    def part_xy(self) -> np.ndarray:
+        """The current position in part coordinates (mm)."""
+        assert self.pos is not None
+        return self.rot.T @ (np.array(self.pos[:2]) - self.shift)
+
+    def travel(self, pts: np.ndarray, z: float, layer: int, speed: float, kind: int) -> None:
+        """Travel through the points `pts` ((k, 2), part coordinates) at height z."""
+        for p in pts:
+            q = self._xy(p)
+            self.rows.append((float(q[0]), float(q[1]), z, 0.0, 0.0, speed, 0.0, layer, kind))
+            self.pos = (float(q[0]), float(q[1]), z)
+
     def toolpath(self, layer_z: list[float], part: str) -> Toolpath:
         a = np.array(self.rows, dtype=float)
         return Toolpath(a[:, 0:3].copy(), a[:, 3].copy(), a[:, 4].copy(), a[:, 5].copy(),
@@ -240,170 +247,7 @@ class _Builder:
                         np.array(layer_z), part)
 
 
-# ----------------------------------------------------------------------------- net
-def net_toolpath(net: NetDesign, printer: Printer, style: PrintStyle, material: Material, *,
-                 crossing_flow_factor: float | None = None) -> Toolpath:
-    """Toolpath of the whole net, one layer per pass (see the module docstring)."""
-    angle, centre = check_part("net", net, printer, style)
-    f = style.crossing_flow_factor if crossing_flow_factor is None else crossing_flow_factor
-    if not 0.0 <= f <= 1.0:
-        raise ProfileError(f"crossing_flow_factor {f!r} must lie in 0..1")
-    g = diamond_net(net.width_mm, net.height_mm, net.mesh_x_mm, net.mesh_y_mm)
-    size = np.array(g.size_mm)
-    b = _Builder(angle, centre, size / 2)
-    sec = net.strand
-    n_loops, wb = _border_bead(net)
-    heights = list(sec.layer_heights_mm)
-    speeds = _speeds(material, [sec.bead_width_mm, wb], heights)
-    travel = printer.travel_speed_mm_per_s
-    z = np.cumsum(heights)
-    fams = _strands_by_family(g)
-    for k, (h, v) in enumerate(zip(heights, speeds, strict=True)):
-        zk = float(round(z[k], 6))
-        for j in range(n_loops):
-            o = (j - (n_loops - 1) / 2) * wb
-            corners = [(-o, -o), (size[0] + o, -o), (size[0] + o, size[1] + o),
-                       (-o, size[1] + o), (-o, -o)]
-            for p0, p1 in itertools.pairwise(corners):
-                b.line(p0, p1, zk, wb, h, v, 1.0, k, BORDER, travel)
-        order = (1, -1) if k % 2 == 0 else (-1, 1)
-        for rank, fam in enumerate(order):
-            reduce = rank == 1 and f < 1.0
-            for n, s in enumerate(fams[fam]):
-                pts = g.nodes_mm[s] if n % 2 == 0 else g.nodes_mm[s[::-1]]
-                kind = STRAND_PLUS if fam == 1 else STRAND_MINUS
-                for p0, p1, fl in _strand_pieces(pts, sec, g, f if reduce else 1.0):
-                    for off in _bead_offsets(sec, p1 - p0):
-                        b.line(p0 + off, p1 + off, zk, sec.bead_width_mm, h, v, fl, k, kind,
-                               travel)
-    return b.toolpath([float(round(x, 6)) for x in z], "net")
-
-
-def _strands_by_family(g: NetGraph) -> dict[int, list[np.ndarray]]:
-    """Strands of each family sorted across the panel (so consecutive strands are neighbours)."""
-    out: dict[int, list[np.ndarray]] = {1: [], -1: []}
-    a, bb = g.mesh_mm
-    for s in g.strands:
-        p0, p1 = g.nodes_mm[s[0]], g.nodes_mm[s[-1]]
-        fam = 1 if p1[1] > p0[1] else -1
-        out[fam].append(s)
-    for fam, lst in out.items():
-        # intercept of the line y = fam * (b/a) * x + c: sorting by c orders them across
-        lst.sort(key=lambda s, fam=fam: g.nodes_mm[s[0], 1] - fam * bb / a * g.nodes_mm[s[0], 0])
-    return out
-
-
-def _crossing_half_span(sec: Section, g: NetGraph) -> float:
-    """Half length of a strand lying over a crossing strand of the same width (mm)."""
-    return sec.width_mm / 2 / _sin_crossing(g)
-
-
-def _sin_crossing(g: NetGraph) -> float:
-    a, b = g.mesh_mm
-    return 2 * a * b / (a * a + b * b)  # sin of the angle between the two families
-
-
-def _strand_pieces(pts: np.ndarray, sec: Section, g: NetGraph, f: float):
-    """Straight pieces (p0, p1, flow) of one strand: one piece unless crossings get less flow."""
-    if f >= 1.0 or len(pts) <= 2:
-        return [(pts[0], pts[-1], 1.0)]
-    d = pts[-1] - pts[0]
-    length = float(np.hypot(*d))
-    u = d / length
-    half = _crossing_half_span(sec, g)
-    cuts = [0.0]
-    flows = []
-    for p in pts[1:-1]:
-        t = float(np.dot(p - pts[0], u))
-        lo, hi = max(t - half, cuts[-1]), min(t + half, length)
-        if lo > cuts[-1]:
-            cuts.append(lo)
-            flows.append(1.0)
-        cuts.append(hi)
-        flows.append(f)
-    if cuts[-1] < length:
-        cuts.append(length)
-        flows.append(1.0)
-    return [(pts[0] + u * t0, pts[0] + u * t1, fl)
-            for t0, t1, fl in zip(cuts[:-1], cuts[1:], flows, strict=True) if t1 > t0]
-
-
-def _bead_offsets(sec: Section, d: np.ndarray) -> list[np.ndarray]:
-    """Perpendicular offsets of the beads side by side in a strand of direction d."""
-    n = sec.beads_across
-    perp = np.array([-d[1], d[0]]) / np.hypot(*d)
-    return [perp * (j - (n - 1) / 2) * sec.bead_width_mm for j in range(n)]
-
-
-def net_volume_budget(net: NetDesign, style: PrintStyle, *,
-                      crossing_flow_factor: float | None = None) -> VolumeBudget:
-    """Designed volumes of the net (analytic, rectangular sections)."""
-    f = style.crossing_flow_factor if crossing_flow_factor is None else crossing_flow_factor
-    g = diamond_net(net.width_mm, net.height_mm, net.mesh_x_mm, net.mesh_y_mm)
-    sec = net.strand
-    t = sec.thickness_mm
-    w = sec.width_mm
-    size = np.array(g.size_mm)
-    strand_len = sum(float(np.hypot(*(g.nodes_mm[s[-1]] - g.nodes_mm[s[0]]))) for s in g.strands)
-    n_cross = sum(len(s) - 2 for s in g.strands) // 2
-    border = 2 * (size[0] + size[1]) * net.border_width_mm
-    nominal = (strand_len * w + border) * t
-    crossing = n_cross * w * w / _sin_crossing(g) * t
-    a, b = g.mesh_mm
-    diag = np.hypot(a, b)
-    junction = 0.0
-    for s in g.strands:
-        for end in (g.nodes_mm[s[0]], g.nodes_mm[s[-1]]):
-            on_side = np.isclose(end[0], 0) or np.isclose(end[0], size[0])
-            sin_phi = a / diag if on_side else b / diag  # strand vs the border edge it meets
-            junction += net.border_width_mm / 2 / sin_phi * w * t
-    return VolumeBudget(nominal, crossing, junction, f, n_cross)
-
-
-# ----------------------------------------------------------------------------- cable
-def cable_toolpath(cable: CableDesign, printer: Printer, style: PrintStyle,
-                   material: Material) -> Toolpath:
-    """Toolpath of one cable: eyelet rings, then the strip beads, per layer."""
-    angle, centre = check_part("cable", cable, printer, style)
-    sec = cable.section
-    n_rings, wr = _ring_layout(cable)
-    ri, ro = cable.eyelet_inner_mm / 2, cable.eyelet_outer_mm / 2
-    half = cable.length_mm / 2
-    b = _Builder(angle, centre, np.zeros(2))
-    heights = list(sec.layer_heights_mm)
-    speeds = _speeds(material, [sec.bead_width_mm, wr], heights)
-    travel = printer.travel_speed_mm_per_s
-    z = np.cumsum(heights)
-    offsets = [(j - (sec.beads_across - 1) / 2) * sec.bead_width_mm
-               for j in range(sec.beads_across)]
-    for k, (h, v) in enumerate(zip(heights, speeds, strict=True)):
-        zk = float(round(z[k], 6))
-        for cx in (-half, half):
-            for j in range(n_rings):
-                ring = _circle(np.array([cx, 0.0]), ri + wr * (j + 0.5))
-                for p0, p1 in itertools.pairwise(ring):
-                    b.line(p0, p1, zk, wr, h, v, 1.0, k, EYELET, travel)
-        for j, y in enumerate(offsets):
-            x = half - np.sqrt(ro * ro - y * y)
-            p0, p1 = np.array([-x, y]), np.array([x, y])
-            if j % 2:
-                p0, p1 = p1, p0
-            b.line(p0, p1, zk, sec.bead_width_mm, h, v, 1.0, k, CABLE_STRIP, travel)
-    return b.toolpath([float(round(x, 6)) for x in z], f"cable {cable.name}")
-
-
-def _circle(c: np.ndarray, r: float) -> np.ndarray:
+def circle(c: np.ndarray, r: float) -> np.ndarray:
     n = max(8, int(np.ceil(np.pi / np.arccos(1 - CHORD_TOL_MM / r))))
     t = np.linspace(0.0, 2 * np.pi, n + 1)
     return c + r * np.column_stack([np.cos(t), np.sin(t)])
-
-
-def cable_volume_budget(cable: CableDesign) -> VolumeBudget:
-    """Designed volumes of a cable: two annuli plus the strip between them (mm^3)."""
-    sec = cable.section
-    ri, ro = cable.eyelet_inner_mm / 2, cable.eyelet_outer_mm / 2
-    rings = 2 * np.pi * (ro * ro - ri * ri)
-    strip = sum(cable.length_mm - 2 * np.sqrt(ro * ro - y * y)
-                for y in ((j - (sec.beads_across - 1) / 2) * sec.bead_width_mm
-                          for j in range(sec.beads_across))) * sec.bead_width_mm
-    return VolumeBudget((rings + strip) * sec.thickness_mm, 0.0, 0.0, 1.0, 0)

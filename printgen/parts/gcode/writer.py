@@ -2,6 +2,10 @@
 
 Temperatures, fan, retraction and start/end code come from the material and printer
 profiles; `{placeholder}`s in the printer's start/end code are filled from the material.
+Before the part, a prime line (`;TYPE:Skirt`) along the bed's front margin fills the nozzle.
+Travels are retracted (the material's length and speed) when longer than
+RETRACT_MIN_TRAVEL_MM, except travels over printed beads (kind COMB): ooze there lands on
+the part, and flexible filament is spared the retractions that make it string and jam.
 """
 
 from __future__ import annotations
@@ -16,9 +20,12 @@ from printgen.errors import ProfileError
 from printgen.inputs.materials import Material
 from printgen.inputs.printers import Printer
 from printgen.outputs import write_text
-from printgen.parts.gcode.toolpath import KIND_NAMES, TRAVEL, Toolpath
+from printgen.parts.gcode.toolpath import COMB, KIND_NAMES, SPEED_MARGIN, TRAVEL, Toolpath
 
 RETRACT_MIN_TRAVEL_MM = 2.0  # travels shorter than this are not retracted (no ooze gap)
+PRIME_LENGTH_MM = 60.0  # prime line along the bed's front edge, there and back
+PRIME_WIDTH_FACTOR = 1.5  # prime bead width / nozzle: a wide, slow line fills the nozzle
+PRIME_TYPE = "Skirt"  # a ;TYPE: that slicers and the checker leave out of the part
 _PLACEHOLDER = re.compile(r"\{(\w+)\}")
 
 
@@ -73,7 +80,9 @@ def gcode_text(tp: Toolpath, printer: Printer, material: Material, *,
     if "M109" not in start:
         out.append(f"M109 S{t0:g}")
     out += ["G21", "G90", "M83" if relative_e else "M82", "G92 E0", "M107"]
-    out += _moves(tp, printer, material, relative_e)
+    prime, e_prime = prime_line(tp, printer, material, relative_e)
+    out += prime
+    out += _moves(tp, printer, material, relative_e, e_start=e_prime)
     out += ["M107", end.strip(), ""]
     return "\n".join(out)
 
@@ -89,7 +98,28 @@ def _layer_start(k: int, z: float, material: Material) -> list[str]:
     return lines
 
 
-def _moves(tp: Toolpath, printer: Printer, material: Material, relative_e: bool) -> list[str]:
+def prime_line(tp: Toolpath, printer: Printer, material: Material,
+               relative_e: bool) -> tuple[list[str], float]:
+    """G-code of the prime line (there and back along the bed's front margin, at the first
+    layer's height and the material's flow limit) and the E it leaves (absolute mode)."""
+    m = printer.bed_margin_mm
+    w = PRIME_WIDTH_FACTOR * printer.nozzle_diameter_mm
+    h = float(tp.layer_z_mm[0])
+    p = material.print
+    v = min(p.first_layer_speed_mm_per_s, SPEED_MARGIN * p.max_volumetric_flow_mm3_per_s / (w * h))
+    x1 = min(m + PRIME_LENGTH_MM, printer.bed_x_mm - m)
+    y0, y1 = m / 2 - w / 2, m / 2 + w / 2
+    de = w * h * (x1 - m) / (math.pi * printer.filament_diameter_mm ** 2 / 4)
+    e1, e2 = (de, de) if relative_e else (de, 2 * de)
+    f = math.floor(v * 600) / 10
+    lines = [f";TYPE:{PRIME_TYPE}", f"G0 Z{h:.3f} F600", f"G0 X{m:.3f} Y{y0:.3f} F3000",
+             f"G1 X{x1:.3f} Y{y0:.3f} E{e1:.5f} F{f:.1f}", f"G0 X{x1:.3f} Y{y1:.3f}",
+             f"G1 X{m:.3f} Y{y1:.3f} E{e2:.5f} F{f:.1f}"]
+    return lines, (0.0 if relative_e else 2 * de)
+
+
+def _moves(tp: Toolpath, printer: Printer, material: Material, relative_e: bool, *,
+           e_start: float = 0.0) -> list[str]:
     e = e_values(tp, printer.filament_diameter_mm)
     lengths = tp.lengths_mm()
     retract = material.print.retract_length_mm
@@ -97,8 +127,8 @@ def _moves(tp: Toolpath, printer: Printer, material: Material, relative_e: bool)
     feed = np.floor(tp.speed_mm_per_s * 600) / 10  # mm/min, rounded down: never above the cap
     x, y, z = tp.xyz_mm[:, 0], tp.xyz_mm[:, 1], tp.xyz_mm[:, 2]
     lines: list[str] = []
-    e_abs = 0.0
-    cur_z = None
+    e_abs = e_start
+    cur_z = float(tp.layer_z_mm[0])  # the prime line left the nozzle at the first layer
     cur_layer = -1
     cur_kind = -1
     retracted = False
@@ -113,8 +143,8 @@ def _moves(tp: Toolpath, printer: Printer, material: Material, relative_e: bool)
             cur_layer = int(tp.layer[i])
             lines += _layer_start(cur_layer, tp.layer_z_mm[cur_layer], material)
         if tp.kind[i] == TRAVEL or e[i] <= 0:
-            long_travel = lengths[i] >= RETRACT_MIN_TRAVEL_MM or cur_z is None
-            if retract > 0 and long_travel and not retracted and cur_z is not None:
+            long_travel = (lengths[i] >= RETRACT_MIN_TRAVEL_MM or i == 0) and tp.kind[i] != COMB
+            if retract > 0 and long_travel and not retracted:
                 lines.append(f"G1 {ecode(-retract)} F{f_retract:.0f}")
                 retracted = True
             if z[i] != cur_z:

@@ -1,0 +1,256 @@
+"""Direct toolpath of the diamond net (mm, mm/s), one layer per pass.
+
+Each layer: the border first, then every diagonal strand of one family as one straight
+extrusion from border to border through the crossings, then the other family; the family
+order alternates from layer to layer ("crossed passes"). The strands laid second in a layer
+cross beads already there: over each crossing their flow is `crossing_flow_factor` (1 = full
+bead, the crossing gets a double deposit; 0 = the crossing holds one bead, as the mesh).
+
+With an `Attachment` (loops on the edge nodes, eyelets on the corners,
+`printgen.parts.geometry.attach`) the border beads detour around every hole on their own
+side of the edge (together they make each loop's ring), the corner eyelets get their extra
+full rings first, and each strand ends at its loop's hole; over the ring it overlaps, a
+strand lays the same reduced flow as over a crossing. Between strands the nozzle travels
+along the inner border bead (over printed material, so the writer does not retract there).
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+
+from printgen.design.record import NetDesign, Section
+from printgen.errors import ProfileError
+from printgen.inputs.materials import Material
+from printgen.inputs.printers import Printer, PrintStyle
+from printgen.parts.gcode.toolpath import (
+    BORDER,
+    COMB,
+    EYELET,
+    STRAND_MINUS,
+    STRAND_PLUS,
+    Builder,
+    Toolpath,
+    VolumeBudget,
+    border_bead,
+    check_part,
+    circle,
+    speeds,
+)
+from printgen.parts.geometry.attach import CORNER_EXTRA_RINGS, Attachment, Hole, holes
+from printgen.parts.geometry.net import NetGraph, diamond_net
+
+
+def net_toolpath(net: NetDesign, printer: Printer, style: PrintStyle, material: Material, *,
+                 crossing_flow_factor: float | None = None,
+                 attachment: Attachment | None = None) -> Toolpath:
+    """Toolpath of the whole net, one layer per pass (see the module docstring)."""
+    g = diamond_net(net.width_mm, net.height_mm, net.mesh_x_mm, net.mesh_y_mm)
+    hs = [] if attachment is None else holes(net, g, attachment)
+    angle, centre = check_part("net", net, printer, style,
+                               reach_mm=max((h.outer_r_mm for h in hs), default=0.0))
+    f = style.crossing_flow_factor if crossing_flow_factor is None else crossing_flow_factor
+    if not 0.0 <= f <= 1.0:
+        raise ProfileError(f"crossing_flow_factor {f!r} must lie in 0..1")
+    size = np.array(g.size_mm)
+    b = Builder(angle, centre, size / 2)
+    sec = net.strand
+    wb = border_bead(net)[1]
+    heights = list(sec.layer_heights_mm)
+    layer_speeds = speeds(material, [sec.bead_width_mm, wb], heights)
+    travel = printer.travel_speed_mm_per_s
+    z = np.cumsum(heights)
+    fams = _strands_by_family(g)
+    rings = _border_rings(net, g, hs) if hs else _plain_border(net, g)
+    by_node = {h.node: h for h in hs}
+    for k, (h, v) in enumerate(zip(heights, layer_speeds, strict=True)):
+        zk = float(round(z[k], 6))
+        for ring, kind in rings:
+            for p0, p1 in itertools.pairwise(ring):
+                b.line(p0, p1, zk, wb, h, v, 1.0, k, kind, travel)
+        comb = _Comb(rings[-1][0]) if hs else None
+        order = (1, -1) if k % 2 == 0 else (-1, 1)
+        for rank, fam in enumerate(order):
+            f_cross = f if rank == 1 else 1.0
+            kind = STRAND_PLUS if fam == 1 else STRAND_MINUS
+            for n, s in enumerate(fams[fam]):
+                s = s if n % 2 == 0 else s[::-1]
+                pieces = _strand_pieces(g.nodes_mm[s], sec, g, f_cross, f,
+                                        by_node.get(int(s[0])), by_node.get(int(s[-1])))
+                if comb is not None and b.pos is not None and b.pos[2] == zk:
+                    b.travel(comb.route(b.part_xy(), pieces[0][0]), zk, k, travel, COMB)
+                for p0, p1, fl in pieces:
+                    for off in _bead_offsets(sec, p1 - p0):
+                        b.line(p0 + off, p1 + off, zk, sec.bead_width_mm, h, v, fl, k, kind,
+                               travel)
+    return b.toolpath([float(round(x, 6)) for x in z], "net")
+
+
+def _plain_border(net: NetDesign, g: NetGraph) -> list[tuple[np.ndarray, int]]:
+    """Concentric rectangles of the border beads, outermost first."""
+    n_loops, wb = border_bead(net)
+    sx, sy = g.size_mm
+    out = []
+    for j in range(n_loops):
+        o = (j - (n_loops - 1) / 2) * wb
+        out.append((np.array([(-o, -o), (sx + o, -o), (sx + o, sy + o), (-o, sy + o),
+                              (-o, -o)]), BORDER))
+    return out
+
+
+def _border_rings(net: NetDesign, g: NetGraph, hs: list[Hole]) -> list[tuple[np.ndarray, int]]:
+    """The corner eyelets' extra rings, then each border bead's closed path around the holes
+    (outward beads around the outside of every hole, inward beads around the inside),
+    outermost first; the last one is the innermost bead, along which the nozzle travels."""
+    from shapely import unary_union
+    from shapely.geometry import box
+
+    n_loops, wb = border_bead(net)
+    sx, sy = g.size_mm
+    out = []
+    for h in hs:
+        if h.corner:
+            out += [(circle(h.centre_mm, h.hole_r_mm + wb * (j + 0.5)), EYELET)
+                    for j in range(CORNER_EXTRA_RINGS)]
+    for j in range(n_loops):
+        o = (j - (n_loops - 1) / 2) * wb
+        discs = unary_union([_disc(h.centre_mm, h.hole_r_mm + abs(o)
+                                   + (CORNER_EXTRA_RINGS * wb if h.corner else 0.0))
+                             for h in hs])
+        rect = box(o, o, sx - o, sy - o)
+        region = rect.union(discs) if o < 0 else rect.difference(discs)
+        if region.geom_type != "Polygon":
+            raise ProfileError(f"net border bead {j} falls apart around the loops; use a "
+                               "larger mesh or smaller loops")
+        ring = np.asarray(region.exterior.coords)
+        start = int(np.argmin(ring[:-1, 0] + ring[:-1, 1]))  # nearest the lower-left corner
+        out.append((np.vstack([ring[start:-1], ring[:start + 1]]), BORDER))
+    return out
+
+
+def _disc(c: np.ndarray, r: float):
+    from shapely.geometry import Polygon
+
+    return Polygon(circle(c, r)[:-1])
+
+
+class _Comb:
+    """Travel routes along a closed bead path (over printed material)."""
+
+    def __init__(self, ring: np.ndarray) -> None:
+        from shapely.geometry import LineString
+
+        self.line = LineString(ring)
+        self.length = float(self.line.length)
+
+    def route(self, p: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """(k, 2) points from near p to q: onto the path, along it the shorter way, off it."""
+        from shapely.geometry import Point
+        from shapely.ops import substring
+
+        d0 = float(self.line.project(Point(p)))
+        d1 = float(self.line.project(Point(q)))
+        L = self.length
+        fwd = (d1 - d0) % L
+        if fwd <= L / 2:
+            legs = [(d0, d0 + fwd)] if d0 + fwd <= L else [(d0, L), (0.0, d0 + fwd - L)]
+        else:
+            back = L - fwd
+            legs = [(d0, d0 - back)] if d0 - back >= 0 else [(d0, 0.0), (L, d0 - back + L)]
+        pts = [np.asarray(substring(self.line, a, c).coords) for a, c in legs]
+        return np.vstack([*pts, np.asarray(q, dtype=float)[None, :]])
+
+
+def _strands_by_family(g: NetGraph) -> dict[int, list[np.ndarray]]:
+    """Strands of each family sorted across the panel (so consecutive strands are neighbours)."""
+    out: dict[int, list[np.ndarray]] = {1: [], -1: []}
+    a, bb = g.mesh_mm
+    for s in g.strands:
+        p0, p1 = g.nodes_mm[s[0]], g.nodes_mm[s[-1]]
+        fam = 1 if p1[1] > p0[1] else -1
+        out[fam].append(s)
+    for fam, lst in out.items():
+        # intercept of the line y = fam * (b/a) * x + c: sorting by c orders them across
+        lst.sort(key=lambda s, fam=fam: g.nodes_mm[s[0], 1] - fam * bb / a * g.nodes_mm[s[0], 0])
+    return out
+
+
+def _crossing_half_span(sec: Section, g: NetGraph) -> float:
+    """Half length of a strand lying over a crossing strand of the same width (mm)."""
+    return sec.width_mm / 2 / _sin_crossing(g)
+
+
+def _sin_crossing(g: NetGraph) -> float:
+    a, b = g.mesh_mm
+    return 2 * a * b / (a * a + b * b)  # sin of the angle between the two families
+
+
+def _strand_pieces(pts: np.ndarray, sec: Section, g: NetGraph, f_cross: float, f_end: float,
+                   start: Hole | None = None, end: Hole | None = None):
+    """Straight pieces (p0, p1, flow) of one strand: `f_cross` over the crossings, `f_end`
+    over the ring at an end with a hole (the strand stops where its beads meet the hole)."""
+    d = pts[-1] - pts[0]
+    length = float(np.hypot(*d))
+    u = d / length
+    t0 = _trim(start, sec)
+    t1 = length - _trim(end, sec)
+    spans = []
+    if f_cross < 1.0:
+        half = _crossing_half_span(sec, g)
+        spans += [(t - half, t + half, f_cross)
+                  for t in (float(np.dot(p - pts[0], u)) for p in pts[1:-1])]
+    if start is not None:
+        spans.append((t0, start.outer_r_mm, f_end))
+    if end is not None:
+        spans.append((length - end.outer_r_mm, t1, f_end))
+    cuts = sorted({t0, t1, *(min(max(c, t0), t1) for lo, hi, _ in spans for c in (lo, hi))})
+    out: list[tuple[np.ndarray, np.ndarray, float]] = []
+    for a, c in itertools.pairwise(cuts):
+        mid = (a + c) / 2
+        fl = min([fl for lo, hi, fl in spans if lo <= mid <= hi], default=1.0)
+        if out and out[-1][2] == fl:
+            out[-1] = (out[-1][0], pts[0] + u * c, fl)
+        else:
+            out.append((pts[0] + u * a, pts[0] + u * c, fl))
+    return out
+
+
+def _trim(h: Hole | None, sec: Section) -> float:
+    """Distance from a strand's end node to where its beads' corners meet the hole (mm)."""
+    if h is None:
+        return 0.0
+    return float(np.sqrt(max(h.hole_r_mm ** 2 - (sec.width_mm / 2) ** 2, 0.0)))
+
+
+def _bead_offsets(sec: Section, d: np.ndarray) -> list[np.ndarray]:
+    """Perpendicular offsets of the beads side by side in a strand of direction d."""
+    n = sec.beads_across
+    perp = np.array([-d[1], d[0]]) / np.hypot(*d)
+    return [perp * (j - (n - 1) / 2) * sec.bead_width_mm for j in range(n)]
+
+
+def net_volume_budget(net: NetDesign, style: PrintStyle, *,
+                      crossing_flow_factor: float | None = None) -> VolumeBudget:
+    """Designed volumes of the net (analytic, rectangular sections)."""
+    f = style.crossing_flow_factor if crossing_flow_factor is None else crossing_flow_factor
+    g = diamond_net(net.width_mm, net.height_mm, net.mesh_x_mm, net.mesh_y_mm)
+    sec = net.strand
+    t = sec.thickness_mm
+    w = sec.width_mm
+    size = np.array(g.size_mm)
+    strand_len = sum(float(np.hypot(*(g.nodes_mm[s[-1]] - g.nodes_mm[s[0]]))) for s in g.strands)
+    n_cross = sum(len(s) - 2 for s in g.strands) // 2
+    border = 2 * (size[0] + size[1]) * net.border_width_mm
+    nominal = (strand_len * w + border) * t
+    crossing = n_cross * w * w / _sin_crossing(g) * t
+    a, b = g.mesh_mm
+    diag = np.hypot(a, b)
+    junction = 0.0
+    for s in g.strands:
+        for end in (g.nodes_mm[s[0]], g.nodes_mm[s[-1]]):
+            on_side = np.isclose(end[0], 0) or np.isclose(end[0], size[0])
+            sin_phi = a / diag if on_side else b / diag  # strand vs the border edge it meets
+            junction += net.border_width_mm / 2 / sin_phi * w * t
+    return VolumeBudget(nominal, crossing, junction, f, n_cross)
+
