@@ -67,14 +67,21 @@ def plan(prototype_path: str | Path, scale: float, *, printer: str | None = None
 
 def gcode_step(ctx: MakeContext, stage: Path) -> None:
     """Direct G-code for the net and each cable, checked by read-back against the design."""
+    from printgen.parts.gcode import cable_toolpath, net_toolpath
     from printgen.parts.gcode.readback import read_gcode_text
-    from printgen.parts.gcode.toolpath import cable_toolpath, net_toolpath
     from printgen.parts.gcode.writer import gcode_text
+    from printgen.parts.geometry.attach import attachment_for
 
     d = ctx.design
     printer = load_printer(d.printer)
-    parts = [("net", d.net, net_toolpath)] + [(f"cable-{c.name}", c, cable_toolpath)
-                                              for c in d.cables]
+    att = (attachment_for(d, hole_compensation_mm=printer.hole_compensation_mm)
+           if d.cables else None)
+
+    def net_path(*args):
+        return net_toolpath(*args, attachment=att)
+
+    parts = [("net", d.net, net_path)] + [(f"cable-{c.name}", c, cable_toolpath)
+                                          for c in d.cables]
     rows, rec = [], {}
     for name, part, build in parts:
         mat, style = load_material(part.material), load_print_style(part.print_style)
@@ -87,17 +94,23 @@ def gcode_step(ctx: MakeContext, stage: Path) -> None:
         path.write_text(text)
         ctx.files.append(path.name)
         err = back.volume_mm3 / tp.volume_mm3 - 1
+        stl = ctx.record.get("parts", {}).get(name, {}).get("volume_mm3")
+        vs_stl = back.volume_mm3 / stl - 1 if stl else None
+        retractions = text.count(f"E-{mat.print.retract_length_mm:.5f}")
         rec[name] = {"file": path.name, "layers": len(back.layer_z_mm),
                      "volume_mm3": tp.volume_mm3, "readback_volume_mm3": back.volume_mm3,
-                     "readback_error": err, "seconds": seconds}
+                     "readback_error": err, "readback_vs_stl": vs_stl,
+                     "retractions": retractions, "seconds": seconds}
         rows.append([name, path.name, str(len(back.layer_z_mm)), f"{tp.volume_mm3:.1f}",
-                     f"{err:+.2%}"])  # times go to timings.json: the report is reproducible
+                     f"{err:+.2%}", "-" if vs_stl is None else f"{vs_stl:+.2%}",
+                     str(retractions)])  # times go to timings.json: the report is reproducible
     ctx.record["gcode"] = rec
     ctx.report.heading("Direct G-code")
     ctx.report.paragraph("Every net strand is one straight extrusion through the crossings, the "
                          "strand families alternate per pass; the G-code is read back and its "
                          "extruded volume compared with the toolpath's.")
-    ctx.report.table(["part", "file", "layers", "volume mm^3", "read-back error"], rows)
+    ctx.report.table(["part", "file", "layers", "volume mm^3", "read-back error",
+                      "read back vs STL", "retractions"], rows)
 
 
 def slicer_step(ctx: MakeContext, stage: Path) -> None:
