@@ -72,7 +72,7 @@ def test_reynolds_uses_the_hydraulic_radius(realistic):
 
 
 def test_laminar_and_oversized_models_warn(realistic):
-    t = scale_targets(realistic, 2000)
+    t = scale_targets(realistic, 100)  # the largest scale allowed: Re ~ 2100
     assert any("not turbulent" in w for w in t.flow.warnings)
     t = scale_targets(realistic, 10)  # 1.32 m wide model in a 0.4 m flume
     assert any("exceeds the flume width" in w for w in t.flow.warnings)
@@ -84,7 +84,8 @@ def test_discharge_limit_warns(tmp_path):
     assert any("exceeds the flume's 1.00 L/s" in w for w in t.flow.warnings)
 
 
-@pytest.mark.parametrize("bad", [0.5, 0.0, -3.0, float("nan"), float("inf"), True, "40"])
+@pytest.mark.parametrize("bad", [0.5, 0.0, -3.0, float("nan"), float("inf"), True, "40", 101.0,
+                                 1e9])
 def test_bad_scale_is_an_input_error(bad):
     with pytest.raises(InputError, match="scale"):
         check_scale(bad)

@@ -12,6 +12,7 @@ from rich.console import Console
 
 from printgen.commands.common import add_json_arg, add_prototype_args, console, emit_json, table
 from printgen.run import api
+from printgen.run.budget import DEFAULT_LIMIT_S
 from printgen.run.make import json_output
 
 
@@ -24,6 +25,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--drag", action="store_true",
                    help="also verify under hydrostatic + drag at the Froude-scaled velocity")
     p.add_argument("--step", action="store_true", help="also write STEP files (needs cadquery)")
+    p.add_argument("--time-limit", type=float, default=DEFAULT_LIMIT_S, metavar="SECONDS",
+                   help=f"refuse runs estimated longer than this (default {DEFAULT_LIMIT_S:g} s,"
+                        " about a minute on 2 cores)")
     p.add_argument("--force", action="store_true",
                    help="replace --out even when it holds files printgen did not write")
     add_json_arg(p)
@@ -36,14 +40,22 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     with err.status("planning") as status:
         ctx = api.make(args.prototype, args.scale, out, printer=args.printer, drag=args.drag,
-                       step=args.step, progress=lambda label: status.update(f"{label} ..."),
-                       options={"force": args.force, "command": getattr(args, "argv", None)})
+                       step=args.step, progress=lambda label: _progress(err, status, label),
+                       options={"force": args.force, "command": getattr(args, "argv", None),
+                                "time_limit_s": args.time_limit})
     seconds = time.perf_counter() - t0
     if args.json:
         emit_json(json_output(ctx.record))
         return 0
     show_summary(ctx, out, seconds)
     return 0
+
+
+def _progress(err: Console, status, label: str) -> None:
+    """Step names go to the spinner; the size estimate of a long run stays on screen."""
+    if label.startswith("estimate:"):
+        err.print(f"printgen make: {label}", soft_wrap=True)
+    status.update(f"{label} ...")
 
 
 def show_summary(ctx, out: Path, seconds: float) -> None:

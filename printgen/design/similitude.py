@@ -17,6 +17,7 @@ from printgen.inputs.prototype import Prototype
 from printgen.units import NU_WATER, G
 
 RE_TURBULENT = 2500.0  # model flow must stay turbulent (reference, section 2)
+SCALE_MAX = 100.0  # largest lambda of the reference's scale series (1, 10, 30, 50, 100)
 
 
 @dataclass(frozen=True)
@@ -74,12 +75,18 @@ class ScaledTargets:
 
 
 def check_scale(scale: float) -> float:
-    """Return scale as float; raise InputError unless it is finite and >= 1."""
+    """Return scale as float; raise InputError unless it is finite and in [1, SCALE_MAX]."""
     if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not math.isfinite(scale):
         raise InputError(f"scale = {scale!r} is not a finite number; give lambda >= 1, e.g. 40")
     if scale < 1:
         raise InputError(f"scale = {scale:g} is below 1; lambda is prototype / model "
                          "(1:40 -> --scale 40), so it must be >= 1")
+    if scale > SCALE_MAX:
+        raise InputError(f"scale = {scale:g} exceeds {SCALE_MAX:g}: the similitude is established "
+                         f"from lambda = 1 to {SCALE_MAX:g} (Lambert et al. 2023's scale series), "
+                         "and beyond it a barrier's strands (16 mm / lambda) are far thinner than "
+                         "a printed bead (about 0.4 mm) and the model flow is laminar; use a "
+                         f"scale of at most {SCALE_MAX:g}")
     return float(scale)
 
 

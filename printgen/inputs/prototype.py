@@ -13,6 +13,8 @@ from pathlib import Path
 from printgen.errors import InputError
 from printgen.inputs.schema import Field, load_toml, positive, read_table
 
+DEPTH_OVER_HEIGHT_MAX = 2.0  # flow depth / barrier height: beyond it the barrier is drowned
+
 TOP = [Field("name", str), Field("description", str, required=False, default=""),
        Field("barrier", dict), Field("net", dict), Field("border", dict, required=False),
        Field("flow", dict), Field("flume", dict, required=False),
@@ -123,6 +125,12 @@ def load_prototype(path: str | Path) -> Prototype:
     flume = top["flume"] and FlumeSpec(**read_table(top["flume"], FLUME, where=f"{where} [flume]"))
     model = read_table(top["model"], MODEL, where=f"{where} [model]") if top["model"] else {}
     depth = flow["depth"] if flow["depth"] is not None else bar["height"]
+    if depth > DEPTH_OVER_HEIGHT_MAX * bar["height"]:
+        raise InputError(f"{where} [flow]: depth_m = {depth:g} m is more than "
+                         f"{DEPTH_OVER_HEIGHT_MAX:g} x the barrier height ({bar['height']:g} m): "
+                         "such a flow drowns the barrier, and printgen's loads (hydrostatic up to "
+                         f"overflow, h = 1.1 h_B) do not describe it; give a depth up to "
+                         f"{DEPTH_OVER_HEIGHT_MAX * bar['height']:g} m")
     for label, mesh in (("mesh_x_m", net["mesh_x"]), ("mesh_y_m", net["mesh_y"])):
         limit = bar["width"] if label == "mesh_x_m" else bar["height"]
         if mesh > limit / 2:
@@ -154,3 +162,38 @@ def _panel_law(raw: dict | None, where: str):
         raise InputError(f"{where}: give increasing knees and one kappa per segment "
                          f"(got {len(knees)} knees, {len(kappas)} kappas)")
     return (tuple(k / 100 for k in knees), tuple(k * 1e3 for k in kappas), t["panel_length"])
+
+
+SCHEMA_TABLES = (("", TOP), ("[barrier]", BARRIER), ("[net]", NET),
+                 ("[net.panel_law]", PANEL_LAW), ("[border]", BORDER), ("[flow]", FLOW),
+                 ("[flume]", FLUME), ("[model]", MODEL))
+CROSS_CHECKS = (
+    "[net] mesh_x_m <= barrier width / 2 and mesh_y_m <= barrier height / 2 (two meshes each way)",
+    f"[flow] depth_m <= {DEPTH_OVER_HEIGHT_MAX:g} x barrier height_m (deeper flows drown it)",
+    "[net.panel_law]: increasing knees, one kappa per segment (knees + 1), all > 0 and < 1e9",
+    "[net]: strand_modulus_gpa or a [net.panel_law] is required",
+)
+
+
+def ranges_markdown() -> str:
+    """The README's table of every key of the prototype schema with its range (generated here,
+    and compared with the README by the tests, so the two cannot drift apart)."""
+    rows = ["| table | key | type | range | required |", "|---|---|---|---|---|"]
+    for table, fields in SCHEMA_TABLES:
+        for f in fields:
+            if f.kind is dict:
+                continue
+            rows.append(f"| {table or '(top)'} | `{f.key}` | {f.kind.__name__} | {_range(f)} | "
+                        f"{'yes' if f.required else 'no'} |")
+    rows += ["", "Checks across keys:", ""] + [f"- {c}" for c in CROSS_CHECKS]
+    return "\n".join(rows) + "\n"
+
+
+def _range(f: Field) -> str:
+    if f.choices:
+        return ", ".join(f"`{c}`" for c in f.choices)
+    if f.lo is None and f.hi is None:
+        return "-"
+    lo = "" if f.lo is None else f"{'>' if f.lo_open else '>='} {f.lo:g}"
+    hi = "" if f.hi is None else f"<= {f.hi:g}"
+    return " and ".join(x for x in (lo, hi) if x)

@@ -55,12 +55,18 @@ def positive(key: str, hi: float | None = None, **kw: Any) -> Field:
 def load_toml(path: str | Path) -> dict[str, Any]:
     """Read a TOML file; missing files and syntax errors become `InputError`."""
     p = Path(path)
+    if p.is_dir():
+        some = sorted(p.glob("*.toml"))[:3]
+        hint = f" such as {', '.join(str(x) for x in some)}" if some else ""
+        raise InputError(f"{p} is a folder, not a TOML file; give the file itself{hint}")
     if not p.is_file():
         raise InputError(f"file not found: {p}; check the path (relative to {Path.cwd()})")
     try:
         return tomllib.loads(p.read_text(encoding="utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InputError(f"{p}: not valid TOML: {exc}; fix the file's syntax") from exc
+    except OSError as exc:
+        raise InputError(f"cannot read {p}: {exc.strerror}; check its permissions") from exc
 
 
 def read_table(data: Any, fields: Sequence[Field], *, where: str) -> dict[str, Any]:

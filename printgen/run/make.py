@@ -215,13 +215,16 @@ def part_thickness(kind: str, part) -> float:
 
 
 def verify_step(ctx: MakeContext, stage: Path) -> None:
-    """Prototype vs model over the loading sweep, and the steel counter-example.
+    """Prototype vs model over the loading sweep, the model's uncertainty band
+    (printgen.check.bands), and the steel counter-example.
 
     The sweep is the scene realistic-1:40 (barrier-physics.md, section 7): it needs border
     cables. A barrier without them gets the counter-example and a note saying so.
     """
+    from printgen.check.bands import model_band, model_load_kw
     from printgen.check.verify import steel_counterexample, verify
     from printgen.report.report import verification_record, verification_sections
+    from printgen.report.uncertainty import band_record, band_sections
 
     if not ctx.design.cables:
         ce = steel_counterexample(ctx.targets.scale)
@@ -233,10 +236,13 @@ def verify_step(ctx: MakeContext, stage: Path) -> None:
         ctx.record["verification"] = {"verdict": "NOT RUN", "summary": note,
                                       "counterexample": ce}
         return
-    v = verify(ctx.prototype, ctx.design, drag=bool(ctx.options.get("drag")),
-               counterexample=True)
-    verification_sections(ctx.report, v, v.counterexample, ctx.targets.scale)
+    drag = bool(ctx.options.get("drag"))
+    v = verify(ctx.prototype, ctx.design, drag=drag, counterexample=True)
+    band = model_band(ctx.design, v.model, load_kw=model_load_kw(ctx.prototype, ctx.design, drag))
+    verification_sections(ctx.report, v, v.counterexample, ctx.targets.scale, band=band)
+    band_sections(ctx.report, v, band)
     ctx.record["verification"] = verification_record(v, v.counterexample)
+    ctx.record["verification"]["bands"] = band_record(v, band)
 
 
 LONG_RUN_S = 15.0  # runs estimated longer than this show their estimate and progress

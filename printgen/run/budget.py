@@ -1,0 +1,141 @@
+"""The size of a `make` run, before any of it is done: nodes, unknowns, memory and time.
+
+The verification solves two nets over 23 load levels (prototype and model, in parallel on two
+cores); the meshes step builds one solid strand per model net segment. Both costs grow with
+the node count, which follows from the meshes alone (no net is built here). The constants are
+measured on the 1:40 example (`examples/realistic_barrier.toml`: 518 prototype nodes in 6.5 s,
+365 model nodes in 5.5 s, 1039 prototype nodes in 16 s; one core each); the estimate is meant
+to be right within a factor of about two, enough to stop a run that would take an hour.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from printgen.design.record import Design
+from printgen.errors import InputError
+from printgen.inputs.prototype import Prototype
+
+DEFAULT_LIMIT_S = 60.0  # about a minute of `make` on 2 cores (issue 16)
+LEVELS = 23  # load levels of the sweep, h / h_B = 0 to 1.1 by 0.05
+SWEEP_S_PER_NODE_LEVEL = 6.0e-4  # one core, at REFERENCE_NODES (1:40 example, see above)
+REFERENCE_NODES = 500  # node count at which SWEEP_S_PER_NODE_LEVEL was measured
+SWEEP_EXPONENT = 1.1  # time per level grows as nodes^1.1 (518 -> 1039 nodes: 6.5 -> 16 s)
+MESH_S_PER_SEGMENT = 2.5e-3  # meshes step: solid strands, STL and 3MF (1:40: ~1.8 s)
+FIXED_S = 3.0  # planning, slicer profiles, G-code, counter-example, report
+BASE_MEMORY_B = 150e6  # Python, numpy, scipy and the geometry libraries
+MEMORY_B_PER_NODE = 20e3  # sparse factor, path results kept per level (1998 nodes: +39 MB)
+COARSEN_MAX = 1000.0  # search bound for the mesh factor that fits
+
+
+@dataclass(frozen=True)
+class NetSize:
+    """One solver net: nodes, free unknowns (3 per node) and its share of the cost."""
+
+    name: str
+    nodes: int
+    unknowns: int
+    seconds: float
+    memory_b: float
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """The whole run: the nets, the meshes step, wall-clock time on `cores`, peak memory."""
+
+    nets: tuple[NetSize, ...]
+    mesh_segments: int
+    seconds: float
+    memory_b: float
+    cores: int
+
+    def summary(self) -> str:
+        nets = ", ".join(f"{n.name} {n.nodes:,} nodes / {n.unknowns:,} unknowns"
+                         for n in self.nets) or "no solver sweep"
+        return (f"{nets}; {self.mesh_segments:,} model strand segments; about "
+                f"{self.seconds:.0f} s and {self.memory_b / 1e9:.1f} GB on {self.cores} cores")
+
+    def to_record(self) -> dict:
+        return {"nets": {n.name: {"nodes": n.nodes, "unknowns": n.unknowns} for n in self.nets},
+                "mesh_segments": self.mesh_segments, "memory_bytes": round(self.memory_b),
+                "cores": self.cores}
+
+
+def diamond_nodes(width: float, height: float, mesh_x: float, mesh_y: float) -> int:
+    """Nodes of `printgen.parts.geometry.net.diamond_net` (any length unit)."""
+    nx, ny = max(round(2 * width / mesh_x), 1), max(round(2 * height / mesh_y), 1)
+    odd_corners = sum((i + j) % 2 for i in (0, nx) for j in (0, ny))  # kept as nodes too
+    return ((nx + 1) * (ny + 1) + 1) // 2 + odd_corners
+
+
+def prototype_nodes(p: Prototype, factor: float = 1.0) -> int:
+    """Nodes of the prototype scene with its meshes `factor` times coarser."""
+    ax, ay = p.net.mesh_x * factor, p.net.mesh_y * factor
+    if p.net.pattern == "square":
+        return (round(p.width / ax) + 1) * (round(p.height / ax) + 1)
+    return diamond_nodes(p.width, p.height, ax, ay)
+
+
+def model_nodes(d: Design, factor: float = 1.0) -> int:
+    n = d.net
+    return diamond_nodes(n.width_mm, n.height_mm, n.mesh_x_mm * factor, n.mesh_y_mm * factor)
+
+
+def sweep_seconds(nodes: int) -> float:
+    """One net over the load path on one core."""
+    scale = (nodes / REFERENCE_NODES) ** SWEEP_EXPONENT
+    return LEVELS * SWEEP_S_PER_NODE_LEVEL * REFERENCE_NODES * scale
+
+
+def estimate(p: Prototype, d: Design, *, cores: int, proto_factor: float = 1.0,
+             model_factor: float = 1.0) -> Estimate:
+    """The run's size; the factors coarsen the prototype's or the model's meshes."""
+    m_nodes = model_nodes(d, model_factor)
+    nets: tuple[NetSize, ...] = ()
+    if d.cables:  # the sweep runs only for barriers with border cables (verify_step)
+        nets = tuple(NetSize(name, n, 3 * n, sweep_seconds(n), MEMORY_B_PER_NODE * n)
+                     for name, n in (("prototype", prototype_nodes(p, proto_factor)),
+                                     ("model", m_nodes)))
+    times = sorted((n.seconds for n in nets), reverse=True)
+    sweep = sum(times) if cores < 2 else (times[0] if times else 0.0)
+    segments = 2 * m_nodes
+    seconds = FIXED_S + MESH_S_PER_SEGMENT * segments + sweep
+    memory = BASE_MEMORY_B + sum(n.memory_b for n in nets)
+    return Estimate(nets, segments, seconds, memory, cores)
+
+
+def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int) -> Estimate:
+    """Return the estimate; raise InputError with the estimate, the limit, the option that
+    raises it and the least coarsening of the meshes that fits, when it is over the limit."""
+    if not (math.isfinite(limit_s) and limit_s > 0):
+        raise InputError(f"--time-limit {limit_s:g} s must be a positive number of seconds")
+    est = estimate(p, d, cores=cores)
+    if est.seconds <= limit_s:
+        return est
+    fix = coarsest_fix(p, d, limit_s=limit_s, cores=cores)
+    raise InputError(f"this run is too big: {est.summary()}; the limit is {limit_s:g} s "
+                     f"(about a minute of make on 2 cores). Raise it with --time-limit "
+                     f"{math.ceil(est.seconds * 1.5 / 60) * 60:g}, or {fix}")
+
+
+def coarsest_fix(p: Prototype, d: Design, *, limit_s: float, cores: int) -> str:
+    """The smallest uniform coarsening of the meshes that fits `limit_s`, as advice."""
+    user_model = p.model.mesh_x_mm is not None
+    model_scales = not user_model  # the model mesh follows the prototype's unless [model] sets it
+
+    def fits(f: float) -> bool:
+        return estimate(p, d, cores=cores, proto_factor=f,
+                        model_factor=f if model_scales else 1.0).seconds <= limit_s
+
+    lo, hi = 1.0, COARSEN_MAX
+    if not fits(hi):
+        if user_model and estimate(p, d, cores=cores, proto_factor=hi,
+                                   model_factor=hi).seconds <= limit_s:
+            return "coarsen [model] mesh_x_mm / mesh_y_mm as well as the prototype's net"
+        return "no mesh coarsening alone fits; raise --time-limit"
+    for _ in range(40):  # bisection to 1e-12 of the range
+        mid = math.sqrt(lo * hi)
+        lo, hi = (lo, mid) if fits(mid) else (mid, hi)
+    return (f"coarsen the prototype's net to mesh_x_m = {p.net.mesh_x * hi:.3g}, mesh_y_m = "
+            f"{p.net.mesh_y * hi:.3g} or more (x{hi:.2f}), which fits")
