@@ -113,6 +113,43 @@ def gcode_step(ctx: MakeContext, stage: Path) -> None:
                       "read back vs STL", "retractions"], rows)
 
 
+def kit_step(ctx: MakeContext, stage: Path) -> None:
+    """How the kit goes together (labelled picture, checks after printing) and top views of
+    the direct toolpaths per pass (the net's corner and a cable's eyelet)."""
+    from printgen.parts.assembly import assemble
+    from printgen.parts.gcode import cable_toolpath, net_toolpath
+    from printgen.parts.geometry.solid import net_outline
+    from printgen.report.kit import kit_figures
+
+    d = ctx.design
+    if not d.cables:
+        return
+    printer = load_printer(d.printer)
+    a = assemble(d, printer)
+    net_tp = net_toolpath(d.net, printer, load_print_style(d.net.print_style),
+                          load_material(d.net.material), attachment=a.attachment)
+    c = min(d.cables, key=lambda c: c.length_mm)
+    cable_tp = cable_toolpath(c, printer, load_print_style(c.print_style),
+                              load_material(c.material))
+    figs = kit_figures(a, net_outline(d.net, a.attachment), net_tp, cable_tp, c.name)
+    ctx.report.heading("Assembly")
+    problems = a.problems()
+    ctx.report.verdict(not problems, "; ".join(problems) or
+                       "the kit closes: cables as long as the net's sides, every loop on its "
+                       "cable's line with the stated clearance")
+    for name, png, caption in figs:
+        (stage / name).write_bytes(png)
+        ctx.files.append(name)
+        if name == "preview-net.png":
+            ctx.report.heading("Toolpath previews")
+        ctx.report.figure(png, caption)
+        if name == "assembly.png":
+            ctx.report.paragraph("Check after printing:")
+            for k, line in enumerate(a.checklist(), 1):
+                ctx.report.paragraph(f"{k}. {line}")
+    ctx.record["assembly"] = a.to_record()
+
+
 def slicer_step(ctx: MakeContext, stage: Path) -> None:
     """PrusaSlicer .ini for every part and CuraEngine settings for the cables."""
     from printgen.parts.slicer.cura import cura_cfg_text
@@ -370,5 +407,5 @@ def provenance_section(rep: Report, meta: dict[str, Any]) -> None:
 
 def default_steps() -> list[tuple[str, Step]]:
     return [("meshes (STL, 3MF)", parts_step), ("slicer profiles", slicer_step),
-            ("direct G-code", gcode_step),
+            ("direct G-code", gcode_step), ("assembly and toolpath previews", kit_step),
             ("verification (prototype and model load sweeps)", verify_step)]
