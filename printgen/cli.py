@@ -23,6 +23,7 @@ COMMAND_MODULES = (
     "printgen.commands.select",
     "printgen.commands.profiles",
     "printgen.commands.make",
+    "printgen.commands.design",
     "printgen.commands.verify",
     "printgen.commands.check",
     "printgen.commands.bench",

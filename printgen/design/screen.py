@@ -1,0 +1,159 @@
+"""Stage 1 of `printgen design`: screen every candidate net by the analytic membrane law.
+
+For one `NetPoint`: the membrane law of its diamond geometry (`section.net_membrane_law`)
+against the target law over 1-40 % strain (RMS log error, as `select`), its small-strain error,
+and the constraints: safety factor >= `MIN_SAFETY_FACTOR` at the estimated overflow strand force,
+printable passes and flow (`selection.print_limits`), the panel fits the bed, clear mesh opening
+>= `MIN_OPENING_MM`. Also the similitude it breaks (Pi2: mesh / h_B for both diagonals; Pi3:
+equal-area strand diameter / h_B) and an estimate of its print time.
+
+`screen_batch` is a pure function of (context, points): a sweep task.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from printgen.design.record import Section
+from printgen.design.search_space import NetPoint, SearchContext
+from printgen.design.section import area_m2, equal_area_diameter, net_membrane_law
+from printgen.design.selection import (
+    DATASHEET_PENALTY,
+    MIN_SAFETY_FACTOR,
+    NET_STRAINS,
+    peak_strand_force,
+    print_limits,
+    target_net_law,
+)
+from printgen.inputs.laws import piecewise_linear
+from printgen.units import MM
+
+MIN_OPENING_MM = 2.0  # clear mesh opening: narrower holes fuse when printed and pass no water
+CONSTRAINTS = ("strength", "print", "bed", "opening")  # kinds a candidate can violate
+
+
+@dataclass(frozen=True)
+class Screened:
+    """A screened candidate: analytic law error, constraints, similitude break, print time.
+
+    Errors are relative (model / target - 1) except `error_rms_log`; `d_pi2` is the larger
+    relative deviation of the two mesh diagonals from the scaled prototype's, with its sign;
+    `violations` are (kind in CONSTRAINTS, message) pairs, empty when printable.
+    """
+
+    point: NetPoint
+    law_source: str
+    datasheet: bool
+    membrane_n_per_m: float  # small-strain membrane stiffness
+    target_n_per_m: float
+    error_small: float
+    error_rms_log: float
+    score: float
+    peak_force_n: float
+    safety_factor: float
+    speed_mm_per_s: float
+    opening_mm: float
+    d_pi2: float
+    d_pi3: float
+    print_time_s: float
+    violations: tuple[tuple[str, str], ...]
+
+    @property
+    def feasible(self) -> bool:
+        return not self.violations
+
+    def to_record(self) -> dict:
+        """JSON-ready record (stable keys)."""
+        p = self.point
+        return {
+            "index": p.index, "material": p.material, "beads_across": p.beads_across,
+            "layers": p.layers, "mesh_x_mm": p.mesh_x_mm, "mesh_y_mm": p.mesh_y_mm,
+            "half_cells": [p.half_cells_x, p.half_cells_y], "border_beads": p.border_beads,
+            "law_source": self.law_source, "datasheet": self.datasheet,
+            "membrane_n_per_m": self.membrane_n_per_m, "target_n_per_m": self.target_n_per_m,
+            "error_small_strain": self.error_small, "error_rms_log": self.error_rms_log,
+            "score": self.score, "peak_force_n": self.peak_force_n,
+            "safety_factor": self.safety_factor, "speed_mm_per_s": self.speed_mm_per_s,
+            "opening_mm": self.opening_mm, "d_pi2": self.d_pi2, "d_pi3": self.d_pi3,
+            "print_time_s": self.print_time_s, "feasible": self.feasible,
+            "violations": [{"constraint": k, "reason": r} for k, r in self.violations],
+        }
+
+
+def strand_section(ctx: SearchContext, point: NetPoint) -> Section:
+    """The candidate's strand: `beads_across` beads of the style x `layers` stacked layers."""
+    s = ctx.style
+    return Section(s.bead_width_mm, point.beads_across, tuple(s.layer_heights_mm(point.layers)))
+
+
+def clear_opening_mm(mesh_x_mm: float, mesh_y_mm: float, strand_width_mm: float) -> float:
+    """Clear distance between parallel strands of a diamond mesh (mm): the rhombus height
+    (area a_x a_y / 2 over its side) less one strand width."""
+    side = math.hypot(mesh_x_mm / 2, mesh_y_mm / 2)
+    return mesh_x_mm * mesh_y_mm / (2 * side) - strand_width_mm
+
+
+def print_time_s(ctx: SearchContext, point: NetPoint, sec: Section, speed: float) -> float:
+    """Extrusion time of the net (s): every diagonal strand piece (one per half-cell
+    rectangle) and the border frame, bead by bead and layer by layer, at the flow-limited
+    speed. Travel moves are not counted: this ranks candidates, it is not a slicer's estimate."""
+    px, py = point.mesh_x_mm / 2, point.mesh_y_mm / 2
+    diagonals = point.half_cells_x * point.half_cells_y * math.hypot(px, py)
+    border = 2 * (ctx.width_mm + ctx.height_mm)
+    per_layer = sec.beads_across * diagonals + point.border_beads * border
+    return len(sec.layer_heights_mm) * per_layer / speed
+
+
+def bed_violation(ctx: SearchContext, point: NetPoint, bead_mm: float) -> str | None:
+    """Why the panel (with its border frame) does not fit the bed, axis-aligned or turned."""
+    pr = ctx.printer
+    w = ctx.width_mm + point.border_beads * bead_mm
+    h = ctx.height_mm + point.border_beads * bead_mm
+    bx, by = pr.bed_x_mm - 2 * pr.bed_margin_mm, pr.bed_y_mm - 2 * pr.bed_margin_mm
+    if (w <= bx and h <= by) or (w <= by and h <= bx):
+        return None
+    return (f"net {w:.0f} x {h:.0f} mm does not fit the {bx:.0f} x {by:.0f} mm usable bed of "
+            f"{pr.key}; use a larger scale (lambda) or a larger printer")
+
+
+def screen_point(ctx: SearchContext, point: NetPoint) -> Screened:
+    """Analytic membrane law, constraints and similitude break of one candidate."""
+    t, m = ctx.targets, ctx.material(point.material)
+    sec = strand_section(ctx, point)
+    ax, ay = point.mesh_x_mm * MM, point.mesh_y_mm * MM
+    knees, slopes, source = net_membrane_law(m, sec, ay, ax)
+    t_knees, t_slopes = target_net_law(ctx.prototype, t)
+    ratio = (piecewise_linear(NET_STRAINS, knees, slopes)
+             / piecewise_linear(NET_STRAINS, t_knees, t_slopes))
+    rms = float(np.sqrt(np.mean(np.log(ratio) ** 2)))
+    datasheet = source != "measured panel law" and m.modulus()[1] == "datasheet"
+    where = f"net {m.name} strand {sec.width_mm:g}x{sec.thickness_mm:g} mm"
+    speed, print_reasons = print_limits(sec, m, ctx.printer, where)
+    violations = [("print", r) for r in print_reasons]
+    force = peak_strand_force(t, ax, ay)
+    sf = m.failure_stress()[0] * area_m2(sec) / force
+    if sf < MIN_SAFETY_FACTOR:
+        violations.append(("strength", (f"{where}: safety factor {sf:.2f} below "
+                                       f"{MIN_SAFETY_FACTOR} at {force:.3g} N (overflow)")))
+    bed = bed_violation(ctx, point, sec.bead_width_mm)
+    if bed:
+        violations.append(("bed", bed))
+    opening = clear_opening_mm(point.mesh_x_mm, point.mesh_y_mm, sec.width_mm)
+    if opening < MIN_OPENING_MM:
+        violations.append(("opening", (f"clear mesh opening {opening:.2f} mm below "
+                                      f"{MIN_OPENING_MM:g} mm; use a larger mesh or a thinner "
+                                      "strand")))
+    dx, dy = ax / t["mesh_x"] - 1, ay / t["mesh_y"] - 1
+    return Screened(point, source, datasheet, slopes[0], t_slopes[0],
+                    slopes[0] / t_slopes[0] - 1, rms, rms + DATASHEET_PENALTY * datasheet,
+                    force, sf, speed, opening, dx if abs(dx) >= abs(dy) else dy,
+                    equal_area_diameter(sec) / t["strand_d"] - 1,
+                    print_time_s(ctx, point, sec, speed), tuple(violations))
+
+
+def screen_batch(ctx: SearchContext, points: list[NetPoint]) -> list[Screened]:
+    """`screen_point` over a batch (a sweep task: pure, ordered like `points`)."""
+    return [screen_point(ctx, p) for p in points]

@@ -1,0 +1,214 @@
+"""Inverse design (`printgen design`): the printable net that deforms most like the prototype.
+
+Two stages over the space of `search_space` (material x strand section x diamond mesh x border):
+
+1. screen every candidate by the analytic membrane law (`screen`): error over 1-40 % strain,
+   constraints, similitude break, print time (cheap: thousands per second per core);
+2. with the `deformation` objective, verify the best few with the solver (`verifier`, the
+   pre-print verification over h / h_B = 0-1.1) and rank them by their deformation mismatch:
+   the best `verify_nets` distinct material x section nets (each at its best mesh), each with
+   every border width, and `select`'s pick for comparison.
+
+Both stages run on a `sweep.Runner` (Dask, or serial): each task is a pure function of a small
+frozen record, so the result does not depend on where it ran. The solver stage is passed in
+(`verifier`) because the check stage sits above the design stage (`printgen.run.design` wires
+it); with the `stiffness` objective the search stops after stage 1.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from printgen.design.pareto import pareto_mask
+from printgen.design.plan import make_design
+from printgen.design.record import Design, NetDesign
+from printgen.design.screen import Screened, screen_batch, strand_section
+from printgen.design.search_choice import binding_constraints, choice_reasons
+from printgen.design.search_space import (
+    NetPoint,
+    SearchContext,
+    SearchSpace,
+    default_space,
+    grid,
+    search_context,
+)
+from printgen.design.selection import select
+from printgen.design.similitude import scale_targets
+from printgen.design.sweep import Runner, batches
+from printgen.errors import InputError
+from printgen.inputs.materials import load_material
+from printgen.inputs.prototype import Prototype
+
+OBJECTIVES = ("deformation", "stiffness")
+VERIFY_NETS = 3  # distinct material x section nets verified by the solver (x border widths)
+SELECT_KEY = "select"  # key of select's pick among the verified designs
+
+
+@dataclass(frozen=True)
+class VerifyShared:
+    """What every solver task shares: the prototype and the load-level step (None: the
+    verification's own levels)."""
+
+    prototype: Prototype
+    level_step: float | None
+
+
+@dataclass(frozen=True)
+class VerifyTask:
+    """One solver task: a design to verify against the prototype."""
+
+    key: str
+    design: Design
+
+
+@dataclass(frozen=True)
+class VerifyScore:
+    """The solver's verdict on one design: RMS mismatch of the normalised deformations
+    (over load levels and metrics, relative to the prototype's peak) and per metric."""
+
+    key: str
+    mismatch: float
+    per_metric: dict[str, float]
+    max_rel: float
+    ok: bool
+    failed_levels: tuple[float, ...]
+
+
+Verifier = Callable[[VerifyShared, VerifyTask], VerifyScore]
+
+
+@dataclass(frozen=True)
+class SearchResult:
+    """Everything the design search found at one scale (indices refer to `screened`)."""
+
+    prototype: str
+    scale: float
+    objective: str
+    space: SearchSpace
+    screened: tuple[Screened, ...]
+    verified: dict[int, VerifyScore]
+    select_design: Design
+    select_screened: Screened  # select's pick, screened like the candidates (index -1)
+    select_score: VerifyScore | None
+    pareto: tuple[int, ...]
+    chosen: int | None
+    design: Design | None
+    reasons: tuple[str, ...]
+    binding: tuple[str, ...]
+    closest: int | None  # feasible candidate closest to the target at small strain
+
+    def objective_value(self, i: int) -> float:
+        """The ranked objective of candidate i: solver mismatch, or membrane-law error."""
+        if self.objective == "deformation":
+            return self.verified[i].mismatch
+        return self.screened[i].error_rms_log
+
+
+def candidate_design(ctx: SearchContext, point: NetPoint, base: Design) -> Design:
+    """`base` (select's design: printer, cables) with the candidate's net."""
+    sec = strand_section(ctx, point)
+    net = NetDesign(material=point.material, print_style=ctx.style.key,
+                    width_mm=round(ctx.width_mm, 6), height_mm=round(ctx.height_mm, 6),
+                    mesh_x_mm=point.mesh_x_mm, mesh_y_mm=point.mesh_y_mm, strand=sec,
+                    border_width_mm=round(point.border_beads * sec.bead_width_mm, 6))
+    return dataclasses.replace(base, net=net)
+
+
+def design_point(ctx: SearchContext, d: Design) -> NetPoint:
+    """The NetPoint (index -1) of a design's net, to screen it like the candidates."""
+    n = d.net
+    return NetPoint(-1, n.material, n.strand.beads_across, len(n.strand.layer_heights_mm),
+                    round(2 * n.width_mm / n.mesh_x_mm), round(2 * n.height_mm / n.mesh_y_mm),
+                    n.mesh_x_mm, n.mesh_y_mm, round(n.border_width_mm / n.strand.bead_width_mm))
+
+
+def stage_two(screened: list[Screened], nets: int) -> list[Screened]:
+    """The candidates the solver verifies: the best feasible net (lowest screening score) of
+    each of the `nets` best material x section pairs, with every border width."""
+    feasible = sorted((s for s in screened if s.feasible),
+                      key=lambda s: (round(s.score, 12), s.print_time_s, s.point.index))
+    pairs: dict[tuple, tuple] = {}
+    for s in feasible:
+        pair = (s.point.material, s.point.beads_across, s.point.layers)
+        if pair not in pairs and len(pairs) < nets:
+            pairs[pair] = s.point.net_key
+    keys = set(pairs.values())
+    return sorted((s for s in feasible if s.point.net_key in keys), key=lambda s: s.point.index)
+
+
+def pareto_indices(res_objective: str, screened: list[Screened],
+                   verified: dict[int, VerifyScore]) -> tuple[int, ...]:
+    """Candidates on the Pareto front of (objective, |dPi2|, |dPi3|, print time)."""
+    if res_objective == "deformation":
+        idx = sorted(verified)
+        first = [verified[i].mismatch for i in idx]
+    else:
+        idx = [s.point.index for s in screened if s.feasible]
+        first = [screened[i].error_rms_log for i in idx]
+    if not idx:
+        return ()
+    vals = np.column_stack([first, [abs(screened[i].d_pi2) for i in idx],
+                            [abs(screened[i].d_pi3) for i in idx],
+                            [screened[i].print_time_s for i in idx]])
+    return tuple(int(i) for i, k in zip(idx, pareto_mask(vals)) if k)
+
+
+def _choose(objective: str, screened: list[Screened], verified: dict[int, VerifyScore]
+            ) -> int | None:
+    """Measured laws before datasheet ones (a datasheet modulus can be 2x off), then the
+    lowest objective; ties to the lower index."""
+    if objective == "deformation":
+        pool = [(screened[i].datasheet, v.mismatch, i) for i, v in verified.items()]
+    else:
+        pool = [(s.datasheet, s.score, s.point.index) for s in screened if s.feasible]
+    return min(pool)[2] if pool else None
+
+
+def screen_all(runner: Runner, ctx: SearchContext, points: list[NetPoint]) -> list[Screened]:
+    """Stage 1 over every point, batched for the runner's workers, in point order."""
+    parts = runner.map(screen_batch, batches(points, runner.workers), shared=ctx,
+                       label=f"1:{ctx.targets.scale:g} screening {len(points)} nets")
+    return [s for part in parts for s in part]
+
+
+def search(p: Prototype, scale: float, runner: Runner, *, objective: str = "deformation",
+           space: SearchSpace | None = None, printer: str | None = None,
+           verifier: Verifier | None = None, verify_nets: int = VERIFY_NETS,
+           level_step: float | None = None) -> SearchResult:
+    """Run the search at 1:`scale` on `runner`. `verifier` is required for `deformation`."""
+    if objective not in OBJECTIVES:
+        raise InputError(f"objective {objective!r} is not one of {', '.join(OBJECTIVES)}")
+    if objective == "deformation" and verifier is None:
+        raise InputError("the deformation objective needs the solver stage (a verifier)")
+    if verify_nets < 1:
+        raise InputError(f"verify_nets = {verify_nets} must be >= 1")
+    t = scale_targets(p, scale)
+    space = space or default_space(p, t)
+    ctx = search_context(p, t, space, printer=printer)
+    base = make_design(p, t, select(p, t, printer=ctx.printer.key))
+    if base.net.material not in space.materials:  # to screen select's pick like the others
+        ctx = dataclasses.replace(ctx, materials=ctx.materials + (
+            load_material(base.net.material),))
+    screened = screen_all(runner, ctx, grid(ctx, space))
+    verified: dict[int, VerifyScore] = {}
+    select_score = None
+    if objective == "deformation":
+        picks = stage_two(screened, verify_nets)
+        tasks = [VerifyTask(str(s.point.index), candidate_design(ctx, s.point, base))
+                 for s in picks] + [VerifyTask(SELECT_KEY, base)]
+        scores = runner.map(verifier, tasks, shared=VerifyShared(p, level_step),
+                            label=f"1:{t.scale:g} verifying {len(tasks)} nets (solver)")
+        verified = {int(v.key): v for v in scores if v.key != SELECT_KEY}
+        select_score = next(v for v in scores if v.key == SELECT_KEY)
+    chosen = _choose(objective, screened, verified)
+    closest, binding = binding_constraints(screened, space)
+    res = SearchResult(p.name, t.scale, objective, space, tuple(screened), verified, base,
+                       screen_batch(ctx, [design_point(ctx, base)])[0], select_score, pareto_indices(objective, screened, verified), chosen,
+                       None if chosen is None else candidate_design(ctx, screened[chosen].point,
+                                                                     base),
+                       (), binding, closest)
+    return dataclasses.replace(res, reasons=tuple(choice_reasons(res)))

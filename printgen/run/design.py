@@ -1,0 +1,162 @@
+"""`printgen design`: the design search at one scale or a series of scales, with the solver
+stage wired in, and its output folder.
+
+The search (`printgen.design.search`) screens the candidates by the analytic membrane law and
+verifies the best few with the pre-print verification (`printgen.check.verify`); the solver
+task lives here because the check stage sits above the design stage. Output folder (written
+whole, `outputs.staged_dir`):
+
+- report.json: per scale the chosen net and the reasons, the Pareto set, the verified nets,
+  select's pick with its mismatch, the binding constraints; and the scale-series table;
+- candidates.json: every candidate of every scale (one row per line);
+- design.json (the chosen net at the main scale) and design-1-<lambda>.json per scale: what
+  `printgen make --design FILE` prints;
+- pareto-1-<lambda>.png: objective against |dPi2|, |dPi3| and print time.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from printgen.design.search import (
+    SearchResult,
+    VerifyScore,
+    VerifyShared,
+    VerifyTask,
+    search,
+)
+from printgen.design.search_record import candidates_json, result_record
+from printgen.design.search_space import SearchSpace, default_space
+from printgen.design.similitude import scale_targets
+from printgen.design.sweep import open_runner
+from printgen.inputs.prototype import Prototype, load_prototype
+from printgen.outputs import staged_dir
+from printgen.report.jsonout import dumps
+
+
+def verify_task(shared: VerifyShared, task: VerifyTask) -> VerifyScore:
+    """Solver stage of the search: the verification of one design, as a score. Pure: the
+    same task gives the same score in any process (the sweep worker runs it serially)."""
+    from printgen.check.verify import levels, verify
+
+    lv = None if shared.level_step is None else levels(step=shared.level_step)
+    with _serial():
+        v = verify(shared.prototype, task.design, lv=lv)
+    rms = math.sqrt(sum(m.rms_rel**2 for m in v.mismatches) / len(v.mismatches))
+    failed = sorted(set(v.prototype.failed) | set(v.model.failed))
+    return VerifyScore(task.key, rms, {m.metric: m.rms_rel for m in v.mismatches},
+                       max(m.max_rel for m in v.mismatches), v.ok, tuple(failed))
+
+
+@contextlib.contextmanager
+def _serial() -> Iterator[None]:
+    """No nested process pool inside a sweep worker: the sweep already fills the cores."""
+    old = os.environ.get("PRINTGEN_SERIAL")
+    os.environ["PRINTGEN_SERIAL"] = "1"
+    try:
+        yield
+    finally:
+        if old is None:
+            os.environ.pop("PRINTGEN_SERIAL", None)
+        else:
+            os.environ["PRINTGEN_SERIAL"] = old
+
+
+@dataclass(frozen=True)
+class SearchOptions:
+    """The search's knobs (None: the default of `default_space`)."""
+
+    objective: str = "deformation"
+    materials: tuple[str, ...] | None = None
+    mesh_x_mm: tuple[float, float] | None = None
+    mesh_y_mm: tuple[float, float] | None = None
+    mesh_tolerance: float | None = None
+    border_beads: tuple[int, ...] | None = None
+    printer: str | None = None
+    verify_nets: int = 3
+    level_step: float | None = None
+
+
+@dataclass
+class DesignRun:
+    """The searches of one call, where they ran and what was written."""
+
+    results: list[SearchResult]
+    where: str
+    record: dict = field(default_factory=dict)
+    files: list[str] = field(default_factory=list)
+
+
+def space_for(p: Prototype, scale: float, o: SearchOptions) -> SearchSpace:
+    kw = {k: v for k, v in (("materials", o.materials), ("mesh_x_mm", o.mesh_x_mm),
+                            ("mesh_y_mm", o.mesh_y_mm), ("tolerance", o.mesh_tolerance),
+                            ("border_beads", o.border_beads)) if v is not None}
+    return default_space(p, scale_targets(p, scale), **kw)
+
+
+def design_searches(prototype: str | Path | Prototype, scales: list[float], *,
+                    options: SearchOptions = SearchOptions(), scheduler: str | None = None,
+                    workers: int | None = None, serial: bool = False,
+                    progress: bool = False) -> DesignRun:
+    """Search at every scale on one Dask runner (a LocalCluster unless `scheduler`/`serial`)."""
+    p = prototype if isinstance(prototype, Prototype) else load_prototype(prototype)
+    results = []
+    with open_runner(scheduler=scheduler, workers=workers, serial=serial,
+                     progress=progress) as runner:
+        for s in scales:
+            results.append(search(p, s, runner, objective=options.objective,
+                                  space=space_for(p, s, options), printer=options.printer,
+                                  verifier=verify_task, verify_nets=options.verify_nets,
+                                  level_step=options.level_step))
+        where = runner.where
+    return DesignRun(results, where, design_record(p, results, options))
+
+
+def design_record(p: Prototype, results: list[SearchResult], o: SearchOptions) -> dict:
+    """The report.json of a call: every scale's record and the series table."""
+    return {"prototype": p.name, "objective": o.objective,
+            "level_step": o.level_step, "verify_nets": o.verify_nets,
+            "scales": {f"{r.scale:g}": result_record(r) for r in results},
+            "series": [series_row(r) for r in results]}
+
+
+def series_row(r: SearchResult) -> dict:
+    """One line of the scale-series table: the best net at this scale."""
+    if r.chosen is None:
+        return {"scale": r.scale, "chosen": None, "binding_constraints": list(r.binding)}
+    s = r.screened[r.chosen]
+    v = r.verified.get(r.chosen)
+    return {"scale": r.scale, "chosen": s.to_record(),
+            "mismatch_rms": None if v is None else v.mismatch,
+            "select_mismatch_rms": None if r.select_score is None else r.select_score.mismatch,
+            "error_small_strain": s.error_small, "d_pi2": s.d_pi2, "d_pi3": s.d_pi3,
+            "print_time_s": s.print_time_s, "binding_constraints": list(r.binding)}
+
+
+def write_outputs(run: DesignRun, out: str | Path, main_scale: float | None) -> list[str]:
+    """Write the folder (whole, atomically); returns the file names."""
+    from printgen.report.design_plots import pareto_figure
+
+    files: dict[str, str | bytes] = {"report.json": dumps(run.record),
+                                     "candidates.json": candidates_json(run.results)}
+    for r in run.results:
+        if r.design is not None:
+            text = dumps(r.design.to_dict())
+            files[f"design-1-{r.scale:g}.json"] = text
+            if main_scale is not None and r.scale == main_scale:
+                files["design.json"] = text
+        files[f"pareto-1-{r.scale:g}.png"] = pareto_figure(r)
+    with staged_dir(out) as stage:
+        for name, data in files.items():
+            path = stage / name
+            if isinstance(data, bytes):
+                path.write_bytes(data)
+            else:
+                path.write_text(data)
+    run.files = sorted(files)
+    return run.files
