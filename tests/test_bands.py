@@ -78,6 +78,10 @@ def test_variants_of_the_1_40_design_say_what_is_left_out():
     text = " ".join(notes)
     assert "TPE (net): no SD" in text and "PETG (cables): no SD" in text
     assert "tested net the profile assumes" in text
+    others = bands.mounting_options()[1:]  # every mounting but the nominal is a variant
+    assert [v.mounting for v in variants if v.mounting] == list(others)
+    variants, _ = model_variants(reference_design_1_40(), mounting=others[-1] if others else None)
+    assert all(v.mounting != (others[-1] if others else "") for v in variants)
 
 
 def test_modulus_sd_and_panel_geometry_variants(tmp_path, monkeypatch):

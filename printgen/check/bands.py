@@ -75,8 +75,9 @@ def mounting_options() -> tuple[str, ...]:
     return tuple(getattr(scenes, "MOUNTINGS", ()))
 
 
-def model_variants(d: Design) -> tuple[list[Variant], list[str]]:
-    """The variants of design `d` to sweep, and one note per uncertainty left out and why."""
+def model_variants(d: Design, mounting: str | None = None) -> tuple[list[Variant], list[str]]:
+    """The variants of design `d` to sweep, and one note per uncertainty left out and why;
+    `mounting` is the nominal run's (the other mountings become variants)."""
     out, notes = [], []
     net = load_material(d.net.material)
     panel = net.panel_law
@@ -98,8 +99,9 @@ def model_variants(d: Design) -> tuple[list[Variant], list[str]]:
     if panel is not None and panel.has_geometry:
         out += _panel_geometry_variant(d, notes)
     opts = mounting_options()
-    out += [Variant(f"mounting: {m}", mounting=m, source="flume mounting option")
-            for m in opts[1:]]
+    nominal = mounting or (opts[0] if opts else None)
+    out += [Variant(f"mounting: {m}", mounting=m, source="flume mounting option "
+                    f"(nominal: {nominal})") for m in opts if m != nominal]
     if not opts:
         notes.append("mounting: the model scene has one mounting only; no mounting variant")
     out.append(Variant(f"initial slack {SLACK_MAX:.0%}", slack=SLACK_MAX,
@@ -197,6 +199,7 @@ class Band:
     refinement: dict[int, float]
     seconds: float = 0.0
     failed: dict[str, list[float]] = field(default_factory=dict)
+    mounting: str | None = None  # the nominal run's mounting, kept by every variant
 
     def envelope(self, *, from_start: bool = False
                  ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
@@ -219,7 +222,8 @@ def _nan_reduce(stack: np.ndarray, fn) -> np.ndarray:
 
 
 def refinement_test(d: Design, nominal: dict[str, np.ndarray], lv: np.ndarray,
-                    load_kw: dict | None = None) -> tuple[int, dict[int, float]]:
+                    load_kw: dict | None = None, base: Variant | None = None
+                    ) -> tuple[int, dict[int, float]]:
     """Coarsest mesh multiplier whose nominal sweep stays within REFINE_TOL of `nominal` (the
     design's own net) on every metric, and each tried multiplier's largest change. The
     multipliers are tried from the finest: once one fails, coarser ones are not run."""
@@ -227,7 +231,8 @@ def refinement_test(d: Design, nominal: dict[str, np.ndarray], lv: np.ndarray,
     for k in COARSENINGS:
         if not _meshable(d, k):
             break
-        change[k] = _largest_change(curves(run_variant(d, Variant(), lv, k, load_kw)), nominal)
+        run = run_variant(d, base or Variant(), lv, k, load_kw)
+        change[k] = _largest_change(curves(run), nominal)
         if change[k] >= REFINE_TOL:
             break
         best = k
@@ -262,14 +267,17 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
     """
     t0 = time.perf_counter()
     lv = nominal.deformation.levels
+    mounting = getattr(nominal.scene, "mounting", None)
     if variants is None:
-        variants, auto_notes = model_variants(d)
+        variants, auto_notes = model_variants(d, mounting)
         notes = [*(notes or []), *auto_notes]
+    variants = [v if v.mounting else dataclasses.replace(v, mounting=mounting)
+                for v in variants]
     nom = curves(nominal)
-    k, change = refinement_test(d, nom, lv, load_kw)
+    k, change = refinement_test(d, nom, lv, load_kw, Variant(mounting=mounting))
     jobs = [(run_variant, (d, v, lv, k, load_kw), {}) for v in variants]
     if k > 1:
-        jobs.append((run_variant, (d, Variant(), lv, k, load_kw), {}))
+        jobs.append((run_variant, (d, Variant(mounting=mounting), lv, k, load_kw), {}))
     runs = run_jobs(jobs)
     base = curves(runs.pop()) if k > 1 else None
     out, failed = {}, {}
@@ -279,7 +287,7 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
         if r.failed:
             failed[v.label] = sorted(r.failed)
     return Band(lv, nom, out, {v.label: v.source for v in variants}, list(notes or []), k,
-                change, time.perf_counter() - t0, failed)
+                change, time.perf_counter() - t0, failed, mounting)
 
 
 SIGNIFICANT = 0.1  # levels where the prototype is below 10 % of its peak carry no verdict
@@ -321,7 +329,7 @@ def band_verdict(metric: str, proto: np.ndarray, lo: np.ndarray, hi: np.ndarray
     low, high = np.minimum(a, b), np.maximum(a, b)
     tol = INSIDE * peak
     stiffer, softer = high < pp - tol, low > pp + tol
-    gap_stiff = 1 - high[stiffer] / pp[stiffer]  # the model deforms this much less
+    gap_stiff = np.minimum(1 - high[stiffer] / pp[stiffer], 1.0)  # the model deforms less
     gap_soft = low[softer] / pp[softer] - 1  # the model deforms more
     n, inside = int(keep.sum()), int((~stiffer & ~softer).sum())
     if inside == n:

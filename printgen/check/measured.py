@@ -10,6 +10,7 @@ An empty cell is a reading that was not taken.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -262,11 +263,13 @@ def model_predictor(d: Design, band: Band, m: Measurement, kind: str = "stiffnes
     above = np.flatnonzero(band.levels >= top - 1e-9)
     n = int(above[0]) + 1 if above.size else len(band.levels)
     lv, k = band.levels[:n], band.coarsen
-    base = curves(run_variant(d, Variant(), lv, k, load_kw)) if k > 1 else None
+    nominal = Variant(mounting=band.mounting)
+    base = curves(run_variant(d, nominal, lv, k, load_kw)) if k > 1 else None
 
     def predict(value: float) -> dict[str, np.ndarray]:
-        v = (Variant("fit", net_factor=value, frame_factor=value) if kind == "stiffness"
-             else Variant("fit", slack=value))
+        v = dataclasses.replace(nominal, label="fit", **(
+            {"net_factor": value, "frame_factor": value} if kind == "stiffness"
+            else {"slack": value}))
         c = curves(run_variant(d, v, lv, k, load_kw))
         out = {}
         for key in m.values:
