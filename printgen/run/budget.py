@@ -22,8 +22,8 @@ LEVELS = 23  # load levels of the sweep, h / h_B = 0 to 1.1 by 0.05
 SWEEP_S_PER_NODE_LEVEL = 6.0e-4  # one core, at REFERENCE_NODES (1:40 example, see above)
 REFERENCE_NODES = 500  # node count at which SWEEP_S_PER_NODE_LEVEL was measured
 SWEEP_EXPONENT = 1.1  # time per level grows as nodes^1.1 (518 -> 1039 nodes: 6.5 -> 16 s)
-MESH_S_PER_SEGMENT = 2.5e-3  # meshes step: solid strands, STL and 3MF (1:40: ~1.8 s)
-FIXED_S = 3.0  # planning, slicer profiles, G-code, counter-example, report
+MESH_S_PER_SEGMENT = 4e-4  # meshes step per net segment (simple 1:40: 4962 in 1.4 s)
+FIXED_S = 5.0  # planning, cables, slicer profiles, G-code, counter-example, report
 BASE_MEMORY_B = 150e6  # Python, numpy, scipy and the geometry libraries
 MEMORY_B_PER_NODE = 20e3  # sparse factor, path results kept per level (1998 nodes: +39 MB)
 COARSEN_MAX = 1000.0  # search bound for the mesh factor that fits

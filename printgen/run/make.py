@@ -25,7 +25,7 @@ from printgen.design.similitude import ScaledTargets, scale_targets
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
 from printgen.inputs.prototype import Prototype, load_prototype
-from printgen.outputs import MANIFEST, file_digest, staged_dir
+from printgen.outputs import MANIFEST, check_destination, file_digest, staged_dir
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
 from printgen.report.report import design_record, design_sections
@@ -282,7 +282,7 @@ def verify_step(ctx: MakeContext, stage: Path) -> None:
     ctx.record["verification"]["bands"] = band_record(v, band)
 
 
-LONG_RUN_S = 15.0  # runs estimated longer than this show their estimate and progress
+LONG_RUN_S = 30.0  # runs estimated longer than this show their estimate and progress
 TIMINGS = "timings.json"  # the one volatile file: every wall-clock time of the run
 TIME_KEYS = ("timings_s", "seconds", "time_s")  # record keys that hold wall-clock times
 
@@ -298,6 +298,7 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     version, command line) and timings.json (the only file that differs between runs).
     """
     t0 = time.perf_counter()
+    check_destination(Path(out), force=bool((options or {}).get("force")))  # fail fast
     ctx = plan(prototype_path, scale, printer=printer, options=options)
     est = size_check(ctx, steps is None or any(s is verify_step for _, s in steps))
     if progress and est.seconds > LONG_RUN_S:
