@@ -33,8 +33,8 @@ def run() -> Verification:
     for key in ("strain_bottom", "strain_top", "deflection", "lowering"):
         assert np.all(np.diff(p.values[key][half]) > 0), key
         assert np.all(np.diff(m.values[key][half]) > 0), key
-    # the 1 N sensors deform the soft model before any water arrives (reference, section 4)
-    assert m.values["deflection"][0] > 0.02 and p.values["deflection"][0] == 0.0
+    # the 1 N sensor wires pull along themselves: no deflection before the water arrives
+    assert abs(m.values["deflection"][0]) < 0.01 and p.values["deflection"][0] == 0.0
     # prototype at overflow: a flexible barrier, mid-height deflection 10-30 % of its width
     assert 0.10 < p.values["deflection"][-1] < 0.30
     # the model's net is stiffer than the target (selection: +325 % at small strain)

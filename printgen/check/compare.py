@@ -8,15 +8,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from printgen.check.scenes import BarrierScene
+from printgen.check.scenes import BarrierScene, Wire
+from printgen.check.solvernet import path_length
 
 # Normalised quantities compared between prototype and model, with their labels.
 METRICS = {
     "deflection": "mid-height deflection / width",
     "lowering": "top-centre lowering / height",
-    "strain_bottom": "bottom cable elongation (strain)",
-    "strain_top": "top cable elongation (strain)",
-    "strain_mid": "elongation at mid-height (strain)",
+    "strain_bottom": "bottom cable elongation (sensor wire, strain)",
+    "strain_top": "top cable elongation (sensor wire, strain)",
+    "strain_mid": "elongation at mid-height (sensor wire, strain)",
 }
 TOLERANCE = 0.25  # max mismatch / prototype peak allowed: the paper's model matched to ~25 %
 UPPER_RANGE = 0.8  # relative loading above which a mismatch is reported as "at high loading"
@@ -39,6 +40,14 @@ def row_strain(x0: np.ndarray, x: np.ndarray) -> float:
     return length(x) / length(x0) - 1.0
 
 
+def wire_elongation(x0: np.ndarray, x: np.ndarray, wire: Wire) -> float:
+    """What a sensor reads, as a strain: the change of its wire's length (anchor, over the
+    row's nodes, to the potentiometer) over the row's rest length."""
+    rest = path_length(x0, wire.nodes, wire.exit)
+    row = rest - float(np.linalg.norm(wire.exit - x0[wire.nodes[-1]]))
+    return (path_length(x, wire.nodes, wire.exit) - rest) / row
+
+
 def deformation(scene: BarrierScene, levels: np.ndarray, positions: list[np.ndarray],
                 strand_tension: list[np.ndarray], cable_tension: list[np.ndarray]) -> Deformation:
     """Normalised deformation of `scene` for each solved state (positions (n, 3) m)."""
@@ -48,8 +57,7 @@ def deformation(scene: BarrierScene, levels: np.ndarray, positions: list[np.ndar
         vals["deflection"].append((x[scene.centre, 1] - x0[scene.centre, 1]) / scene.width)
         vals["lowering"].append(-(x[scene.top_centre, 2] - x0[scene.top_centre, 2]) / scene.height)
         for row in ("bottom", "top", "mid"):
-            r = scene.rows[row]
-            vals[f"strain_{row}"].append(row_strain(x0[r], x[r]))
+            vals[f"strain_{row}"].append(wire_elongation(x0, x, scene.wires[row]))
     return Deformation(np.asarray(levels, float), {k: np.array(v) for k, v in vals.items()},
                        np.array([t.max() if t.size else 0.0 for t in strand_tension]),
                        np.array([t.max() if t.size else 0.0 for t in cable_tension]))

@@ -1,16 +1,28 @@
-"""Solver scenes of the realistic barrier (barrier-physics.md, section 7, `realistic-1:40`):
-the prototype and the printed model as tension-only strand nets with sliding border cables.
+"""Solver scenes of the pre-print check (barrier-physics.md, section 7): the prototype and the
+printed model as tension-only strand nets, mounted as in the flume and measured by the
+three extension sensors of the loading test (Lambert et al. 2023, doi:10.1061/JHEND8.HYENG-13070).
 
 Plane of the net: x across the barrier, z up (from the flume bed), y the flow direction.
 Net strands are the diamond graph's diagonal segments; their force-strain law is the panel
-law turned into a strand law (`strand_law_from_membrane`). The border cables slide through
-the net's edge nodes between the four corner anchors. The model also carries the printed
-border frame (family-0 segments) and the three 1 N extension sensors (Lambert et al. 2023),
-pulling downstream at mid-span of the bottom and top cables and at the net's centre.
+law turned into a strand law (`strand_law_from_membrane`). With border cables, the cables
+slide through the net's edge nodes between the four corner anchors; the lateral edges are
+held by the flume's side sheets along their whole height (`walls`, the default) or only the
+lateral cables' eyelets are anchored (`eyelets`). Without border cables the net is anchored
+on the bed and the banks and its top is free.
+
+Sensor wires (`Wire`; as solver cables in `printgen.check.solvernet`): a string
+potentiometer's wire is anchored at the barrier's left edge node of its row, runs along the
+row of nodes (the nodes are the points the wire bends over, frictionless), leaves the right
+edge node and runs on, in line with the row at rest, to the potentiometer `SENSOR_EXIT` x width
+beyond the right edge. Its spring keeps it taut at `SENSOR_FORCE_N` whatever its length. The
+reading is the change of the wire's length from the anchor to the potentiometer; the
+elongation is that change over the row's rest length.
+On the model the wires pull (the flume test as it is run); on the prototype they only read.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -18,15 +30,33 @@ import numpy as np
 
 from printgen.design.record import Design
 from printgen.design.section import area_m2, diamond_factor, diamond_sin, net_membrane_law
+from printgen.errors import GeometryError
 from printgen.inputs.materials import load_material
-from printgen.inputs.prototype import Prototype
+from printgen.inputs.prototype import LATERAL, Prototype
 from printgen.parts.geometry.net import NetGraph, diamond_net
-from printgen.units import MM
+from printgen.units import MM, RHO_WATER, G
 
-SENSOR_FORCE_N = 1.0  # retraction force of each cable extension sensor (reference, section 4)
-FLOW = np.array([0.0, 1.0, 0.0])  # flow direction: the sensors pull and the water pushes along it
+SENSOR_FORCE_N = 1.0  # wire tension of each string potentiometer (reference, section 4)
+SENSOR_EXIT = 0.1  # the potentiometer stands this fraction of the width beyond the right edge
+FLOW = np.array([0.0, 1.0, 0.0])  # flow direction: the water pushes along it
+MOUNTINGS = LATERAL  # lateral mounting in the flume ([flume] lateral), the default first
+# Stiffness holding each free node where it is when its strands carry no load (N/m), as a
+# fraction of rho g A* (the rate at which a node's hydrostatic load grows per metre of head):
+# it scales like every stiffness (lambda^-2), so prototype and model get the same share.
+HOLD_FRACTION = 1e-3
 
 Law = tuple[tuple[float, ...], tuple[float, ...]]  # (strain knees, force slopes N per strain)
+Assumption = tuple[str, str, str]  # (what, value, source)
+
+
+@dataclass(frozen=True)
+class Wire:
+    """A sensor wire: `nodes` (k,) the row it follows, anchor first; `exit` (3,) m the fixed
+    point where it enters the potentiometer; `force` N its tension (0: it only reads)."""
+
+    nodes: np.ndarray
+    exit: np.ndarray
+    force: float
 
 
 @dataclass(frozen=True)
@@ -35,8 +65,10 @@ class BarrierScene:
 
     nodes : (n, 3) m; fixed : (n,) bool anchors; elements : (m, 2) int; element_law : (m,) int
     index into `laws`; cables : name -> (node sequence anchor..anchor, law);
-    rows : name -> node sequence whose elongation is reported (bottom, top, mid);
-    sensors : (node, force (3,) N) point loads; area_per_node : m^2 (A* = net area / nodes).
+    rows : name -> node sequence of the bottom, top and mid-height rows (left to right);
+    wires : the three sensor wires by row name; area_per_node : m^2 (A* = net area / nodes);
+    mounting : one of MOUNTINGS; hold : N/m holding each free node at rest (0: none);
+    assumptions : (what, value, source) of every modelling choice, for the report.
     """
 
     name: str
@@ -53,7 +85,10 @@ class BarrierScene:
     centre: int
     top_centre: int
     area_per_node: float
-    sensors: list[tuple[int, np.ndarray]] = field(default_factory=list)
+    wires: dict[str, Wire] = field(default_factory=dict)
+    mounting: str = MOUNTINGS[0]
+    hold: float = 0.0
+    assumptions: tuple[Assumption, ...] = ()
 
 
 def strand_law_from_membrane(knees: tuple[float, ...], slopes: tuple[float, ...],
@@ -83,17 +118,27 @@ def _net_arrays(g: NetGraph, to_m: float) -> tuple[np.ndarray, dict[str, np.ndar
     x, z = nodes[:, 0], nodes[:, 2]
     edges = {"bottom": edge(z < tol, x), "top": edge(z > h - tol, x),
              "left": edge(x < tol, z), "right": edge(x > w - tol, z)}
-    levels = np.unique(np.round(z / tol)) * tol
-    mid_z = levels[np.argmin(np.abs(levels - h / 2))]  # the node row nearest mid-height
-    mid_row = np.abs(z - mid_z) < 2 * tol
-    edges["mid"] = edge(mid_row, x)
+    edges["mid"] = edge(np.abs(z - _mid_level(x, z, w, h, tol)) < 2 * tol, x)
     centre = int(edges["mid"][np.argmin(np.abs(x[edges["mid"]] - w / 2))])
     top_centre = int(edges["top"][np.argmin(np.abs(x[edges["top"]] - w / 2))])
     return nodes, edges, centre, top_centre
 
 
+def _mid_level(x: np.ndarray, z: np.ndarray, w: float, h: float, tol: float) -> float:
+    """Height of the node row nearest mid-height that reaches both lateral edges (a sensor
+    wire is anchored at the edge), else of the row nearest mid-height."""
+    levels = np.unique(np.round(z / tol)) * tol
+    spans = [lv for lv in levels if np.any((np.abs(z - lv) < 2 * tol) & (x < tol))
+             and np.any((np.abs(z - lv) < 2 * tol) & (x > w - tol))]
+    pool = np.array(spans) if spans else levels
+    return float(pool[np.argmin(np.abs(pool - h / 2))])
+
+
 def _scene(name: str, scale: float, g: NetGraph, to_m: float, net_law: Law,
-           cable_law: Law | None, border_law: Law | None) -> BarrierScene:
+           cable_law: Law | None, border_law: Law | None, mounting: str) -> BarrierScene:
+    if mounting not in MOUNTINGS:
+        raise GeometryError(f"mounting {mounting!r} is not one of {', '.join(MOUNTINGS)}; "
+                            "set [flume] lateral in the prototype file")
     nodes, edges, centre, top_centre = _net_arrays(g, to_m)
     diag = g.family != 0
     elements, element_law, laws = g.segments[diag], np.zeros(int(diag.sum()), int), [net_law]
@@ -105,13 +150,23 @@ def _scene(name: str, scale: float, g: NetGraph, to_m: float, net_law: Law,
     cables = {}
     if cable_law is not None:  # four corner anchors, cables sliding along the edges
         fixed[[edges["bottom"][0], edges["bottom"][-1], edges["top"][0], edges["top"][-1]]] = True
+        if mounting == "walls":  # the side sheets hold the lateral edges along their height
+            fixed[np.concatenate([edges["left"], edges["right"]])] = True
         cables = {side: (edges[side], cable_law) for side in ("bottom", "top", "left", "right")}
+    elif mounting != "walls":
+        raise GeometryError(f"mounting {mounting!r} needs border cables (their eyelets are the "
+                            "anchors); a net without border cables is anchored on the bed and "
+                            "the banks: set [flume] lateral = \"walls\"")
     else:  # no border cables: anchored on the bed and the banks, top free (simple-free-top)
         fixed[np.concatenate([edges["bottom"], edges["left"], edges["right"]])] = True
     w, h = float(nodes[:, 0].max()), float(nodes[:, 2].max())
+    rows = {k: edges[k] for k in ("bottom", "top", "mid")}
+    wires = {k: Wire(r, nodes[r[-1]] + np.array([SENSOR_EXIT * w, 0.0, 0.0]), 0.0)
+             for k, r in rows.items()}
+    area = w * h / len(nodes)
+    hold = HOLD_FRACTION * RHO_WATER * G * area if cable_law is None else 0.0
     return BarrierScene(name, scale, w, h, nodes, fixed, elements, element_law, laws, cables,
-                        {k: edges[k] for k in ("bottom", "top", "mid")}, centre, top_centre,
-                        w * h / len(nodes))
+                        rows, centre, top_centre, area, wires, mounting, hold)
 
 
 def square_graph(width_mm: float, height_mm: float, mesh_mm: float) -> NetGraph:
@@ -127,8 +182,16 @@ def square_graph(width_mm: float, height_mm: float, mesh_mm: float) -> NetGraph:
                     (2.0 * mesh_mm, 2.0 * mesh_mm), (2 * nx, 2 * ny))
 
 
-def prototype_scene(p: Prototype) -> BarrierScene:
-    """The prototype: net with its panel law (or linear strands), sliding border cables."""
+def lateral_mounting(p: Prototype) -> str:
+    """The prototype file's `[flume] lateral` (the default when it has no [flume] table)."""
+    return p.flume.lateral if p.flume is not None else MOUNTINGS[0]
+
+
+def prototype_scene(p: Prototype, *, mounting: str | None = None) -> BarrierScene:
+    """The prototype: net with its panel law (or linear strands), sliding border cables,
+    mounted like the model (`mounting`, default the file's [flume] lateral); its sensor
+    wires only read (a field barrier carries no sensors)."""
+    mounting = mounting or lateral_mounting(p)
     if p.net.pattern == "square":
         g = square_graph(p.width / MM, p.height / MM, p.net.mesh_x / MM)
     else:
@@ -137,36 +200,89 @@ def prototype_scene(p: Prototype) -> BarrierScene:
         knees, kappas, length = p.net.panel_law
         net_law = strand_law_from_membrane(knees, tuple(k * length for k in kappas),
                                            p.net.mesh_y, p.net.mesh_x)
+        law_text = ("panel law " + ", ".join(f"{k / 1e3:g}" for k in kappas) + " kN/m/m"
+                    + (" (knees " + ", ".join(f"{k:.0%}" for k in knees) + ")" if knees else "")
+                    + " turned into a strand law")
     else:
-        ea = p.net.strand_modulus * math.pi / 4 * p.net.strand_diameter**2
-        net_law = ((), (ea,))
+        net_law = ((), (p.net.strand_modulus * math.pi / 4 * p.net.strand_diameter**2,))
+        law_text = (f"linear strands E = {p.net.strand_modulus / 1e9:g} GPa, "
+                    f"d = {p.net.strand_diameter / MM:g} mm")
     cable_law = None
     if p.border is not None:
         cable_law = ((), (p.border.modulus * math.pi / 4 * p.border.diameter**2,))
-    return _scene(f"{p.name}: prototype", 1.0, g, MM, net_law, cable_law, None)
+    s = _scene(f"{p.name}: prototype", 1.0, g, MM, net_law, cable_law, None, mounting)
+    src = f"prototype file {p.path.name}" if p.path else "prototype file"
+    rows = [("net", (f"{p.net.pattern} mesh {p.net.mesh_x / MM:g} x {p.net.mesh_y / MM:g} mm, "
+             f"{len(s.nodes)} nodes"), src), ("net strands", law_text, src)]
+    if p.border is not None:
+        rows.append(("border cables", (f"d = {p.border.diameter / MM:g} mm, E = "
+                     f"{p.border.modulus / 1e9:g} GPa, sliding, no pretension"), src))
+    return _finish(s, rows, sensors=False)
 
 
-def model_scene(d: Design) -> BarrierScene:
+def model_scene(d: Design, *, mounting: str = MOUNTINGS[0]) -> BarrierScene:
     """The printed model: diamond net with the material's (measured) law, printed border frame,
-    cables of the measured modulus, and the three 1 N sensors."""
+    cables of the measured modulus, mounted by `mounting`, and the three sensor wires pulling
+    SENSOR_FORCE_N along themselves."""
     n = d.net
     g = diamond_net(n.width_mm, n.height_mm, n.mesh_x_mm, n.mesh_y_mm)
     mat = load_material(n.material)
-    knees, slopes, _ = net_membrane_law(mat, n.strand, n.mesh_y_mm * MM, n.mesh_x_mm * MM)
+    knees, slopes, how = net_membrane_law(mat, n.strand, n.mesh_y_mm * MM, n.mesh_x_mm * MM)
     net_law = strand_law_from_membrane(knees, slopes, n.mesh_y_mm * MM, n.mesh_x_mm * MM)
-    border_ea = mat.modulus()[0] * n.border_width_mm * n.strand.thickness_mm * MM * MM
-    cable_law = None
+    e, e_src = mat.modulus()
+    border_ea = e * n.border_width_mm * n.strand.thickness_mm * MM * MM
+    cable_law, rows = None, []
     if d.cables:
         c = d.cables[0]
-        cable_law = ((), (load_material(c.material).modulus()[0] * area_m2(c.section),))
+        cm = load_material(c.material)
+        ce, ce_src = cm.modulus()
+        cable_law = ((), (ce * area_m2(c.section),))
+        rows.append(("border cables", (f"{cm.name}, E = {ce / 1e9:.3g} GPa ({ce_src}), "
+                     f"{c.section.width_mm:g} x {c.section.thickness_mm:g} mm, sliding"),
+                     f"profile materials/{c.material}"))
     s = _scene(f"printed model 1:{d.scale:g}", d.scale, g, MM, net_law, cable_law,
-               ((), (border_ea,)))
-    if not d.cables:  # the three sensors belong to the realistic barrier's flume setup
-        return s
-    sensors = [(_middle(s.rows["bottom"]), SENSOR_FORCE_N * FLOW),
-               (_middle(s.rows["top"]), SENSOR_FORCE_N * FLOW), (s.centre, SENSOR_FORCE_N * FLOW)]
-    return BarrierScene(**{**s.__dict__, "sensors": sensors})
+               ((), (border_ea,)), mounting)
+    rows = [("net", (f"diamond mesh {n.mesh_x_mm:g} x {n.mesh_y_mm:g} mm, {len(s.nodes)} "
+             "nodes, rigid junctions"), "design"),
+            ("net strands", (f"{mat.name}: {how}, strand {n.strand.width_mm:g} x "
+             f"{n.strand.thickness_mm:g} mm"), f"profile materials/{n.material}"),
+            ("printed border frame", (f"{n.border_width_mm:g} mm wide, E = {e / 1e9:.3g} GPa "
+             f"({e_src})"), f"design; profile materials/{n.material}"), *rows]
+    return _finish(s, rows, sensors=True)
 
 
-def _middle(row: np.ndarray) -> int:
-    return int(row[len(row) // 2])
+def _finish(s: BarrierScene, rows: list[Assumption], *, sensors: bool) -> BarrierScene:
+    """The scene with its sensor wires pulling (model) or only reading (prototype), and the
+    assumptions shared by every scene after the scene's own."""
+    force = SENSOR_FORCE_N if sensors else 0.0
+    wires = {k: dataclasses.replace(w, force=force) for k, w in s.wires.items()}
+    rows = [*rows, *_common_assumptions(s, sensors)]
+    return dataclasses.replace(s, wires=wires, assumptions=tuple(rows))
+
+
+def _common_assumptions(s: BarrierScene, sensors: bool) -> list[Assumption]:
+    ref = "barrier-physics.md"
+    out = []
+    if s.cables:
+        held = ("lateral edges held by the side sheets along their whole height"
+                if s.mounting == "walls" else "lateral cables held only at their eyelets")
+        out.append(("mounting", (f"{s.mounting}: {held}; top and bottom cables on the four "
+                     "corner anchors"), f"[flume] lateral (default walls: {ref} section 4)"))
+    else:
+        out.append(("mounting", "anchored on the bed and the banks, top free",
+                    f"scene simple-free-top ({ref} section 7)"))
+    wire = (f"{SENSOR_FORCE_N:g} N along each wire" if sensors
+            else "read only (no sensors on a field barrier)")
+    out += [("sensor wires", (f"bottom, top and mid-height rows, {wire}; anchored at the left "
+             f"edge node, over the row's nodes, to the potentiometer {SENSOR_EXIT:.0%} of the "
+             "width beyond the right edge; reading = change of wire length"), f"{ref} section 4"),
+            ("loading", ("hydrostatic rho g (h - z) A* at the current node height, h/h_B = 0 "
+             "to 1.1; the folded film adds no stiffness"), f"{ref} sections 3 and 4"),
+            ("initial state", "flat, no pretension, no slack; gravity on the net neglected",
+             f"{ref} section 4")]
+    if s.hold > 0:
+        out.append(("unloaded strands", (f"stay where they are: each free node held at rest by "
+                    f"{s.hold:.3g} N/m ({HOLD_FRACTION:g} x rho g A*), a regularisation of the "
+                    "dry, slack net above the water (a mechanism otherwise)"),
+                    "printgen (issue 10); its force share is reported"))
+    return out

@@ -7,24 +7,34 @@ Also the counter-example the report warns about: the simple barrier with steel a
 
 from __future__ import annotations
 
+import dataclasses
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 import solver
 from printgen.check.compare import Deformation, Mismatch, compare, deformation, explain, increments
-from printgen.check.scenes import FLOW, BarrierScene, model_scene, prototype_scene
+from printgen.check.scenes import (
+    FLOW,
+    BarrierScene,
+    lateral_mounting,
+    model_scene,
+    prototype_scene,
+)
+from printgen.check.solvernet import build, hold_share
 from printgen.design.record import Design
 from printgen.errors import SolverError
 from printgen.inputs.prototype import Prototype
 from printgen.units import RHO_WATER, G
 from printgen.workers import run_jobs  # the worker lifecycle lives on the ground floor
+from solver.loads import total_forces
 
 LEVEL_STEP = 0.05  # relative loading step of the sweep (issue: at most 0.05)
 OVERFLOW = 1.1  # last relative loading h / h_B
 PATH_CUTS = 2  # halvings tried before a load level is reported as not converged
 MAX_FAILED_FRACTION = 0.25  # more unconverged levels than this and the sweep is an error
+SHAPE_LEVELS = (0.5, 1.0, 1.1)  # relative loadings whose deformed shapes are kept
 SOLVER_TOL = 1e-7  # out-of-balance force / load: far below what a flume measures (~1e-2)
 
 
@@ -35,19 +45,18 @@ def levels(step: float = LEVEL_STEP, top: float = OVERFLOW) -> np.ndarray:
 
 
 def solver_net(s: BarrierScene, *, slack: float = 0.0) -> solver.Net:
-    """The scene as a solver net; `slack` is the relative initial slack of every strand and
-    cable (0.01 = rest lengths 1 % longer than the printed ones)."""
-    laws = [solver.piecewise(k, sl) for k, sl in s.laws]
-    cables = [solver.SlidingCable(nodes, solver.piecewise(*law))
-              for nodes, law in s.cables.values()]
-    return solver.Net(s.nodes, s.fixed, s.elements, laws, element_law=s.element_law,
-                      cables=cables, slack=slack)
+    """The scene as a solver net (`printgen.check.solvernet`): its sensor wires pulling as
+    cables at constant tension, its unloaded nodes held when the scene says so; `slack` is the
+    relative initial slack of every strand and cable (0.01 = rest lengths 1 % longer than the
+    printed ones)."""
+    return build(s, slack=slack)[0]
 
 
 def loads_function(s: BarrierScene, *, velocity: float | None = None,
                    strand_diameter: float = 0.0):
     """Loads at relative loading r: hydrostatic rho g (r h_B - z) A* on the free nodes at their
-    current height, drag 0.5 rho v^2 l d when a velocity is given, and the sensors' pulls."""
+    current height, and drag 0.5 rho v^2 l d when a velocity is given (the sensor wires are
+    part of the net: `solver_net`)."""
     free = np.flatnonzero(~s.fixed)
     strand_per_node = _strand_length(s) / len(s.nodes)
     row_gap = float(np.diff(np.unique(np.round(s.nodes[:, 2], 12))).min())  # node rows apart
@@ -58,9 +67,6 @@ def loads_function(s: BarrierScene, *, velocity: float | None = None,
         if velocity:
             out.append(solver.Drag(free, strand_per_node, strand_diameter, velocity,
                                    r * s.height, tuple(FLOW), rho=RHO_WATER, ramp=row_gap))
-        if s.sensors:
-            out.append(solver.PointLoads(np.array([n for n, _ in s.sensors]),
-                                         np.array([f for _, f in s.sensors])))
         return out
 
     return loads_at
@@ -73,27 +79,41 @@ def _strand_length(s: BarrierScene) -> float:
 
 @dataclass(frozen=True)
 class Run:
-    """One barrier's sweep: its deformation and solver statistics."""
+    """One barrier's sweep: its deformation and solver statistics; `shapes`: node positions
+    (n, 3) m at the SHAPE_LEVELS it reached; `hold_share`: the largest force of the hold of
+    unloaded nodes over the applied load (0 without a hold)."""
 
     scene: BarrierScene
     deformation: Deformation
     iterations: list[int]
     seconds: float
     failed: dict[float, str]  # load levels that did not converge -> the solver's reason
+    shapes: dict[float, np.ndarray] = field(default_factory=dict)
+    hold_share: float = 0.0
 
 
 def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw) -> Run:
     """Solve the load path; raise SolverError when a level cannot be reached."""
     t0 = time.perf_counter()
-    results = solver.solve_path(solver_net(s, slack=slack), loads_function(s, **load_kw), lv,
-                                tol=SOLVER_TOL, max_cuts=PATH_CUTS, skip_failed=True)
+    net, ex = build(s, slack=slack)
+    loads_at = loads_function(s, **load_kw)
+    results = solver.solve_path(net, loads_at, lv, tol=SOLVER_TOL, max_cuts=PATH_CUTS,
+                                skip_failed=True)
     failed = {float(r.level): r.reason for r in results if not r.converged}
     if len(failed) > MAX_FAILED_FRACTION * len(lv):
         raise SolverError(f"{s.name}: {len(failed)} of {len(lv)} load levels did not converge; "
                           f"first: {next(iter(failed.values()))}")
-    d = deformation(s, lv, [r.positions for r in results], [r.tensions for r in results],
-                    [r.cable_tensions for r in results])
-    return Run(s, d, [r.iterations for r in results], time.perf_counter() - t0, failed)
+    n, m, c = ex.n_nodes, ex.n_elements, ex.n_cables
+    d = deformation(s, lv, [r.positions[:n] for r in results],
+                    [r.tensions[:m] for r in results], [r.cable_tensions[:c] for r in results])
+    share = 0.0
+    for r in results:
+        applied = float(np.abs(total_forces(loads_at(float(r.level)), r.positions)[0]).sum())
+        share = max(share, hold_share(r.positions, r.tensions, ex, applied))
+    shapes = {float(r.level): r.positions[:n] for r in results
+              if r.converged and np.any(np.isclose(r.level, SHAPE_LEVELS))}
+    return Run(s, d, [r.iterations for r in results], time.perf_counter() - t0, failed, shapes,
+               share)
 
 
 @dataclass(frozen=True)
@@ -114,10 +134,12 @@ class Verification:
 
 
 def verify(p: Prototype, d: Design, *, drag: bool = False, lv: np.ndarray | None = None,
-           counterexample: bool = False) -> Verification:
-    """Sweep both barriers under the same relative loading and compare them."""
+           counterexample: bool = False, mounting: str | None = None) -> Verification:
+    """Sweep both barriers under the same relative loading and compare them; both are mounted
+    by `mounting` (default: the prototype file's [flume] lateral)."""
     lv = levels() if lv is None else np.asarray(lv, dtype=float)
-    ps, ms = prototype_scene(p), model_scene(d)
+    mounting = mounting or lateral_mounting(p)
+    ps, ms = prototype_scene(p, mounting=mounting), model_scene(d, mounting=mounting)
     kw_p, kw_m, case = {}, {}, "hydrostatic (z at the current node height)"
     if drag:
         kw_p = {"velocity": p.velocity, "strand_diameter": p.net.strand_diameter}
@@ -142,7 +164,7 @@ def _only(run: Run, keep: np.ndarray) -> Run:
     d = run.deformation
     dd = Deformation(d.levels[keep], {k: v[keep] for k, v in d.values.items()},
                      d.max_strand_tension[keep], d.max_cable_tension[keep])
-    return Run(run.scene, dd, run.iterations, run.seconds, run.failed)
+    return dataclasses.replace(run, deformation=dd)
 
 
 @dataclass(frozen=True)

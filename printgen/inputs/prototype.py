@@ -38,9 +38,12 @@ BORDER = [positive("diameter_mm", 1000.0), positive("modulus_gpa", 500.0),
           Field("pretension_n", float, lo=0.0, hi=1e9, required=False, default=0.0)]
 FLOW = [positive("velocity_m_per_s", 50.0), positive("depth_m", 100.0, required=False),
         positive("density_kg_per_m3", 3000.0, required=False, default=1000.0, si=False)]
+LATERAL = ("walls", "eyelets")  # lateral mounting of the barrier in the flume, default first
 FLUME = [positive("width_m", 10.0), positive("max_discharge_l_per_s", 1e5),
          positive("free_section_m", 10.0, required=False),
-         positive("froude_min", 10.0, si=False), positive("froude_max", 10.0, si=False)]
+         positive("froude_min", 10.0, si=False), positive("froude_max", 10.0, si=False),
+         Field("lateral", str, choices=LATERAL, required=False, default=LATERAL[0],
+               help="walls: side sheets hold the lateral edges; eyelets: only the cables' ends")]
 MODEL = [positive("mesh_x_mm", 1000.0, si=False), positive("mesh_y_mm", 1000.0, si=False),
          Field("printer", str, required=False), Field("net_print", str, required=False),
          Field("cable_print", str, required=False),
@@ -75,6 +78,7 @@ class FlumeSpec:
     free_section: float | None
     froude_min: float
     froude_max: float
+    lateral: str = LATERAL[0]  # walls: lateral edges held along their height; eyelets: ends only
 
 
 @dataclass(frozen=True)
@@ -125,6 +129,10 @@ def load_prototype(path: str | Path) -> Prototype:
     flume = top["flume"] and FlumeSpec(**read_table(top["flume"], FLUME, where=f"{where} [flume]"))
     model = read_table(top["model"], MODEL, where=f"{where} [model]") if top["model"] else {}
     depth = flow["depth"] if flow["depth"] is not None else bar["height"]
+    if flume and flume.lateral == "eyelets" and not border:
+        raise InputError(f"{where} [flume]: lateral = \"eyelets\" anchors the lateral border "
+                         "cables at their eyelets, but the barrier has no [border] cables; set "
+                         "lateral = \"walls\" (net anchored on the banks) or add a [border] table")
     if depth > DEPTH_OVER_HEIGHT_MAX * bar["height"]:
         raise InputError(f"{where} [flow]: depth_m = {depth:g} m is more than "
                          f"{DEPTH_OVER_HEIGHT_MAX:g} x the barrier height ({bar['height']:g} m): "
@@ -172,6 +180,7 @@ CROSS_CHECKS = (
     f"[flow] depth_m <= {DEPTH_OVER_HEIGHT_MAX:g} x barrier height_m (deeper flows drown it)",
     "[net.panel_law]: increasing knees, one kappa per segment (knees + 1), all > 0 and < 1e9",
     "[net]: strand_modulus_gpa or a [net.panel_law] is required",
+    "[flume] lateral = \"eyelets\" needs a [border] table (the eyelets are the cables' ends)",
 )
 
 
