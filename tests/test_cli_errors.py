@@ -14,7 +14,7 @@ import pytest
 from conftest import ROOT
 from proto_files import REALISTIC, SIMPLE, write_variant
 
-import printgen.run.api as api
+from printgen.run import api
 import printgen.run.make as make_mod
 from printgen.cli import main
 from printgen.inputs.prototype import ranges_markdown

@@ -3,13 +3,19 @@
 from __future__ import annotations
 
 import json
+import re
+import time
 
 import pytest
-from proto_files import REALISTIC
+from proto_files import REALISTIC, write_variant
 
 import printgen.run.make as make_mod
 from printgen.cli import main
 from printgen.errors import PrintgenError
+from printgen.outputs import check_folder
+from printgen.report.jsonout import dumps
+
+REFUSE_WITHIN_S = 15.0  # issue 16: a run too big to do is refused within 15 s
 
 
 @pytest.fixture(scope="module")
@@ -44,11 +50,67 @@ def test_report_json_schema(made):
         assert abs(part["readback_error"]) < READBACK
 
 
-def test_same_input_gives_byte_identical_json(made, tmp_path):
-    _, out = made
-    make_mod.make(REALISTIC, 40, tmp_path / "again")
-    for name in ("report.json", "design.json", "net.gcode", "net.prusa.ini"):
+def test_same_input_gives_byte_identical_files(made, tmp_path):
+    """Every file but the volatile timings.json, and `--json` but its "timings" key."""
+    ctx, out = made
+    again = make_mod.make(REALISTIC, 40, tmp_path / "again")
+    names = sorted(p.name for p in out.iterdir())
+    assert names == sorted(p.name for p in (tmp_path / "again").iterdir())
+    volatile = json.loads((out / "manifest.json").read_text())["volatile"]
+    assert volatile == ["timings.json"]
+    for name in set(names) - set(volatile):
         assert (tmp_path / "again" / name).read_bytes() == (out / name).read_bytes(), name
+    first, second = make_mod.json_output(ctx.record), make_mod.json_output(again.record)
+    assert first.pop("timings") != second.pop("timings")  # wall-clock times differ
+    assert dumps(first) == dumps(second)
+
+
+def times_outside_timings(obj, path=""):
+    """Paths of every time figure (a key in make_mod.TIME_KEYS) in `obj`."""
+    if isinstance(obj, dict):
+        return [p for k, v in obj.items()
+                for p in ([f"{path}/{k}"] if k in make_mod.TIME_KEYS else [])
+                + times_outside_timings(v, f"{path}/{k}")]
+    if isinstance(obj, list):
+        return [p for i, v in enumerate(obj) for p in times_outside_timings(v, f"{path}/{i}")]
+    return []
+
+
+def test_simple_after_realistic_leaves_only_the_simple_run(tmp_path):
+    from proto_files import SIMPLE
+
+    out = tmp_path / "out"
+    fast = [s for s in make_mod.default_steps() if s[1] is not make_mod.verify_step]
+    make_mod.make(REALISTIC, 40, out, steps=fast)
+    assert (out / "cable-left.gcode").exists()
+    ctx = make_mod.make(SIMPLE, 40, out, steps=fast)
+    assert sorted(p.name for p in out.iterdir()) == ctx.record["files"]
+    assert not any(p.name.startswith("cable") for p in out.iterdir())
+    assert check_folder(out) == [] and [p.name for p in tmp_path.iterdir()] == ["out"]
+
+
+def test_fine_mesh_is_refused_with_its_estimate(tmp_path, capsys):
+    """Issue 16: a 0.02 m prototype mesh (265 000 nodes) exits 2 quickly, before any work."""
+    fine = write_variant(tmp_path, {("net", "mesh_x_m"): 0.02, ("net", "mesh_y_m"): 0.02})
+    t0 = time.perf_counter()
+    code = main(["make", str(fine), "-s", "40", "--out", str(tmp_path / "o")])
+    seconds = time.perf_counter() - t0
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err
+    assert "prototype 264,861 nodes" in err and "the limit is 60 s" in err and "--time-limit" in err
+    assert re.search(r"coarsen the prototype's net to mesh_x_m = 0\.\d+", err)
+    assert seconds < REFUSE_WITHIN_S and not (tmp_path / "o").exists()
+
+
+def test_estimate_counts_the_nodes_the_solver_gets(made):
+    from printgen.check.scenes import model_scene, prototype_scene
+    from printgen.run.budget import model_nodes, prototype_nodes
+
+    ctx, _ = made
+    assert prototype_nodes(ctx.prototype) == len(prototype_scene(ctx.prototype).nodes)
+    assert model_nodes(ctx.design) == len(model_scene(ctx.design).nodes)
+    size = json.loads((made[1] / "report.json").read_text())["size"]
+    assert size["nets"]["prototype"]["unknowns"] == 3 * prototype_nodes(ctx.prototype)
 
 
 def test_failed_step_leaves_previous_outputs_intact(made, tmp_path, monkeypatch):
@@ -79,6 +141,8 @@ def test_cli_make_json_and_exit_codes(tmp_path, capsys):
                  "--drag"]) == 0
     rec = json.loads(capsys.readouterr().out)
     assert rec["targets"]["scale"] == 40
+    assert rec["timings"]["timings_s"]["total"] > 0
+    assert times_outside_timings({k: v for k, v in rec.items() if k != "timings"}) == []
     assert rec["verification"]["load_case"] == "hydrostatic + drag at the Froude-scaled velocity"
     assert main(["make", str(REALISTIC), "-s", "40", "--printer", "prusa-mk4",
                  "--out", str(tmp_path / "bad")]) == 2
