@@ -14,10 +14,10 @@ import pytest
 from conftest import ROOT
 from proto_files import REALISTIC, SIMPLE, write_variant
 
-from printgen.run import api
 import printgen.run.make as make_mod
 from printgen.cli import main
 from printgen.inputs.prototype import ranges_markdown
+from printgen.run import api
 from printgen.workers import Interrupted
 
 
