@@ -1,0 +1,125 @@
+"""Design search (printgen design): Pareto sets, the same JSON serially and on Dask, bad input.
+
+The grid is small and coarse (two materials, one bead, three layer counts, coarse meshes) and
+the solver stage runs at a coarse load step, so the whole file stays well under a minute.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from conftest import EXAMPLES
+
+from printgen.design.design_file import design_from_dict, load_design
+from printgen.design.pareto import dominates, pareto_mask
+from printgen.errors import InputError
+from printgen.report.jsonout import dumps
+from printgen.run.design import SearchOptions, design_searches
+
+REALISTIC = EXAMPLES / "realistic_barrier.toml"
+SCALE = 40.0
+COARSE_STEP = 0.275  # solver stage at h/h_B = 0, 0.275, ..., 1.1: enough to compare runs
+SMALL = SearchOptions(objective="deformation", materials=("tpe", "petg"),
+                      mesh_x_mm=(26.0, 30.0), mesh_y_mm=(12.5, 14.5), border_beads=(1, 2),
+                      verify_nets=1, level_step=COARSE_STEP)
+
+pytest.importorskip("distributed")
+
+
+@pytest.fixture(scope="module")
+def serial_run():
+    return design_searches(REALISTIC, [SCALE], options=SMALL, serial=True)
+
+
+def _objectives(rec: dict, rows: list[dict]) -> np.ndarray:
+    key = "mismatch_rms" if rec["objective"] == "deformation" else None
+    return np.array([[r["verification"]["mismatch_rms"] if key else r["error_rms_log"],
+                      abs(r["d_pi2"]), abs(r["d_pi3"]), r["print_time_s"]] for r in rows])
+
+
+def test_pareto_mask_analytic():
+    v = np.array([[1, 2], [2, 1], [2, 2], [1, 2], [0.5, 3]])
+    assert pareto_mask(v).tolist() == [True, True, False, True, True]  # equal rows both kept
+    assert dominates(np.array([1, 1]), np.array([1, 2]))
+    assert not dominates(np.array([1, 2]), np.array([1, 2]))
+    with pytest.raises(ValueError, match="finite"):
+        pareto_mask(np.array([[np.nan, 1.0]]))
+
+
+def test_pareto_set_has_no_dominated_member(serial_run):
+    rec = serial_run.record["scales"][f"{SCALE:g}"]
+    verified = rec["verified"]
+    assert verified and rec["pareto"]["members"]
+    members = {m[0] for m in rec["pareto"]["members"]}
+    vals = _objectives(rec, verified)
+    index = [r["index"] for r in verified]
+    for i, row in zip(index, vals, strict=True):
+        beaten = any(dominates(other, row) for other in vals)
+        assert (i in members) == (not beaten), f"candidate {i}: member {i in members}"
+
+
+def test_stiffness_objective_pareto_over_every_printable_candidate():
+    run = design_searches(REALISTIC, [SCALE], options=SearchOptions(
+        objective="stiffness", materials=("tpe", "tpu"), mesh_x_mm=(18.0, 22.0),
+        mesh_y_mm=(8.0, 10.0)), serial=True)
+    res = run.results[0]
+    assert not res.verified and res.select_score is None  # no solver with this objective
+    feasible = [s for s in res.screened if s.feasible]
+    vals = np.array([[s.error_rms_log, abs(s.d_pi2), abs(s.d_pi3), s.print_time_s]
+                     for s in feasible])
+    members = set(res.pareto)
+    for s, row in zip(feasible, vals, strict=True):
+        assert (s.point.index in members) == (not any(dominates(o, row) for o in vals))
+    assert res.chosen == min(feasible, key=lambda s: (s.datasheet, s.score)).point.index
+
+
+def test_same_json_serial_local_cluster_and_remote_scheduler(serial_run):
+    from distributed import LocalCluster
+
+    local = design_searches(REALISTIC, [SCALE], options=SMALL, workers=2)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster:
+        remote = design_searches(REALISTIC, [SCALE], options=SMALL,
+                                 scheduler=cluster.scheduler_address)
+    assert "local Dask cluster" in local.where and "scheduler" in remote.where
+    ref = dumps(serial_run.record)
+    assert dumps(local.record) == ref
+    assert dumps(remote.record) == ref
+    assert len(serial_run.results[0].verified) == 2  # one net x two border widths
+
+
+def test_report_names_choice_select_pick_and_design_round_trips(serial_run, tmp_path):
+    from printgen.run.design import write_outputs
+
+    rec = serial_run.record["scales"][f"{SCALE:g}"]
+    assert rec["chosen"]["feasible"] and rec["chosen"]["safety_factor"] >= 1.5
+    assert rec["select_pick"]["verification"]["mismatch_rms"] > 0
+    assert isinstance(rec["mismatch_lower_than_select"], bool)
+    assert rec["reasons"][0].startswith("chosen:")
+    files = write_outputs(serial_run, tmp_path / "out", SCALE)
+    assert {"report.json", "candidates.json", "design.json", "pareto-1-40.png"} <= set(files)
+    d = load_design(tmp_path / "out" / "design.json")
+    assert d == serial_run.results[0].design
+    table = json.loads((tmp_path / "out" / "candidates.json").read_text())
+    assert len(table["40"]["rows"]) == rec["counts"]["screened"]
+
+
+def test_bad_input_is_named():
+    with pytest.raises(InputError, match="mesh x bounds"):
+        design_searches(REALISTIC, [SCALE], options=SearchOptions(mesh_x_mm=(20.0, 10.0)),
+                        serial=True)
+    with pytest.raises(InputError, match="objective"):
+        design_searches(REALISTIC, [SCALE], options=SearchOptions(objective="speed"),
+                        serial=True)
+    with pytest.raises(InputError, match="unknown keys"):
+        design_from_dict({"scale": 40, "printer": "generic-350", "net": {}, "cables": [],
+                          "colour": "red"})
+
+
+def test_cli_exit_2_without_scale(capsys):
+    from printgen.cli import main
+
+    assert main(["design", str(REALISTIC), "--serial"]) == 2
+    assert "--scale" in capsys.readouterr().err
