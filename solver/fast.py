@@ -19,7 +19,6 @@ The answer is the same (R = 0 to the same tolerance): only the path to it differ
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from solver.linsolve import Factorization, ldl_available
 from solver.newton import (
@@ -57,12 +56,15 @@ class Stepper:
         self.factorizations += 1
         return fact
 
-    def newton(self, st: State, boost: float = 1.0) -> Factorization:
-        """Factorization of J + mu D at `st`, mu = MU_FACTOR |R| x boost (floored)."""
+    def matrix(self, st: State, boost: float = 1.0) -> np.ndarray:
+        """CSR data of J + mu D at `st`, mu = MU_FACTOR |R| x boost (floored)."""
         data = tangent_values(self.ns, st)
         diag = float(np.abs(data[self.ns.pattern.diagonal]).max()) if data.size else 0.0
         mu = max(MU_FACTOR * float(np.linalg.norm(st.r)), MU_MIN * max(diag, 1e-300))
-        return self.factor(data + boost * mu * self.ns.damping)
+        return data + boost * mu * self.ns.damping
+
+    def newton(self, st: State, boost: float = 1.0) -> Factorization:
+        return self.factor(self.matrix(st, boost))
 
 
 def iterate(ns: NetSystem, st: State, tol: float, max_iter: int, stepper: Stepper):
@@ -156,13 +158,29 @@ def membrane_start(ns: NetSystem, st: State, stepper: Stepper) -> State:
     grid = np.linspace(*START_SPAN, START_GRID)
     values = [pot(x) for x in grid]
     k = int(np.argmin(values))
-    lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
-    best = minimize_scalar(pot, bounds=(lo, hi), method="bounded",
-                           options={"xatol": START_XTOL})
-    log_s = float(best.x) if best.fun < values[k] else float(grid[k])
-    if min(best.fun, values[k]) >= st.potential(st.f):
+    log_s, best = golden(pot, grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)], START_XTOL)
+    if best > values[k]:
+        log_s, best = float(grid[k]), values[k]
+    if best >= st.potential(st.f):
         return st
     return evaluate(ns, _moved(ns, st.u, 10.0**log_s * v))
+
+
+def golden(fn, lo: float, hi: float, xtol: float) -> tuple[float, float]:
+    """(x, fn(x)) at the minimum of a unimodal fn on [lo, hi], to xtol (golden section)."""
+    ratio = (np.sqrt(5.0) - 1.0) / 2.0
+    a, b = lo + (1 - ratio) * (hi - lo), lo + ratio * (hi - lo)
+    fa, fb = fn(a), fn(b)
+    while hi - lo > xtol:
+        if fa <= fb:
+            hi, b, fb = b, a, fa
+            a = lo + (1 - ratio) * (hi - lo)
+            fa = fn(a)
+        else:
+            lo, a, fa = a, b, fb
+            b = lo + ratio * (hi - lo)
+            fb = fn(b)
+    return (a, fa) if fa <= fb else (b, fb)
 
 
 def best_start(ns: NetSystem, candidates: list[np.ndarray]) -> State:

@@ -73,7 +73,7 @@ class State:
     energy: float  # strain energy
     f: np.ndarray  # external forces (n, 3)
     dz: np.ndarray  # their z-derivative (n, 3)
-    bar: tuple  # (force, tangent, d, l) of the strands
+    bar: tuple  # (strain, force, tangent, d, l) of the strands
     cab: list  # (tension, tangent, unit vectors, lengths, grad) of each cable
 
     def potential(self, f_frozen: np.ndarray) -> float:
@@ -126,7 +126,7 @@ def evaluate(ns: NetSystem, u: np.ndarray) -> State:
     r = (g - f).ravel()[ns.free]
     scales.append(float(np.abs(f).max()) if f.size else 0.0)
     return State(u, r, float(np.abs(r).max()) if r.size else 0.0, max(max(scales), 1e-300),
-                 energy, f, dz, (force, tangent, d, l), cabs)
+                 energy, f, dz, (eps, force, tangent, d, l), cabs)
 
 
 def potential(ns: NetSystem, u: np.ndarray, f_frozen: np.ndarray) -> float:
@@ -139,7 +139,7 @@ def potential(ns: NetSystem, u: np.ndarray, f_frozen: np.ndarray) -> float:
 
 def tangent_values(ns: NetSystem, st: State) -> np.ndarray:
     """CSR data of the tangent K - dF_ext/du at a state (the pattern's slot order)."""
-    force, tangent, d, l = st.bar
+    _, force, tangent, d, l = st.bar
     n = d / l[:, None]
     nn = np.einsum("ki,kj->kij", n, n)
     geo = np.where(force > 0, force / l, 0.0)[:, None, None]
