@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Set up printgen on a fresh Debian 12 machine: system slicers (when root), a venv in .venv,
+# Set up printgen on a fresh Debian 12 machine: system slicers and chromium (when root), a venv
+# in .venv,
 # and printgen with its extras. Safe to run again: it skips what is already there.
 # Usage: bash scripts/setup.sh [--with-slicers]
 set -euo pipefail
@@ -9,6 +10,7 @@ if [[ "${1:-}" == "--with-slicers" ]]; then
   need=()
   command -v prusa-slicer >/dev/null || need+=(prusa-slicer)
   command -v CuraEngine >/dev/null || need+=(cura-engine)
+  command -v chromium >/dev/null || need+=(chromium)  # tests/test_browser.py opens the report
   if ((${#need[@]})); then
     if [[ $(id -u) -ne 0 ]]; then
       echo "setup: ${need[*]} missing; run as root or: sudo apt-get install ${need[*]}" >&2
