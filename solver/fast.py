@@ -68,22 +68,28 @@ class Stepper:
 
 
 def iterate(ns: NetSystem, st: State, tol: float, max_iter: int, stepper: Stepper):
-    """(state, iterations, converged, reason) from state `st` (chord steps count too)."""
+    """(state, iterations, converged, reason) from state `st` (chord steps count too).
+
+    At the round-off level (max |R| <= ROUND_OFF but above tol x the force scale) one more
+    Newton step is still taken while it lowers max |R|: the answer then does not depend on
+    how close to round-off the path happened to land."""
     it, chord = 0, None
     while True:
-        if st.r_norm <= tol * st.f_norm or st.r_norm <= ROUND_OFF:
+        if st.r_norm <= tol * st.f_norm:
             return st, it, True, "converged"
         if it >= max_iter:
             return st, it, False, (f"no convergence in {max_iter} iterations: max out-of-balance "
                                    f"{st.r_norm * ns.S:.3g} N, {st.r_norm / st.f_norm:.2g} of "
                                    "the load")
         it += 1
-        if chord is not None:
+        if chord is not None and st.r_norm > ROUND_OFF:
             trial = _chord_step(ns, st, chord)
             if trial is not None:
                 st = trial
                 continue
         fact, found = _newton_step(ns, st, stepper)
+        if st.r_norm <= ROUND_OFF and (found is None or found[0].r_norm >= st.r_norm):
+            return st, it, True, "converged (round-off)"
         if found is None:
             return st, it, False, (f"line search failed: no step lowers the energy or the "
                                    f"out-of-balance force ({st.r_norm * ns.S:.3g} N, "
