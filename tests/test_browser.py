@@ -62,7 +62,15 @@ def report(tmp_path_factory):
 def chromium(exe: str, tmp_path, *args: str) -> subprocess.CompletedProcess:
     profile = tmp_path / "chromium-profile"
     return subprocess.run([exe, *FLAGS, f"--user-data-dir={profile}", "--enable-logging=stderr",
-                           "--v=0", *args], capture_output=True, text=True, timeout=CHROMIUM_S)
+                           "--v=0", *args], check=False, capture_output=True, text=True,
+                          timeout=CHROMIUM_S)
+
+
+def probe_of(run: subprocess.CompletedProcess) -> dict:
+    """The probe's JSON from a --dump-dom run."""
+    m = re.search(r'<pre id="printgen-probe">(.*?)</pre>', run.stdout, re.DOTALL)
+    assert m, f"the page did not finish loading: {run.stderr[-2000:]}"
+    return json.loads(m.group(1).replace("&quot;", '"').replace("&amp;", "&"))
 
 
 def test_report_renders_with_every_image_and_no_errors(report, tmp_path):
@@ -71,9 +79,7 @@ def test_report_renders_with_every_image_and_no_errors(report, tmp_path):
     probed = tmp_path / "probed.html"
     probed.write_text(html.replace("<head>", "<head>" + PROBE, 1))
     run = chromium(exe, tmp_path, "--dump-dom", probed.as_uri())
-    m = re.search(r'<pre id="printgen-probe">(.*?)</pre>', run.stdout, re.S)
-    assert m, f"the page did not finish loading: {run.stderr[-2000:]}"
-    probe = json.loads(m.group(1).replace("&quot;", '"').replace("&amp;", "&"))
+    probe = probe_of(run)
     assert probe["images"] == html.count("<img") >= 1
     assert probe["broken"] == [] and probe["errors"] == []
     assert probe["h1"].startswith("printgen: ") and probe["height"] > 1000
@@ -101,8 +107,7 @@ def test_the_probe_sees_a_broken_image_and_an_error(tmp_path):
                     '<img alt="gone" src="missing.png"><script>undefinedCall();</script>'
                     "</body></html>")
     run = chromium(exe, tmp_path, "--dump-dom", page.as_uri())
-    m = re.search(r'<pre id="printgen-probe">(.*?)</pre>', run.stdout, re.S)
-    probe = json.loads(m.group(1).replace("&quot;", '"').replace("&amp;", "&"))
+    probe = probe_of(run)
     assert probe["broken"] == ["gone"]
     assert any("missing.png" in e for e in probe["errors"])
     assert any("undefinedCall" in e for e in probe["errors"])
