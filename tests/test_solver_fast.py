@@ -1,0 +1,107 @@
+"""The fast path (fixed pattern, LDL^T + GMRES, membrane start, chord steps, path predictor)
+against the reference path (COO assembly, SuperLU every step): the same equilibrium."""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+import pytest
+
+from solver import Hydrostatic, Net, SlidingCable, linear, solve, solve_path
+from solver.driver import FastSolver
+from solver.linsolve import Factorization, ldl_available
+from solver.scenes import simple_scene, square_net
+from solver.state import NetSystem, evaluate, tangent_values
+
+AGREE = 1e-9  # issue 11: fast and reference displacements agree to 1e-9 of the largest one
+TIGHT = 1e-12  # solver tolerance of both paths here: far below AGREE
+LINEAR = 1e-10  # relative residual |b - A x| / |b| of a checked linear solve
+
+
+def _agree(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.abs(a - b).max() / np.abs(b).max())
+
+
+def _sliding_net() -> tuple[Net, list]:
+    """A 2 x 1 m square net (0.1 m mesh) on anchors at the bed and the sides, its top edge
+    threaded on a sliding cable between the two top corners, loaded hydrostatically with the
+    water at 90 % of the height (z at the current node height)."""
+    nodes, el, idx = square_net(2.0, 1.0, 0.1)
+    x, z = nodes[:, 0], nodes[:, 2]
+    fixed = (x < 1e-9) | (x > 2 - 1e-9) | (z < 1e-9)
+    top = idx[:, -1]
+    cable = SlidingCable(top, linear(4e5))
+    net = Net(nodes, fixed, el, [linear(1e5)], cables=[cable])
+    free = np.flatnonzero(~fixed)
+    return net, [Hydrostatic(free, 0.01, 0.9)]
+
+
+@pytest.mark.parametrize("current_z", [False, True])
+def test_fast_and_reference_agree_on_simple_pinned(current_z):
+    sc = simple_scene(current_z=current_z)
+    fast = solve(sc.net, sc.loads_at(1.0), tol=TIGHT)
+    ref = solve(sc.net, sc.loads_at(1.0), tol=TIGHT, method="reference")
+    assert fast.converged and ref.converged
+    assert _agree(fast.displacements, ref.displacements) < AGREE
+    assert _agree(fast.tensions, ref.tensions) < AGREE
+    assert fast.factorizations >= 1
+
+
+def test_fast_and_reference_agree_on_a_sliding_cable_net():
+    net, loads = _sliding_net()
+    fast = solve(net, loads, tol=TIGHT)
+    ref = solve(net, loads, tol=TIGHT, method="reference")
+    assert fast.converged and ref.converged
+    assert fast.cable_tensions[0] > 0  # the cable carries load: the case is exercised
+    assert _agree(fast.displacements, ref.displacements) < AGREE
+    assert fast.cable_tensions[0] == pytest.approx(ref.cable_tensions[0], rel=AGREE)
+
+
+def test_paths_agree_level_by_level():
+    """Hydrostatic at the current node height, no drag (its sharp switch at a node's height
+    makes the tightest tolerances a matter of luck for either path)."""
+    sc = simple_scene(current_z=True, drag=False)
+    levels = [0.25, 0.5, 0.75, 1.0]
+    fast = solve_path(sc.net, sc.loads_at, levels, tol=TIGHT)
+    ref = solve_path(sc.net, sc.loads_at, levels, tol=TIGHT, method="reference")
+    assert all(r.converged for r in fast + ref)
+    for f, r in zip(fast, ref):
+        assert _agree(f.displacements, r.displacements) < AGREE
+
+
+def test_without_the_optional_ldl_the_superlu_fallback_gives_the_same_answer(monkeypatch):
+    """`qdldl` not importable (the `fast` extra absent): every solve goes through SuperLU."""
+    net, loads = _sliding_net()
+    with_ldl = solve(net, loads, tol=TIGHT)
+    monkeypatch.setitem(sys.modules, "qdldl", None)  # import qdldl now raises ImportError
+    assert not ldl_available()
+    fs = FastSolver(net)
+    assert fs.stepper.backend == "lu"
+    plain = fs.solve(loads, [], TIGHT, 400)
+    assert plain.converged
+    assert _agree(plain.displacements, with_ldl.displacements) < AGREE
+
+
+@pytest.mark.parametrize("backend", ["ldl", "lu"])
+def test_linear_solves_include_the_follower_term(backend):
+    """With the hydrostatic load at the current node height the tangent is not symmetric:
+    the LDL^T of its symmetric part + GMRES must still solve the true system."""
+    if backend == "ldl" and not ldl_available():
+        pytest.skip("qdldl not installed")
+    sc = simple_scene(current_z=True)
+    ns = NetSystem(sc.net)
+    ns.loads = sc.loads_at(1.0)
+    u = solve(sc.net, sc.loads_at(1.0), tol=1e-4).displacements / ns.L
+    data = tangent_values(ns, evaluate(ns, u))
+    A = ns.pattern.csr(data)
+    assert abs(A - A.T).max() > 0  # the follower term is there
+    b = np.random.default_rng(1).normal(size=ns.pattern.size)
+    x = Factorization(ns.pattern, data, backend).solve(b)
+    assert np.linalg.norm(A @ x - b) <= LINEAR * np.linalg.norm(b)
+
+
+def test_unknown_method_is_rejected():
+    sc = simple_scene()
+    with pytest.raises(ValueError, match="method"):
+        solve(sc.net, sc.loads_at(1.0), method="fastest")
