@@ -1,4 +1,4 @@
-"""`printgen bench solver|gcode|parts --out DIR`: run a benchmark of benchmarks/ (a source
+"""`printgen bench solver|gcode|parts|design|make --out DIR`: run a benchmark of benchmarks/ (a source
 checkout) and write its JSON/PNG into DIR."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from pathlib import Path
 from printgen.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[2]
-BENCHES = ("solver", "gcode", "parts")
+BENCHES = ("solver", "gcode", "parts", "design", "make")
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from printgen.commands.common import add_json_arg, console, emit_json, table
 from printgen.design.search import OBJECTIVES, VERIFY_NETS
-from printgen.design.search_choice import describe
+from printgen.design.search_choice import short
 from printgen.errors import InputError
 from printgen.run.design import DesignRun, SearchOptions, design_searches, write_outputs
 
@@ -117,13 +117,13 @@ def show(result: DesignRun, out: Path, files: list[str]) -> None:
         rows = []
         for i in r.pareto[:SHOW]:
             s = sc[i]
-            rows.append([str(i), ("* " if i == r.chosen else "") + describe(s),
+            rows.append([str(i), ("* " if i == r.chosen else "") + short(s),
                          f"{r.objective_value(i):.3f}", f"{s.error_small:+.0%}",
                          f"{s.d_pi2:+.0%}", f"{s.d_pi3:+.0%}", f"{s.print_time_s / 60:.0f}",
                          f"{s.safety_factor:.2f}"])
         obj = "mismatch" if r.objective == "deformation" else "law error"
         c.print(table(f"1:{r.scale:g}: Pareto set ({len(r.pareto)} of {len(sc)} candidates; "
-                      f"* chosen)", ["#", "net", obj, "k small strain", "dPi2", "dPi3",
+                      f"* chosen)", ["#", "net (material beads x layers, mesh, border)", obj, "k small strain", "dPi2", "dPi3",
                                      "print min", "SF"], rows))
         for line in r.reasons:
             c.print(f"- {line}")

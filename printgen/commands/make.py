@@ -25,6 +25,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--drag", action="store_true",
                    help="also verify under hydrostatic + drag at the Froude-scaled velocity")
     p.add_argument("--step", action="store_true", help="also write STEP files (needs cadquery)")
+    p.add_argument("--design", metavar="FILE", type=Path,
+                   help="print this design.json (from printgen design) instead of select's")
     p.add_argument("--time-limit", type=float, default=DEFAULT_LIMIT_S, metavar="SECONDS",
                    help=f"refuse runs estimated longer than this (default {DEFAULT_LIMIT_S:g} s,"
                         " about a minute on 2 cores)")
@@ -42,6 +44,7 @@ def run(args: argparse.Namespace) -> int:
         ctx = api.make(args.prototype, args.scale, out, printer=args.printer, drag=args.drag,
                        step=args.step, progress=lambda label: _progress(err, status, label),
                        options={"force": args.force, "command": getattr(args, "argv", None),
+                                "design_file": args.design,
                                 "time_limit_s": args.time_limit})
     seconds = time.perf_counter() - t0
     if args.json:

@@ -68,8 +68,8 @@ def design_from_dict(data: Any, where: str = "design") -> Design:
                   net=NetDesign(**net), cables=tuple(cables))
 
 
-def load_design(path: str | Path) -> Design:
-    """Read a design.json file."""
+def load_design(path: str | Path, *, scale: float | None = None) -> Design:
+    """Read a design.json file; with `scale`, it must be a design at that scale."""
     p = Path(path)
     try:
         data = json.loads(p.read_text("utf-8"))
@@ -77,4 +77,8 @@ def load_design(path: str | Path) -> Design:
         raise InputError(f"design file {p} not found; write one with printgen design") from exc
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise InputError(f"design file {p} cannot be read as JSON: {exc}") from exc
-    return design_from_dict(data, where=str(p))
+    d = design_from_dict(data, where=str(p))
+    if scale is not None and abs(d.scale - scale) > 1e-9 * scale:
+        raise InputError(f"design file {p} is a 1:{d.scale:g} design, not 1:{scale:g}; pass "
+                         f"--scale {d.scale:g} or search at 1:{scale:g} (printgen design)")
+    return d

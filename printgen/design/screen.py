@@ -119,15 +119,22 @@ def bed_violation(ctx: SearchContext, point: NetPoint, bead_mm: float) -> str | 
             f"{pr.key}; use a larger scale (lambda) or a larger printer")
 
 
-def screen_point(ctx: SearchContext, point: NetPoint) -> Screened:
-    """Analytic membrane law, constraints and similitude break of one candidate."""
+def target_curve(ctx: SearchContext) -> tuple[float, np.ndarray]:
+    """(small-strain target slope N/m, target force per width at NET_STRAINS N/m)."""
+    knees, slopes = target_net_law(ctx.prototype, ctx.targets)
+    return slopes[0], piecewise_linear(NET_STRAINS, knees, slopes)
+
+
+def screen_point(ctx: SearchContext, point: NetPoint,
+                 target: tuple[float, np.ndarray] | None = None) -> Screened:
+    """Analytic membrane law, constraints and similitude break of one candidate
+    (`target`: `target_curve(ctx)`, computed here when not given)."""
     t, m = ctx.targets, ctx.material(point.material)
+    t_slope, want = target or target_curve(ctx)
     sec = strand_section(ctx, point)
     ax, ay = point.mesh_x_mm * MM, point.mesh_y_mm * MM
     knees, slopes, source = net_membrane_law(m, sec, ay, ax)
-    t_knees, t_slopes = target_net_law(ctx.prototype, t)
-    ratio = (piecewise_linear(NET_STRAINS, knees, slopes)
-             / piecewise_linear(NET_STRAINS, t_knees, t_slopes))
+    ratio = piecewise_linear(NET_STRAINS, knees, slopes) / want
     rms = float(np.sqrt(np.mean(np.log(ratio) ** 2)))
     datasheet = source != "measured panel law" and m.modulus()[1] == "datasheet"
     where = f"net {m.name} strand {sec.width_mm:g}x{sec.thickness_mm:g} mm"
@@ -147,8 +154,7 @@ def screen_point(ctx: SearchContext, point: NetPoint) -> Screened:
                                       f"{MIN_OPENING_MM:g} mm; use a larger mesh or a thinner "
                                       "strand")))
     dx, dy = ax / t["mesh_x"] - 1, ay / t["mesh_y"] - 1
-    return Screened(point, source, datasheet, slopes[0], t_slopes[0],
-                    slopes[0] / t_slopes[0] - 1, rms, rms + DATASHEET_PENALTY * datasheet,
+    return Screened(point, source, datasheet, slopes[0], t_slope, slopes[0] / t_slope - 1, rms, rms + DATASHEET_PENALTY * datasheet,
                     force, sf, speed, opening, dx if abs(dx) >= abs(dy) else dy,
                     equal_area_diameter(sec) / t["strand_d"] - 1,
                     print_time_s(ctx, point, sec, speed), tuple(violations))
@@ -156,4 +162,5 @@ def screen_point(ctx: SearchContext, point: NetPoint) -> Screened:
 
 def screen_batch(ctx: SearchContext, points: list[NetPoint]) -> list[Screened]:
     """`screen_point` over a batch (a sweep task: pure, ordered like `points`)."""
-    return [screen_point(ctx, p) for p in points]
+    target = target_curve(ctx)
+    return [screen_point(ctx, p, target) for p in points]

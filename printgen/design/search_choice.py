@@ -70,6 +70,13 @@ def _bounds(best: Screened, space: SearchSpace) -> list[str]:
     return out
 
 
+def short(s: Screened) -> str:
+    """A candidate net in a table cell: material beads x layers, mesh, border."""
+    p = s.point
+    return (f"{p.material.upper()} {p.beads_across}x{p.layers}, {p.mesh_x_mm:.4g} x "
+            f"{p.mesh_y_mm:.4g} mm, border {p.border_beads}")
+
+
 def describe(s: Screened) -> str:
     """One phrase naming a candidate net."""
     p = s.point

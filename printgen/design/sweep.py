@@ -105,6 +105,9 @@ def open_runner(*, scheduler: str | None = None, workers: int | None = None,
         raise InputError(f"--workers {workers} must be >= 1")
     distributed = _distributed()
     with ExitStack() as stack:
+        quiet = logging.getLogger("distributed")
+        stack.callback(quiet.setLevel, quiet.level)
+        quiet.setLevel(logging.ERROR)  # the cluster's chatter is not the user's business
         if scheduler:
             try:
                 client = stack.enter_context(distributed.Client(
@@ -118,7 +121,7 @@ def open_runner(*, scheduler: str | None = None, workers: int | None = None,
             n = workers or os.cpu_count() or 1
             cluster = stack.enter_context(distributed.LocalCluster(
                 n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                silence_logs=logging.ERROR))
+                silence_logs=logging.CRITICAL))
             client = stack.enter_context(distributed.Client(cluster, set_as_default=False))
             where = f"local Dask cluster ({n} worker processes)"
         log.info("sweep on %s", where)

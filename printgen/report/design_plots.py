@@ -8,7 +8,7 @@ import numpy as np
 from printgen.design.search import SearchResult
 from printgen.report.plots import _png, _pyplot
 
-MAX_CLOUD = 20000  # candidates drawn in the background cloud (every k-th beyond this)
+MAX_CLOUD = 4000  # candidates drawn in the background cloud (every k-th beyond this)
 
 
 def pareto_figure(res: SearchResult) -> bytes:

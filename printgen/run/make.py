@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from printgen.design.design_file import load_design
 from printgen.design.plan import make_design
 from printgen.design.record import Design
 from printgen.design.selection import Selection, select
@@ -58,10 +59,17 @@ def plan(prototype_path: str | Path, scale: float, *, printer: str | None = None
     t = scale_targets(proto, scale)
     sel = select(proto, t, printer=printer)
     design = make_design(proto, t, sel)
+    design_file = (options or {}).get("design_file")
+    if design_file:  # the net of `printgen design` (its design.json) instead of select's
+        design = load_design(design_file, scale=t.scale)
     rep = Report(f"printgen: {proto.name} at 1:{t.scale:g}")
     design_sections(rep, proto, t, sel, design)
     ctx = MakeContext(proto, t, sel, design, rep, options or {})
     ctx.record.update(design_record(proto, t, sel, design))
+    if design_file:
+        ctx.record["design_file"] = Path(design_file).name
+        rep.paragraph(f"The printed parts are the design of {Path(design_file).name} "
+                      "(printgen design), not the selection's choice above.")
     return ctx
 
 
