@@ -1,0 +1,90 @@
+"""Benchmark: `printgen make` on the 1:40 example (examples/realistic_barrier.toml --scale 40,
+every output but STEP), the whole command line as a user runs it, median of 3.
+
+    python -m benchmarks.bench_make --out DIR [--repeat 3]
+
+Each run is a fresh process (imports included) writing into its own folder; the time of each
+step comes from the run's own timings.json. Writes bench_make.json and bench_make.png.
+Goal (issue 11): median total < 3 s on this machine.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE = ROOT / "examples" / "realistic_barrier.toml"
+SCALE = 40.0
+GOAL_S = 3.0  # issue 11: make at 1:40 in under 3 s
+REPEAT = 3
+
+
+def one_run(out: Path) -> dict:
+    """Wall time of one `printgen make` process and the step times it recorded."""
+    cmd = [sys.executable, "-m", "printgen", "make", str(EXAMPLE), "--scale", f"{SCALE:g}",
+           "--out", str(out), "--force"]
+    t = time.perf_counter()
+    proc = subprocess.run(cmd, check=False, capture_output=True, text=True, cwd=ROOT,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    wall = time.perf_counter() - t
+    if proc.returncode not in (0, 1):  # 1: the verification reported a mismatch (a result)
+        raise RuntimeError(f"printgen make failed ({proc.returncode}): {proc.stderr[-2000:]}")
+    timings = json.loads((out / "timings.json").read_text())
+    steps = timings.get("timings_s", timings)
+    return {"wall_s": wall, "steps_s": {k: float(v) for k, v in steps.items()
+                                        if isinstance(v, (int, float))}}
+
+
+def run(out: Path, repeat: int) -> dict:
+    out.mkdir(parents=True, exist_ok=True)
+    runs = [one_run(out / f"run{k}") for k in range(repeat)]
+    walls = [r["wall_s"] for r in runs]
+    labels = list(runs[0]["steps_s"])
+    median_steps = {k: statistics.median(r["steps_s"].get(k, 0.0) for r in runs)
+                    for k in labels}
+    median = statistics.median(walls)
+    report = {"benchmark": "bench_make", "example": EXAMPLE.name, "scale": SCALE,
+              "repeat": repeat, "cores": os.cpu_count(), "runs": runs, "median_wall_s": median,
+              "median_steps_s": median_steps,
+              "outside_steps_s": median - median_steps.get("total", 0.0),
+              "goal_s": GOAL_S, "goal_met": median < GOAL_S}
+    (out / "bench_make.json").write_text(json.dumps(report, indent=1) + "\n")
+    figure(report, out / "bench_make.png")
+    return report
+
+
+def figure(report: dict, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    steps = {k: v for k, v in report["median_steps_s"].items() if k not in ("total", "estimate")}
+    steps["start-up (imports, CLI)"] = max(report["outside_steps_s"], 0.0)
+    fig, ax = plt.subplots(figsize=(7, 3.8), constrained_layout=True)
+    names = list(steps)
+    ax.barh(names, [steps[k] for k in names], color="C0")
+    ax.axvline(report["goal_s"], color="C3", ls="--", label=f"goal {report['goal_s']:g} s total")
+    ax.set_xlabel("median time (s)")
+    ax.set_title(f"printgen make 1:{report['scale']:g}: {report['median_wall_s']:.2f} s total "
+                 f"(median of {report['repeat']})")
+    ax.invert_yaxis()
+    ax.legend(fontsize=8)
+    fig.savefig(path, dpi=110, metadata={"Software": None})
+    plt.close(fig)
+
+
+def main(argv: list[str] | None = None) -> int:
+    from benchmarks.timing import goal_main
+
+    return goal_main(run, __doc__, argv, REPEAT)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
