@@ -16,12 +16,14 @@ import ctypes
 import multiprocessing
 import os
 import signal
-from collections.abc import Iterator
+import threading
+from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any
 
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
 HANDLED = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+READER_JOIN_S = 5.0  # the progress reader has only the queued reports left to pass on
 
 
 class Interrupted(BaseException):
@@ -61,8 +63,6 @@ def signals_raise() -> Iterator[None]:
 
 
 def _main_thread() -> bool:
-    import threading
-
     return threading.current_thread() is threading.main_thread()
 
 
@@ -77,6 +77,39 @@ def init_worker(parent_pid: int) -> None:
         os._exit(1)
 
 
+_listener: Callable[[str, float, float], None] | None = None  # set by `reporting`
+_sink: Any = None  # in a job: the queue (workers) or the listener (serial) to report to
+
+
+@contextlib.contextmanager
+def reporting(listener: Callable[[str, float, float], None]) -> Iterator[None]:
+    """Within the block, `report_progress(task, done, total)` calls from jobs run by
+    `run_jobs` reach `listener` (in the parent, from a helper thread when jobs run in
+    workers). Used by `make` for its per-load-level progress."""
+    global _listener
+    previous, _listener = _listener, listener
+    try:
+        yield
+    finally:
+        _listener = previous
+
+
+def report_progress(task: str, done: float, total: float) -> None:
+    """From inside a job: `task` has reached `done` of `total` (e.g. load level 0.35 of 1.1).
+    A no-op unless the caller of `run_jobs` is listening."""
+    sink = _sink
+    if sink is None:
+        return
+    with contextlib.suppress(Exception):  # progress must never break the work
+        sink(task, done, total) if callable(sink) else sink.put((task, done, total))
+
+
+def _drain(queue: Any, listener: Callable[[str, float, float], None]) -> None:
+    while (item := queue.get()) is not None:
+        with contextlib.suppress(Exception):
+            listener(*item)
+
+
 def run_jobs(jobs: list[tuple]) -> list:
     """Run each (fn, args, kwargs) and return the results in order: in worker processes when
     the machine has two cores or more (the jobs are independent; the results are identical
@@ -84,10 +117,20 @@ def run_jobs(jobs: list[tuple]) -> list:
 
     On any exception or signal in the parent the workers are killed before it propagates.
     """
+    global _sink
     workers = min(len(jobs), os.cpu_count() or 1)
     if workers < 2 or os.environ.get("PRINTGEN_SERIAL"):
-        return [fn(*args, **kw) for fn, args, kw in jobs]
+        _sink = _listener
+        try:
+            return [fn(*args, **kw) for fn, args, kw in jobs]
+        finally:
+            _sink = None
     ctx = multiprocessing.get_context("fork")
+    queue = ctx.SimpleQueue() if _listener else None
+    if queue is not None:
+        _sink = queue  # the forked workers inherit it
+        reader = threading.Thread(target=_drain, args=(queue, _listener), daemon=True)
+        reader.start()
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=init_worker,
                                initargs=(os.getpid(),))
     try:
@@ -96,7 +139,12 @@ def run_jobs(jobs: list[tuple]) -> list:
     except BaseException:
         stop(pool)
         raise
+    finally:
+        _sink = None
     pool.shutdown(wait=True)
+    if queue is not None:
+        queue.put(None)  # the workers are done: end the helper thread after the last report
+        reader.join(timeout=READER_JOIN_S)
     return results
 
 

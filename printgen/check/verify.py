@@ -27,7 +27,7 @@ from printgen.design.record import Design
 from printgen.errors import SolverError
 from printgen.inputs.prototype import Prototype
 from printgen.units import RHO_WATER, G
-from printgen.workers import run_jobs  # the worker lifecycle lives on the ground floor
+from printgen.workers import report_progress, run_jobs  # worker lifecycle: ground floor
 from solver.loads import total_forces
 
 LEVEL_STEP = 0.05  # relative loading step of the sweep (issue: at most 0.05)
@@ -97,7 +97,12 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw) -> 
     t0 = time.perf_counter()
     net, ex = build(s, slack=slack)
     loads_at = loads_function(s, **load_kw)
-    results = solver.solve_path(net, loads_at, lv, tol=SOLVER_TOL, max_cuts=PATH_CUTS,
+
+    def tracked(r: float) -> list:  # one progress report per load level tried
+        report_progress(s.name, float(r), float(lv[-1]))
+        return loads_at(r)
+
+    results = solver.solve_path(net, tracked, lv, tol=SOLVER_TOL, max_cuts=PATH_CUTS,
                                 skip_failed=True)
     failed = {float(r.level): r.reason for r in results if not r.converged}
     if len(failed) > MAX_FAILED_FRACTION * len(lv):

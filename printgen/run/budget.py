@@ -10,12 +10,15 @@ to be right within a factor of about two, enough to stop a run that would take a
 
 from __future__ import annotations
 
+import contextlib
 import math
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 from printgen.design.record import Design
 from printgen.errors import InputError
 from printgen.inputs.prototype import Prototype
+from printgen.workers import reporting
 
 DEFAULT_LIMIT_S = 60.0  # about a minute of `make` on 2 cores (issue 16)
 LEVELS = 23  # load levels of the sweep, h / h_B = 0 to 1.1 by 0.05
@@ -139,3 +142,27 @@ def coarsest_fix(p: Prototype, d: Design, *, limit_s: float, cores: int) -> str:
         lo, hi = (lo, mid) if fits(mid) else (mid, hi)
     return (f"coarsen the prototype's net to mesh_x_m = {p.net.mesh_x * hi:.3g}, mesh_y_m = "
             f"{p.net.mesh_y * hi:.3g} or more (x{hi:.2f}), which fits")
+
+
+BAR_CELLS = 20  # characters of a text progress bar
+
+
+@contextlib.contextmanager
+def level_bars(progress: Callable[[str], None] | None) -> Iterator[None]:
+    """While the block runs, pass `progress` one line of text bars, one per net being solved,
+    at each load level (from `printgen.workers.report_progress`). None: no reporting."""
+    if progress is None:
+        yield
+        return
+    state: dict[str, tuple[float, float]] = {}
+
+    def listener(task: str, done: float, total: float) -> None:
+        state[task.rsplit(": ", 1)[-1]] = (done, total)  # "...: prototype" -> "prototype"
+        bars = []
+        for name, (d, t) in sorted(state.items()):
+            full = round(BAR_CELLS * min(max(d / t, 0.0), 1.0)) if t > 0 else 0
+            bars.append(f"{name} [{'#' * full}{'.' * (BAR_CELLS - full)}] h/h_B {d:.2f}/{t:g}")
+        progress("verification: " + "  ".join(bars))
+
+    with reporting(listener):
+        yield

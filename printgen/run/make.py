@@ -30,7 +30,7 @@ from printgen.outputs import MANIFEST, check_destination, file_digest, staged_di
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
 from printgen.report.report import design_record, design_sections
-from printgen.run.budget import DEFAULT_LIMIT_S, Estimate, check_budget
+from printgen.run.budget import DEFAULT_LIMIT_S, Estimate, check_budget, level_bars
 
 log = logging.getLogger(__name__)
 
@@ -312,8 +312,9 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     if progress and est.seconds > LONG_RUN_S:
         progress(f"estimate: {est.summary()}")
     meta: dict[str, Any] = {}
+    long_run = progress if est.seconds > LONG_RUN_S else None  # per-level bars when long
     with staged_dir(out, force=bool(ctx.options.get("force")), meta=meta,
-                    volatile=(TIMINGS,)) as stage:
+                    volatile=(TIMINGS,)) as stage, level_bars(long_run):
         for label, step in steps if steps is not None else default_steps():
             if progress:
                 progress(label)

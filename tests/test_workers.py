@@ -1,0 +1,98 @@
+"""Worker processes (printgen/workers.py): they die with their parent, leave signals to it, are
+killed when the parent stops, and pass progress reports back."""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import signal
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from printgen import workers
+from printgen.run.budget import level_bars
+
+PR_GET_PDEATHSIG = 2  # linux/prctl.h
+GONE_WITHIN_S = 5.0  # issue 16: no worker left 5 s after the parent stops
+SLEEP_S = 60.0  # a job far longer than the test
+
+two_cores = pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="workers need 2 cores")
+
+
+def worker_state() -> tuple[int, object]:
+    sig = ctypes.c_int(0)
+    ctypes.CDLL(None, use_errno=True).prctl(PR_GET_PDEATHSIG, ctypes.byref(sig), 0, 0, 0)
+    return sig.value, signal.getsignal(signal.SIGINT)
+
+
+def reporting_job(name: str) -> str:
+    for level in (0.5, 1.0, 1.1):
+        workers.report_progress(name, level, 1.1)
+    return name
+
+
+def sleeper(pid_file: str) -> None:
+    Path(pid_file).write_text(str(os.getpid()))
+    time.sleep(SLEEP_S)
+
+
+@two_cores
+def test_workers_die_with_the_parent_and_ignore_signals(monkeypatch):
+    monkeypatch.delenv("PRINTGEN_SERIAL", raising=False)
+    states = workers.run_jobs([(worker_state, (), {}), (worker_state, (), {})])
+    assert states == [(signal.SIGKILL, signal.SIG_IGN)] * 2
+
+
+@pytest.mark.parametrize("serial", ["", "1"])
+def test_progress_reaches_the_listener(monkeypatch, serial):
+    monkeypatch.delenv("PRINTGEN_SERIAL", raising=False)
+    if serial:
+        monkeypatch.setenv("PRINTGEN_SERIAL", serial)
+    got = []
+    with workers.reporting(lambda *a: got.append(a)):
+        assert workers.run_jobs([(reporting_job, ("a",), {}), (reporting_job, ("b",), {})]) == [
+            "a", "b"]
+    assert sorted(got) == sorted((n, lv, 1.1) for n in "ab" for lv in (0.5, 1.0, 1.1))
+    workers.report_progress("after", 1.0, 1.0)  # nobody listens: a no-op
+    assert len(got) == 6
+
+
+def test_level_bars_text():
+    lines = []
+    with level_bars(lines.append):
+        workers.run_jobs([(reporting_job, ("Barrier: prototype",), {})])
+    assert lines[-1] == "verification: prototype [" + "#" * 20 + "] h/h_B 1.10/1.1"
+    assert lines[0].startswith("verification: prototype [#########.")
+
+
+@two_cores
+def test_a_signal_in_the_parent_kills_the_workers(tmp_path, monkeypatch):
+    monkeypatch.delenv("PRINTGEN_SERIAL", raising=False)
+    files = [tmp_path / "a.pid", tmp_path / "b.pid"]
+
+    def term_when_started():
+        while not all(f.exists() and f.read_text() for f in files):
+            time.sleep(0.05)
+        os.kill(os.getpid(), signal.SIGTERM)
+
+    threading.Thread(target=term_when_started, daemon=True).start()
+    t0 = time.monotonic()
+    with pytest.raises(workers.Interrupted) as exc, workers.signals_raise():
+        workers.run_jobs([(sleeper, (str(f),), {}) for f in files])
+    assert exc.value.exit_code == 143 and time.monotonic() - t0 < SLEEP_S
+    pids = [int(f.read_text()) for f in files]
+    deadline = time.monotonic() + GONE_WITHIN_S
+    while any(Path(f"/proc/{p}").exists() and "Z" not in _state(p) for p in pids):
+        assert time.monotonic() < deadline, "workers still running"
+        time.sleep(0.1)
+
+
+def _state(pid: int) -> str:
+    try:
+        text = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return "Z"
+    return text[text.rindex(")") + 2]
