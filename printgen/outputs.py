@@ -105,7 +105,10 @@ def staged_dir(final: str | Path, *, force: bool = False,
 
 def check_destination(dest: Path, *, force: bool) -> None:
     """Raise OutputError unless `dest` may be replaced by a new run."""
-    if dest.is_symlink() or (dest.exists() and not dest.is_dir()):
+    if dest.is_symlink():
+        raise OutputError(f"output {dest} is a symbolic link (to {os.readlink(dest)}); a run "
+                          "replaces its folder whole, so give --out the folder itself")
+    if dest.exists() and not dest.is_dir():
         raise OutputError(f"output {dest} exists and is not a folder; give --out a new or "
                           "empty folder, or an earlier printgen output")
     if dest.is_dir() and not force and not (dest / MANIFEST).is_file() and any(dest.iterdir()):

@@ -117,6 +117,14 @@ def test_foreign_folder_needs_force(tmp_path):
     run_into(empty, {"a.txt": "1"})  # an empty folder is fine
 
 
+def test_symlinked_output_is_refused(tmp_path):
+    real = run_into(tmp_path / "real", {"a.txt": "1"})
+    (tmp_path / "link").symlink_to(real)
+    with pytest.raises(OutputError, match="is a symbolic link"):
+        run_into(tmp_path / "link", {"a.txt": "2"})
+    assert (real / "a.txt").read_text() == "1"
+
+
 @pytest.mark.parametrize("kind", ["file", "under-a-file"])
 def test_output_that_is_or_is_under_a_file(tmp_path, kind):
     f = tmp_path / "notes.txt"
