@@ -72,7 +72,7 @@ def test_stiffness_objective_pareto_over_every_printable_candidate():
     members = set(res.pareto)
     for s, row in zip(feasible, vals, strict=True):
         assert (s.point.index in members) == (not any(dominates(o, row) for o in vals))
-    assert res.chosen == min(feasible, key=lambda s: (s.datasheet, s.score)).point.index
+    assert res.chosen == min(feasible, key=lambda s: (s.score, s.point.index)).point.index
 
 
 def test_same_json_serial_local_cluster_and_remote_scheduler(serial_run):

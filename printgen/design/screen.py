@@ -1,7 +1,8 @@
 """Stage 1 of `printgen design`: screen every candidate net by the analytic membrane law.
 
 For one `NetPoint`: the membrane law of its diamond geometry (`section.net_membrane_law`)
-against the target law over 1-40 % strain (RMS log error, as `select`), its small-strain error,
+against the target law over 1-40 % strain, along the load and across it (RMS log error over
+both: a net flattened to soften it along the load stiffens across it), its small-strain error,
 and the constraints: safety factor >= `MIN_SAFETY_FACTOR` at the estimated overflow strand force,
 printable passes and flow (`selection.print_limits`), the panel fits the bed, clear mesh opening
 >= `MIN_OPENING_MM`. Also the similitude it breaks (Pi2: mesh / h_B for both diagonals; Pi3:
@@ -119,10 +120,23 @@ def bed_violation(ctx: SearchContext, point: NetPoint, bead_mm: float) -> str | 
             f"{pr.key}; use a larger scale (lambda) or a larger printer")
 
 
+def across_law(knees: tuple[float, ...], slopes: tuple[float, ...], mesh_along: float,
+               mesh_across: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """The membrane law of the same diamond net loaded across: a strand strains eps cos^2
+    instead of eps sin^2 and 2 / a_along strands carry it, so with r = a_across / a_along
+    (= cot theta) the knees scale by 1 / r^2 and the slopes by r^4."""
+    r = mesh_across / mesh_along
+    return tuple(k / r**2 for k in knees), tuple(k * r**4 for k in slopes)
+
+
 def target_curve(ctx: SearchContext) -> tuple[float, np.ndarray]:
-    """(small-strain target slope N/m, target force per width at NET_STRAINS N/m)."""
-    knees, slopes = target_net_law(ctx.prototype, ctx.targets)
-    return slopes[0], piecewise_linear(NET_STRAINS, knees, slopes)
+    """(small-strain target slope N/m, target force per width N/m at NET_STRAINS along the
+    load, then across it: the prototype's law and its diamond geometry)."""
+    p = ctx.prototype
+    knees, slopes = target_net_law(p, ctx.targets)
+    k2, s2 = across_law(knees, slopes, p.net.mesh_y, p.net.mesh_x)
+    return slopes[0], np.concatenate([piecewise_linear(NET_STRAINS, knees, slopes),
+                                      piecewise_linear(NET_STRAINS, k2, s2)])
 
 
 def screen_point(ctx: SearchContext, point: NetPoint,
@@ -134,7 +148,9 @@ def screen_point(ctx: SearchContext, point: NetPoint,
     sec = strand_section(ctx, point)
     ax, ay = point.mesh_x_mm * MM, point.mesh_y_mm * MM
     knees, slopes, source = net_membrane_law(m, sec, ay, ax)
-    ratio = piecewise_linear(NET_STRAINS, knees, slopes) / want
+    k2, s2 = across_law(knees, slopes, ay, ax)
+    ratio = np.concatenate([piecewise_linear(NET_STRAINS, knees, slopes),
+                            piecewise_linear(NET_STRAINS, k2, s2)]) / want
     rms = float(np.sqrt(np.mean(np.log(ratio) ** 2)))
     datasheet = source != "measured panel law" and m.modulus()[1] == "datasheet"
     where = f"net {m.name} strand {sec.width_mm:g}x{sec.thickness_mm:g} mm"

@@ -6,8 +6,8 @@ Two stages over the space of `search_space` (material x strand section x diamond
    constraints, similitude break, print time (cheap: thousands per second per core);
 2. with the `deformation` objective, verify the best few with the solver (`verifier`, the
    pre-print verification over h / h_B = 0-1.1) and rank them by their deformation mismatch:
-   `verify_nets` nets spread along the screen's Pareto front (law error, |dPi2|, |dPi3|, print
-   time), each with every border width, and `select`'s pick for comparison.
+   the best net of each of the `verify_nets` best material x section pairs, each with every
+   border width, and `select`'s pick for comparison.
 
 Both stages run on a `sweep.Runner` (Dask, or serial): each task is a pure function of a small
 frozen record, so the result does not depend on where it ran. The solver stage is passed in
@@ -127,20 +127,17 @@ def design_point(ctx: SearchContext, d: Design) -> NetPoint:
 
 
 def stage_two(screened: list[Screened], nets: int) -> list[Screened]:
-    """The candidates the solver verifies: `nets` nets spread along the screen's Pareto front
-    (membrane-law error, |dPi2|, |dPi3|, print time; at the narrowest border), from the
-    lowest law error to the least broken similitude, each with every border width."""
-    thin = min((s.point.border_beads for s in screened), default=1)
-    pool = sorted((s for s in screened if s.feasible and s.point.border_beads == thin),
-                  key=lambda s: (round(s.score, 12), s.point.index))
-    if not pool:
-        return []
-    vals = np.array([[s.score, abs(s.d_pi2), abs(s.d_pi3), s.print_time_s] for s in pool])
-    front = [s for s, keep in zip(pool, pareto_mask(vals), strict=True) if keep]
-    picks = sorted({round(k * (len(front) - 1) / max(1, nets - 1)) for k in range(nets)})
-    keys = {front[i].point.net_key for i in picks}
-    return sorted((s for s in screened if s.feasible and s.point.net_key in keys),
-                  key=lambda s: s.point.index)
+    """The candidates the solver verifies: the best printable net (lowest screening score) of
+    each of the `nets` best material x section pairs, each with every border width."""
+    feasible = sorted((s for s in screened if s.feasible),
+                      key=lambda s: (round(s.score, 12), s.print_time_s, s.point.index))
+    pairs: dict[tuple, tuple] = {}
+    for s in feasible:
+        pair = (s.point.material, s.point.beads_across, s.point.layers)
+        if pair not in pairs and len(pairs) < nets:
+            pairs[pair] = s.point.net_key
+    keys = set(pairs.values())
+    return sorted((s for s in feasible if s.point.net_key in keys), key=lambda s: s.point.index)
 
 
 def pareto_indices(res_objective: str, screened: list[Screened],
@@ -162,13 +159,13 @@ def pareto_indices(res_objective: str, screened: list[Screened],
 
 def _choose(objective: str, screened: list[Screened], verified: dict[int, VerifyScore]
             ) -> int | None:
-    """Measured laws before datasheet ones (a datasheet modulus can be 2x off), then the
-    lowest objective; ties to the lower index."""
+    """The lowest objective (the screen's score includes select's datasheet penalty; the
+    reasons flag a datasheet law); ties to the lower index."""
     if objective == "deformation":
-        pool = [(screened[i].datasheet, v.mismatch, i) for i, v in verified.items()]
+        pool = [(v.mismatch, i) for i, v in verified.items()]
     else:
-        pool = [(s.datasheet, s.score, s.point.index) for s in screened if s.feasible]
-    return min(pool)[2] if pool else None
+        pool = [(s.score, s.point.index) for s in screened if s.feasible]
+    return min(pool)[1] if pool else None
 
 
 def screen_all(runner: Runner, ctx: SearchContext, points: list[NetPoint]) -> list[Screened]:
