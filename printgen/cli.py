@@ -12,6 +12,7 @@ import importlib
 import logging
 import os
 import sys
+from concurrent.futures.process import BrokenProcessPool
 
 from printgen.errors import PrintgenError
 from printgen.outputs import describe_os_error, os_error_exit_code
@@ -81,6 +82,9 @@ def run_command(args: argparse.Namespace, name: str) -> int:
         return _fail(f"{name}: error: {describe_os_error(exc)}", os_error_exit_code(exc))
     except MemoryError:
         return _fail(f"{name}: error: out of memory; use a coarser mesh or a larger machine", 1)
+    except BrokenProcessPool:
+        return _fail(f"{name}: error: a worker process died (killed, or out of memory: see "
+                     "`dmesg`); outputs left as they were; try again, or a coarser mesh", 1)
     except Exception as exc:
         if os.environ.get("PRINTGEN_DEBUG"):
             raise

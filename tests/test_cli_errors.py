@@ -97,6 +97,17 @@ def test_unexpected_error_is_one_line_with_a_hint(capsys, monkeypatch):
     assert code == 1 and "internal error: ZeroDivisionError" in line and "report" in line
 
 
+def test_a_dead_worker_is_one_line(capsys, monkeypatch):
+    from concurrent.futures.process import BrokenProcessPool
+
+    def died(*a, **k):
+        raise BrokenProcessPool("A process in the process pool was terminated abruptly")
+
+    monkeypatch.setattr(api, "make", died)
+    code, _, err = run(capsys, *make_args("unused-out"))
+    assert code == 1 and "a worker process died" in one_line(err)
+
+
 @pytest.mark.parametrize("exc, code, name", [(KeyboardInterrupt(), 130, "SIGINT"),
                                              (Interrupted(signal.SIGTERM), 143, "SIGTERM"),
                                              (Interrupted(signal.SIGHUP), 129, "SIGHUP")])
