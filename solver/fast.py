@@ -35,6 +35,7 @@ from solver.state import NetSystem, State, evaluate, potential, tangent_values
 FORCING = 0.1  # inexact Newton: linear solves to min(FORCING, |R| / force scale), relative
 MU_GROWTH = 10.0  # mu grows by this factor when no damped step descends
 MU_RETRIES = 6  # ... at most this many times in one iteration
+NONMONOTONE = 5  # Armijo against the highest potential of the last 5 Newton states
 CHORD_RATE = 0.5  # a chord step is kept when it at least halves the out-of-balance force
 START_SPAN = (-6.0, 0.0)  # log10 of the membrane start's largest displacement / net extent
 START_GRID = 13  # potentials sampled over START_SPAN before the scalar minimisation
@@ -73,7 +74,7 @@ def iterate(ns: NetSystem, st: State, tol: float, max_iter: int, stepper: Steppe
     At the round-off level (max |R| <= ROUND_OFF but above tol x the force scale) one more
     Newton step is still taken while it lowers max |R|: the answer then does not depend on
     how close to round-off the path happened to land."""
-    it, chord = 0, None
+    it, chord, recent = 0, None, []
     while True:
         if st.r_norm <= tol * st.f_norm:
             return st, it, True, "converged"
@@ -87,7 +88,8 @@ def iterate(ns: NetSystem, st: State, tol: float, max_iter: int, stepper: Steppe
             if trial is not None:
                 st = trial
                 continue
-        fact, found = _newton_step(ns, st, stepper)
+        recent = [*recent[-(NONMONOTONE - 1):], st.potential(st.f)]
+        fact, found = _newton_step(ns, st, stepper, max(recent))
         if st.r_norm <= ROUND_OFF and (found is None or found[0].r_norm >= st.r_norm):
             return st, it, True, "converged (round-off)"
         if found is None:
@@ -98,7 +100,7 @@ def iterate(ns: NetSystem, st: State, tol: float, max_iter: int, stepper: Steppe
         chord = fact if full else None
 
 
-def _newton_step(ns: NetSystem, st: State, stepper: Stepper):
+def _newton_step(ns: NetSystem, st: State, stepper: Stepper, reference: float):
     """(factorization, (state, full step) or None): the damped Newton step, then the step on
     its symmetric part; when neither lowers the potential (the follower load can make the
     damped tangent indefinite) mu grows tenfold, at most MU_RETRIES times."""
@@ -106,7 +108,7 @@ def _newton_step(ns: NetSystem, st: State, stepper: Stepper):
     for attempt in range(MU_RETRIES + 1):
         fact = stepper.newton(st, MU_GROWTH**attempt)
         for step in (fact.solve(-st.r, forcing), fact.symmetric_solve(-st.r)):
-            found = None if step is None else _line_search(ns, st, step)
+            found = None if step is None else _line_search(ns, st, step, reference)
             if found is not None:
                 return fact, found
     return fact, None
@@ -129,8 +131,11 @@ def _moved(ns: NetSystem, u: np.ndarray, step: np.ndarray) -> np.ndarray:
     return out
 
 
-def _line_search(ns: NetSystem, st: State, step: np.ndarray):
-    """(state, full step taken) from backtracking as in `solver.newton._line_search`."""
+def _line_search(ns: NetSystem, st: State, step: np.ndarray, reference: float | None = None):
+    """(state, full step taken) from backtracking as in `solver.newton._line_search`, but
+    non-monotone: the Armijo test is against `reference`, the highest potential of the last
+    NONMONOTONE states (Grippo et al. 1986), so a full Newton step may raise the potential a
+    little while strands settle slack or taut; the window still forces a decrease."""
     alpha = min(1.0, MAX_STEP / max(float(np.abs(step).max()), 1e-300))
     slope = float(st.r @ step)
     if slope >= 0:
@@ -139,7 +144,7 @@ def _line_search(ns: NetSystem, st: State, step: np.ndarray):
     for _ in range(MAX_BACKTRACK):
         trial = evaluate(ns, _moved(ns, st.u, alpha * step))
         pi = trial.potential(st.f)
-        if pi <= pi0 + ARMIJO * alpha * slope:
+        if pi <= max(pi0, reference if reference is not None else pi0) + ARMIJO * alpha * slope:
             return trial, alpha == 1.0
         if (abs(alpha * slope) < POTENTIAL_ROUND_OFF * max(abs(pi0), abs(pi), 1e-300)
                 and trial.r_norm < st.r_norm):
