@@ -1,11 +1,14 @@
 """Benchmark: the solver's speed against its error on scene simple-pinned (barrier-physics.md,
-section 7) at 61 x 21, 121 x 41 and 241 x 81 nodes, with OpenSeesPy side by side.
+section 7) at 61 x 21, 121 x 41, 241 x 81 and 481 x 161 nodes, with OpenSeesPy side by side
+(up to 241 x 81) and the reference path (method="reference", the solver before issue 11);
+the load paths of the 1:40 verification; the robustness table of the hard cases.
 
-    python -m benchmarks.bench_solver --out DIR [--sizes 1 2 4]
+    python -m benchmarks.bench_solver --out DIR [--sizes 1 2 4 8] [--no-paths]
 
-Errors are the mid-height centre deflection against a tight-tolerance reference solve of the
-same size (relative). Loads at the initial node height (the variant OpenSees can model);
-printgen's current-height variant is timed too. Writes bench_solver.json and bench_solver.png.
+Errors are the mid-height centre deflection against a tight-tolerance solve of the same size
+(relative). Loads at the initial node height (the variant OpenSees can model); printgen's
+current-height variant is timed too. Times are wall-clock, best of REPEAT at GOAL_TOL.
+Writes bench_solver.json and bench_solver.png.
 """
 
 from __future__ import annotations
@@ -18,13 +21,18 @@ from pathlib import Path
 
 import numpy as np
 
-from solver import solve
+from solver import solve, solve_path
 from solver.loads import total_forces
 from solver.scenes import simple_scene
 
 REFERENCE_TOL = 1e-13  # the reference solve: round-off level
 TOLERANCES = (1e-4, 1e-6, 1e-8)  # printgen's runs: out-of-balance force / load
-SIZES = {1: "61 x 21", 2: "121 x 41", 4: "241 x 81"}
+GOAL_TOL = 1e-6  # issue 11's goals are stated at this tolerance
+REPEAT = 3  # timing repeats at GOAL_TOL (best kept)
+SIZES = {1: "61 x 21", 2: "121 x 41", 4: "241 x 81", 8: "481 x 161"}
+COMPARED = (1, 2, 4)  # sizes also run by OpenSeesPy and by the reference path
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "realistic_barrier.toml"
+EXAMPLE_SCALE = 40.0  # the 1:40 verification whose load paths are timed
 
 
 def strand_state(net, disp: np.ndarray) -> tuple[float, float]:
@@ -51,33 +59,114 @@ def robustness() -> list[dict]:
             sc = simple_scene(**kw)
             r = solve(sc.net, sc.loads_at(level))
             out.append({"case": name, "relative_loading": level, "converged": r.converged,
-                        "iterations": r.iterations, "time_s": r.seconds,
-                        "max_strain": float(r.strains.max()), "reason": r.reason})
+                        "iterations": r.iterations, "factorizations": r.factorizations,
+                        "time_s": r.seconds, "max_strain": float(r.strains.max()),
+                        "reason": r.reason})
     return out
+
+
+def _run(sc, tol: float, d_ref: float, *, method: str = "fast", repeat: int = 1) -> dict:
+    """One printgen solve at `tol` (best wall time of `repeat`)."""
+    best = None
+    for _ in range(repeat):
+        r = solve(sc.net, sc.loads_at(1.0), tol=tol, method=method)
+        best = r if best is None or r.seconds < best.seconds else best
+    d = float(best.displacements[sc.centre, 1])
+    return {"tool": "printgen" if method == "fast" else "printgen reference path (before)",
+            "tol": tol, "converged": best.converged, "max_strain": float(best.strains.max()),
+            "max_tension_n": float(best.tensions.max()), "iterations": best.iterations,
+            "factorizations": best.factorizations, "time_s": best.seconds, "deflection_m": d,
+            "error": abs(d / d_ref - 1)}
 
 
 def bench_size(refine: int) -> dict:
     sc = simple_scene(refine=refine, current_z=False)
     ref = solve(sc.net, sc.loads_at(1.0), tol=REFERENCE_TOL, strict=True)
     d_ref = float(ref.displacements[sc.centre, 1])
-    runs = []
-    for tol in TOLERANCES:
-        r = solve(sc.net, sc.loads_at(1.0), tol=tol)
-        runs.append({"tool": "printgen", "tol": tol, "converged": r.converged,
-                     "max_strain": float(r.strains.max()), "max_tension_n": float(r.tensions.max()),
-                     "iterations": r.iterations, "time_s": r.seconds,
-                     "deflection_m": float(r.displacements[sc.centre, 1]),
-                     "error": abs(float(r.displacements[sc.centre, 1]) / d_ref - 1)})
+    runs = [_run(sc, tol, d_ref, repeat=REPEAT if tol == GOAL_TOL else 1) for tol in TOLERANCES]
+    if refine in COMPARED:
+        runs.append(_run(sc, GOAL_TOL, d_ref, method="reference"))
     cur = simple_scene(refine=refine, current_z=True)
     rc = solve(cur.net, cur.loads_at(1.0), tol=1e-8)
     runs.append({"tool": "printgen (load at current node height)", "tol": 1e-8,
-                 "converged": rc.converged, "iterations": rc.iterations, "time_s": rc.seconds,
+                 "converged": rc.converged, "iterations": rc.iterations,
+                 "factorizations": rc.factorizations, "time_s": rc.seconds,
                  "deflection_m": float(rc.displacements[cur.centre, 1]), "error": None})
-    runs.append(_opensees(sc, d_ref))
+    if refine in COMPARED:
+        runs.append(_opensees(sc, d_ref))
+    unknowns = int((~sc.net.fixed_dofs).sum())
+    goal = next(r for r in runs if r["tool"] == "printgen" and r["tol"] == GOAL_TOL)
     return {"size": SIZES.get(refine, f"refine {refine}"), "nodes": len(sc.net.nodes),
-            "strands": len(sc.net.elements), "reference_deflection_m": d_ref,
-            "reference_time_s": ref.seconds, "reference_iterations": ref.iterations,
-            "slack_strands_at_reference": int(ref.slack.sum()), "runs": runs}
+            "strands": len(sc.net.elements), "unknowns": unknowns,
+            "reference_deflection_m": d_ref, "reference_time_s": ref.seconds,
+            "reference_iterations": ref.iterations,
+            "slack_strands_at_reference": int(ref.slack.sum()),
+            "us_per_unknown_at_goal_tol": 1e6 * goal["time_s"] / unknowns, "runs": runs}
+
+
+def capture_verification_paths() -> list[tuple]:
+    """(net, loads_at, levels, keywords) of every load path the 1:40 verification solves,
+    recorded while it runs (serially, in this process)."""
+    import os
+
+    import solver
+    from printgen.run.api import verify
+
+    captured, original = [], solver.solve_path
+
+    def recording(net, loads_at, levels, **kw):
+        captured.append((net, loads_at, list(levels), kw))
+        return original(net, loads_at, levels, **kw)
+
+    os.environ["PRINTGEN_SERIAL"] = "1"
+    solver.solve_path = recording
+    try:
+        verify(EXAMPLE, EXAMPLE_SCALE)
+    finally:
+        solver.solve_path = original
+        del os.environ["PRINTGEN_SERIAL"]
+    return captured
+
+
+def bench_tent(net, tol: float) -> dict:
+    """The "tent": the 1:40 model net with no water, pulled only by three 1 N sensor loads
+    (flow-wise, at the free nodes nearest the bed-centre, the top-centre and the centre).
+    Most strands stay slack, many nodes have no stiffness: the hardest start there is."""
+    from solver import PointLoads
+
+    x = np.asarray(net.nodes)
+    lo, span = x.min(axis=0), np.ptp(x, axis=0)
+    rel = (x - lo) / np.where(span > 0, span, 1.0)
+    free = np.flatnonzero(~net.fixed_dofs.all(axis=1))
+    picks = [int(free[np.argmin(np.hypot(rel[free, 0] - a, rel[free, 2] - b))])
+             for a, b in ((0.5, 0.0), (0.5, 1.0), (0.5, 0.5))]
+    loads = [PointLoads(np.array(picks), np.tile([0.0, 1.0, 0.0], (len(picks), 1)))]
+    out = {"nodes": len(x), "sensor_nodes": picks, "tol": tol}
+    for method in ("fast", "reference"):
+        r = solve(net, loads, tol=tol, method=method)
+        out[method] = {"converged": r.converged, "iterations": r.iterations,
+                       "factorizations": r.factorizations, "time_s": r.seconds}
+    return out
+
+
+def bench_paths(captured: list[tuple]) -> list[dict]:
+    """Each verification load path by both paths: time, iterations and factorizations per
+    level."""
+    out = []
+    for k, (net, loads_at, levels, kw) in enumerate(captured):
+        row = {"path": k, "nodes": len(net.nodes), "strands": len(net.elements),
+               "cables": len(net.cables), "levels": len(levels)}
+        for method in ("fast", "reference"):
+            t = time.perf_counter()
+            res = solve_path(net, loads_at, levels, method=method, **kw)
+            row[method] = {"time_s": time.perf_counter() - t,
+                           "converged_levels": sum(r.converged for r in res),
+                           "iterations": [r.iterations for r in res],
+                           "factorizations": [r.factorizations for r in res]}
+        fac = row["fast"]["factorizations"]
+        row["fast"]["factorizations_per_level"] = sum(fac) / max(len(fac), 1)
+        out.append(row)
+    return out
 
 
 def _opensees(sc, d_ref: float) -> dict:
@@ -105,7 +194,7 @@ def figure(results: list[dict], path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7, 4.5), constrained_layout=True)
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.5), constrained_layout=True)
     for k, res in enumerate(results):
         pg = [r for r in res["runs"] if r["tool"] == "printgen"]
         ax.loglog([r["time_s"] for r in pg], [max(r["error"], 1e-16) for r in pg], "-o",
@@ -118,19 +207,68 @@ def figure(results: list[dict], path: Path) -> None:
     ax.set_ylabel("relative error, mid-height deflection")
     ax.set_title("simple-pinned: speed against error")
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7)
+    for tool, style in (("printgen", "-o"), ("printgen reference path (before)", "--s"),
+                        ("OpenSeesPy", ":^")):
+        pts = [(res["unknowns"], r["time_s"]) for res in results for r in res["runs"]
+               if r["tool"] == tool and r.get("tol", GOAL_TOL) == GOAL_TOL and "time_s" in r]
+        if pts:
+            bx.loglog(*zip(*pts), style, label=tool)
+    if results:
+        n0 = results[0]["unknowns"]
+        t0 = next(r["time_s"] for r in results[0]["runs"]
+                  if r["tool"] == "printgen" and r["tol"] == GOAL_TOL)
+        n = np.array([res["unknowns"] for res in results])
+        bx.loglog(n, t0 * n / n0, color="0.6", lw=0.8, label="linear in unknowns")
+    bx.set_xlabel("unknowns")
+    bx.set_ylabel(f"wall time at tol {GOAL_TOL:g} (s)")
+    bx.set_title("time against size")
+    bx.grid(alpha=0.3, which="both")
+    bx.legend(fontsize=7)
     fig.savefig(path, dpi=110, metadata={"Software": None})
     plt.close(fig)
 
 
-def run(out: Path, sizes: list[int]) -> dict:
+def goals(results: list[dict], paths: list[dict], tent: dict | None) -> dict:
+    """Issue 11's targets, each with its measured figure."""
+    def at(size: str, tool: str):
+        for res in results:
+            if res["size"] == size:
+                return next((r for r in res["runs"] if r["tool"] == tool
+                             and r.get("tol", GOAL_TOL) == GOAL_TOL and r.get("converged")),
+                            None)
+        return None
+
+    out = {}
+    pg, os_ = at("61 x 21", "printgen"), at("61 x 21", "OpenSeesPy")
+    if pg and os_:
+        out["speedup_vs_opensees_61x21"] = os_["time_s"] / pg["time_s"]
+    big = at("241 x 81", "printgen")
+    if big:
+        out["time_241x81_s"] = big["time_s"]
+    per = {res["size"]: res["us_per_unknown_at_goal_tol"] for res in results}
+    out["us_per_unknown"] = per
+    if tent:
+        out["tent_iterations"] = {m: tent[m]["iterations"] for m in ("fast", "reference")}
+    if paths:
+        out["path_time_s"] = {m: [p[m]["time_s"] for p in paths] for m in ("fast", "reference")}
+        out["path_factorizations_per_level"] = [p["fast"]["factorizations_per_level"]
+                                                for p in paths]
+    return out
+
+
+def run(out: Path, sizes: list[int], with_paths: bool = True) -> dict:
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     results = [bench_size(s) for s in sizes]
+    captured = capture_verification_paths() if with_paths else []
+    paths = bench_paths(captured)
+    tent = bench_tent(captured[0][0], captured[0][3].get("tol", GOAL_TOL)) if captured else None
     report = {"benchmark": "bench_solver", "scene": "simple-pinned",
               "load": "hydrostatic at h = h_B + drag at 6 m/s, at the initial node height",
-              "reference_tol": REFERENCE_TOL, "sizes": results, "robustness": robustness(),
-              "total_s": time.perf_counter() - t0}
+              "reference_tol": REFERENCE_TOL, "goal_tol": GOAL_TOL, "sizes": results,
+              "verification_paths": paths, "tent": tent, "robustness": robustness(),
+              "goals": goals(results, paths, tent), "total_s": time.perf_counter() - t0}
     (out / "bench_solver.json").write_text(json.dumps(report, indent=1) + "\n")
     figure(results, out / "bench_solver.png")
     return report
@@ -140,15 +278,23 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", required=True, type=Path)
     ap.add_argument("--sizes", type=int, nargs="+", default=list(SIZES),
-                    help="mesh refinements: 1 = 61 x 21, 2 = 121 x 41, 4 = 241 x 81")
+                    help="mesh refinements: 1 = 61 x 21, 2 = 121 x 41, 4 = 241 x 81, 8 = 481 x 161")
+    ap.add_argument("--no-paths", action="store_true", help="skip the verification load paths")
     a = ap.parse_args(argv)
-    report = run(a.out, a.sizes)
+    report = run(a.out, a.sizes, not a.no_paths)
     for res in report["sizes"]:
         for r in res["runs"]:
             err = r.get("error")
             print(f"{res['size']:9s} {r['tool']:40s} tol {r.get('tol', '-')!s:6s} "
-                  f"{r.get('time_s', float('nan')):7.2f} s  error "
+                  f"{r.get('time_s', float('nan')):7.2f} s  it {r.get('iterations', '-')!s:4s} "
+                  f"fact {r.get('factorizations', '-')!s:4s} error "
                   f"{'-' if err is None else f'{err:.1e}'}")
+    for p in report["verification_paths"]:
+        print(f"path {p['path']} ({p['nodes']} nodes, {p['levels']} levels): fast "
+              f"{p['fast']['time_s']:.2f} s, {sum(p['fast']['iterations'])} it, "
+              f"{p['fast']['factorizations_per_level']:.1f} fact/level; reference "
+              f"{p['reference']['time_s']:.2f} s, {sum(p['reference']['iterations'])} it")
+    print(json.dumps(report["goals"], indent=1))
     return 0
 
 
