@@ -42,10 +42,12 @@ from printgen.report.jsonout import dumps
 def verify_task(shared: VerifyShared, task: VerifyTask) -> VerifyScore:
     """Solver stage of the search: the verification of one design, as a score. Pure: the
     same task gives the same score in any process (the sweep worker runs it serially)."""
+    from threadpoolctl import threadpool_limits
+
     from printgen.check.verify import levels, verify
 
     lv = None if shared.level_step is None else levels(step=shared.level_step)
-    with _serial():
+    with _serial(), threadpool_limits(limits=1):  # one BLAS thread: the same sums everywhere
         v = verify(shared.prototype, task.design, lv=lv)
     rms = math.sqrt(sum(m.rms_rel**2 for m in v.mismatches) / len(v.mismatches))
     failed = sorted(set(v.prototype.failed) | set(v.model.failed))
