@@ -22,7 +22,7 @@ REALISTIC = EXAMPLES / "realistic_barrier.toml"
 SCALE = 40.0
 COARSE_STEP = 0.275  # solver stage at h/h_B = 0, 0.275, ..., 1.1: enough to compare runs
 SMALL = SearchOptions(objective="deformation", materials=("tpe", "petg"),
-                      mesh_x_mm=(26.0, 30.0), mesh_y_mm=(12.5, 14.5), border_beads=(1, 2),
+                      mesh_x_mm=(26.0, 30.0), mesh_y_mm=(12.5, 14.5), border_beads=(2, 4),
                       verify_nets=1, level_step=COARSE_STEP)
 
 pytest.importorskip("distributed")

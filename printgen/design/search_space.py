@@ -29,7 +29,8 @@ from printgen.inputs.profiles import list_profiles
 from printgen.inputs.prototype import Prototype
 
 MESH_TOLERANCE = 0.25  # default bounds: each diagonal within +-25 % of the scaled prototype's
-BORDER_BEADS = (1, 2, 3)  # border frame widths searched, in net beads
+BORDER_BEADS = (2, 4)  # border frame widths searched, in net beads (even: the frame splits
+# around the net's corner loops in the parts stage)
 MIN_HALF_CELLS = 4  # fewer half-meshes than this across or up is not a net worth verifying
 MESH_DIGITS = 6  # mesh diagonals are rounded to 1e-6 mm in the records
 
@@ -135,6 +136,10 @@ def check_space(space: SearchSpace) -> None:
                        ("border beads", space.border_beads)):
         if not vals or min(vals) < 1:
             raise InputError(f"{name} {list(vals)} must be whole numbers >= 1")
+    odd = [b for b in space.border_beads if b % 2]
+    if odd:
+        raise InputError(f"border beads {odd} must be even: the printed border frame splits "
+                         "around the net's corner loops; use e.g. --border-beads 2,4")
     if not space.materials:
         raise InputError("no materials to search; name at least one (--materials tpe)")
 
