@@ -1,6 +1,7 @@
-"""STEP export through CadQuery (the optional `cad` extra, imported only when asked for):
-the part's plan-view outline (`solid.net_outline` / `cable.cable_outline`) extruded as a
-B-rep, in mm. The input is checked before CadQuery is imported or anything is written."""
+"""STEP export through CadQuery's OCP kernel (the optional `cad` extra, imported only when
+asked for): the part's plan-view outline (`solid.net_outline` / `cable.cable_outline`) as
+one face swept once into a prism, in mm. The input is checked before OCP is imported or
+anything is written."""
 
 from __future__ import annotations
 
@@ -14,6 +15,8 @@ from printgen.outputs import write_bytes
 from printgen.parts.geometry.cable import check_positive_mm
 
 INSTALL_HINT = "pip install 'printgen[cad]'"  # quoted: zsh globs brackets
+STEP_SIMPLIFY_MM = 0.005  # outline vertices dropped within 5 um (circles: 128 -> ~20 sides)
+STEP_VOLUME_TOL = 1e-3  # the prism's volume vs the mesh outline's area x thickness
 
 
 def _cadquery():
@@ -33,21 +36,62 @@ def _single_polygon(outline):
 
 
 def step_bytes(outline, thickness_mm: float) -> bytes:
-    """STEP text of a shapely polygon (with holes) extruded by `thickness_mm` (mm)."""
+    """STEP text of a shapely polygon (with holes) extruded by `thickness_mm` (mm).
+
+    One planar face (outer wire plus one wire per hole) swept once into a prism: no boolean
+    per hole. Circles are thinned to STEP_SIMPLIFY_MM (fewer faces to write); the solid's
+    volume is checked against the mesh outline's area x thickness.
+    """
     check_positive_mm(thickness_mm, "STEP part thickness")
-    poly = _single_polygon(outline)
-    cq = _cadquery()
+    full = _single_polygon(outline)
+    from shapely.geometry.polygon import orient
 
-    def prism(ring) -> object:
-        pts = [tuple(map(float, p)) for p in np.asarray(ring.coords)[:-1]]
-        return cq.Workplane("XY").polyline(pts).close().extrude(thickness_mm)
+    # exterior counter-clockwise, holes clockwise; circles thinned to STEP_SIMPLIFY_MM
+    poly = orient(full.simplify(STEP_SIMPLIFY_MM, preserve_topology=True), sign=1.0)
+    _cadquery()  # the install hint when CadQuery (and its OCP kernel) is missing
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism
+    from OCP.gp import gp_Vec
 
-    body = prism(poly.exterior)
+    maker = BRepBuilderAPI_MakeFace(_wire(poly.exterior), True)
     for hole in poly.interiors:
-        body = body.cut(prism(hole))
+        maker.Add(_wire(hole))
+    if not maker.IsDone():
+        raise GeometryError("STEP: the outline does not make a planar face")
+    solid = BRepPrimAPI_MakePrism(maker.Face(), gp_Vec(0.0, 0.0, thickness_mm)).Shape()
+    volume = _volume_mm3(solid)
+    expected = full.area * thickness_mm
+    if not poly.is_valid or abs(volume / expected - 1) > STEP_VOLUME_TOL:
+        raise GeometryError(f"STEP: solid volume {volume:.6g} mm^3 differs from the outline's "
+                            f"{expected:.6g} mm^3")
+    return _write(solid)
+
+
+def _wire(ring):
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakePolygon
+    from OCP.gp import gp_Pnt
+
+    mp = BRepBuilderAPI_MakePolygon()
+    for x, y in np.asarray(ring.coords)[:-1]:
+        mp.Add(gp_Pnt(float(x), float(y), 0.0))
+    mp.Close()
+    return mp.Wire()
+
+
+def _volume_mm3(solid) -> float:
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(solid, props)
+    return float(props.Mass())
+
+
+def _write(solid) -> bytes:
+    cq = _cadquery()
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "part.step"
-        cq.exporters.export(body, str(path), "STEP")
+        cq.exporters.export(cq.Shape.cast(solid), str(path), "STEP")
         return path.read_bytes()
 
 
