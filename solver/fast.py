@@ -4,7 +4,7 @@ steps:
 
 - one strand pass per trial state (`solver.state`), the tangent scattered into a pattern
   fixed per net (`solver.pattern`), factorized by a sparse LDL^T whose ordering is reused
-  (`solver.linsolve`; SuperLU when `qdldl` is not installed);
+  (`solver.linsolve`: MKL PARDISO for large nets, qdldl's LDL^T, SuperLU without either);
 - steps damped by mu D (D: the net's stiffness under unit force density) instead of mu I;
 - a membrane start from rest: the shape of the net under unit force density, scaled to the
   lowest potential along it, instead of the flat net;
@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from solver.linsolve import Factorization, ldl_available
+from solver.linsolve import Factorization, choose_backend
 from solver.newton import (
     ARMIJO,
     MAX_BACKTRACK,
@@ -43,17 +43,17 @@ START_XTOL = 0.01  # log10 resolution of the membrane start's scale
 
 
 class Stepper:
-    """Factorizations of one net, reusing the LDL^T ordering; counts what it does."""
+    """Factorizations of one net, reusing the backend's ordering; counts what it does."""
 
     def __init__(self, ns: NetSystem, backend: str | None = None) -> None:
         self.ns = ns
-        self.backend = backend or ("ldl" if ldl_available() else "lu")
-        self.ldl = None
+        self.backend = backend or choose_backend(ns.pattern.size)
+        self.handle = None
         self.factorizations = 0
 
     def factor(self, data: np.ndarray) -> Factorization:
-        fact = Factorization(self.ns.pattern, data, self.backend, self.ldl)
-        self.ldl = fact.ldl  # None after a failed LDL^T: a fresh one next time
+        fact = Factorization(self.ns.pattern, data, self.backend, self.handle)
+        self.handle = fact.handle  # None after a failed factorization: a fresh one next time
         self.factorizations += 1
         return fact
 

@@ -1,15 +1,20 @@
 """Linear solves of a Newton step, (J + mu D) x = b, on the net's fixed pattern.
 
 J is symmetric except for the hydrostatic follower term (the load on a node falls as the node
-rises: a (flow, z) entry with no (z, flow) partner). The fast backend factorizes the
-symmetric part S = (A + A^T) / 2 by a sparse LDL^T (`qdldl`, optional: the `fast` extra; its
-fill-reducing ordering is computed once per net and reused by every refactorization), then
-recovers the solution of the true, non-symmetric A by GMRES preconditioned with S^-1 (a few
-iterations: the follower term is a small part of A). The result is checked: if it does not
-reach LINEAR_RTOL (the follower term too strong, or S indefinite), the same system is solved
-by SuperLU on A. The
-answer is always that of A; symmetrizing only chooses how it is computed.
-Without `qdldl` every solve is SuperLU's (scipy), which is also the reference backend.
+rises: a (flow, z) entry with no (z, flow) partner). Backends, each optional and imported
+lazily (the `fast` extra), in the order `choose_backend` prefers them:
+
+- "pardiso" (MKL PARDISO via `pypardiso`, nets of PARDISO_MIN_DOFS unknowns and more): a
+  supernodal LU of A itself; its fill-reducing analysis runs once per net, every later step
+  only refactorizes numerically;
+- "ldl" (`qdldl`): a sparse LDL^T of the symmetric part S = (A + A^T) / 2, ordering computed
+  once per net, then GMRES on A preconditioned by S^-1 (a few iterations: the follower term
+  is a small part of A);
+- "lu": scipy's SuperLU on A (always there; also the reference path's solver).
+
+Every result is checked against A (backward error LINEAR_RTOL, or the inexact-Newton
+forcing); GMRES preconditioned by the factorization repairs a result that misses it, and
+SuperLU on A is the last resort. The answer is always that of A.
 """
 
 from __future__ import annotations
@@ -22,6 +27,9 @@ from solver.pattern import Pattern
 LINEAR_RTOL = 1e-13  # backward error a solve must reach: |b - A x| <= tol (|A| |x| + |b|)
 GMRES_RTOL = 1e-14  # GMRES stops at this relative 2-norm residual at the latest
 GMRES_RESTART = 30  # GMRES iterations (one restart cycle) before falling back to SuperLU
+PARDISO_MIN_DOFS = 100_000  # from here on PARDISO's supernodal LU beats qdldl's LDL^T
+# (simple-pinned at 1e-6, 2 cores: even at 57k unknowns, 0.9 s against 2.5 s CPU per
+# factorization at 226k; its import and threads cost more than they save on small nets)
 
 
 def ldl_available() -> bool:
@@ -33,31 +41,94 @@ def ldl_available() -> bool:
     return True
 
 
+def _mkl_hint() -> None:
+    """Point pypardiso at MKL's runtime when it sits in the environment's lib folder: without
+    the hint it searches the whole environment tree at import (seconds)."""
+    import glob
+    import os
+    import sys
+
+    if "PYPARDISO_MKL_RT" not in os.environ:
+        found = sorted(glob.glob(os.path.join(sys.prefix, "lib", "libmkl_rt.so*")), key=len)
+        if found:
+            os.environ["PYPARDISO_MKL_RT"] = found[0]
+
+
+def pardiso_available() -> bool:
+    """True when the optional MKL PARDISO wrapper (`pypardiso`) imports."""
+    try:
+        _mkl_hint()
+        import pypardiso  # noqa: F401
+    except (ImportError, OSError):
+        return False
+    return True
+
+
+def choose_backend(size: int) -> str:
+    """The fastest installed backend for a system of `size` unknowns."""
+    if size >= PARDISO_MIN_DOFS and pardiso_available():
+        return "pardiso"
+    return "ldl" if ldl_available() else "lu"
+
+
+class Pardiso:
+    """One PARDISO instance per net: symbolic analysis once, numeric refactorizations after."""
+
+    def __init__(self) -> None:
+        import pypardiso
+
+        self.solver = pypardiso.PyPardisoSolver(mtype=11)  # real, non-symmetric
+        self.analysed = False
+        self.A = None
+
+    def factor(self, A) -> None:
+        zero = np.zeros(A.shape[0])
+        if not self.analysed:
+            self.solver.set_phase(11)
+            self.solver._call_pardiso(A, zero)  # the documented direct call (pypardiso)
+            self.analysed = True
+        self.solver.set_phase(22)
+        self.solver._call_pardiso(A, zero)
+        self.A = A
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        self.solver.set_phase(33)
+        return self.solver._call_pardiso(self.A, np.asfortranarray(b))
+
+
 class Factorization:
     """One factorization of A = J + mu D; `solve` returns None when A is singular.
 
-    backend "ldl" (LDL^T of the symmetric part + GMRES, SuperLU when that fails) or "lu"
-    (SuperLU); `ldl`: the qdldl solver of an earlier factorization, refactorized in place.
+    backend "pardiso", "ldl" or "lu" (see the module docstring); `handle`: the backend's
+    object from an earlier factorization of the same net (a qdldl solver, a Pardiso), reused
+    so the ordering is not computed again.
     """
 
-    def __init__(self, pattern: Pattern, data: np.ndarray, backend: str, ldl=None) -> None:
-        self.pattern, self.A, self.backend, self.ldl = pattern, pattern.csr(data), backend, None
-        self.lu = None
+    def __init__(self, pattern: Pattern, data: np.ndarray, backend: str, handle=None) -> None:
+        self.pattern, self.A, self.backend = pattern, pattern.csr(data), backend
+        self.handle, self.direct, self.symmetric, self.lu = None, None, False, None
         self.ok = True
-        if backend == "ldl":
-            try:
-                upper = pattern.symmetric_upper(data)
-                if ldl is None:
-                    import qdldl
-
-                    ldl = qdldl.Solver(upper, upper=True)
-                else:
-                    ldl.update(upper, upper=True)
-                self.ldl = ldl
-            except (ValueError, RuntimeError):  # a zero pivot: S singular
-                self.ldl = None
-        if self.ldl is None:
+        try:
+            if backend == "ldl":
+                self._factor_ldl(data, handle)
+            elif backend == "pardiso":
+                handle = handle if handle is not None else Pardiso()
+                handle.factor(self.A)
+                self.handle, self.direct = handle, handle.solve
+        except Exception:  # noqa: BLE001 - a zero pivot or a solver error: SuperLU decides
+            self.handle, self.direct = None, None
+        if self.direct is None:
             self._factor_lu()
+
+    def _factor_ldl(self, data: np.ndarray, handle) -> None:
+        upper = self.pattern.symmetric_upper(data)
+        if handle is None:
+            import qdldl
+
+            handle = qdldl.Solver(upper, upper=True)
+        else:
+            handle.update(upper, upper=True)
+        self.handle, self.direct, self.symmetric = handle, handle.solve, True
 
     def _factor_lu(self) -> None:
         try:
@@ -69,7 +140,7 @@ class Factorization:
     def solve(self, b: np.ndarray, forcing: float = 0.0) -> np.ndarray | None:
         """A^-1 b to a backward error of LINEAR_RTOL, or (inexact Newton) to a residual
         max |b - A x| <= forcing max |b|; None when A is singular."""
-        if self.ldl is not None:
+        if self.direct is not None:
             x = self._refined(b, forcing)
             if x is not None:
                 return x
@@ -83,15 +154,15 @@ class Factorization:
 
     def symmetric_solve(self, b: np.ndarray) -> np.ndarray | None:
         """S^-1 b alone (a direction on the symmetric model), or None without an LDL^T."""
-        if self.ldl is None:
+        if not self.symmetric:
             return None
         with np.errstate(all="ignore"):
-            x = self.ldl.solve(b)
+            x = self.direct(b)
         return x if np.all(np.isfinite(x)) else None
 
     def _refined(self, b: np.ndarray, forcing: float) -> np.ndarray | None:
-        """S^-1 b, then GMRES on A preconditioned by S^-1 when the follower term matters;
-        None unless the backward error reaches LINEAR_RTOL."""
+        """The direct solve, then GMRES on A preconditioned by it when that misses the
+        target (the follower term, with an LDL^T of S); None unless the target is met."""
         a_norm = float(abs(self.A).sum(axis=1).max()) if self.A.nnz else 0.0
         b_norm = float(np.abs(b).max()) if b.size else 0.0
 
@@ -104,14 +175,17 @@ class Factorization:
             return float(np.abs(res).max()) <= LINEAR_RTOL * (a_norm * float(np.abs(x).max())
                                                               + b_norm)
 
-        with np.errstate(all="ignore"):
-            x = self.ldl.solve(b)
-            if good(x):
-                return x
-            if not np.all(np.isfinite(x)):
-                return None
-            target = max(forcing * b_norm, GMRES_RTOL * float(np.linalg.norm(b)))
-            x = gmres(self.A, self.ldl.solve, b, x, target, GMRES_RESTART)
+        try:
+            with np.errstate(all="ignore"):
+                x = self.direct(b)
+                if good(x):
+                    return x
+                if not np.all(np.isfinite(x)):
+                    return None
+                target = max(forcing * b_norm, GMRES_RTOL * float(np.linalg.norm(b)))
+                x = gmres(self.A, self.direct, b, x, target, GMRES_RESTART)
+        except Exception:  # noqa: BLE001 - a failing backend: SuperLU decides
+            return None
         return x if good(x) else None
 
 

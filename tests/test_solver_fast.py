@@ -10,7 +10,7 @@ import pytest
 
 from solver import Hydrostatic, Net, SlidingCable, linear, solve, solve_path
 from solver.driver import FastSolver
-from solver.linsolve import Factorization, ldl_available
+from solver.linsolve import Factorization, choose_backend, ldl_available, pardiso_available
 from solver.scenes import simple_scene, square_net
 from solver.state import NetSystem, evaluate, tangent_values
 
@@ -71,11 +71,14 @@ def test_paths_agree_level_by_level():
 
 
 def test_without_the_optional_ldl_the_superlu_fallback_gives_the_same_answer(monkeypatch):
-    """`qdldl` not importable (the `fast` extra absent): every solve goes through SuperLU."""
+    """`qdldl` and `pypardiso` not importable (the `fast` extra absent): every solve goes
+    through SuperLU."""
     net, loads = _sliding_net()
     with_ldl = solve(net, loads, tol=TIGHT)
-    monkeypatch.setitem(sys.modules, "qdldl", None)  # import qdldl now raises ImportError
-    assert not ldl_available()
+    for name in ("qdldl", "pypardiso"):
+        monkeypatch.setitem(sys.modules, name, None)  # import now raises ImportError
+    assert not ldl_available() and not pardiso_available()
+    assert choose_backend(10**6) == "lu"
     fs = FastSolver(net)
     assert fs.stepper.backend == "lu"
     plain = fs.solve(loads, [], TIGHT, 400)
@@ -83,12 +86,14 @@ def test_without_the_optional_ldl_the_superlu_fallback_gives_the_same_answer(mon
     assert _agree(plain.displacements, with_ldl.displacements) < AGREE
 
 
-@pytest.mark.parametrize("backend", ["ldl", "lu"])
+@pytest.mark.parametrize("backend", ["ldl", "pardiso", "lu"])
 def test_linear_solves_include_the_follower_term(backend):
     """With the hydrostatic load at the current node height the tangent is not symmetric:
-    the LDL^T of its symmetric part + GMRES must still solve the true system."""
-    if backend == "ldl" and not ldl_available():
-        pytest.skip("qdldl not installed")
+    the LDL^T of its symmetric part + GMRES (and every other backend) must still solve the
+    true system."""
+    if (backend == "ldl" and not ldl_available()) or (
+            backend == "pardiso" and not pardiso_available()):
+        pytest.skip(f"{backend} not installed")
     sc = simple_scene(current_z=True)
     ns = NetSystem(sc.net)
     ns.loads = sc.loads_at(1.0)
