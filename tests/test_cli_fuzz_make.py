@@ -4,10 +4,9 @@ a folder that matches its manifest, or exits 2 with one line; never a traceback,
 never a partial folder, stage or lock left behind.
 
 To stay fast (issue: < 60 s for 100 runs) the runs are in-process and skip the heavy steps
-(meshes, figures, and the verification, whose solver has its own tests); `--time-limit` is
-lowered so that nets too big for a quick run are refused by the size estimate, which is one of
-the paths under test. About 15 of the 100 succeed; the rest name a printability, strength,
-printer-bed or size limit.
+(meshes, figures, and the verification, whose solver has its own tests); nets too big for the
+default limit are refused by the size estimate, one of the paths under test. About half of
+the 100 succeed; the rest name a printability, strength, printer-bed or size limit.
 """
 
 from __future__ import annotations
@@ -24,7 +23,6 @@ from printgen.cli import main
 from printgen.outputs import check_folder
 
 EXAMPLES = 100  # issue 13: 100 random prototypes
-TIME_LIMIT_S = "15"  # refuse runs estimated above 15 s (default 60 s; meshes and sweep skipped)
 
 
 def log_uniform(lo: float, hi: float) -> st.SearchStrategy[float]:
@@ -84,8 +82,7 @@ def test_make_succeeds_or_says_why_in_one_line(quick_make, tmp_path_factory, cap
         del edits[("flow", "depth_m")]
     proto = write_variant(tmp, edits, base=case["base"])
     out = tmp / "out"
-    code = main(["make", str(proto), "-s", f"{case['scale']:.6g}", "--out", str(out),
-                 "--time-limit", TIME_LIMIT_S])
+    code = main(["make", str(proto), "-s", f"{case['scale']:.6g}", "--out", str(out)])
     _, err = capsys.readouterr()
     assert "Traceback" not in err, err
     assert code in (0, 2), err

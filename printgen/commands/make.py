@@ -42,7 +42,7 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     with err.status("planning") as status:
         ctx = api.make(args.prototype, args.scale, out, printer=args.printer, drag=args.drag,
-                       step=args.step, progress=lambda label: _progress(err, status, label),
+                       step=args.step, progress=Progress(status),
                        options={"force": args.force, "command": getattr(args, "argv", None),
                                 "design_file": args.design,
                                 "time_limit_s": args.time_limit})
@@ -54,11 +54,19 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _progress(err: Console, status, label: str) -> None:
-    """Step names go to the spinner; the size estimate of a long run stays on screen."""
-    if label.startswith("estimate:"):
-        err.print(f"printgen make: {label}", soft_wrap=True)
-    status.update(f"{label} ...")
+class Progress:
+    """The spinner's text: the current step (or the load-level bars of the verification) and,
+    for a long run, its size estimate below it. Transient: a failed run still ends in one line,
+    and the estimate is in report.json ("size") and in the summary."""
+
+    def __init__(self, status) -> None:
+        self.status, self.estimate = status, ""
+
+    def __call__(self, label: str) -> None:
+        if label.startswith("estimate:"):
+            self.estimate = f"\n{label}"
+            return
+        self.status.update(f"{label} ...{self.estimate}")
 
 
 def show_summary(ctx, out: Path, seconds: float) -> None:
@@ -72,6 +80,10 @@ def show_summary(ctx, out: Path, seconds: float) -> None:
         rows.append(["cables", (f"{cab.material_name} {cab.section.width_mm:g} x "
                      f"{cab.section.thickness_mm:g} mm, {cab.section.passes} passes"),
                      f"{cab.error:+.1%} E*A"])
+    size = ctx.record.get("size")
+    if size:
+        nets = ", ".join(f"{k} {v['nodes']:,}" for k, v in size["nets"].items()) or "no sweep"
+        rows.append(["size", f"nodes: {nets}", f"{size['mesh_segments']:,} strand segments"])
     ver = ctx.record.get("verification")
     if ver:
         rows.append(["verification", ver["verdict"], ver["summary"][:90]])

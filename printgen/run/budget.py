@@ -1,7 +1,7 @@
 """The size of a `make` run, before any of it is done: nodes, unknowns, memory and time.
 
 The verification solves two nets over 23 load levels (prototype and model, in parallel on two
-cores); the meshes step builds one solid strand per model net segment. Both costs grow with
+cores), then the model's uncertainty-band variants; the meshes step builds one solid strand per model net segment. Both costs grow with
 the node count, which follows from the meshes alone (no net is built here). The constants are
 measured on the 1:40 example (`examples/realistic_barrier.toml`: 518 prototype nodes in 6.5 s,
 365 model nodes in 5.5 s, 1039 prototype nodes in 16 s; one core each); the estimate is meant
@@ -27,6 +27,9 @@ REFERENCE_NODES = 500  # node count at which SWEEP_S_PER_NODE_LEVEL was measured
 SWEEP_EXPONENT = 1.1  # time per level grows as nodes^1.1 (518 -> 1039 nodes: 6.5 -> 16 s)
 MESH_S_PER_SEGMENT = 4e-4  # meshes step per net segment (simple 1:40: 4962 in 1.4 s)
 FIXED_S = 5.0  # planning, cables, slicer profiles, G-code, counter-example, report
+# Uncertainty bands (check/bands.py): model variants on coarsened nets after the nominal sweeps;
+# on the 1:40 example they took 2.1 x the nominal sweeps' wall time (16.6 s of 24.4 s).
+BANDS_FACTOR = 2.0
 BASE_MEMORY_B = 150e6  # Python, numpy, scipy and the geometry libraries
 MEMORY_B_PER_NODE = 20e3  # sparse factor, path results kept per level (1998 nodes: +39 MB)
 COARSEN_MAX = 1000.0  # search bound for the mesh factor that fits
@@ -102,6 +105,7 @@ def estimate(p: Prototype, d: Design, *, cores: int, proto_factor: float = 1.0,
                                      ("model", m_nodes)))
     times = sorted((n.seconds for n in nets), reverse=True)
     sweep = sum(times) if cores < 2 else (times[0] if times else 0.0)
+    sweep *= 1.0 + BANDS_FACTOR
     segments = 2 * m_nodes
     seconds = FIXED_S + MESH_S_PER_SEGMENT * segments + sweep
     memory = BASE_MEMORY_B + sum(n.memory_b for n in nets)
