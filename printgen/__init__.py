@@ -11,6 +11,7 @@ The public verbs (`printgen.run.api`), imported on first use so `import printgen
 - ``make(prototype, scale, out)`` -> `MakeContext` (files in `out`)
 - ``verify(prototype, scale, design=None)`` -> `Verification`
 - ``calibrate(paths, material=...)`` -> `Calibration`
+- ``design_search(prototype, scales)`` -> `DesignRun` (the inverse design, on Dask)
 """
 
 from __future__ import annotations
@@ -19,11 +20,20 @@ from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
 
-VERBS = ("targets", "select", "plan", "make", "verify", "calibrate")
-__all__ = ["__version__", "calibrate", "make", "plan", "select", "targets", "verify"]
+VERBS = ("targets", "select", "plan", "make", "verify", "calibrate", "design_search")
+__all__ = ["__version__", "calibrate", "design_search", "make", "plan", "select", "targets",
+           "verify"]
 
 if TYPE_CHECKING:
-    from printgen.run.api import calibrate, make, plan, select, targets, verify
+    from printgen.run.api import (
+        calibrate,
+        design_search,
+        make,
+        plan,
+        select,
+        targets,
+        verify,
+    )
 
 
 def __getattr__(name: str) -> Any:

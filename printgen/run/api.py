@@ -27,6 +27,7 @@ if TYPE_CHECKING:
     from printgen.calibrate.pipeline import Calibration
     from printgen.calibrate.sample import FitOptions
     from printgen.check.verify import Verification
+    from printgen.run.design import DesignRun, SearchOptions
     from printgen.run.make import MakeContext
 
 PrototypeLike = str | Path | Prototype
@@ -72,16 +73,34 @@ def make(prototype: str | Path, scale: float, out: str | Path, *,
     return _make(prototype, scale, out, printer=printer, options=opts, progress=progress)
 
 
-def verify(prototype: PrototypeLike, scale: float, design_: Design | None = None, *,
-           printer: str | None = None, drag: bool = False) -> Verification:
+def verify(prototype: PrototypeLike, scale: float, design_: Design | str | Path | None = None,
+           *, printer: str | None = None, drag: bool = False) -> Verification:
     """The pre-print check: prototype and printed model solved under the same relative
-    loading, h/h_B = 0 to 1.1, and compared by their normalised deformations. Without a
-    `design_`, the design `make` would print is checked."""
+    loading, h/h_B = 0 to 1.1, and compared by their normalised deformations. `design_` is a
+    `Design` or the design.json that `make` wrote; without it, the design `make` would print
+    is checked."""
     from printgen.check.verify import verify as _verify
+    from printgen.run.verify import load_design
 
     p = prototype_of(prototype)
-    d = design_ if design_ is not None else plan(p, scale, printer=printer)
+    if design_ is None:
+        d = plan(p, scale, printer=printer)
+    else:
+        d = design_ if isinstance(design_, Design) else load_design(design_, scale)
     return _verify(p, d, drag=drag)
+
+
+def design_search(prototype: PrototypeLike, scales: float | Sequence[float], *,
+                  options: SearchOptions | None = None, scheduler: str | None = None,
+                  serial: bool = False) -> DesignRun:
+    """The inverse design: the printable net that deforms most like the prototype at each
+    scale (screened by the membrane law, the best verified with the solver), on a local Dask
+    cluster, the cluster at `scheduler`, or serially."""
+    from printgen.run.design import SearchOptions, design_searches
+
+    lams = [float(scales)] if isinstance(scales, int | float) else [float(s) for s in scales]
+    return design_searches(prototype, lams, options=options or SearchOptions(),
+                           scheduler=scheduler, serial=serial)
 
 
 def calibrate(paths: Sequence[str | Path], *, material: str,
