@@ -2,7 +2,7 @@
 
     python -m benchmarks.bench_parts --out DIR [--repeat N]
 
-Times the net mesh (without and with corner eyelets) and the cable meshes (outline +
+Times the net mesh (without and with its loops and corner eyelets) and the cable meshes (outline +
 extrusion, best of N), the bed layout and the STL/3MF encoding; compares the volumes with
 the analytic ones. Goal: the net mesh in under 5 s. Writes DIR/bench_parts.json.
 """
@@ -44,18 +44,17 @@ def run(out_dir: Path, repeat: int = 3) -> dict:
     from printgen.parts.geometry.solid import (
         analytic_cable_volume,
         analytic_net_volume,
+        attachment_for,
         cable_solid,
-        corner_eyelets_for,
         net_solid,
     )
     from tests.conftest import reference_design_1_40
 
     d = reference_design_1_40()
     printer = load_printer(d.printer)
-    eyelets = corner_eyelets_for(d)
+    att = attachment_for(d, hole_compensation_mm=printer.hole_compensation_mm)
     parts = [("net", lambda: net_solid(d.net), analytic_net_volume(d.net)),
-             ("net-eyelets", lambda: net_solid(d.net, eyelets),
-              analytic_net_volume(d.net, eyelets))]
+             ("net-eyelets", lambda: net_solid(d.net, att), analytic_net_volume(d.net, att))]
     parts += [(f"cable-{c.name}", lambda c=c: cable_solid(c), analytic_cable_volume(c))
               for c in d.cables]
     results, meshes = {}, {}
