@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from printgen.check.compare import METRICS, Deformation, compare, explain, row_strain
+from printgen.check.compare import METRICS, Deformation, compare, explain, headline, row_strain
 
 EXACT = 1e-12  # closed-form geometry, round-off only
 
@@ -48,3 +48,15 @@ def test_a_stiffer_model_fails_with_a_reason():
 def test_levels_must_agree():
     with pytest.raises(ValueError):
         compare(_deformation(1, np.linspace(0, 1, 5)), _deformation(1, np.linspace(0, 1.1, 5)))
+
+
+def test_headline_says_which_way_and_by_how_much():
+    lv = np.linspace(0, 1.1, 23)
+    stiff = headline(compare(_deformation(1.0, lv), _deformation(0.5, lv)))
+    assert stiff.startswith("model too stiff: deforms 50% to 50% less than the prototype")
+    assert "(5 of 5 quantities off by more than 25%" in stiff
+    soft = headline(compare(_deformation(1.0, lv), _deformation(1.5, lv)))
+    assert soft.startswith("model too soft: deforms 50% to 50% more")
+    close = headline(compare(_deformation(1.0, lv), _deformation(0.9, lv)))
+    assert close.startswith("model within 25% of the prototype's peak on all 5 quantities")
+    assert "0.90x to 0.90x" in close

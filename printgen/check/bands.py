@@ -98,7 +98,7 @@ def model_variants(d: Design, mounting: str | None = None) -> tuple[list[Variant
         out += _cable_variants(d, notes)
     if panel is not None and panel.has_geometry:
         out += _panel_geometry_variant(d, notes)
-    opts = mounting_options()
+    opts = mounting_options() if d.cables else ()  # no border cables: bed and banks only
     nominal = mounting or (opts[0] if opts else None)
     out += [Variant(f"mounting: {m}", mounting=m, source="flume mounting option "
                     f"(nominal: {nominal})") for m in opts if m != nominal]

@@ -116,3 +116,30 @@ def increments(d: Deformation) -> Deformation:
     zeroed before the water arrives read."""
     return Deformation(d.levels, {k: v - v[0] for k, v in d.values.items()},
                        d.max_strand_tension, d.max_cable_tension)
+
+
+def headline(mismatches: list[Mismatch], *, tolerance: float = TOLERANCE) -> str:
+    """The verdict in one sentence: which way the model is off and by how much (model /
+    prototype above h/h_B = UPPER_RANGE; every quantity is a deformation, so less is stiffer)."""
+    known = [m for m in mismatches if np.isfinite(m.ratio_high)]
+    bad = [m for m in known if not m.ok]
+    if not known:
+        return "no deformation to compare"
+    if not bad:
+        lo, hi = min(m.ratio_high for m in known), max(m.ratio_high for m in known)
+        return (f"model within {tolerance:.0%} of the prototype's peak on all {len(mismatches)} "
+                f"quantities; it deforms {lo:.2f}x to {hi:.2f}x the prototype above h/h_B = "
+                f"{UPPER_RANGE:g}")
+    stiff = [m.ratio_high for m in bad if m.ratio_high < 1]
+    soft = [m.ratio_high for m in bad if m.ratio_high >= 1]
+    parts = []
+    if stiff:
+        parts.append(f"too stiff: deforms {1 - max(stiff):.0%} to {1 - min(stiff):.0%} less"
+                     if len(stiff) > 1 else f"too stiff: deforms {1 - stiff[0]:.0%} less")
+    if soft:
+        parts.append(f"too soft: deforms {min(soft) - 1:.0%} to {max(soft) - 1:.0%} more"
+                     if len(soft) > 1 else f"too soft: deforms {soft[0] - 1:.0%} more")
+    way = " in some quantities, ".join(parts) if stiff and soft else parts[0]
+    return (f"model {way} than the prototype above h/h_B = {UPPER_RANGE:g} ({len(bad)} of "
+            f"{len(mismatches)} quantities off by more than {tolerance:.0%} of the prototype's "
+            "peak)")

@@ -10,7 +10,10 @@ cable tangent (geometric stiffness T / l over each segment) comes with it.
 Hold ("strands that carry no load stay where they are", `BarrierScene.hold` N/m): each free net
 node is tied to two fixed points `HOLD_ARM` x the shortest strand upstream and downstream of
 it by tension-only ties at strain 1, tension T = hold x arm / 2: together they pull nothing at
-rest and resist a move by `hold` N/m in the wall's plane (2 x hold out of it).
+rest and resist a move by `hold` N/m in the wall's plane (2 x hold out of it; hold once the
+node has moved more than arm / 2 downstream and the downstream tie is slack). Short ties keep
+their constant share of the strain energy small (the solver's line search compares energies);
+ties as long as the net did not converge.
 """
 
 from __future__ import annotations
@@ -31,7 +34,7 @@ HOLD_ARM = 1.0  # tie length / shortest strand
 @dataclass(frozen=True)
 class Extras:
     """What `build` appended after the scene's own items: node, strand and cable counts of
-    the scene, the wires' cable indices, and the hold ties (node, anchor) pairs."""
+    the scene (the net's items come first), and the hold ties (node, anchor) pairs."""
 
     n_nodes: int
     n_elements: int

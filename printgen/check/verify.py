@@ -14,7 +14,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 import solver
-from printgen.check.compare import Deformation, Mismatch, compare, deformation, explain, increments
+from printgen.check.compare import (
+    Deformation,
+    Mismatch,
+    compare,
+    deformation,
+    explain,
+    headline,
+    increments,
+)
 from printgen.check.scenes import (
     FLOW,
     BarrierScene,
@@ -136,6 +144,11 @@ class Verification:
     @property
     def ok(self) -> bool:
         return all(m.ok for m in self.mismatches)
+
+    @property
+    def headline(self) -> str:
+        """Which way the model is off and by how much, in one sentence."""
+        return headline(self.mismatches)
 
 
 def verify(p: Prototype, d: Design, *, drag: bool = False, lv: np.ndarray | None = None,

@@ -9,6 +9,7 @@ import numpy as np
 from printgen.check.bands import Band
 from printgen.check.compare import METRICS, Deformation
 from printgen.check.measured import Fit, Measurement
+from printgen.check.scenes import BarrierScene
 from printgen.errors import PrintgenError
 
 DPI = 110
@@ -108,4 +109,32 @@ def measured_figure(m: Measurement, band: Band, fit: Fit | None) -> bytes:
         ax.grid(alpha=0.3)
     axes.flat[0].legend(fontsize=8)
     fig.suptitle("Measured loading test against the prediction")
+    return _png(fig)
+
+
+def deformed_figure(shapes: list[tuple[str, BarrierScene, np.ndarray]], level: float) -> bytes:
+    """Each barrier's net deformed at relative loading `level`, in 3D, on the same normalised
+    axes: x / width across, deflection y / width downstream, z / height up.
+
+    shapes : (label, scene, positions (n, 3) m) per barrier.
+    """
+    plt = _pyplot()
+    from matplotlib.ticker import MaxNLocator
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection
+
+    fig = plt.figure(figsize=(6 * len(shapes), 5.2), constrained_layout=True)
+    norm = [(label, s, x / [s.width, s.width, s.height]) for label, s, x in shapes]
+    depth = max(float(np.abs(x[:, 1]).max()) for _, _, x in norm) or 1.0
+    for k, (label, s, x) in enumerate(norm):
+        ax = fig.add_subplot(1, len(norm), k + 1, projection="3d")
+        ax.add_collection3d(Line3DCollection(x[s.elements], colors=f"C{k}", linewidths=0.4))
+        for nodes, _ in s.cables.values():
+            ax.plot(*x[nodes].T, color="k", lw=1.2)
+        ax.set_xlim(0, 1), ax.set_ylim(0, depth), ax.set_zlim(0, 1)
+        ax.set_box_aspect((1.0, 0.5, 0.5))
+        ax.yaxis.set_major_locator(MaxNLocator(3))
+        ax.set_xlabel("x / width"), ax.set_ylabel("deflection / width"), ax.set_zlabel("z / height")
+        ax.view_init(elev=20, azim=-60)
+        ax.set_title(label, fontsize=10)
+    fig.suptitle(f"Deformed at h/h_B = {level:g} (same normalised axes)")
     return _png(fig)

@@ -1,0 +1,87 @@
+"""The pre-print check as it is run: every level of a free-top barrier solved (the hold of
+unloaded strands), the verdict's wording, and the deformed shapes in the report."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+from proto_files import REALISTIC, SIMPLE, write_variant
+
+from printgen.check.scenes import model_scene, prototype_scene
+from printgen.check.verify import SHAPE_LEVELS, sweep, verify
+from printgen.design.plan import make_design
+from printgen.design.selection import select
+from printgen.design.similitude import scale_targets
+from printgen.inputs.prototype import load_prototype
+from printgen.report.jsonout import dumps
+from printgen.report.plots import deformed_figure
+from printgen.report.report import verification_record
+
+HOLD_SHARE_MAX = 0.01  # the hold may carry at most 1 % of the applied load (a regularisation)
+HOLD_EFFECT = 0.01  # ... and move no normalised deformation by more than 1 % of its peak
+LOW_LEVELS = np.array([0.0, 0.05, 0.1, 0.15, 1.1])  # the dry net is largest at low water
+
+
+def _design(path, scale: float = 40):
+    p = load_prototype(path)
+    t = scale_targets(p, scale)
+    return p, make_design(p, t, select(p, t))
+
+
+@pytest.fixture(scope="module")
+def coarse_simple(tmp_path_factory):
+    """The simple barrier (bed and banks, top free) on a mesh twice as coarse (the test's
+    budget); the same scene as examples/simple_barrier.toml otherwise."""
+    tmp = tmp_path_factory.mktemp("simple")
+    path = write_variant(tmp, {("net", "mesh_x_m"): 0.4, ("net", "mesh_y_m"): 0.4,
+                               ("model", "mesh_x_mm"): 10.0, ("model", "mesh_y_mm"): 10.0},
+                         base=SIMPLE)
+    return _design(path)
+
+
+@pytest.mark.parametrize("who", ["prototype", "model"])
+def test_free_top_barrier_solves_every_level(coarse_simple, who):
+    """Without border cables the dry net above the water is a mechanism; with unloaded strands
+    held where they are every level converges, and the hold carries almost nothing."""
+    p, d = coarse_simple
+    s = prototype_scene(p) if who == "prototype" else model_scene(d)
+    assert s.hold > 0 and not s.cables
+    run = sweep(s, LOW_LEVELS)
+    assert not run.failed
+    assert 0 < run.hold_share < HOLD_SHARE_MAX
+    if who == "prototype":  # the hold selects an equilibrium, it does not change the answer
+        free = sweep(dataclasses.replace(s, hold=0.0), LOW_LEVELS[[0, -1]])
+        for key, v in run.deformation.values.items():
+            peak = np.abs(v).max()
+            if peak > 0:
+                assert abs(v[-1] - free.deformation.values[key][-1]) < HOLD_EFFECT * peak, key
+
+
+@pytest.fixture(scope="module")
+def realistic():
+    p, d = _design(REALISTIC)
+    return verify(p, d, lv=np.array([0.0, 0.5, 1.0, 1.1]))
+
+
+def test_deformed_shapes_in_the_record_are_reproducible(realistic):
+    v = realistic
+    assert set(v.model.shapes) == set(SHAPE_LEVELS)
+    rec = json.loads(dumps(verification_record(v, None)))
+    shape = rec["deformed_shape"]
+    assert set(shape["levels"]) == {"0.5", "1", "1.1"}
+    x = np.array(shape["levels"]["1"])
+    assert x.shape == v.model.scene.nodes.shape
+    np.testing.assert_allclose(x, v.model.shapes[1.0], atol=0.5 * 10.0 ** -shape["decimals"])
+    assert dumps(verification_record(v, None)) == dumps(verification_record(v, None))
+    assert rec["mounting"] == "walls" and rec["assumptions"]["model"]
+    assert rec["summary"] == v.headline
+
+
+def test_deformed_figure_is_a_png(realistic):
+    v = realistic
+    png = deformed_figure([("prototype", v.prototype.scene, v.prototype.shapes[1.0]),
+                           ("model", v.model.scene, v.model.shapes[1.0])], 1.0)
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
