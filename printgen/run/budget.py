@@ -1,11 +1,13 @@
 """The size of a `make` run, before any of it is done: nodes, unknowns, memory and time.
 
 The verification solves two nets over 23 load levels (prototype and model, in parallel on two
-cores), then the model's uncertainty-band variants; the meshes step builds one solid strand per model net segment. Both costs grow with
-the node count, which follows from the meshes alone (no net is built here). The constants are
-measured on the 1:40 example (`examples/realistic_barrier.toml`: 518 prototype nodes in 6.5 s,
-365 model nodes in 5.5 s, 1039 prototype nodes in 16 s; one core each); the estimate is meant
-to be right within a factor of about two, enough to stop a run that would take an hour.
+cores), then the model's uncertainty-band variants; the meshes step builds one solid strand per
+model net segment. Both costs grow with the node count, which follows from the meshes alone (no
+net is built here). The constants are measured on the 1:40 example with the solver's fast path
+(`examples/realistic_barrier.toml`, one core per sweep: 518 prototype nodes in 0.43 s, 365
+model nodes in 0.40 s, 1998 nodes in 2.5 s, 7776 nodes in 21 s; bands 2.7 s; meshes 2.9 s;
+whole `make` 9.0 s); the estimate is meant to be right within a factor of about two, enough
+to stop a run that would take an hour.
 """
 
 from __future__ import annotations
@@ -21,15 +23,16 @@ from printgen.inputs.prototype import Prototype
 from printgen.workers import reporting
 
 DEFAULT_LIMIT_S = 60.0  # about a minute of `make` on 2 cores (issue 16)
-LEVELS = 23  # load levels of the sweep, h / h_B = 0 to 1.1 by 0.05
-SWEEP_S_PER_NODE_LEVEL = 6.0e-4  # one core, at REFERENCE_NODES (1:40 example, see above)
-REFERENCE_NODES = 500  # node count at which SWEEP_S_PER_NODE_LEVEL was measured
-SWEEP_EXPONENT = 1.1  # time per level grows as nodes^1.1 (518 -> 1039 nodes: 6.5 -> 16 s)
-MESH_S_PER_SEGMENT = 4e-4  # meshes step per net segment (simple 1:40: 4962 in 1.4 s)
-FIXED_S = 5.0  # planning, cables, slicer profiles, G-code, counter-example, report
-# Uncertainty bands (check/bands.py): model variants on coarsened nets after the nominal sweeps;
-# on the 1:40 example they took 2.1 x the nominal sweeps' wall time (16.6 s of 24.4 s).
-BANDS_FACTOR = 2.0
+SWEEP_S_AT_REFERENCE = 0.45  # one net over the 23 load levels of the sweep, one core
+REFERENCE_NODES = 500  # node count at which SWEEP_S_AT_REFERENCE was measured
+SWEEP_EXPONENT = 1.45  # sweep time grows as nodes^1.45 (518 -> 1998 -> 7776 nodes)
+# Uncertainty bands (check/bands.py): refinement test and model variants after the nominal
+# sweeps; on the 1:40 example 2.7 s, 6.7 x the model's own sweep.
+BANDS_FACTOR = 6.0
+VERIFY_FIXED_S = 1.5  # worker start, the steel counter-example, the comparison
+MESH_S_PER_SEGMENT = 1e-4  # meshes step per model net segment (simple 1:40: 4962 in 0.46 s)
+CABLE_PARTS_S = 2.5  # the four cables, their eyelets and plate (1:40: 2.9 s meshes in all)
+FIXED_S = 2.5  # planning, slicer profiles, G-code, previews, report (1:40: ~1.6 s)
 BASE_MEMORY_B = 150e6  # Python, numpy, scipy and the geometry libraries
 MEMORY_B_PER_NODE = 20e3  # sparse factor, path results kept per level (1998 nodes: +39 MB)
 COARSEN_MAX = 1000.0  # search bound for the mesh factor that fits
@@ -90,54 +93,58 @@ def model_nodes(d: Design, factor: float = 1.0) -> int:
 
 def sweep_seconds(nodes: int) -> float:
     """One net over the load path on one core."""
-    scale = (nodes / REFERENCE_NODES) ** SWEEP_EXPONENT
-    return LEVELS * SWEEP_S_PER_NODE_LEVEL * REFERENCE_NODES * scale
+    return SWEEP_S_AT_REFERENCE * (nodes / REFERENCE_NODES) ** SWEEP_EXPONENT
 
 
-def estimate(p: Prototype, d: Design, *, cores: int, proto_factor: float = 1.0,
-             model_factor: float = 1.0) -> Estimate:
-    """The run's size; the factors coarsen the prototype's or the model's meshes."""
+def estimate(p: Prototype, d: Design, *, cores: int, sweep: bool = True,
+             proto_factor: float = 1.0, model_factor: float = 1.0) -> Estimate:
+    """The run's size (`sweep`: the verification runs); the factors coarsen the prototype's or
+    the model's meshes."""
     m_nodes = model_nodes(d, model_factor)
     nets: tuple[NetSize, ...] = ()
-    if d.cables:  # the sweep runs only for barriers with border cables (verify_step)
+    if sweep and d.cables:  # the sweep runs only for barriers with border cables (verify_step)
         nets = tuple(NetSize(name, n, 3 * n, sweep_seconds(n), MEMORY_B_PER_NODE * n)
                      for name, n in (("prototype", prototype_nodes(p, proto_factor)),
                                      ("model", m_nodes)))
-    times = sorted((n.seconds for n in nets), reverse=True)
-    sweep = sum(times) if cores < 2 else (times[0] if times else 0.0)
-    sweep *= 1.0 + BANDS_FACTOR
+    verify = 0.0
+    if nets:
+        times = [n.seconds for n in nets]
+        nominal = sum(times) if cores < 2 else max(times)
+        verify = VERIFY_FIXED_S + nominal + BANDS_FACTOR * nets[1].seconds
     segments = 2 * m_nodes
-    seconds = FIXED_S + MESH_S_PER_SEGMENT * segments + sweep
+    parts = FIXED_S + MESH_S_PER_SEGMENT * segments + (CABLE_PARTS_S if d.cables else 0.0)
     memory = BASE_MEMORY_B + sum(n.memory_b for n in nets)
-    return Estimate(nets, segments, seconds, memory, cores)
+    return Estimate(nets, segments, parts + verify, memory, cores)
 
 
-def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int) -> Estimate:
+def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
+                 sweep: bool = True) -> Estimate:
     """Return the estimate; raise InputError with the estimate, the limit, the option that
     raises it and the least coarsening of the meshes that fits, when it is over the limit."""
     if not (math.isfinite(limit_s) and limit_s > 0):
         raise InputError(f"--time-limit {limit_s:g} s must be a positive number of seconds")
-    est = estimate(p, d, cores=cores)
+    est = estimate(p, d, cores=cores, sweep=sweep)
     if est.seconds <= limit_s:
         return est
-    fix = coarsest_fix(p, d, limit_s=limit_s, cores=cores)
+    fix = coarsest_fix(p, d, limit_s=limit_s, cores=cores, sweep=sweep)
     raise InputError(f"this run is too big: {est.summary()}; the limit is {limit_s:g} s "
                      f"(about a minute of make on 2 cores). Raise it with --time-limit "
                      f"{math.ceil(est.seconds * 1.5 / 60) * 60:g}, or {fix}")
 
 
-def coarsest_fix(p: Prototype, d: Design, *, limit_s: float, cores: int) -> str:
+def coarsest_fix(p: Prototype, d: Design, *, limit_s: float, cores: int,
+                 sweep: bool = True) -> str:
     """The smallest uniform coarsening of the meshes that fits `limit_s`, as advice."""
     user_model = p.model.mesh_x_mm is not None
     model_scales = not user_model  # the model mesh follows the prototype's unless [model] sets it
 
     def fits(f: float) -> bool:
-        return estimate(p, d, cores=cores, proto_factor=f,
+        return estimate(p, d, cores=cores, sweep=sweep, proto_factor=f,
                         model_factor=f if model_scales else 1.0).seconds <= limit_s
 
     lo, hi = 1.0, COARSEN_MAX
     if not fits(hi):
-        if user_model and estimate(p, d, cores=cores, proto_factor=hi,
+        if user_model and estimate(p, d, cores=cores, sweep=sweep, proto_factor=hi,
                                    model_factor=hi).seconds <= limit_s:
             return "coarsen [model] mesh_x_mm / mesh_y_mm as well as the prototype's net"
         return "no mesh coarsening alone fits; raise --time-limit"

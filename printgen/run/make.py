@@ -12,7 +12,7 @@ import logging
 import os
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -330,8 +330,8 @@ def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
     (options["time_limit_s"], default about a minute on 2 cores)."""
     cores = 1 if os.environ.get("PRINTGEN_SERIAL") else min(2, os.cpu_count() or 1)
     limit = ctx.options.get("time_limit_s") or DEFAULT_LIMIT_S
-    d = ctx.design if verifies else replace(ctx.design, cables=())  # no sweep, no cost
-    est = check_budget(ctx.prototype, d, limit_s=float(limit), cores=cores)
+    est = check_budget(ctx.prototype, ctx.design, limit_s=float(limit), cores=cores,
+                       sweep=verifies)
     ctx.record["size"] = est.to_record()
     ctx.record.setdefault("timings_s", {})["estimate"] = est.seconds
     return est
