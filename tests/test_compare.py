@@ -54,7 +54,7 @@ def test_headline_says_which_way_and_by_how_much():
     lv = np.linspace(0, 1.1, 23)
     stiff = headline(compare(_deformation(1.0, lv), _deformation(0.5, lv)))
     assert stiff.startswith("model too stiff: deforms 50% to 50% less than the prototype")
-    assert "(5 of 5 quantities off by more than 25%" in stiff
+    assert "; 5 of 5 quantities fail (off by more than 25% of the prototype's peak)" in stiff
     soft = headline(compare(_deformation(1.0, lv), _deformation(1.5, lv)))
     assert soft.startswith("model too soft: deforms 50% to 50% more")
     close = headline(compare(_deformation(1.0, lv), _deformation(0.9, lv)))

@@ -140,6 +140,6 @@ def headline(mismatches: list[Mismatch], *, tolerance: float = TOLERANCE) -> str
         parts.append(f"too soft: deforms {min(soft) - 1:.0%} to {max(soft) - 1:.0%} more"
                      if len(soft) > 1 else f"too soft: deforms {soft[0] - 1:.0%} more")
     way = " in some quantities, ".join(parts) if stiff and soft else parts[0]
-    return (f"model {way} than the prototype above h/h_B = {UPPER_RANGE:g} ({len(bad)} of "
-            f"{len(mismatches)} quantities off by more than {tolerance:.0%} of the prototype's "
-            "peak)")
+    return (f"model {way} than the prototype above h/h_B = {UPPER_RANGE:g}; {len(bad)} of "
+            f"{len(mismatches)} quantities fail (off by more than {tolerance:.0%} of the "
+            "prototype's peak)")

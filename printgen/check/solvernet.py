@@ -13,7 +13,7 @@ it by tension-only ties at strain 1, tension T = hold x arm / 2: together they p
 rest and resist a move by `hold` N/m in the wall's plane (2 x hold out of it; hold once the
 node has moved more than arm / 2 downstream and the downstream tie is slack). Short ties keep
 their constant share of the strain energy small (the solver's line search compares energies);
-ties as long as the net did not converge.
+ties of 5 % to 200 % of the net's size did not converge on the simple barrier's model.
 """
 
 from __future__ import annotations
