@@ -14,11 +14,12 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from solver import newton
+from solver.assemble import cable_state
 from solver.fast import Stepper, best_start, iterate, membrane_start
 from solver.model import Net
 from solver.newton import MAX_CUTS, MAX_ITER, TOL_FORCE
 from solver.result import Result, SolverError
-from solver.state import NetSystem, State, _bar_pass, cable_state, evaluate
+from solver.state import NetSystem, State, _bar_pass, evaluate
 
 METHODS = ("fast", "reference")
 

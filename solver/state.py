@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.assemble import Bars, _law_eval, cable_state, make_bars, make_cable
+from solver.assemble import Bars, _law_eval, make_bars, make_cable
 from solver.loads import total_forces
 from solver.model import Net
 from solver.pattern import Pattern, pair_values
@@ -35,6 +35,7 @@ class NetSystem:
         self.cables = [make_cable(x0 / self.L, np.asarray(c.nodes, dtype=int),
                                   net.cable_rest_length(c) / self.L, c.law.scaled(1 / self.S))
                        for c in net.cables]
+        self.cable_set = CableSet(self.cables)
         self.free = ~net.fixed_dofs.ravel()
         self.pattern = Pattern(self.n, self.free, self.bars.i, self.bars.j,
                                [c.nodes for c in self.cables])
@@ -62,6 +63,42 @@ class NetSystem:
         return f / self.S, dz * self.L / self.S
 
 
+class CableSet:
+    """All sliding cables at once: their segments concatenated (a, b node pairs, D0, |D0|,
+    owning cable), so a state costs a few array operations however many cables there are."""
+
+    def __init__(self, cables: list) -> None:
+        self.count = len(cables)
+        self.rest = np.array([c.rest for c in cables], dtype=float)
+        self.laws = [c.law for c in cables]
+        self.offsets = np.cumsum([0, *[len(c.l0) for c in cables]])
+        if cables:
+            self.a = np.concatenate([c.nodes[:-1] for c in cables])
+            self.b = np.concatenate([c.nodes[1:] for c in cables])
+            self.d0 = np.concatenate([c.d0 for c in cables])
+            self.l0 = np.concatenate([c.l0 for c in cables])
+            self.owner = np.repeat(np.arange(self.count), np.diff(self.offsets))
+            self.l0_sum = np.bincount(self.owner, self.l0, self.count)
+
+    def strains(self, u: np.ndarray):
+        """(cable strains (c,), unit vectors (s, 3), lengths (s,)) of every segment."""
+        du = u[self.b] - u[self.a]
+        d = self.d0 + du
+        l = np.sqrt(np.einsum("ij,ij->i", d, d))
+        stretch = (2 * np.einsum("ij,ij->i", self.d0, du) + np.einsum("ij,ij->i", du, du)) / (
+            l + self.l0)
+        eps = (np.bincount(self.owner, stretch, self.count) + self.l0_sum - self.rest) / self.rest
+        return eps, d / l[:, None], l
+
+    def laws_at(self, eps: np.ndarray):
+        """(tension, tangent, energy per rest length) of each cable at its strain."""
+        t, kt, e = np.zeros(self.count), np.zeros(self.count), np.zeros(self.count)
+        for k, law in enumerate(self.laws):
+            t[k], kt[k] = (float(v[0]) for v in law.force_and_tangent(eps[k:k + 1]))
+            e[k] = float(law.energy(eps[k:k + 1])[0])
+        return t, kt, e
+
+
 @dataclass
 class State:
     """A trial displacement field u (n, 3) and what follows from it (nondimensional)."""
@@ -74,7 +111,7 @@ class State:
     f: np.ndarray  # external forces (n, 3)
     dz: np.ndarray  # their z-derivative (n, 3)
     bar: tuple  # (strain, force, tangent, d, l) of the strands
-    cab: list  # (tension, tangent, unit vectors, lengths, grad) of each cable
+    cab: tuple  # (tensions, tangents, unit vectors, lengths) of the cables and segments
 
     def potential(self, f_frozen: np.ndarray) -> float:
         """Total potential with the loads frozen at another state's values."""
@@ -111,29 +148,31 @@ def evaluate(ns: NetSystem, u: np.ndarray) -> State:
     for k in range(3):
         g[:, k] = (np.bincount(b.j, fn[:, k], ns.n) - np.bincount(b.i, fn[:, k], ns.n))
     energy = _bar_energy(b, eps)
-    cabs, scales = [], [float(force.max()) if force.size else 0.0]
-    for c in ns.cables:
-        ce, t, kt, nvec, ls = cable_state(c, u)
-        grad = np.zeros((len(c.nodes), 3))
-        grad[:-1] -= nvec
-        grad[1:] += nvec
-        if t > 0:
-            np.add.at(g, c.nodes, t * grad)
-        energy += c.rest * float(c.law.energy(np.array([ce]))[0])
-        cabs.append((t, kt, nvec, ls, grad))
-        scales.append(t)
+    scales = [float(force.max()) if force.size else 0.0]
+    cab: tuple = ()
+    cs = ns.cable_set
+    if cs.count:
+        ce, nvec, ls = cs.strains(u)
+        t, kt, e = cs.laws_at(ce)
+        fseg = np.maximum(t, 0.0)[cs.owner][:, None] * nvec
+        for k in range(3):
+            g[:, k] += (np.bincount(cs.b, fseg[:, k], ns.n) - np.bincount(cs.a, fseg[:, k], ns.n))
+        energy += float((cs.rest * e).sum())
+        scales.append(float(t.max()))
+        cab = (t, kt, nvec, ls)
     f, dz = ns.external(u)
     r = (g - f).ravel()[ns.free]
     scales.append(float(np.abs(f).max()) if f.size else 0.0)
     return State(u, r, float(np.abs(r).max()) if r.size else 0.0, max(max(scales), 1e-300),
-                 energy, f, dz, (eps, force, tangent, d, l), cabs)
+                 energy, f, dz, (eps, force, tangent, d, l), cab)
 
 
 def potential(ns: NetSystem, u: np.ndarray, f_frozen: np.ndarray) -> float:
     """Strain energy minus the work of frozen loads, without forces (for scalar searches)."""
     energy = _bar_energy(ns.bars, _bar_pass(ns.bars, u)[0])
-    for c in ns.cables:
-        energy += c.rest * float(c.law.energy(np.array([cable_state(c, u)[0]]))[0])
+    cs = ns.cable_set
+    if cs.count:
+        energy += float((cs.rest * cs.laws_at(cs.strains(u)[0])[2]).sum())
     return energy - float((f_frozen * u).sum())
 
 
@@ -145,12 +184,19 @@ def tangent_values(ns: NetSystem, st: State) -> np.ndarray:
     geo = np.where(force > 0, force / l, 0.0)[:, None, None]
     mat = (tangent / ns.bars.rest)[:, None, None]
     vals = [pair_values(geo * (np.eye(3)[None] - nn) + mat * nn).ravel()]
-    for c, (t, kt, nvec, ls, grad) in zip(ns.cables, st.cab):
+    cs = ns.cable_set
+    for k, c in enumerate(ns.cables):
+        t, kt = st.cab[0][k], st.cab[1][k]
         if t <= 0:
-            vals.append(np.zeros(36 * len(ls) + (3 * len(c.nodes)) ** 2))
+            vals.append(np.zeros(36 * len(c.l0) + (3 * len(c.nodes)) ** 2))
             continue
+        seg = slice(cs.offsets[k], cs.offsets[k + 1])
+        nvec, ls = st.cab[2][seg], st.cab[3][seg]
         cnn = np.einsum("ki,kj->kij", nvec, nvec)
         vals.append(pair_values((t / ls)[:, None, None] * (np.eye(3)[None] - cnn)).ravel())
+        grad = np.zeros((len(c.nodes), 3))
+        grad[:-1] -= nvec
+        grad[1:] += nvec
         gv = grad.ravel()
         vals.append((kt / c.rest) * np.outer(gv, gv).ravel())
     hyd = np.zeros((ns.n, 3, 3))
