@@ -6,7 +6,8 @@ model net segment. Both costs grow with the node count, which follows from the m
 net is built here). The constants are measured on the 1:40 example with the solver's fast path
 (`examples/realistic_barrier.toml`, one core per sweep: 518 prototype nodes in 0.43 s, 365
 model nodes in 0.40 s, 1998 nodes in 2.5 s, 7776 nodes in 21 s; bands 2.7 s; meshes 2.9 s;
-whole `make` 9.0 s); the estimate is meant to be right within a factor of about two, enough
+whole `make` 9.0 s) and on the simple barrier (free top: model 2481 nodes in 34 s of CPU,
+whole `make` ~100 s); the estimate is meant to be right within a factor of about two, enough
 to stop a run that would take an hour.
 """
 
@@ -22,13 +23,19 @@ from printgen.errors import InputError
 from printgen.inputs.prototype import Prototype
 from printgen.workers import reporting
 
-DEFAULT_LIMIT_S = 60.0  # about a minute of `make` on 2 cores (issue 16)
+# About a minute of `make` on 2 cores (issue 16) is not enough for the bundled simple barrier
+# (examples/simple_barrier.toml, ~100 s: its free-top model converges slowly), so two minutes.
+DEFAULT_LIMIT_S = 120.0
 SWEEP_S_AT_REFERENCE = 0.45  # one net over the 23 load levels of the sweep, one core
 REFERENCE_NODES = 500  # node count at which SWEEP_S_AT_REFERENCE was measured
 SWEEP_EXPONENT = 1.45  # sweep time grows as nodes^1.45 (518 -> 1998 -> 7776 nodes)
-# Uncertainty bands (check/bands.py): refinement test and model variants after the nominal
-# sweeps; on the 1:40 example 2.7 s, 6.7 x the model's own sweep.
-BANDS_FACTOR = 6.0
+# Uncertainty bands (check/bands.py): refinement test and model variants on coarsened nets
+# after the nominal sweeps: 2.7 s on the 1:40 example, ~1.4 x the model's sweep on the simple.
+BANDS_FACTOR = 1.5
+BANDS_MIN_S = 2.5
+# A net without border cables (free top, anchored on bed and banks) is slack at low water:
+# the simple barrier's 1:40 model took 1475 Newton iterations against 197 for the realistic.
+FREE_TOP_MODEL_FACTOR = 7.5
 VERIFY_FIXED_S = 1.5  # worker start, the steel counter-example, the comparison
 MESH_S_PER_SEGMENT = 1e-4  # meshes step per model net segment (simple 1:40: 4962 in 0.46 s)
 CABLE_PARTS_S = 2.5  # the four cables, their eyelets and plate (1:40: 2.9 s meshes in all)
@@ -102,15 +109,17 @@ def estimate(p: Prototype, d: Design, *, cores: int, sweep: bool = True,
     the model's meshes."""
     m_nodes = model_nodes(d, model_factor)
     nets: tuple[NetSize, ...] = ()
-    if sweep and d.cables:  # the sweep runs only for barriers with border cables (verify_step)
-        nets = tuple(NetSize(name, n, 3 * n, sweep_seconds(n), MEMORY_B_PER_NODE * n)
-                     for name, n in (("prototype", prototype_nodes(p, proto_factor)),
-                                     ("model", m_nodes)))
+    if sweep:
+        slow = 1.0 if d.cables else FREE_TOP_MODEL_FACTOR
+        nets = tuple(NetSize(name, n, 3 * n, factor * sweep_seconds(n), MEMORY_B_PER_NODE * n)
+                     for name, n, factor in (("prototype", prototype_nodes(p, proto_factor), 1.0),
+                                             ("model", m_nodes, slow)))
     verify = 0.0
     if nets:
         times = [n.seconds for n in nets]
         nominal = sum(times) if cores < 2 else max(times)
-        verify = VERIFY_FIXED_S + nominal + BANDS_FACTOR * nets[1].seconds
+        bands = max(BANDS_MIN_S, BANDS_FACTOR * nets[1].seconds)
+        verify = VERIFY_FIXED_S + nominal + bands
     segments = 2 * m_nodes
     parts = FIXED_S + MESH_S_PER_SEGMENT * segments + (CABLE_PARTS_S if d.cables else 0.0)
     memory = BASE_MEMORY_B + sum(n.memory_b for n in nets)
@@ -127,8 +136,10 @@ def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
     if est.seconds <= limit_s:
         return est
     fix = coarsest_fix(p, d, limit_s=limit_s, cores=cores, sweep=sweep)
+    which = ("the default, about two minutes of make on 2 cores" if limit_s == DEFAULT_LIMIT_S
+             else "from --time-limit")
     raise InputError(f"this run is too big: {est.summary()}; the limit is {limit_s:g} s "
-                     f"(about a minute of make on 2 cores). Raise it with --time-limit "
+                     f"({which}). Raise it with --time-limit "
                      f"{math.ceil(est.seconds * 1.5 / 60) * 60:g}, or {fix}")
 
 
