@@ -70,7 +70,9 @@ class CableSet:
     def __init__(self, cables: list) -> None:
         self.count = len(cables)
         self.rest = np.array([c.rest for c in cables], dtype=float)
-        self.laws = [c.law for c in cables]
+        distinct = list(dict.fromkeys(c.law for c in cables))  # laws are frozen, hashable
+        self.groups = [(law, np.array([k for k, c in enumerate(cables) if c.law == law]))
+                       for law in distinct]
         self.offsets = np.cumsum([0, *[len(c.l0) for c in cables]])
         if cables:
             self.a = np.concatenate([c.nodes[:-1] for c in cables])
@@ -91,11 +93,12 @@ class CableSet:
         return eps, d / l[:, None], l
 
     def laws_at(self, eps: np.ndarray):
-        """(tension, tangent, energy per rest length) of each cable at its strain."""
+        """(tension, tangent, energy per rest length) of each cable at its strain (one law
+        evaluation per distinct law)."""
         t, kt, e = np.zeros(self.count), np.zeros(self.count), np.zeros(self.count)
-        for k, law in enumerate(self.laws):
-            t[k], kt[k] = (float(v[0]) for v in law.force_and_tangent(eps[k:k + 1]))
-            e[k] = float(law.energy(eps[k:k + 1])[0])
+        for law, sel in self.groups:
+            t[sel], kt[sel] = law.force_and_tangent(eps[sel])
+            e[sel] = law.energy(eps[sel])
         return t, kt, e
 
 
