@@ -1,6 +1,5 @@
-"""The fast path: the same regularised Newton method as `solver.newton` (same convergence
-test, same energy line search, same step cap), computed with less work per step and fewer
-steps:
+"""The fast path: the regularised Newton method of `solver.newton` (same convergence test,
+same energy line search and step cap), computed with less work per step and fewer steps:
 
 - one strand pass per trial state (`solver.state`), the tangent scattered into a pattern
   fixed per net (`solver.pattern`), factorized by a sparse LDL^T whose ordering is reused
@@ -11,8 +10,15 @@ steps:
 - chord steps on large nets: after a full Newton step the same factorization is tried once
   more, and kept while it at least halves the out-of-balance force (modified Newton);
 - along load paths, a start extrapolated from the last two converged levels when its
-  potential is lower than the last level's state.
+  potential is lower than the last level's state;
+- a non-monotone Armijo test (the last NONMONOTONE states), so full Newton steps survive
+  while strands settle slack or taut; mu grows tenfold when no damped step descends (the
+  follower load can make the damped tangent indefinite);
+- inexact Newton: linear solves to a residual of min(FORCING, |R| / force scale).
 
+The tangent is not symmetric (hydrostatic follower term): every step solves the true
+system; the symmetric part only serves as a factorization to precondition it
+(`solver.linsolve`) and, failing all else, as a descent direction of the energy.
 The answer is the same (R = 0 to the same tolerance): only the path to it differs.
 """
 
