@@ -26,11 +26,19 @@ from printgen.design.similitude import ScaledTargets, scale_targets
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
 from printgen.inputs.prototype import Prototype, load_prototype
-from printgen.outputs import MANIFEST, check_destination, file_digest, staged_dir
+from printgen.outputs import MANIFEST, check_destination, staged_dir
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
 from printgen.report.report import design_record, design_sections
 from printgen.run.budget import DEFAULT_LIMIT_S, Estimate, check_budget, level_bars
+from printgen.run.provenance import (  # noqa: F401 (json_output, TIME_KEYS: used via make)
+    TIME_KEYS,
+    TIMINGS,
+    json_output,
+    provenance,
+    provenance_section,
+    split_timings,
+)
 
 log = logging.getLogger(__name__)
 
@@ -281,8 +289,6 @@ def verify_step(ctx: MakeContext, stage: Path) -> None:
 
 
 LONG_RUN_S = 30.0  # runs estimated longer than this show their estimate and progress
-TIMINGS = "timings.json"  # the one volatile file: every wall-clock time of the run
-TIME_KEYS = ("timings_s", "seconds", "time_s")  # record keys that hold wall-clock times
 
 
 def make(prototype_path: str | Path, scale: float, out: str | Path, *,
@@ -335,76 +341,6 @@ def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
     ctx.record["size"] = est.to_record()
     ctx.record.setdefault("timings_s", {})["estimate"] = est.seconds
     return est
-
-
-def split_timings(record: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
-    """(the record without wall-clock times, the times at the same paths).
-
-    The first is byte-reproducible; the second is `timings.json` and `--json`'s "timings".
-    """
-    def split(v: Any) -> tuple[Any, Any]:
-        if isinstance(v, dict):
-            keep, times = {}, {}
-            for k, x in v.items():
-                if k in TIME_KEYS:
-                    times[k] = x
-                    continue
-                keep[k], t = split(x)
-                if t:
-                    times[k] = t
-            return keep, times
-        if isinstance(v, list):
-            parts = [split(x) for x in v]
-            times = {str(i): t for i, (_, t) in enumerate(parts) if t}
-            return [k for k, _ in parts], times
-        return v, {}
-
-    return split(record)
-
-
-def json_output(record: dict[str, Any]) -> dict[str, Any]:
-    """What `make --json` prints: the reproducible record plus one top-level "timings" key."""
-    stable, timings = split_timings(record)
-    return {**stable, "timings": timings}
-
-
-def provenance(ctx: MakeContext) -> dict[str, Any]:
-    """Version, command line and the sha256 of every input (prototype, each profile used)."""
-    from importlib.metadata import version
-
-    from printgen.inputs.profiles import BUNDLED, load_raw
-
-    d = ctx.design
-    used = {("printers", d.printer), ("materials", d.net.material),
-            ("prints", d.net.print_style)}
-    used |= {("materials", c.material) for c in d.cables}
-    used |= {("prints", c.print_style) for c in d.cables}
-    inputs = {"prototype": _digest(ctx.prototype.path)} if ctx.prototype.path else {}
-    if ctx.options.get("design_file"):  # make --design FILE: the design is an input too
-        inputs["design_file"] = _digest(Path(ctx.options["design_file"]))
-    for kind, name in sorted(used):
-        for path in load_raw(kind, name)[1]:
-            shown = (Path("profiles") / path.relative_to(BUNDLED)
-                     if path.is_relative_to(BUNDLED) else path)
-            inputs[f"{kind}/{path.stem}"] = _digest(path, shown)
-    return {"printgen_version": version("printgen"), "command": ctx.options.get("command"),
-            "inputs": inputs}
-
-
-def _digest(path: Path, shown: Path | None = None) -> dict[str, Any]:
-    return {"path": str(shown or path), "sha256": file_digest(Path(path))["sha256"]}
-
-
-def provenance_section(rep: Report, meta: dict[str, Any]) -> None:
-    """The report's provenance: what made this folder (the manifest holds the same)."""
-    rep.heading("Provenance")
-    cmd = meta.get("command")
-    rep.paragraph(f"printgen {meta['printgen_version']}; command: "
-                  f"{' '.join(cmd) if cmd else 'printgen.make() from Python'}. Every file of "
-                  f"this folder and its sha256 are in {MANIFEST}; `printgen check FOLDER` "
-                  "verifies them.")
-    rep.table(["input", "file", "sha256"],
-              [[k, v["path"], v["sha256"]] for k, v in meta["inputs"].items()])
 
 
 def default_steps() -> list[tuple[str, Step]]:
