@@ -88,7 +88,7 @@ def staged_dir(final: str | Path, *, force: bool = False,
     between identical runs (at most one: the timings).
     On an exception (or a signal turned into one) the stage is removed and `final` untouched.
     """
-    dest = Path(final)
+    dest = Path(os.path.abspath(final))  # "." and "a/.." have a name and a parent this way
     check_destination(dest, force=force)
     make_parent(dest)
     with folder_lock(dest):

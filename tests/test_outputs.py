@@ -117,6 +117,14 @@ def test_foreign_folder_needs_force(tmp_path):
     run_into(empty, {"a.txt": "1"})  # an empty folder is fine
 
 
+def test_output_given_as_dot(tmp_path, monkeypatch):
+    out = run_into(tmp_path / "out", {"a.txt": "1"})
+    monkeypatch.chdir(out)
+    run_into(".", {"b.txt": "2"})  # the stage is a sibling of the folder, not inside it
+    assert listing(out) == ["b.txt", "manifest.json"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+
+
 def test_symlinked_output_is_refused(tmp_path):
     real = run_into(tmp_path / "real", {"a.txt": "1"})
     (tmp_path / "link").symlink_to(real)
