@@ -212,7 +212,8 @@ def prototype_scene(p: Prototype, *, mounting: str | None = None) -> BarrierScen
         cable_law = ((), (p.border.modulus * math.pi / 4 * p.border.diameter**2,))
     s = _scene(f"{p.name}: prototype", 1.0, g, MM, net_law, cable_law, None, mounting)
     src = f"prototype file {p.path.name}" if p.path else "prototype file"
-    rows = [("net", (f"{p.net.pattern} mesh {p.net.mesh_x / MM:g} x {p.net.mesh_y / MM:g} mm, "
+    rows = [("net", (f"{p.net.pattern} mesh {p.net.mesh_x / MM:g} x {p.net.mesh_y / MM:g} mm"
+                     f"{'' if p.net.pattern in ('square', 'diamond') else ' (as diamonds)'}, "
              f"{len(s.nodes)} nodes"), src), ("net strands", law_text, src)]
     if p.border is not None:
         rows.append(("border cables", (f"d = {p.border.diameter / MM:g} mm, E = "
