@@ -86,7 +86,7 @@ def show_summary(ctx, out: Path, seconds: float) -> None:
         rows.append(["size", f"nodes: {nets}", f"{size['mesh_segments']:,} strand segments"])
     ver = ctx.record.get("verification")
     if ver:
-        rows.append(["verification", ver["verdict"], ver["summary"][:90]])
+        rows.append(["verification", ver["verdict"], ver["summary"]])
     c.print(table(f"printgen make: 1:{ctx.targets.scale:g} in {seconds:.1f} s",
                   ["item", "choice", "stiffness / result"], rows))
     c.print(f"{len(ctx.record['files'])} files in {out}/ ; open {out / 'report.html'}")
