@@ -14,8 +14,9 @@ the true K: mu only shapes the path, never the answer (a vanishing regularisatio
 Units: the solve runs on x / L_ref and F / S_ref (L_ref the net's extent, S_ref its stiffest
 strand law), so a net at 1:100 or of 0.02 GPa polymer sees the same numbers as the prototype.
 The hydrostatic load depends on the current node height; its derivative enters the tangent.
-Load paths are solved level by level, each warm-started from the previous state; a level that
-fails is approached through halved sub-steps (automatic step cutting).
+Load paths (`solver.driver.solve_path`, either method) are solved level by level, each
+warm-started from the previous state; a level that fails is approached through halved
+sub-steps (automatic step cutting).
 """
 
 from __future__ import annotations
