@@ -62,6 +62,25 @@ def test_out_in_a_foreign_folder_needs_force(capsys, tmp_path):
     assert code == 2 and "--force" in one_line(err) and (tmp_path / "data.csv").exists()
 
 
+def test_second_make_into_a_busy_folder_names_the_pid(capsys, tmp_path):
+    import subprocess
+    import sys
+
+    from test_outputs import LOCK_HOLDER
+
+    out = tmp_path / "out"
+    holder = subprocess.Popen([sys.executable, "-c", LOCK_HOLDER, str(out)],
+                              stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        code, _, err = run(capsys, *make_args(out))
+    finally:
+        holder.kill()
+        holder.wait()
+    assert code == 2 and f"another printgen (pid {holder.pid})" in one_line(err)
+    assert not out.exists()
+
+
 @pytest.mark.parametrize("eno, code", [(errno.ENOSPC, 1), (errno.EROFS, 2), (errno.EIO, 1)])
 def test_os_errors_are_one_line(capsys, tmp_path, monkeypatch, eno, code):
     def failing(*a, **k):
