@@ -166,7 +166,9 @@ def membrane_start(ns: NetSystem, st: State, stepper: Stepper) -> State:
     lowest potential along it. Returns `st` unchanged when that does not lower it."""
     if not st.r.size or st.r_norm == 0.0:
         return st
-    v = stepper.factor(ns.damping.copy()).solve(-st.r)
+    v = ns.membrane_shape(-st.r)
+    if v is None:  # a part of the net hangs on nothing in D: factorize D whole
+        v = stepper.factor(ns.damping.copy()).solve(-st.r)
     if v is None or not np.any(v):
         return st
     v = v / float(np.abs(v).max())

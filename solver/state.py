@@ -12,6 +12,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from solver.assemble import Bars, _law_eval, make_bars, make_cable
 from solver.loads import total_forces
@@ -56,6 +58,35 @@ class NetSystem:
         data = self.pattern.scatter(np.concatenate(vals))
         mean = float(data[self.pattern.diagonal].mean()) if self.pattern.size else 1.0
         return data / (mean or 1.0)
+
+    def membrane_shape(self, b: np.ndarray) -> np.ndarray | None:
+        """D^-1 b on the free dofs, solved per direction on the node graph (D is the graph
+        Laplacian times I3, so the three directions decouple and each system is a third of
+        the size); None when a direction's Laplacian is singular."""
+        n, fixed = self.n, self.net.fixed_dofs
+        edges = [(self.bars.i, self.bars.j, 1.0 / self.bars.rest)]
+        edges += [(c.nodes[:-1], c.nodes[1:], 1.0 / c.l0) for c in self.cables]
+        i, j, w = (np.concatenate(x) for x in zip(*edges))
+        lap = sp.coo_matrix((np.concatenate([w, w, -w, -w]), (np.concatenate([i, j, i, j]),
+                             np.concatenate([i, j, j, i]))), shape=(n, n)).tocsc()
+        full = np.zeros(3 * n)
+        full[self.free] = b
+        rhs, out = full.reshape(n, 3), np.zeros((n, 3))
+        masks = {fixed[:, k].tobytes(): [] for k in range(3)}
+        for k in range(3):
+            masks[fixed[:, k].tobytes()].append(k)
+        for dirs in masks.values():  # one factorization per distinct set of free nodes
+            nodes = np.flatnonzero(~fixed[:, dirs[0]])
+            if not nodes.size:
+                continue
+            try:
+                with np.errstate(all="ignore"):
+                    lu = spla.splu(lap[nodes][:, nodes].tocsc())
+                    out[np.ix_(nodes, dirs)] = lu.solve(rhs[np.ix_(nodes, dirs)])
+            except RuntimeError:  # singular: some nodes reach no anchor through D
+                return None
+        v = out.ravel()[self.free]
+        return v if np.all(np.isfinite(v)) else None
 
     def external(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Nondimensional loads and their z-derivative at nondimensional displacements u."""
