@@ -67,13 +67,13 @@ def figure(report: dict, path: Path) -> None:
 
     steps = {k: v for k, v in report["median_steps_s"].items() if k not in ("total", "estimate")}
     steps["start-up (imports, CLI)"] = max(report["outside_steps_s"], 0.0)
-    fig, ax = plt.subplots(figsize=(7, 3.8), constrained_layout=True)
+    fig, ax = plt.subplots(figsize=(9, 3.8), constrained_layout=True)
     names = list(steps)
     ax.barh(names, [steps[k] for k in names], color="C0")
     ax.axvline(report["goal_s"], color="C3", ls="--", label=f"goal {report['goal_s']:g} s total")
     ax.set_xlabel("median time (s)")
     ax.set_title(f"printgen make 1:{report['scale']:g}: {report['median_wall_s']:.2f} s total "
-                 f"(median of {report['repeat']})")
+                 f"(median of {report['repeat']})", fontsize=10)
     ax.invert_yaxis()
     ax.legend(fontsize=8)
     fig.savefig(path, dpi=110, metadata={"Software": None})
