@@ -11,8 +11,14 @@ from proto_files import REALISTIC
 
 import solver
 from printgen.check.compare import wire_elongation
-from printgen.check.scenes import SENSOR_FORCE_N, Wire, model_scene, prototype_scene
-from printgen.check.solvernet import build, wire_law
+from printgen.check.scenes import (
+    SENSOR_FORCE_N,
+    BarrierScene,
+    Wire,
+    model_scene,
+    prototype_scene,
+)
+from printgen.check.solvernet import WIRE_RATE, WIRE_STRAIN, build, wire_law
 from printgen.check.verify import sweep
 from printgen.design.plan import make_design
 from printgen.design.selection import select
@@ -25,6 +31,8 @@ EXACT = 1e-12  # closed-form geometry: round-off only
 SOLVED = 1e-6  # relative: solver tolerance (1e-7 of the load) plus the spring's 1e-6 slope
 AT_REST = 1e-12  # m per m of width: "does not move" (round-off of a converged solve)
 MOVES = 1e-4  # m per m of width: clearly moved (the edges deflect ~1e-2 of the width)
+# N: the wire springs' slope (1e-6 x the tension per unit strain) over strain changes < 10
+WIRE_SPRING = 10 * WIRE_RATE * SENSOR_FORCE_N
 
 
 @pytest.fixture(scope="module")
@@ -47,16 +55,50 @@ def test_taut_wire_on_a_flat_net_pushes_nothing_out_of_plane(design):
     sensor force towards the potentiometer, the nodes it runs over feel nothing."""
     _, d = design
     s = model_scene(d)
-    net, _ = build(s)
+    net, ex = build(s)
     n = len(s.nodes)
-    for k, cable in enumerate(net.cables[len(s.cables):]):
-        x = net.nodes
-        f = _cable_forces(x, np.asarray(cable.nodes), cable.law, net.cable_rest_length(cable))
-        assert np.abs(f[:, 1]).max() <= EXACT * SENSOR_FORCE_N, k  # no out-of-plane force
-        anchor, over = cable.nodes[0], cable.nodes[1:-1]
-        np.testing.assert_allclose(f[anchor], [SENSOR_FORCE_N, 0, 0], atol=SOLVED)
-        assert np.abs(f[over]).max() <= EXACT * SENSOR_FORCE_N
-        assert cable.nodes[-1] >= n  # the potentiometer: a fixed point outside the net
+    assert len(net.cables) == len(s.cables)  # the wires are segments, not sliding cables
+    laws = [net.laws[k] for k in net.law_index]
+    start = 0
+    for name, w in s.wires.items():
+        seg = ex.wire_elements[start:start + len(w.nodes)]  # anchor .. last node, to the exit
+        start += len(w.nodes)
+        el = net.elements[seg]
+        assert np.array_equal(el[:, 0], w.nodes) and el[-1, 1] >= n, name  # exit outside
+        bars = make_bars(net.nodes, el, net.rest_lengths()[seg], np.zeros(len(seg), int),
+                         [laws[seg[0]]])
+        g, _ = internal(bars, [], np.zeros_like(net.nodes), len(net.nodes), with_tangent=False)
+        f = -g  # internal returns the resisting forces
+        assert np.abs(f[:, 1]).max() <= EXACT * SENSOR_FORCE_N, name  # no out-of-plane force
+        np.testing.assert_allclose(f[w.nodes[0]], [SENSOR_FORCE_N, 0, 0], atol=SOLVED)
+        assert np.abs(f[w.nodes[1:]]).max() <= SOLVED * SENSOR_FORCE_N, name
+    assert start == len(ex.wire_elements)
+
+
+def test_wire_segments_pull_like_a_sliding_wire():
+    """A wire over two free nodes, each tied by a strand to a point below and pushed out of
+    plane and up: the equilibrium of the wire's segments (the net's build) is an equilibrium of
+    one frictionless sliding cable of the same constant tension (the same nodal forces)."""
+    row = np.array([[0.0, 0, 0], [1.0, 0, 0], [2.0, 0, 0], [3.0, 0, 0]])
+    x = np.vstack([row, row[1:3] - [0, 0, 1.0]])  # the strands' anchors below nodes 1 and 2
+    fixed = np.array([True, False, False, True, True, True])
+    strands = np.array([[4, 1], [5, 2]])
+    exit_point = np.array([3.3, 0, 0])
+    s = BarrierScene("wire", 1.0, 3.0, 1.0, x, fixed, strands, np.zeros(2, int),
+                     [((), (10.0,))], {}, {}, 0, 0, 1.0,
+                     {"w": Wire(np.arange(4), exit_point, SENSOR_FORCE_N)})
+    net, ex = build(s)
+    push = np.array([[0, 0.3, 0.5], [0, 0.4, 0.6]])
+    r = solver.solve(net, [solver.PointLoads(np.array([1, 2]), push)], strict=True)
+    assert np.abs(r.positions[1:3] - x[1:3]).max() > MOVES  # the wire bends
+    assert np.abs(r.tensions[ex.wire_elements] - SENSOR_FORCE_N).max() <= WIRE_SPRING
+    x0 = net.nodes
+    length = float(np.linalg.norm(np.diff(x0[[0, 1, 2, 3, 6]], axis=0), axis=1).sum())
+    cable = make_cable(x0, np.array([0, 1, 2, 3, 6]), length / (1 + WIRE_STRAIN),
+                       wire_law(SENSOR_FORCE_N))
+    bars = make_bars(x0, strands, np.ones(2), np.zeros(2, int), [solver.linear(10.0)])
+    g, _ = internal(bars, [cable], r.displacements, len(x0), with_tangent=False)
+    np.testing.assert_allclose(g[1:3], push, atol=WIRE_SPRING)
 
 
 def test_wire_keeps_its_force_and_bends_as_a_string():
@@ -66,7 +108,8 @@ def test_wire_keeps_its_force_and_bends_as_a_string():
     x = np.array([[0, 0, 0], [span / 2, 0, 0], [span, 0, 0], [1.2 * span, 0, 0.0]])
     net = solver.Net(x, np.array([True, False, True, True]), np.zeros((0, 2), int),
                      [solver.linear(1.0)], cables=[solver.SlidingCable(
-                         np.arange(4), wire_law(SENSOR_FORCE_N), rest_length=0.6 * span)])
+                         np.arange(4), wire_law(SENSOR_FORCE_N),
+                         rest_length=1.2 * span / (1 + WIRE_STRAIN))])
     r = solver.solve(net, [solver.PointLoads(np.array([1]), np.array([[0, push, 0]]))],
                      strict=True)
     theta = math.asin(push / (2 * SENSOR_FORCE_N))

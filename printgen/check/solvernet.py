@@ -1,11 +1,16 @@
 """A scene as a solver net (`solver.Net`): its strands and border cables, the sensor wires
 that pull, and the hold of unloaded nodes when the scene has one.
 
-Sensor wire: a sliding cable from its anchor node over the row's nodes to the potentiometer (a
-fixed node appended after the net's nodes). Its law is a constant-force spring: the spring is
-at strain `WIRE_STRAIN` at rest and its slope there is `WIRE_RATE` x the tension, so the tension
-stays the sensor's force (within 1e-6 per unit strain) whatever the wire's length; the solver's
-cable tangent (geometric stiffness T / l over each segment) comes with it.
+Sensor wire: a wire from its anchor node over the row's nodes to the potentiometer (a fixed
+node appended after the net's nodes), at constant tension. A frictionless wire at constant
+tension pulls every node it bends over exactly as its segments would, each pulling with that
+tension on its own; so the wire is built as one tension-only element per segment, each with
+a constant-force spring law: the spring is at strain `WIRE_STRAIN` at rest and its slope there
+is `WIRE_RATE` x the tension, so the tension stays the sensor's force (within 1e-6 per unit
+strain) whatever the segment's length, as long as no segment shortens below its knee (checked:
+`wire_slack`). The solver's tangent gets each segment's geometric stiffness T / l; a sliding
+cable would add a dense rank-one block over all the wire's nodes (three times the
+factorization's work on the simple barrier's model) for a stiffness of 1e-6 x the tension.
 
 Hold ("strands that carry no load stay where they are", `BarrierScene.hold` N/m): each free net
 node is tied to two fixed points `HOLD_ARM` x the shortest strand upstream and downstream of
@@ -18,15 +23,15 @@ ties of 5 % to 200 % of the net's size did not converge on the simple barrier's 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 import solver
 from printgen.check.scenes import BarrierScene
 
-WIRE_STRAIN = 1.0  # the spring's strain at rest (its rest length is half the wire's)
-WIRE_KNEE = 0.5  # below this strain the spring law is steep (never reached: the wire is taut)
+WIRE_STRAIN = 3.0  # the spring's strain at rest (its rest length is a quarter of the segment's)
+WIRE_KNEE = 0.5  # below this strain the law is steep: a segment shorter than 3/8 of its length
 WIRE_RATE = 1e-6  # slope at rest / tension: a constant-force spring
 HOLD_ARM = 1.0  # tie length / shortest strand
 
@@ -34,12 +39,14 @@ HOLD_ARM = 1.0  # tie length / shortest strand
 @dataclass(frozen=True)
 class Extras:
     """What `build` appended after the scene's own items: node, strand and cable counts of
-    the scene (the net's items come first), and the hold ties (node, anchor) pairs."""
+    the scene (the net's items come first), the elements of the pulling sensor wires' segments
+    and the hold ties (node, anchor) pairs (the last elements)."""
 
     n_nodes: int
     n_elements: int
     n_cables: int
     ties: np.ndarray  # (t, 2) int: net node, fixed anchor
+    wire_elements: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
 
 
 def wire_law(force: float) -> solver.Law:
@@ -63,15 +70,20 @@ def build(s: BarrierScene, *, slack: float = 0.0) -> tuple[solver.Net, Extras]:
     rest = [lengths * (1.0 + slack)]
     laws = [solver.piecewise(k, sl) for k, sl in s.laws]
     cables = [solver.SlidingCable(c, solver.piecewise(*law)) for c, law in s.cables.values()]
-    n = len(s.nodes)
+    n, first = len(s.nodes), len(s.elements)
     for w in s.wires.values():
         if w.force <= 0:
             continue
         nodes.append(w.exit[None, :]), fixed.append(np.array([True]))
-        length = path_length(s.nodes, w.nodes, w.exit)
-        cables.append(solver.SlidingCable(np.append(w.nodes, n), wire_law(w.force),
-                                          rest_length=length / (1.0 + WIRE_STRAIN)))
+        seg = np.column_stack([w.nodes, np.append(w.nodes[1:], n)])
+        span = np.linalg.norm(np.diff(np.vstack([s.nodes[w.nodes], w.exit]), axis=0), axis=1)
+        law = wire_law(w.force)
+        if law not in laws:
+            laws.append(law)
+        elements.append(seg), law_index.append(np.full(len(seg), laws.index(law)))
+        rest.append(span / (1.0 + WIRE_STRAIN))
         n += 1
+    wire_elements = np.arange(first, first + sum(len(e) for e in elements[1:]))
     ties = np.zeros((0, 2), int)
     if s.hold > 0:
         free = np.flatnonzero(~s.fixed)
@@ -87,14 +99,20 @@ def build(s: BarrierScene, *, slack: float = 0.0) -> tuple[solver.Net, Extras]:
     net = solver.Net(np.vstack(nodes), np.concatenate(fixed), np.vstack(elements), laws,
                      element_law=np.concatenate(law_index), rest_length=np.concatenate(rest),
                      slack=slack, cables=cables)
-    return net, Extras(len(s.nodes), len(s.elements), len(s.cables), ties)
+    return net, Extras(len(s.nodes), len(s.elements), len(s.cables), ties, wire_elements)
+
+
+def wire_slack(strains: np.ndarray, ex: Extras) -> int:
+    """How many sensor-wire segments are below the spring's knee (0: every segment pulls with
+    the sensor's force, as a wire sliding over the nodes would)."""
+    return int(np.sum(strains[ex.wire_elements] <= WIRE_KNEE))
 
 
 def hold_share(x: np.ndarray, tensions: np.ndarray, ex: Extras, applied: float) -> float:
     """Force the hold ties exert on the net (sum of |resultant| over nodes, N) / `applied` N."""
     if not len(ex.ties) or applied <= 0:
         return 0.0
-    t = tensions[ex.n_elements:]
+    t = tensions[len(tensions) - len(ex.ties):]  # the ties come last
     d = x[ex.ties[:, 1]] - x[ex.ties[:, 0]]
     f = (t / np.linalg.norm(d, axis=1))[:, None] * d
     per_node = np.zeros((ex.n_nodes, 3))

@@ -30,7 +30,7 @@ from printgen.check.scenes import (
     model_scene,
     prototype_scene,
 )
-from printgen.check.solvernet import build, hold_share
+from printgen.check.solvernet import build, hold_share, wire_slack
 from printgen.design.record import Design
 from printgen.errors import SolverError
 from printgen.inputs.prototype import Prototype
@@ -53,8 +53,8 @@ def levels(step: float = LEVEL_STEP, top: float = OVERFLOW) -> np.ndarray:
 
 
 def solver_net(s: BarrierScene, *, slack: float = 0.0) -> solver.Net:
-    """The scene as a solver net (`printgen.check.solvernet`): its sensor wires pulling as
-    cables at constant tension, its unloaded nodes held when the scene says so; `slack` is the
+    """The scene as a solver net (`printgen.check.solvernet`): its sensor wires pulling at
+    constant tension (one element per wire segment), its unloaded nodes held when the scene says so; `slack` is the
     relative initial slack of every strand and cable (0.01 = rest lengths 1 % longer than the
     printed ones)."""
     return build(s, slack=slack)[0]
@@ -116,6 +116,11 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw) -> 
     if len(failed) > MAX_FAILED_FRACTION * len(lv):
         raise SolverError(f"{s.name}: {len(failed)} of {len(lv)} load levels did not converge; "
                           f"first: {next(iter(failed.values()))}")
+    loose = [float(r.level) for r in results if r.converged and wire_slack(r.strains, ex)]
+    if loose:  # a segment shorter than its knee would pull harder than the sensor
+        raise SolverError(f"{s.name}: a sensor wire segment shortened below its spring's knee "
+                          f"at h/h_B = {loose[0]:g}; raise WIRE_STRAIN in "
+                          "printgen/check/solvernet.py")
     n, m, c = ex.n_nodes, ex.n_elements, ex.n_cables
     d = deformation(s, lv, [r.positions[:n] for r in results],
                     [r.tensions[:m] for r in results], [r.cable_tensions[:c] for r in results])
