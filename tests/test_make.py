@@ -97,7 +97,7 @@ def test_fine_mesh_is_refused_with_its_estimate(tmp_path, capsys):
     seconds = time.perf_counter() - t0
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and "Traceback" not in err
-    assert "prototype 264,861 nodes" in err and "the limit is 120 s" in err and "--time-limit" in err
+    assert "prototype 264,861 nodes" in err and "the limit is 60 s" in err and "--time-limit" in err
     assert re.search(r"coarsen the prototype's net to mesh_x_m = 0\.\d+", err)
     assert seconds < REFUSE_WITHIN_S and not (tmp_path / "o").exists()
 

@@ -29,7 +29,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="print this design.json (from printgen design) instead of select's")
     p.add_argument("--time-limit", type=float, default=DEFAULT_LIMIT_S, metavar="SECONDS",
                    help=f"refuse runs estimated longer than this (default {DEFAULT_LIMIT_S:g} s,"
-                        " about two minutes on 2 cores)")
+                        " about a minute on 2 cores)")
     p.add_argument("--force", action="store_true",
                    help="replace --out even when it holds files printgen did not write")
     add_json_arg(p)
