@@ -85,3 +85,52 @@ def test_deformed_figure_is_a_png(realistic):
     png = deformed_figure([("prototype", v.prototype.scene, v.prototype.shapes[1.0]),
                            ("model", v.model.scene, v.model.shapes[1.0])], 1.0)
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+CURVE_TOL = 0.01  # the brief: nominal curves at 0.5, 1.0, 1.1 within 1 % of their peak
+TIGHT_TOL = 1e-9  # the reference's solver tolerance (100 x tighter than the sweep's)
+
+
+def _reference_curves(s, lv: np.ndarray) -> dict[str, np.ndarray]:
+    """The model's curves with each pulling sensor wire as one frictionless sliding cable of
+    constant tension (not per-segment elements), solved to TIGHT_TOL: an independent
+    formulation of the same physics."""
+    import solver
+    from printgen.check.compare import deformation
+    from printgen.check.solvernet import WIRE_STRAIN, build, path_length, wire_law
+    from printgen.check.verify import loads_function
+
+    net, ex = build(s)
+    keep = np.setdiff1d(np.arange(len(net.elements)), ex.wire_elements)
+    cables = list(net.cables)
+    for k, w in enumerate(s.wires.values()):
+        exit_node = len(s.nodes) + k  # build appends the potentiometers in wire order
+        rest = path_length(s.nodes, w.nodes, w.exit) / (1 + WIRE_STRAIN)
+        cables.append(solver.SlidingCable(np.append(w.nodes, exit_node), wire_law(w.force),
+                                          rest_length=rest))
+    ref = dataclasses.replace(net, elements=net.elements[keep],
+                              element_law=net.law_index[keep],
+                              rest_length=net.rest_lengths()[keep], cables=cables)
+    res = solver.solve_path(ref, loads_function(s), lv, tol=TIGHT_TOL, strict=True)
+    n, m, c = ex.n_nodes, ex.n_elements, ex.n_cables
+    d = deformation(s, lv, [r.positions[:n] for r in res], [r.tensions[:m] for r in res],
+                    [r.cable_tensions[:c] for r in res])
+    return d.values
+
+
+def test_free_top_curves_match_a_tight_sliding_wire_reference(coarse_simple):
+    """The fast formulation (wires as segments, the sweep's tolerance) moves no nominal curve
+    of the free-top model by more than CURVE_TOL of its peak at h/h_B = 0.5, 1.0, 1.1."""
+    _, d = coarse_simple
+    s = model_scene(d)
+    lv = np.round(np.arange(0.0, 1.1 + 1e-9, 0.1), 10)
+    fast = sweep(s, lv)
+    assert not fast.failed
+    ref = _reference_curves(s, lv)
+    at = np.isin(lv, SHAPE_LEVELS)
+    assert at.sum() == len(SHAPE_LEVELS)
+    for key, v in ref.items():
+        peak = np.abs(v).max()
+        if peak > 0:
+            diff = np.abs(fast.deformation.values[key][at] - v[at]).max()
+            assert diff <= CURVE_TOL * peak, key
