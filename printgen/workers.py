@@ -18,7 +18,7 @@ import os
 import signal
 import threading
 from collections.abc import Callable, Iterator
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import Future, ProcessPoolExecutor
 from typing import Any
 
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
@@ -60,6 +60,26 @@ def signals_raise() -> Iterator[None]:
     finally:
         for s, h in previous.items():
             signal.signal(s, h)
+
+
+@contextlib.contextmanager
+def signals_deferred() -> Iterator[None]:
+    """Within the block SIGINT, SIGTERM and SIGHUP are held and re-sent at its end (main
+    thread only), for code that catches BaseException and would swallow `Interrupted`:
+    trimesh's imports turn any exception into a placeholder module and carry on."""
+    if not _main_thread():
+        yield
+        return
+    held: list[int] = []
+    previous = {s: signal.signal(s, lambda signum, _frame: held.append(signum))
+                for s in HANDLED}
+    try:
+        yield
+    finally:
+        for s, h in previous.items():
+            signal.signal(s, h)
+        if held:
+            signal.raise_signal(held[0])
 
 
 def _main_thread() -> bool:
@@ -146,6 +166,28 @@ def run_jobs(jobs: list[tuple]) -> list:
         queue.put(None)  # the workers are done: end the helper thread after the last report
         reader.join(timeout=READER_JOIN_S)
     return results
+
+
+@contextlib.contextmanager
+def background(fn: Callable, *args: Any, **kwargs: Any) -> Iterator[Future]:
+    """Start `fn(*args, **kwargs)` in one worker process and run the block meanwhile; the
+    block collects it with `.result()` (its exception, if any, is raised there). The worker
+    lives like `run_jobs`' workers (dies with its parent, leaves signals to it) and may call
+    `run_jobs` itself: its workers die with it. On any exception or signal in the block, or
+    a result left uncollected, the worker is killed before the block's exit completes."""
+    ctx = multiprocessing.get_context("fork")
+    pool = ProcessPoolExecutor(max_workers=1, mp_context=ctx, initializer=init_worker,
+                               initargs=(os.getpid(),))
+    try:
+        future = pool.submit(fn, *args, **kwargs)
+        yield future
+    except BaseException:
+        stop(pool)
+        raise
+    if future.done():
+        pool.shutdown(wait=True)
+    else:
+        stop(pool)
 
 
 def stop(pool: ProcessPoolExecutor) -> None:

@@ -32,6 +32,16 @@ def children(pid: int) -> list[int]:
     return out
 
 
+def descendants(pid: int) -> list[int]:
+    """Children, grandchildren, ... of `pid` (make's verification runs in a worker process
+    that has the sweeps' workers as its own children)."""
+    out, todo = [], children(pid)
+    while todo:
+        out.append(todo.pop())
+        todo += children(out[-1])
+    return out
+
+
 def live_in_session(sid: int) -> list[int]:
     """Processes of session `sid` that are not zombies."""
     pids = []
@@ -51,7 +61,7 @@ def start_and_wait_for_workers(out: Path) -> subprocess.Popen:
                              str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, start_new_session=True)
     deadline = time.monotonic() + REACH_VERIFICATION_S
-    while len(children(proc.pid)) < 2:  # the two verification workers are running
+    while len(descendants(proc.pid)) < 3:  # the verification's worker and its two workers
         assert proc.poll() is None, proc.communicate()
         assert time.monotonic() < deadline, "make never reached the verification"
         time.sleep(0.1)

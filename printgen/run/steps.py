@@ -1,0 +1,276 @@
+"""The steps of `printgen make`: plain functions `step(ctx, stage)` that add files under
+`stage`, numbers to `ctx.record` and sections to `ctx.report` (the pipeline is
+`printgen.run.make`). The verification's sections are built by `verification_blocks`, which
+`make` runs in a worker process from the start of the run while the other steps run here.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from printgen.inputs.materials import load_material
+from printgen.inputs.printers import load_print_style, load_printer
+
+if TYPE_CHECKING:  # pragma: no cover
+    from printgen.design.record import Design
+    from printgen.inputs.prototype import Prototype
+    from printgen.run.make import MakeContext
+
+
+def preload_parts() -> None:
+    """Import the mesh libraries now (the parts step needs them): trimesh's imports catch
+    BaseException, so a signal must not arrive while they run (the caller holds signals)."""
+    with contextlib.suppress(ImportError):  # the parts step says what is missing
+        import trimesh  # noqa: F401
+
+
+def gcode_step(ctx: MakeContext, stage: Path) -> None:
+    """Direct G-code for the net and each cable, checked by read-back against the design."""
+    from printgen.parts.gcode import cable_toolpath, net_toolpath
+    from printgen.parts.gcode.readback import read_gcode_text
+    from printgen.parts.gcode.writer import gcode_text
+    from printgen.parts.geometry.attach import attachment_for
+
+    d = ctx.design
+    printer = load_printer(d.printer)
+    att = (attachment_for(d, hole_compensation_mm=printer.hole_compensation_mm)
+           if d.cables else None)
+
+    def net_path(*args):
+        return net_toolpath(*args, attachment=att)
+
+    parts = [("net", d.net, net_path)] + [(f"cable-{c.name}", c, cable_toolpath)
+                                          for c in d.cables]
+    rows, rec = [], {}
+    for name, part, build in parts:
+        mat, style = load_material(part.material), load_print_style(part.print_style)
+        t0 = time.perf_counter()
+        tp = build(part, printer, style, mat)
+        text = gcode_text(tp, printer, mat, title=f"{name}, 1:{d.scale:g}")
+        back = read_gcode_text(text, filament_diameter_mm=printer.filament_diameter_mm)
+        seconds = time.perf_counter() - t0
+        path = stage / f"{name}.gcode"
+        path.write_text(text)
+        ctx.files.append(path.name)
+        err = back.volume_mm3 / tp.volume_mm3 - 1
+        stl = ctx.record.get("parts", {}).get(name, {}).get("volume_mm3")
+        vs_stl = back.volume_mm3 / stl - 1 if stl else None
+        retractions = text.count(f"E-{mat.print.retract_length_mm:.5f}")
+        rec[name] = {"file": path.name, "layers": len(back.layer_z_mm),
+                     "volume_mm3": tp.volume_mm3, "readback_volume_mm3": back.volume_mm3,
+                     "readback_error": err, "readback_vs_stl": vs_stl,
+                     "retractions": retractions, "seconds": seconds}
+        rows.append([name, path.name, str(len(back.layer_z_mm)), f"{tp.volume_mm3:.1f}",
+                     f"{err:+.2%}", "-" if vs_stl is None else f"{vs_stl:+.2%}",
+                     str(retractions)])  # times go to timings.json: the report is reproducible
+    ctx.record["gcode"] = rec
+    ctx.report.heading("Direct G-code")
+    ctx.report.paragraph("Every net strand is one straight extrusion through the crossings, the "
+                         "strand families alternate per pass; the G-code is read back and its "
+                         "extruded volume compared with the toolpath's.")
+    ctx.report.table(["part", "file", "layers", "volume mm^3", "read-back error",
+                      "read back vs STL", "retractions"], rows)
+
+
+def kit_step(ctx: MakeContext, stage: Path) -> None:
+    """How the kit goes together (labelled picture, checks after printing) and top views of
+    the direct toolpaths per pass (the net's corner and a cable's eyelet)."""
+    from printgen.parts.assembly import assemble
+    from printgen.parts.gcode import cable_toolpath, net_toolpath
+    from printgen.parts.geometry.solid import net_outline
+    from printgen.report.kit import kit_figures
+
+    d = ctx.design
+    if not d.cables:
+        return
+    printer = load_printer(d.printer)
+    a = assemble(d, printer)
+    net_tp = net_toolpath(d.net, printer, load_print_style(d.net.print_style),
+                          load_material(d.net.material), attachment=a.attachment)
+    c = min(d.cables, key=lambda c: c.length_mm)
+    cable_tp = cable_toolpath(c, printer, load_print_style(c.print_style),
+                              load_material(c.material))
+    figs = kit_figures(a, net_outline(d.net, a.attachment), net_tp, cable_tp, c.name)
+    ctx.report.heading("Assembly")
+    problems = a.problems()
+    ctx.report.verdict(not problems, "; ".join(problems) or
+                       "the kit closes: cables as long as the net's sides, every loop on its "
+                       "cable's line with the stated clearance")
+    for name, png, caption in figs:
+        (stage / name).write_bytes(png)
+        ctx.files.append(name)
+        if name == "preview-net.png":
+            ctx.report.heading("Toolpath previews")
+        ctx.report.figure(png, caption)
+        if name == "assembly.png":
+            ctx.report.paragraph("Check after printing:")
+            for k, line in enumerate(a.checklist(), 1):
+                ctx.report.paragraph(f"{k}. {line}")
+    ctx.record["assembly"] = a.to_record()
+
+
+def slicer_step(ctx: MakeContext, stage: Path) -> None:
+    """PrusaSlicer .ini for every part and CuraEngine settings for the cables."""
+    from printgen.parts.slicer.cura import cura_cfg_text
+    from printgen.parts.slicer.prusa import prusa_ini_text
+
+    d = ctx.design
+    printer = load_printer(d.printer)
+    written = []
+    for kind, name, part in [("net", "net", d.net)] + [("cable", f"cable-{c.name}", c)
+                                                       for c in d.cables]:
+        mat, style = load_material(part.material), load_print_style(part.print_style)
+        ini = stage / f"{name}.prusa.ini"
+        ini.write_text(prusa_ini_text(kind, part, printer, style, mat))
+        written.append(ini.name)
+        if kind == "cable":
+            cfg = stage / f"{name}.cura.cfg"
+            cfg.write_text(cura_cfg_text(kind, part, printer, style, mat))
+            written.append(cfg.name)
+    ctx.files += written
+    ctx.record["slicer_profiles"] = written
+
+
+def parts_step(ctx: MakeContext, stage: Path) -> None:
+    """Watertight meshes of every part: STL, a 3MF carrying its PrusaSlicer settings, and
+    STEP when asked (--step, needs cadquery; the progress line names each part's STEP)."""
+    from printgen.parts.slicer.prusa import prusa_ini_text
+
+    d = ctx.design
+    printer = load_printer(d.printer)
+    parts = _mesh_parts(d, printer.hole_compensation_mm)
+    rows, rec, cables = [], {}, []
+    for k, (name, kind, part, solid, outline, analytic) in enumerate(parts, 1):
+        body = solid(part)
+        if kind == "cable":
+            cables.append((name, body))
+        if ctx.options.get("step") and ctx.progress:
+            ctx.progress(f"STEP {name} ({k} of {len(parts)})")
+        rec[name], row = _write_part(stage, name, kind, part, body, printer,
+                                     outline if ctx.options.get("step") else None,
+                                     analytic(part))
+        ctx.files += rec[name]["files"]
+        rows.append(row)
+    if cables:  # every cable on one plate: one print job, with the cables' settings
+        c = d.cables[0]
+        ini = prusa_ini_text("cable", c, printer, load_print_style(c.print_style),
+                             load_material(c.material))
+        rec["cables-plate"] = _write_plate(stage, cables, printer, ini)
+        ctx.files.append("cables-plate.3mf")
+    ctx.record["parts"] = rec
+    ctx.report.heading("Meshes")
+    ctx.report.paragraph("One watertight body per part (STL, and a 3MF that opens in "
+                         "PrusaSlicer with the part's settings), placed on the printer bed.")
+    ctx.report.table(["part", "size on bed (mm)", "volume mm^3", "vs analytic", "triangles",
+                      "turned (deg)"], rows)
+
+
+def _mesh_parts(d: Design, comp: float) -> list[tuple]:
+    """(file name, kind, part, solid, outline, analytic volume) of the net and each cable."""
+    from printgen.parts.geometry.solid import (
+        analytic_cable_volume,
+        analytic_net_volume,
+        attachment_for,
+        cable_outline,
+        cable_solid,
+        net_outline,
+        net_solid,
+    )
+
+    att = attachment_for(d, hole_compensation_mm=comp) if d.cables else None
+    parts = [("net", "net", d.net, lambda p: net_solid(p, att), lambda p: net_outline(p, att),
+              lambda p: analytic_net_volume(p, att))]
+    parts += [(f"cable-{c.name}", "cable", c, lambda p: cable_solid(p, comp),
+               lambda p: cable_outline(p, comp), lambda p: analytic_cable_volume(p, comp))
+              for c in d.cables]
+    return parts
+
+
+def _write_part(stage: Path, name: str, kind: str, part, body, printer, outline,
+                expected: float) -> tuple[dict[str, Any], list[str]]:
+    """Place `body` on the bed and write its STL, 3MF (and STEP from `outline` when given);
+    (its record, its row of the report's table)."""
+    from printgen.parts.export import place_mesh, prusa_config_from_ini, stl_bytes, threemf_bytes
+    from printgen.parts.slicer.prusa import prusa_ini_text
+
+    mat, style = load_material(part.material), load_print_style(part.print_style)
+    mesh, angle = place_mesh(body, printer, name)
+    ini = prusa_ini_text(kind, part, printer, style, mat)
+    (stage / f"{name}.stl").write_bytes(stl_bytes(mesh))
+    (stage / f"{name}.3mf").write_bytes(threemf_bytes([(name, mesh)],
+                                                       prusa_config_from_ini(ini)))
+    files = [f"{name}.stl", f"{name}.3mf"]
+    if outline is not None:
+        from printgen.parts.geometry.cad import step_bytes
+
+        (stage / f"{name}.step").write_bytes(step_bytes(outline(part),
+                                                        part_thickness(kind, part)))
+        files.append(f"{name}.step")
+    size = mesh.bounds[1] - mesh.bounds[0]
+    volume = float(mesh.volume)
+    rec = {"files": files, "volume_mm3": volume, "analytic_volume_mm3": expected,
+           "volume_error": volume / expected - 1, "size_mm": np.round(size, 4),
+           "triangles": len(mesh.faces), "watertight": bool(mesh.is_watertight),
+           "bed_angle_deg": angle}
+    row = [name, f"{size[0]:.1f} x {size[1]:.1f} x {size[2]:.2f}", f"{mesh.volume:.1f}",
+           f"{volume / expected - 1:+.2%}", str(len(mesh.faces)), f"{angle:g}"]
+    return rec, row
+
+
+def _write_plate(stage: Path, cables: list[tuple[str, Any]], printer, ini: str
+                 ) -> dict[str, Any]:
+    """cables-plate.3mf: the cables laid out together on one bed; its record."""
+    from printgen.parts.export import layout_parts, prusa_config_from_ini, threemf_bytes
+
+    placed = layout_parts(cables, printer)
+    (stage / "cables-plate.3mf").write_bytes(threemf_bytes(
+        [(p.name, p.mesh) for p in placed], prusa_config_from_ini(ini)))
+    return {"files": ["cables-plate.3mf"], "parts": {p.name: p.angle_deg for p in placed}}
+
+
+def part_thickness(kind: str, part) -> float:
+    return (part.strand if kind == "net" else part.section).thickness_mm
+
+
+def verify_step(ctx: MakeContext, stage: Path) -> None:
+    """Prototype vs model over the loading sweep, the model's uncertainty band
+    (printgen.check.bands), and the steel counter-example: the sections and record of
+    `verification_blocks`, collected from the worker `make` started them in, or computed here.
+    """
+    pending = ctx.background.pop("verification", None)
+    if pending is not None:
+        blocks, record = pending.result()
+    else:
+        blocks, record = verification_blocks(ctx.prototype, ctx.design, ctx.targets.scale,
+                                             drag=bool(ctx.options.get("drag")))
+    ctx.report.blocks.extend(blocks)
+    ctx.record["verification"] = record
+
+
+def verification_blocks(prototype: Prototype, design: Design, scale: float, *,
+                        drag: bool = False) -> tuple[list[str], dict[str, Any]]:
+    """The verification's report blocks (figures included) and its record.
+
+    The sweep is the scene realistic-1:40 with border cables, simple-free-top without them
+    (barrier-physics.md, section 7); every load level is solved on both. Needs nothing from
+    the other steps, so it can run in a worker process while they run.
+    """
+    from printgen.check.bands import model_band, model_load_kw
+    from printgen.check.verify import verify
+    from printgen.report.html import Report
+    from printgen.report.report import verification_sections
+    from printgen.report.uncertainty import band_record, band_sections
+
+    v = verify(prototype, design, drag=drag, counterexample=True)
+    band = model_band(design, v.model, load_kw=model_load_kw(prototype, design, drag))
+    rep = Report("")
+    verification_sections(rep, v, v.counterexample, scale, band=band)
+    band_sections(rep, v, band)
+    record = v.to_record()
+    record["bands"] = band_record(v, band)
+    return rep.blocks, record

@@ -1,0 +1,139 @@
+"""`make`'s verification ahead of the other steps: `workers.background` (one worker that may run
+`run_jobs` itself, killed with everything under it when the block fails), `signals_deferred`
+(a signal during trimesh's imports is not swallowed), and the same verification sections and
+record whether the verification ran in the background or in its own step."""
+
+from __future__ import annotations
+
+import os
+import signal
+import threading
+import time
+from pathlib import Path
+
+import pytest
+from proto_files import SIMPLE, write_variant
+
+import printgen.run.make as make_mod
+from printgen import workers
+from printgen.report.jsonout import dumps
+from printgen.run.provenance import split_timings
+
+GONE_WITHIN_S = 5.0  # issue 16: no worker left 5 s after the parent stops
+SLEEP_S = 60.0  # a job far longer than the test
+
+two_cores = pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="workers need 2 cores")
+
+
+def square(x: int) -> int:
+    return x * x
+
+
+def nested(n: int) -> tuple[int, list[int]]:
+    """The worker's pid and the results of its own run_jobs."""
+    return os.getpid(), workers.run_jobs([(square, (k,), {}) for k in range(n)])
+
+
+def failing() -> None:
+    raise ValueError("from the worker")
+
+
+def sleeper_tree(folder: str) -> None:
+    """Write this worker's pid, then sleep in two workers of its own that write theirs."""
+    Path(folder, "top.pid").write_text(str(os.getpid()))
+    workers.run_jobs([(_sleep, (str(Path(folder, f"{k}.pid")),), {}) for k in range(2)])
+
+
+def _sleep(pid_file: str) -> None:
+    Path(pid_file).write_text(str(os.getpid()))
+    time.sleep(SLEEP_S)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        text = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return False
+    return text[text.rindex(")") + 2] != "Z"
+
+
+@two_cores
+def test_background_runs_a_job_that_has_workers_of_its_own(monkeypatch):
+    monkeypatch.delenv("PRINTGEN_SERIAL", raising=False)
+    with workers.background(nested, 3) as future:
+        pid, squares = future.result()
+    assert pid != os.getpid() and squares == [0, 1, 4]
+    with pytest.raises(ValueError, match="from the worker"), \
+            workers.background(failing) as future:
+        future.result()
+
+
+@two_cores
+def test_a_failure_in_the_block_kills_the_worker_and_its_workers(tmp_path, monkeypatch):
+    monkeypatch.delenv("PRINTGEN_SERIAL", raising=False)
+    files = [tmp_path / n for n in ("top.pid", "0.pid", "1.pid")]
+    t0 = time.monotonic()
+    with pytest.raises(RuntimeError, match="parent failed"), \
+            workers.background(sleeper_tree, str(tmp_path)):
+        while not all(f.exists() and f.read_text() for f in files):
+            assert time.monotonic() - t0 < SLEEP_S / 2, "the workers never started"
+            time.sleep(0.05)
+        raise RuntimeError("parent failed")
+    pids = [int(f.read_text()) for f in files]
+    deadline = time.monotonic() + GONE_WITHIN_S
+    while any(_alive(p) for p in pids):
+        assert time.monotonic() < deadline, "workers still running"
+        time.sleep(0.1)
+
+
+def test_signals_deferred_holds_a_signal_until_the_block_ends():
+    reached = []
+    with pytest.raises(workers.Interrupted) as exc, workers.signals_raise(), \
+            workers.signals_deferred():
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.2)  # the handler has run by now: it only held the signal
+        except BaseException:  # noqa: BLE001 (what trimesh's imports do)
+            pytest.fail("the signal reached the block")
+        reached.append("end of block")
+    assert reached == ["end of block"] and exc.value.signum == signal.SIGTERM
+
+
+def test_signals_deferred_outside_the_main_thread_is_a_no_op():
+    done = []
+    t = threading.Thread(target=lambda: done.append(_deferred_in_thread()))
+    t.start()
+    t.join()
+    assert done == [True]
+
+
+def _deferred_in_thread() -> bool:
+    with workers.signals_deferred():
+        return True
+
+
+@two_cores
+def test_verification_in_the_background_equals_the_verification_step(tmp_path, monkeypatch):
+    """Same report blocks and record (times aside) from the worker as from the step itself."""
+    monkeypatch.delenv("PRINTGEN_SERIAL", raising=False)
+    path = write_variant(tmp_path, {("net", "mesh_x_m"): 0.4, ("net", "mesh_y_m"): 0.4,
+                                    ("model", "mesh_x_mm"): 10.0, ("model", "mesh_y_mm"): 10.0},
+                         base=SIMPLE)
+    steps = [s for s in make_mod.default_steps() if s[1] is make_mod.verify_step]
+    started = []
+    monkeypatch.setattr(make_mod, "background", _spy(make_mod.background, started))
+    ahead = make_mod.make(path, 40, tmp_path / "ahead", steps=steps)
+    assert started == ["verification_blocks"]
+    monkeypatch.setenv("PRINTGEN_SERIAL", "1")
+    inline = make_mod.make(path, 40, tmp_path / "inline", steps=steps)
+    assert started == ["verification_blocks"]  # the serial run computed it in its step
+    assert ahead.report.blocks == inline.report.blocks
+    assert (dumps(split_timings(ahead.record["verification"])[0])
+            == dumps(split_timings(inline.record["verification"])[0]))
+
+
+def _spy(fn, calls: list):
+    def wrapped(job, *args, **kwargs):
+        calls.append(job.__name__)
+        return fn(job, *args, **kwargs)
+    return wrapped
