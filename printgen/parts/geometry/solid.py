@@ -13,6 +13,7 @@ Needs the `geometry` extra (manifold3d, trimesh, shapely).
 
 from __future__ import annotations
 
+import functools
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -129,13 +130,10 @@ def analytic_net_area(net: NetDesign, attachment: Attachment | None = None) -> f
 
 def _base_in_disc(net: NetDesign, g: NetGraph, h: Hole) -> float:
     """Area (mm^2) of frame and strands within a ring's outer radius (hole included)."""
-    r = h.outer_r_mm * (np.arange(QUAD_RINGS) + 0.5) / QUAD_RINGS
-    t = (np.arange(QUAD_ANGLES) + 0.5) * (2 * np.pi / QUAD_ANGLES)
-    rr, tt = np.meshgrid(r, t, indexing="ij")
-    p = h.centre_mm + np.stack([rr * np.cos(tt), rr * np.sin(tt)], axis=-1)
+    (ox, oy), cell = _polar_grid(h.outer_r_mm)
+    x, y = h.centre_mm[0] + ox, h.centre_mm[1] + oy
     sx, sy = g.size_mm
     half = net.border_width_mm / 2
-    x, y = p[..., 0], p[..., 1]
     outer = (x >= -half) & (x <= sx + half) & (y >= -half) & (y <= sy + half)
     inner = (x > half) & (x < sx - half) & (y > half) & (y < sy - half)
     inside = outer & ~inner
@@ -144,12 +142,25 @@ def _base_in_disc(net: NetDesign, g: NetGraph, h: Hole) -> float:
         d = p1 - p0
         length = float(np.hypot(*d))
         u = d / length
-        rel = p - p0
-        along = rel @ u
-        across = np.abs(rel @ np.array([-u[1], u[0]]))
+        rx, ry = x - p0[0], y - p0[1]
+        along = rx * u[0] + ry * u[1]
+        across = np.abs(rx * -u[1] + ry * u[0])
         inside |= (along >= 0) & (along <= length) & (across <= net.strand.width_mm / 2)
-    cell = h.outer_r_mm / QUAD_RINGS * (2 * np.pi / QUAD_ANGLES) * rr
     return float(np.sum(cell * inside))
+
+
+@functools.lru_cache(maxsize=8)
+def _polar_grid(radius_mm: float) -> tuple[np.ndarray, np.ndarray]:
+    """Points of the in-ring area integral about the origin (x and y, each QUAD_RINGS x
+    QUAD_ANGLES, mm) and the area of each one's cell (mm^2): the same for every ring of one
+    radius."""
+    r = radius_mm * (np.arange(QUAD_RINGS) + 0.5) / QUAD_RINGS
+    t = (np.arange(QUAD_ANGLES) + 0.5) * (2 * np.pi / QUAD_ANGLES)
+    rr, tt = np.meshgrid(r, t, indexing="ij")
+    offsets = np.stack([rr * np.cos(tt), rr * np.sin(tt)])
+    cell = radius_mm / QUAD_RINGS * (2 * np.pi / QUAD_ANGLES) * rr
+    offsets.flags.writeable = cell.flags.writeable = False  # shared by the cache
+    return offsets, cell
 
 
 def _strands_near(g: NetGraph, centre_mm: np.ndarray, reach_mm: float) -> list:
