@@ -32,7 +32,10 @@ COMMAND_MODULES = (
 )
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
+    """The parser of every command, or with `argv` naming one (its first word that is not an
+    option) of that command alone: the others' imports (scipy.optimize for calibrate, ...)
+    would only delay it (each module registers the command of its own name)."""
     parser = argparse.ArgumentParser(
         prog="printgen",
         description="Stiffness-scaled, printable flexible-barrier models for flume experiments.",
@@ -40,7 +43,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
-    for name in COMMAND_MODULES:
+    words = [a for a in argv or [] if not a.startswith("-") or a in ("-h", "--help")]
+    only = [m for m in COMMAND_MODULES if words and m.rsplit(".", 1)[-1] == words[0]]
+    for name in only or COMMAND_MODULES:
         importlib.import_module(name).register(sub)
     return parser
 
@@ -54,7 +59,7 @@ def main(argv: list[str] | None = None) -> int:
     to report it (PRINTGEN_DEBUG=1 re-raises it, traceback and all)."""
     argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
     try:
-        parser = build_parser()
+        parser = build_parser(argv)
         args = parser.parse_args(argv)
     except KeyboardInterrupt:
         print("printgen: interrupted (Ctrl-C)", file=sys.stderr)

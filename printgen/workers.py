@@ -168,26 +168,37 @@ def run_jobs(jobs: list[tuple]) -> list:
     return results
 
 
+class Helper:
+    """One worker process that runs the jobs submitted to it in order (see `helper`)."""
+
+    def __init__(self) -> None:
+        self.pool = ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context(
+            "fork"), initializer=init_worker, initargs=(os.getpid(),))
+        self.futures: list[Future] = []
+
+    def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> Future:
+        """Start `fn(*args, **kwargs)` there; `.result()` collects it (or raises its error)."""
+        self.futures.append(self.pool.submit(fn, *args, **kwargs))
+        return self.futures[-1]
+
+
 @contextlib.contextmanager
-def background(fn: Callable, *args: Any, **kwargs: Any) -> Iterator[Future]:
-    """Start `fn(*args, **kwargs)` in one worker process and run the block meanwhile; the
-    block collects it with `.result()` (its exception, if any, is raised there). The worker
-    lives like `run_jobs`' workers (dies with its parent, leaves signals to it) and may call
-    `run_jobs` itself: its workers die with it. On any exception or signal in the block, or
-    a result left uncollected, the worker is killed before the block's exit completes."""
-    ctx = multiprocessing.get_context("fork")
-    pool = ProcessPoolExecutor(max_workers=1, mp_context=ctx, initializer=init_worker,
-                               initargs=(os.getpid(),))
+def helper() -> Iterator[Helper]:
+    """A `Helper` for the block: one worker process for jobs that run while the block goes
+    on. The worker lives like `run_jobs`' workers (dies with its parent, leaves signals to
+    it) and may call `run_jobs` itself: its workers die with it. On any exception or signal in
+    the block, or a job left uncollected, the worker is killed before the block's exit
+    completes."""
+    h = Helper()
     try:
-        future = pool.submit(fn, *args, **kwargs)
-        yield future
+        yield h
     except BaseException:
-        stop(pool)
+        stop(h.pool)
         raise
-    if future.done():
-        pool.shutdown(wait=True)
+    if all(f.done() for f in h.futures):
+        h.pool.shutdown(wait=True)
     else:
-        stop(pool)
+        stop(h.pool)
 
 
 def stop(pool: ProcessPoolExecutor) -> None:

@@ -1,10 +1,11 @@
-"""`make`'s verification ahead of the other steps: `workers.background` (one worker that may run
-`run_jobs` itself, killed with everything under it when the block fails), `signals_deferred`
-(a signal during trimesh's imports is not swallowed), and the same verification sections and
-record whether the verification ran in the background or in its own step."""
+"""`make`'s verification ahead of the other steps: `workers.helper` (one worker process whose
+jobs may run `run_jobs` themselves, killed with everything under it when the block fails),
+`signals_deferred` (a signal during trimesh's imports is not swallowed), and the same
+verification sections and record whether the verification ran in the helper or in its step."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import threading
@@ -58,14 +59,15 @@ def _alive(pid: int) -> bool:
 
 
 @two_cores
-def test_background_runs_a_job_that_has_workers_of_its_own(monkeypatch):
+def test_helper_runs_jobs_that_have_workers_of_their_own(monkeypatch):
     monkeypatch.delenv("PRINTGEN_SERIAL", raising=False)
-    with workers.background(nested, 3) as future:
-        pid, squares = future.result()
-    assert pid != os.getpid() and squares == [0, 1, 4]
-    with pytest.raises(ValueError, match="from the worker"), \
-            workers.background(failing) as future:
-        future.result()
+    with workers.helper() as h:
+        pid, squares = h.submit(nested, 3).result()
+        again, cubes = h.submit(nested, 2).result()
+    assert pid != os.getpid() and again == pid  # one process, job after job
+    assert squares == [0, 1, 4] and cubes == [0, 1]
+    with pytest.raises(ValueError, match="from the worker"), workers.helper() as h:
+        h.submit(failing).result()
 
 
 @two_cores
@@ -73,8 +75,8 @@ def test_a_failure_in_the_block_kills_the_worker_and_its_workers(tmp_path, monke
     monkeypatch.delenv("PRINTGEN_SERIAL", raising=False)
     files = [tmp_path / n for n in ("top.pid", "0.pid", "1.pid")]
     t0 = time.monotonic()
-    with pytest.raises(RuntimeError, match="parent failed"), \
-            workers.background(sleeper_tree, str(tmp_path)):
+    with pytest.raises(RuntimeError, match="parent failed"), workers.helper() as h:
+        h.submit(sleeper_tree, str(tmp_path))
         while not all(f.exists() and f.read_text() for f in files):
             assert time.monotonic() - t0 < SLEEP_S / 2, "the workers never started"
             time.sleep(0.05)
@@ -113,27 +115,36 @@ def _deferred_in_thread() -> bool:
 
 
 @two_cores
-def test_verification_in_the_background_equals_the_verification_step(tmp_path, monkeypatch):
-    """Same report blocks and record (times aside) from the worker as from the step itself."""
+def test_verification_in_the_helper_equals_the_verification_step(tmp_path, monkeypatch):
+    """Same report blocks and record (times aside) from the helper as from the step itself."""
     monkeypatch.delenv("PRINTGEN_SERIAL", raising=False)
     path = write_variant(tmp_path, {("net", "mesh_x_m"): 0.4, ("net", "mesh_y_m"): 0.4,
                                     ("model", "mesh_x_mm"): 10.0, ("model", "mesh_y_mm"): 10.0},
                          base=SIMPLE)
     steps = [s for s in make_mod.default_steps() if s[1] is make_mod.verify_step]
     started = []
-    monkeypatch.setattr(make_mod, "background", _spy(make_mod.background, started))
+    monkeypatch.setattr(make_mod, "helper", _spy(make_mod.helper, started))
     ahead = make_mod.make(path, 40, tmp_path / "ahead", steps=steps)
-    assert started == ["verification_blocks"]
+    assert started == ["verification_sweeps", "verification_report"]
     monkeypatch.setenv("PRINTGEN_SERIAL", "1")
     inline = make_mod.make(path, 40, tmp_path / "inline", steps=steps)
-    assert started == ["verification_blocks"]  # the serial run computed it in its step
+    assert len(started) == 2  # the serial run computed both in its step
     assert ahead.report.blocks == inline.report.blocks
     assert (dumps(split_timings(ahead.record["verification"])[0])
             == dumps(split_timings(inline.record["verification"])[0]))
 
 
-def _spy(fn, calls: list):
-    def wrapped(job, *args, **kwargs):
-        calls.append(job.__name__)
-        return fn(job, *args, **kwargs)
-    return wrapped
+def _spy(helper, calls: list):
+    """`helper` whose jobs' names go to `calls`."""
+    @contextlib.contextmanager
+    def spied():
+        with helper() as h:
+            submit = h.submit
+
+            def named(fn, /, *args, **kwargs):
+                calls.append(fn.__name__)
+                return submit(fn, *args, **kwargs)
+
+            h.submit = named
+            yield h
+    return spied

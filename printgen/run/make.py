@@ -44,10 +44,10 @@ from printgen.run.steps import (
     parts_step,
     preload_parts,
     slicer_step,
-    verification_blocks,
+    verification_sweeps,
     verify_step,
 )
-from printgen.workers import background, signals_deferred
+from printgen.workers import Helper, helper, signals_deferred
 
 log = logging.getLogger(__name__)
 
@@ -65,7 +65,8 @@ class MakeContext:
     record: dict[str, Any] = field(default_factory=dict)
     files: list[str] = field(default_factory=list)
     progress: Callable[[str], None] | None = None  # a step's finer progress (STEP per part)
-    background: dict[str, Future] = field(default_factory=dict)  # results running elsewhere
+    background: dict[str, Future] = field(default_factory=dict)  # jobs running in `helper`
+    helper: Helper | None = None  # the helper process of a short run (`verification_ahead`)
 
 
 Step = Callable[[MakeContext, Path], None]
@@ -141,23 +142,25 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
 @contextlib.contextmanager
 def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]], short: bool
                        ) -> Iterator[None]:
-    """Start the verification (`verification_blocks`) in a worker process now, for
-    `verify_step` to collect, so that its sweeps run while the other steps build the parts
-    here. Only for short runs on 2 cores or more: a long run's per-level progress bars come
+    """Start the verification's sweeps (`verification_sweeps`) in a helper process now, so
+    that they run while the parts are built here; `sweeps_done` and `verify_step` collect
+    them. Only for short runs on 2 cores or more: a long run's per-level progress bars come
     from the sweeps' workers to this process, and on one core there is nothing to gain."""
     serial = os.environ.get("PRINTGEN_SERIAL") or (os.cpu_count() or 1) < 2
     if serial or not short or not any(s is verify_step for _, s in steps):
         yield
         return
-    with background(verification_blocks, ctx.prototype, ctx.design, ctx.targets.scale,
-                    drag=bool(ctx.options.get("drag"))) as future:
-        ctx.background["verification"] = future
+    with helper() as h:
+        ctx.helper = h
+        ctx.background["verification sweeps"] = ctx.helper.submit(
+            verification_sweeps, ctx.prototype, ctx.design, drag=bool(ctx.options.get("drag")))
         try:
             with signals_deferred():  # a signal meanwhile would be lost in trimesh's imports
                 preload_parts()
             yield
         finally:
-            ctx.background.pop("verification", None)
+            ctx.background.clear()
+            ctx.helper = None
 
 
 def size_check(ctx: MakeContext, verifies: bool) -> Estimate:

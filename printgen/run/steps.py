@@ -17,6 +17,8 @@ from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
 
 if TYPE_CHECKING:  # pragma: no cover
+    from printgen.check.bands import Band
+    from printgen.check.verify import Verification
     from printgen.design.record import Design
     from printgen.inputs.prototype import Prototype
     from printgen.run.make import MakeContext
@@ -88,6 +90,7 @@ def kit_step(ctx: MakeContext, stage: Path) -> None:
     d = ctx.design
     if not d.cables:
         return
+    sweeps_done(ctx)
     printer = load_printer(d.printer)
     a = assemble(d, printer)
     net_tp = net_toolpath(d.net, printer, load_print_style(d.net.print_style),
@@ -240,21 +243,35 @@ def part_thickness(kind: str, part) -> float:
 def verify_step(ctx: MakeContext, stage: Path) -> None:
     """Prototype vs model over the loading sweep, the model's uncertainty band
     (printgen.check.bands), and the steel counter-example: the sections and record of
-    `verification_blocks`, collected from the worker `make` started them in, or computed here.
-    """
-    pending = ctx.background.pop("verification", None)
+    `verification_report`, collected from the helper process `make` started the sweeps in,
+    or computed here."""
+    sweeps_done(ctx)
+    pending = ctx.background.pop("verification report", None)
     if pending is not None:
         blocks, record = pending.result()
     else:
-        blocks, record = verification_blocks(ctx.prototype, ctx.design, ctx.targets.scale,
-                                             drag=bool(ctx.options.get("drag")))
+        v, band = verification_sweeps(ctx.prototype, ctx.design,
+                                      drag=bool(ctx.options.get("drag")))
+        blocks, record = verification_report(v, band, ctx.targets.scale)
     ctx.report.blocks.extend(blocks)
     ctx.record["verification"] = record
 
 
-def verification_blocks(prototype: Prototype, design: Design, scale: float, *,
-                        drag: bool = False) -> tuple[list[str], dict[str, Any]]:
-    """The verification's report blocks (figures included) and its record.
+def sweeps_done(ctx: MakeContext) -> None:
+    """Wait for the verification's sweeps when they run in the helper process and start its
+    figures there. The figure steps call this first: drawn meanwhile, they would take the
+    cores from the sweeps' workers, and the verification's figures would be left to draw on
+    one core at the end; drawn after, both sets of figures share the two cores."""
+    pending = ctx.background.pop("verification sweeps", None)
+    if pending is not None and ctx.helper is not None:
+        v, band = pending.result()
+        ctx.background["verification report"] = ctx.helper.submit(
+            verification_report, v, band, ctx.targets.scale)
+
+
+def verification_sweeps(prototype: Prototype, design: Design, *, drag: bool = False
+                        ) -> tuple[Verification, Band]:
+    """Both barriers' load sweeps compared, and the model's uncertainty band.
 
     The sweep is the scene realistic-1:40 with border cables, simple-free-top without them
     (barrier-physics.md, section 7); every load level is solved on both. Needs nothing from
@@ -262,12 +279,18 @@ def verification_blocks(prototype: Prototype, design: Design, scale: float, *,
     """
     from printgen.check.bands import model_band, model_load_kw
     from printgen.check.verify import verify
+
+    v = verify(prototype, design, drag=drag, counterexample=True)
+    return v, model_band(design, v.model, load_kw=model_load_kw(prototype, design, drag))
+
+
+def verification_report(v: Verification, band: Band, scale: float
+                        ) -> tuple[list[str], dict[str, Any]]:
+    """The verification's report blocks (figures included) and its record."""
     from printgen.report.html import Report
     from printgen.report.report import verification_sections
     from printgen.report.uncertainty import band_record, band_sections
 
-    v = verify(prototype, design, drag=drag, counterexample=True)
-    band = model_band(design, v.model, load_kw=model_load_kw(prototype, design, drag))
     rep = Report("")
     verification_sections(rep, v, v.counterexample, scale, band=band)
     band_sections(rep, v, band)
