@@ -26,6 +26,12 @@ def _pyplot():
     return plt
 
 
+def load_pyplot() -> None:
+    """Import matplotlib's pyplot (Agg) now, e.g. while a worker still computes what the
+    figures show."""
+    _pyplot()
+
+
 def _png(fig) -> bytes:
     buf = io.BytesIO()
     # fixed metadata: the same figure gives the same bytes

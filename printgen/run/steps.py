@@ -86,11 +86,11 @@ def kit_step(ctx: MakeContext, stage: Path) -> None:
     from printgen.parts.gcode import cable_toolpath, net_toolpath
     from printgen.parts.geometry.solid import net_outline
     from printgen.report.kit import kit_figures
+    from printgen.report.plots import load_pyplot
 
     d = ctx.design
     if not d.cables:
         return
-    sweeps_done(ctx)
     printer = load_printer(d.printer)
     a = assemble(d, printer)
     net_tp = net_toolpath(d.net, printer, load_print_style(d.net.print_style),
@@ -98,7 +98,10 @@ def kit_step(ctx: MakeContext, stage: Path) -> None:
     c = min(d.cables, key=lambda c: c.length_mm)
     cable_tp = cable_toolpath(c, printer, load_print_style(c.print_style),
                               load_material(c.material))
-    figs = kit_figures(a, net_outline(d.net, a.attachment), net_tp, cable_tp, c.name)
+    outline = net_outline(d.net, a.attachment)
+    load_pyplot()
+    sweeps_done(ctx)  # the figures: see there
+    figs = kit_figures(a, outline, net_tp, cable_tp, c.name)
     ctx.report.heading("Assembly")
     problems = a.problems()
     ctx.report.verdict(not problems, "; ".join(problems) or
