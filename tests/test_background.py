@@ -142,7 +142,8 @@ def _spy(helper, calls: list):
             submit = h.submit
 
             def named(fn, /, *args, **kwargs):
-                calls.append(fn.__name__)
+                job = args[0] if fn is make_mod.timed else fn  # timed(job, ...)
+                calls.append(job.__name__)
                 return submit(fn, *args, **kwargs)
 
             h.submit = named

@@ -44,6 +44,7 @@ from printgen.run.steps import (
     parts_step,
     preload_parts,
     slicer_step,
+    timed,
     verification_sweeps,
     verify_step,
 )
@@ -153,7 +154,8 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]], short: b
     with helper() as h:
         ctx.helper = h
         ctx.background["verification sweeps"] = ctx.helper.submit(
-            verification_sweeps, ctx.prototype, ctx.design, drag=bool(ctx.options.get("drag")))
+            timed, verification_sweeps, ctx.prototype, ctx.design,
+            drag=bool(ctx.options.get("drag")))
         try:
             with signals_deferred():  # a signal meanwhile would be lost in trimesh's imports
                 preload_parts()

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import contextlib
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -15,6 +16,10 @@ import numpy as np
 
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
+
+HELPER_SWEEPS = "helper: verification sweeps"  # timings_s keys of work done in the helper
+HELPER_REPORT = "helper: verification figures and tables"
+WAIT_SWEEPS = "waiting for the verification sweeps"  # in this process, within a step
 
 if TYPE_CHECKING:  # pragma: no cover
     from printgen.check.bands import Band
@@ -251,7 +256,8 @@ def verify_step(ctx: MakeContext, stage: Path) -> None:
     sweeps_done(ctx)
     pending = ctx.background.pop("verification report", None)
     if pending is not None:
-        blocks, record = pending.result()
+        (blocks, record), seconds = pending.result()
+        ctx.record.setdefault("timings_s", {})[HELPER_REPORT] = seconds
     else:
         v, band = verification_sweeps(ctx.prototype, ctx.design,
                                       drag=bool(ctx.options.get("drag")))
@@ -267,9 +273,18 @@ def sweeps_done(ctx: MakeContext) -> None:
     one core at the end; drawn after, both sets of figures share the two cores."""
     pending = ctx.background.pop("verification sweeps", None)
     if pending is not None and ctx.helper is not None:
-        v, band = pending.result()
+        t = time.perf_counter()
+        (v, band), seconds = pending.result()
+        times = ctx.record.setdefault("timings_s", {})
+        times[HELPER_SWEEPS], times[WAIT_SWEEPS] = seconds, time.perf_counter() - t
         ctx.background["verification report"] = ctx.helper.submit(
-            verification_report, v, band, ctx.targets.scale)
+            timed, verification_report, v, band, ctx.targets.scale)
+
+
+def timed(fn: Callable, /, *args: Any, **kwargs: Any) -> tuple[Any, float]:
+    """(fn(*args, **kwargs), its wall time in s): a helper job and how long it took there."""
+    t = time.perf_counter()
+    return fn(*args, **kwargs), time.perf_counter() - t
 
 
 def verification_sweeps(prototype: Prototype, design: Design, *, drag: bool = False
