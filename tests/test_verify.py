@@ -18,7 +18,6 @@ from printgen.design.similitude import scale_targets
 from printgen.inputs.prototype import load_prototype
 from printgen.report.jsonout import dumps
 from printgen.report.plots import deformed_figure
-from printgen.report.report import verification_record
 
 HOLD_SHARE_MAX = 0.01  # the hold may carry at most 1 % of the applied load (a regularisation)
 HOLD_EFFECT = 0.01  # ... and move no normalised deformation by more than 1 % of its peak
@@ -69,13 +68,13 @@ def realistic():
 def test_deformed_shapes_in_the_record_are_reproducible(realistic):
     v = realistic
     assert set(v.model.shapes) == set(SHAPE_LEVELS)
-    rec = json.loads(dumps(verification_record(v, None)))
+    rec = json.loads(dumps(v.to_record()))
     shape = rec["deformed_shape"]
     assert set(shape["levels"]) == {"0.5", "1", "1.1"}
     x = np.array(shape["levels"]["1"])
     assert x.shape == v.model.scene.nodes.shape
     np.testing.assert_allclose(x, v.model.shapes[1.0], atol=0.5 * 10.0 ** -shape["decimals"])
-    assert dumps(verification_record(v, None)) == dumps(verification_record(v, None))
+    assert dumps(v.to_record()) == dumps(v.to_record())
     assert rec["mounting"] == "walls" and rec["assumptions"]["model"]
     assert rec["summary"] == v.headline
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -43,6 +44,7 @@ OVERFLOW = 1.1  # last relative loading h / h_B
 PATH_CUTS = 2  # halvings tried before a load level is reported as not converged
 MAX_FAILED_FRACTION = 0.25  # more unconverged levels than this and the sweep is an error
 SHAPE_LEVELS = (0.5, 1.0, 1.1)  # relative loadings whose deformed shapes are kept
+SHAPE_DECIMALS = 6  # node positions in report.json rounded to 1 um: reproducible bytes
 SOLVER_TOL = 1e-7  # out-of-balance force / load: far below what a flume measures (~1e-2)
 
 
@@ -99,6 +101,14 @@ class Run:
     shapes: dict[float, np.ndarray] = field(default_factory=dict)
     hold_share: float = 0.0
 
+    def shape_record(self) -> dict[str, Any]:
+        """The node positions (m, rounded to SHAPE_DECIMALS) at rest and at each kept level."""
+        return {"units": "m", "decimals": SHAPE_DECIMALS,
+                "node_order": "the design's net graph (parts.geometry.net.diamond_net)",
+                "rest": np.round(self.scene.nodes, SHAPE_DECIMALS) + 0.0,
+                "levels": {f"{lv:g}": np.round(x, SHAPE_DECIMALS) + 0.0
+                           for lv, x in sorted(self.shapes.items())}}
+
 
 def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw) -> Run:
     """Solve the load path; raise SolverError when a level cannot be reached."""
@@ -154,6 +164,30 @@ class Verification:
     def headline(self) -> str:
         """Which way the model is off and by how much, in one sentence."""
         return headline(self.mismatches)
+
+    def to_record(self) -> dict[str, Any]:
+        """Every number of the verification, JSON-ready."""
+        def dump(d: Deformation) -> dict[str, Any]:
+            return {"levels": d.levels, "values": d.values,
+                    "max_strand_tension_n": d.max_strand_tension,
+                    "max_cable_tension_n": d.max_cable_tension}
+
+        runs = (("prototype", self.prototype), ("model", self.model))
+        return {
+            "load_case": self.load_case, "ok": self.ok, "verdict": "PASS" if self.ok else "FAIL",
+            "summary": self.headline,
+            "reasons": self.reasons, "mismatches": self.mismatches,
+            "mismatches_from_start": self.from_start,
+            "prototype": dump(self.prototype.deformation), "model": dump(self.model.deformation),
+            "iterations": {who: run.iterations for who, run in runs},
+            "not_converged": {who: run.failed for who, run in runs},
+            "counterexample": self.counterexample,
+            "mounting": self.model.scene.mounting,
+            "hold_share": {who: run.hold_share for who, run in runs},
+            "deformed_shape": self.model.shape_record(),
+            "assumptions": {who: [dict(zip(("what", "value", "source"), a, strict=True))
+                                  for a in run.scene.assumptions] for who, run in runs},
+        }
 
 
 def verify(p: Prototype, d: Design, *, drag: bool = False, lv: np.ndarray | None = None,

@@ -17,7 +17,6 @@ from printgen.report.html import Report
 
 SHOW = 6  # candidates per component in the report's tables (all are in report.json)
 SHOWN_LEVEL = 1.0  # relative loading of the 3D picture of both deformed nets
-SHAPE_DECIMALS = 6  # node positions in report.json rounded to 1 um: reproducible bytes
 
 
 def design_sections(rep: Report, proto: Prototype, t: ScaledTargets, sel: Selection,
@@ -172,37 +171,3 @@ def _counterexample_section(rep: Report, ce: CounterExample) -> None:
         "deflects - the wall-like model this tool exists to avoid.")
     rep.table(["variant", "deflection / width", "lowering / height"],
               [[k, f"{ce.deflection[k]:.4f}", f"{ce.lowering[k]:.4f}"] for k in ce.deflection])
-
-
-def verification_record(v: Verification, ce: CounterExample | None) -> dict[str, Any]:
-    """Every number of the verification, JSON-ready."""
-    def dump(d):
-        return {"levels": d.levels, "values": d.values,
-                "max_strand_tension_n": d.max_strand_tension,
-                "max_cable_tension_n": d.max_cable_tension}
-
-    return {
-        "load_case": v.load_case, "ok": v.ok, "verdict": "PASS" if v.ok else "FAIL",
-        "summary": v.headline,
-        "reasons": v.reasons, "mismatches": v.mismatches,
-        "mismatches_from_start": v.from_start,
-        "prototype": dump(v.prototype.deformation), "model": dump(v.model.deformation),
-        "iterations": {"prototype": v.prototype.iterations, "model": v.model.iterations},
-        "not_converged": {"prototype": v.prototype.failed, "model": v.model.failed},
-        "counterexample": ce,
-        "mounting": v.model.scene.mounting,
-        "hold_share": {"prototype": v.prototype.hold_share, "model": v.model.hold_share},
-        "deformed_shape": shape_record(v.model),
-        "assumptions": {who: [dict(zip(("what", "value", "source"), a, strict=True))
-                              for a in run.scene.assumptions]
-                        for who, run in (("prototype", v.prototype), ("model", v.model))},
-    }
-
-
-def shape_record(run) -> dict[str, Any]:
-    """The model's node positions (m, rounded to SHAPE_DECIMALS) at each kept level."""
-    return {"units": "m", "decimals": SHAPE_DECIMALS,
-            "node_order": "the design's net graph (parts.geometry.net.diamond_net)",
-            "rest": np.round(run.scene.nodes, SHAPE_DECIMALS) + 0.0,
-            "levels": {f"{lv:g}": np.round(x, SHAPE_DECIMALS) + 0.0
-                       for lv, x in sorted(run.shapes.items())}}

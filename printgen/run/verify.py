@@ -31,7 +31,7 @@ from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import staged_dir
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
-from printgen.report.report import verification_record, verification_sections
+from printgen.report.report import verification_sections
 from printgen.report.uncertainty import (
     band_record,
     band_sections,
@@ -104,7 +104,7 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     rep = Report(f"printgen verify: {p.name} at 1:{d.scale:g}")
     verification_sections(rep, v, None, d.scale, band=band)
     band_sections(rep, v, band)
-    record = {"design": d.to_dict(), "verification": verification_record(v, None),
+    record = {"design": d.to_dict(), "verification": v.to_record(),
               "bands": band_record(v, band)}
     if m is not None:
         measured_sections(rep, m, band, result, text)
