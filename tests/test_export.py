@@ -293,3 +293,23 @@ def test_step_rejects_a_flat_part_before_cadquery(cables, tmp_path):
     with pytest.raises(GeometryError, match="thickness = 0.0 mm"):
         write_step(tmp_path / "flat.step", cable_outline(cables[0]), 0.0)
     assert not list(tmp_path.iterdir())
+
+
+def test_step_of_a_plate_with_many_holes_is_one_solid_in_strips(tmp_path):
+    """A face with more holes than STEP_HOLES_PER_FACE is written as strips glued into one
+    solid: read back, one valid solid of the outline's volume, its top cut into strips."""
+    cq = pytest.importorskip("cadquery")
+    import shapely
+    from shapely.geometry import Point, box
+
+    from printgen.parts.geometry.cad import STEP_HOLES_PER_FACE, STEP_VOLUME_TOL, write_step
+
+    n = 2 * STEP_HOLES_PER_FACE + 10  # three strips
+    holes = [Point(3.0 * i + 1.5, 1.5 + 0.4 * (i % 3 - 1)).buffer(0.8, 8) for i in range(n)]
+    plate = box(0.0, 0.0, 3.0 * n, 3.0).difference(shapely.unary_union(holes))
+    path = write_step(tmp_path / "plate.step", plate, 0.5)
+    solids = cq.importers.importStep(str(path)).solids().vals()
+    assert len(solids) == 1 and solids[0].isValid()
+    assert abs(solids[0].Volume() / (plate.area * 0.5) - 1) < STEP_VOLUME_TOL
+    top = [f for f in solids[0].Faces() if abs(f.Center().z - 0.5) < ROUND_OFF]
+    assert len(top) == 3
