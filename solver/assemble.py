@@ -15,6 +15,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from solver.laws import Law
+from solver.model import Net
 
 
 @dataclass(frozen=True)
@@ -154,3 +155,30 @@ def strain_energy(bars: Bars, cables: list[Cable], u: np.ndarray) -> float:
     for c in cables:
         total += c.rest * float(c.law.energy(np.array([cable_state(c, u)[0]]))[0])
     return total
+
+
+@dataclass(frozen=True)
+class Scaled:
+    """A net in nondimensional form: lengths / L (the net's extent), forces / S (the steepest
+    law slope); its strands and cables in those units, and the free degrees of freedom."""
+
+    x0: np.ndarray  # (n, 3) node positions, m
+    L: float
+    S: float
+    bars: Bars
+    cables: list[Cable]
+    free: np.ndarray  # (3 n,) bool
+
+
+def nondimensional(net: Net) -> Scaled:
+    """The nondimensional form shared by the reference and the fast path."""
+    x0 = np.asarray(net.nodes, dtype=float)
+    L = float(np.linalg.norm(x0.max(axis=0) - x0.min(axis=0))) or 1.0
+    slopes = [s for law in net.laws for s in law.slopes]
+    slopes += [s for c in net.cables for s in c.law.slopes]
+    S = float(max(slopes))
+    bars = make_bars(x0 / L, np.asarray(net.elements, dtype=int), net.rest_lengths() / L,
+                     net.law_index, [law.scaled(1 / S) for law in net.laws])
+    cables = [make_cable(x0 / L, np.asarray(c.nodes, dtype=int), net.cable_rest_length(c) / L,
+                         c.law.scaled(1 / S)) for c in net.cables]
+    return Scaled(x0, L, S, bars, cables, ~net.fixed_dofs.ravel())

@@ -28,7 +28,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from solver.assemble import bar_state, cable_state, internal, make_bars, make_cable, strain_energy
+from solver.assemble import bar_state, cable_state, internal, nondimensional, strain_energy
 from solver.loads import total_forces
 from solver.model import Net
 from solver.result import Result, SolverError
@@ -49,20 +49,9 @@ class Problem:
     """A net and loads in nondimensional form, with the free degrees of freedom."""
 
     def __init__(self, net: Net, loads: Sequence) -> None:
-        x0 = np.asarray(net.nodes, dtype=float)
-        self.net, self.loads, self.x0 = net, list(loads), x0
-        self.L = float(np.linalg.norm(x0.max(axis=0) - x0.min(axis=0))) or 1.0
-        slopes = [s for law in net.laws for s in law.slopes]
-        slopes += [s for c in net.cables for s in c.law.slopes]
-        self.S = float(max(slopes))
-        scaled = [law.scaled(1 / self.S) for law in net.laws]
-        self.bars = make_bars(x0 / self.L, np.asarray(net.elements, dtype=int),
-                              net.rest_lengths() / self.L, net.law_index, scaled)
-        self.cables = [make_cable(x0 / self.L, np.asarray(c.nodes, dtype=int),
-                                  net.cable_rest_length(c) / self.L, c.law.scaled(1 / self.S))
-                       for c in net.cables]
-        self.free = ~net.fixed_dofs.ravel()
-        self.n = len(x0)
+        s = nondimensional(net)
+        self.net, self.loads, self.x0, self.n = net, list(loads), s.x0, len(s.x0)
+        self.L, self.S, self.bars, self.cables, self.free = s.L, s.S, s.bars, s.cables, s.free
 
     def external(self, u: np.ndarray):
         """Nondimensional loads and their z-derivative at nondimensional displacements u."""

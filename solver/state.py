@@ -15,7 +15,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from solver.assemble import Bars, _law_eval, make_bars, make_cable
+from solver.assemble import Bars, _law_eval, nondimensional
 from solver.loads import total_forces
 from solver.model import Net
 from solver.pattern import Pattern, pair_values
@@ -25,20 +25,11 @@ class NetSystem:
     """A net in nondimensional form (x / L, F / S) with its fixed tangent pattern."""
 
     def __init__(self, net: Net) -> None:
-        x0 = np.asarray(net.nodes, dtype=float)
-        self.net, self.x0, self.n = net, x0, len(x0)
-        self.L = float(np.linalg.norm(x0.max(axis=0) - x0.min(axis=0))) or 1.0
-        slopes = [s for law in net.laws for s in law.slopes]
-        slopes += [s for c in net.cables for s in c.law.slopes]
-        self.S = float(max(slopes))
-        scaled = [law.scaled(1 / self.S) for law in net.laws]
-        self.bars = make_bars(x0 / self.L, np.asarray(net.elements, dtype=int),
-                              net.rest_lengths() / self.L, net.law_index, scaled)
-        self.cables = [make_cable(x0 / self.L, np.asarray(c.nodes, dtype=int),
-                                  net.cable_rest_length(c) / self.L, c.law.scaled(1 / self.S))
-                       for c in net.cables]
+        s = nondimensional(net)
+        self.net, self.x0, self.n = net, s.x0, len(s.x0)
+        self.L, self.S, self.bars, self.cables = s.L, s.S, s.bars, s.cables
         self.cable_set = CableSet(self.cables)
-        self.free = ~net.fixed_dofs.ravel()
+        self.free = s.free
         self.pattern = Pattern(self.n, self.free, self.bars.i, self.bars.j,
                                [c.nodes for c in self.cables])
         self.damping = self._damping()
