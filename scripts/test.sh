@@ -3,6 +3,11 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh --with-slicers
+# The STEP tests need cadquery (the `cad` extra, ~250 MB): the suite installs it, demo.sh does not.
+if ! .venv/bin/python -c "import cadquery" 2>/dev/null; then
+  .venv/bin/python -m pip install -q -e ".[all,cad]" >.venv/setup-cad.log 2>&1 \
+    || { cat .venv/setup-cad.log >&2; echo "test: installing the cad extra failed" >&2; exit 1; }
+fi
 export PRINTGEN_REQUIRE_SLICERS=1   # slicer tests fail, not skip, when a slicer is missing
 # ../shared tests (G-code checker, tensile exports) fail, not skip, when ../shared sits beside the
 # clone or PRINTGEN_REQUIRE_SHARED=1 is given (.ci/run); a clone with nothing beside it skips them.

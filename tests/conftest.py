@@ -24,6 +24,18 @@ def require_tool(name: str) -> str:
     pytest.skip(msg)
 
 
+def require_module(name: str):
+    """Import an optional package (cadquery for STEP); skip locally, fail under CI, when it
+    is missing (scripts/test.sh installs the `cad` extra)."""
+    try:
+        return __import__(name)
+    except ImportError:
+        msg = f"{name} not installed (pip install -e '.[cad]'; scripts/test.sh installs it)"
+        if os.environ.get("PRINTGEN_REQUIRE_SLICERS") or os.environ.get("CI"):
+            pytest.fail(msg)
+        pytest.skip(msg)
+
+
 def require_shared(rel: str) -> Path:
     """Return a path under ../shared; skip when it is missing, fail instead when
     PRINTGEN_REQUIRE_SHARED=1 (scripts/test.sh beside ../shared, and CI)."""

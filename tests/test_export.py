@@ -11,7 +11,7 @@ import zipfile
 
 import numpy as np
 import pytest
-from conftest import require_tool
+from conftest import require_module, require_tool
 
 from printgen.design.record import Section
 from printgen.errors import GeometryError, InputError, PrintabilityError
@@ -298,7 +298,7 @@ def test_step_rejects_a_flat_part_before_cadquery(cables, tmp_path):
 def test_step_of_a_plate_with_many_holes_is_one_solid_in_strips(tmp_path):
     """A face with more holes than STEP_HOLES_PER_FACE is written as strips glued into one
     solid: read back, one valid solid of the outline's volume, its top cut into strips."""
-    cq = pytest.importorskip("cadquery")
+    cq = require_module("cadquery")
     import shapely
     from shapely.geometry import Point, box
 
