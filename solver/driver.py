@@ -19,7 +19,7 @@ from solver.fast import Stepper, best_start, iterate, membrane_start
 from solver.model import Net
 from solver.newton import MAX_CUTS, MAX_ITER, TOL_FORCE
 from solver.result import Result, SolverError
-from solver.state import NetSystem, State, _bar_pass, evaluate
+from solver.state import NetSystem, State, evaluate
 
 METHODS = ("fast", "reference")
 
@@ -48,7 +48,7 @@ class FastSolver:
 
 def _result(ns: NetSystem, st: State, iters: int, ok: bool, reason: str, seconds: float,
             level: float | None, factorizations: int) -> Result:
-    eps, force, _, _, _ = _bar_pass(ns.bars, st.u)
+    eps, force = st.bar[0], st.bar[1]  # the strand pass `evaluate` made at st.u
     cab = [cable_state(c, st.u) for c in ns.cables]
     disp = st.u * ns.L
     return Result(ns.x0 + disp, disp, eps, force * ns.S, force <= 0,

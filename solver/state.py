@@ -8,7 +8,6 @@ assembles the tangent without a second pass.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -228,7 +227,3 @@ def tangent_values(ns: NetSystem, st: State) -> np.ndarray:
     hyd[:, :, 2] = -st.dz
     vals.append(hyd.ravel())
     return ns.pattern.scatter(np.concatenate(vals))
-
-
-def set_loads(ns: NetSystem, loads: Sequence) -> None:
-    ns.loads = list(loads)
