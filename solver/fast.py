@@ -24,6 +24,8 @@ The answer is the same (R = 0 to the same tolerance): only the path to it differ
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from solver.linsolve import Factorization, choose_backend
@@ -76,7 +78,8 @@ class Stepper:
         return self.factor(self.matrix(st, boost))
 
 
-def iterate(ns: NetSystem, st: State, tol: float, max_iter: int, stepper: Stepper):
+def iterate(ns: NetSystem, st: State, tol: float, max_iter: int, stepper: Stepper
+            ) -> tuple[State, int, bool, str]:
     """(state, iterations, converged, reason) from state `st` (chord steps count too).
 
     At the round-off level (max |R| <= ROUND_OFF but above tol x the force scale) one more
@@ -187,7 +190,7 @@ def membrane_start(ns: NetSystem, st: State, stepper: Stepper) -> State:
     return evaluate(ns, _moved(ns, st.u, 10.0**log_s * v))
 
 
-def golden(fn, lo: float, hi: float, xtol: float) -> tuple[float, float]:
+def golden(fn: Callable[[float], float], lo: float, hi: float, xtol: float) -> tuple[float, float]:
     """(x, fn(x)) at the minimum of a unimodal fn on [lo, hi], to xtol (golden section)."""
     ratio = (np.sqrt(5.0) - 1.0) / 2.0
     a, b = lo + (1 - ratio) * (hi - lo), lo + ratio * (hi - lo)

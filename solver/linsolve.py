@@ -19,10 +19,16 @@ SuperLU on A is the last resort. The answer is always that of A.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
 import numpy as np
 import scipy.sparse.linalg as spla
 
 from solver.pattern import Pattern
+
+if TYPE_CHECKING:
+    import scipy.sparse as sp
 
 LINEAR_RTOL = 1e-13  # backward error a solve must reach: |b - A x| <= tol (|A| |x| + |b|)
 GMRES_RTOL = 1e-14  # GMRES stops at this relative 2-norm residual at the latest
@@ -81,7 +87,7 @@ class Pardiso:
         self.analysed = False
         self.A = None
 
-    def factor(self, A) -> None:
+    def factor(self, A: sp.csr_matrix) -> None:
         zero = np.zeros(A.shape[0])
         if not self.analysed:
             self.solver.set_phase(11)
@@ -189,7 +195,8 @@ class Factorization:
         return x if good(x) else None
 
 
-def gmres(A, precondition, b: np.ndarray, x0: np.ndarray, target: float, m: int) -> np.ndarray:
+def gmres(A: sp.csr_matrix, precondition: Callable[[np.ndarray], np.ndarray], b: np.ndarray,
+          x0: np.ndarray, target: float, m: int) -> np.ndarray:
     """One cycle of right-preconditioned GMRES(m): x0 + M^-1 V y minimising |b - A x|_2 over
     the Krylov space of A M^-1, stopped when |b - A x|_2 <= target (classical Gram-Schmidt,
     twice; least squares on the small Hessenberg matrix)."""

@@ -103,7 +103,7 @@ class CableSet:
             self.owner = np.repeat(np.arange(self.count), np.diff(self.offsets))
             self.l0_sum = np.bincount(self.owner, self.l0, self.count)
 
-    def strains(self, u: np.ndarray):
+    def strains(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(cable strains (c,), unit vectors (s, 3), lengths (s,)) of every segment."""
         du = u[self.b] - u[self.a]
         d = self.d0 + du
@@ -113,7 +113,7 @@ class CableSet:
         eps = (np.bincount(self.owner, stretch, self.count) + self.l0_sum - self.rest) / self.rest
         return eps, d / l[:, None], l
 
-    def laws_at(self, eps: np.ndarray):
+    def laws_at(self, eps: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(tension, tangent, energy per rest length) of each cable at its strain (one law
         evaluation per distinct law)."""
         t, kt, e = np.zeros(self.count), np.zeros(self.count), np.zeros(self.count)

@@ -8,6 +8,10 @@ a units row under the header (`(s),(mm),(N),(%),(MPa)`). Roles: time, force, dis
 from __future__ import annotations
 
 import re
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import numpy as np
 
 # Unit label (lower case, no brackets) -> factor to SI for each kind of quantity.
 FORCE_UNITS = {"n": 1.0, "kn": 1e3, "mn": 1e-3, "lbf": 4.4482216152605, "kgf": 9.80665}
@@ -109,7 +113,8 @@ def is_raw(name: str, unit: str | None) -> bool:
     return (unit is not None and unit in RAW_UNITS) or bool(_RAW_NAME.search(name.lower()))
 
 
-def unit_class(role: str, name: str, unit: str | None, values=None) -> tuple[int, str]:
+def unit_class(role: str, name: str, unit: str | None, values: np.ndarray | None = None
+               ) -> tuple[int, str]:
     """(rank, reason) of a candidate column for `role`: 0 a unit of the role, 1 no unit (the
     default assumed), 2 another unit label (an error when used), 3 raw (never taken): raw by
     its name or unit label, or an unlabelled force column of whole numbers reaching

@@ -3,18 +3,23 @@ of the direct toolpaths per pass with every bead at its true width, coloured by 
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from printgen.parts.assembly import Assembly
 from printgen.parts.gcode.toolpath import Toolpath
 from printgen.report.plots import _png, _pyplot
 
+if TYPE_CHECKING:
+    from shapely.geometry import Polygon
+
 CABLE_COLOURS = {"top": "#1f77b4", "bottom": "#d62728", "left": "#2ca02c", "right": "#9467bd"}
 NET_ZOOM_MM = (44.0, 26.0)  # corner window of the net preview: a loop or two and the eyelet
 CABLE_ZOOM_MM = (16.0, 10.0)  # window around a cable's eyelet
 
 
-def assembly_figure(a: Assembly, outline) -> bytes:
+def assembly_figure(a: Assembly, outline: Polygon) -> bytes:
     """The net (`outline`, shapely polygon in net coordinates), the four cables threading its
     loops, and the eyelets on the flume's anchor pins; a corner enlarged below."""
     plt = _pyplot()
@@ -126,7 +131,7 @@ def toolpath_preview(tp: Toolpath, title: str, *, window_mm: tuple[float, float]
     return _png(fig)
 
 
-def kit_figures(a: Assembly, outline, net_tp: Toolpath, cable_tp: Toolpath,
+def kit_figures(a: Assembly, outline: Polygon, net_tp: Toolpath, cable_tp: Toolpath,
                 cable_name: str) -> list[tuple[str, bytes, str]]:
     """(file name, PNG, caption) of the assembly picture and the toolpath previews."""
     return [
