@@ -68,6 +68,7 @@ class MakeContext:
     progress: Callable[[str], None] | None = None  # a step's finer progress (STEP per part)
     background: dict[str, Future] = field(default_factory=dict)  # jobs running in `helper`
     helper: Helper | None = None  # the helper process of a short run (`verification_ahead`)
+    toolpaths: dict[str, Any] = field(default_factory=dict)  # per part, built once per run
 
 
 Step = Callable[[MakeContext, Path], None]

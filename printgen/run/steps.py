@@ -25,7 +25,9 @@ if TYPE_CHECKING:  # pragma: no cover
     from printgen.check.bands import Band
     from printgen.check.verify import Verification
     from printgen.design.record import Design
+    from printgen.inputs.printers import Printer
     from printgen.inputs.prototype import Prototype
+    from printgen.parts.gcode.toolpath import Toolpath
     from printgen.run.make import MakeContext
 
 
@@ -36,28 +38,37 @@ def preload_parts() -> None:
         import trimesh  # noqa: F401
 
 
+def part_toolpath(ctx: MakeContext, name: str, part: Any, printer: Printer) -> Toolpath:
+    """The direct toolpath of part `name` ("net" or "cable-<name>"), built once per run:
+    the G-code and the previews share it."""
+    if name not in ctx.toolpaths:
+        from printgen.parts.gcode import cable_toolpath, net_toolpath
+        from printgen.parts.geometry.attach import attachment_for
+
+        d = ctx.design
+        mat, style = load_material(part.material), load_print_style(part.print_style)
+        if name == "net":
+            att = (attachment_for(d, hole_compensation_mm=printer.hole_compensation_mm)
+                   if d.cables else None)
+            ctx.toolpaths[name] = net_toolpath(part, printer, style, mat, attachment=att)
+        else:
+            ctx.toolpaths[name] = cable_toolpath(part, printer, style, mat)
+    return ctx.toolpaths[name]
+
+
 def gcode_step(ctx: MakeContext, stage: Path) -> None:
     """Direct G-code for the net and each cable, checked by read-back against the design."""
-    from printgen.parts.gcode import cable_toolpath, net_toolpath
     from printgen.parts.gcode.readback import read_gcode_text
     from printgen.parts.gcode.writer import gcode_text
-    from printgen.parts.geometry.attach import attachment_for
 
     d = ctx.design
     printer = load_printer(d.printer)
-    att = (attachment_for(d, hole_compensation_mm=printer.hole_compensation_mm)
-           if d.cables else None)
-
-    def net_path(*args):
-        return net_toolpath(*args, attachment=att)
-
-    parts = [("net", d.net, net_path)] + [(f"cable-{c.name}", c, cable_toolpath)
-                                          for c in d.cables]
+    parts = [("net", d.net)] + [(f"cable-{c.name}", c) for c in d.cables]
     rows, rec = [], {}
-    for name, part, build in parts:
-        mat, style = load_material(part.material), load_print_style(part.print_style)
+    for name, part in parts:
+        mat = load_material(part.material)
         t0 = time.perf_counter()
-        tp = build(part, printer, style, mat)
+        tp = part_toolpath(ctx, name, part, printer)
         text = gcode_text(tp, printer, mat, title=f"{name}, 1:{d.scale:g}")
         back = read_gcode_text(text, filament_diameter_mm=printer.filament_diameter_mm)
         seconds = time.perf_counter() - t0
@@ -88,7 +99,6 @@ def kit_step(ctx: MakeContext, stage: Path) -> None:
     """How the kit goes together (labelled picture, checks after printing) and top views of
     the direct toolpaths per pass (the net's corner and a cable's eyelet)."""
     from printgen.parts.assembly import assemble
-    from printgen.parts.gcode import cable_toolpath, net_toolpath
     from printgen.parts.geometry.solid import net_outline
     from printgen.report.kit import kit_figures
     from printgen.report.plots import load_pyplot
@@ -98,11 +108,9 @@ def kit_step(ctx: MakeContext, stage: Path) -> None:
         return
     printer = load_printer(d.printer)
     a = assemble(d, printer)
-    net_tp = net_toolpath(d.net, printer, load_print_style(d.net.print_style),
-                          load_material(d.net.material), attachment=a.attachment)
+    net_tp = part_toolpath(ctx, "net", d.net, printer)  # its attachment is a.attachment
     c = min(d.cables, key=lambda c: c.length_mm)
-    cable_tp = cable_toolpath(c, printer, load_print_style(c.print_style),
-                              load_material(c.material))
+    cable_tp = part_toolpath(ctx, f"cable-{c.name}", c, printer)
     outline = net_outline(d.net, a.attachment)
     load_pyplot()
     sweeps_done(ctx)  # the figures: see there
