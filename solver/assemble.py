@@ -144,14 +144,21 @@ def internal(bars: Bars, cables: list[Cable], u: np.ndarray, n_nodes: int, *,
     return g, K
 
 
-def strain_energy(bars: Bars, cables: list[Cable], u: np.ndarray) -> float:
-    """Total strain energy of strands and cables (nondimensional)."""
-    eps = bar_state(bars, u)[0]
+def bar_energy(bars: Bars, eps: np.ndarray) -> float:
+    """Strain energy of the strands at strains `eps` (nondimensional)."""
+    if len(bars.laws) == 1:
+        return float((bars.rest * bars.laws[0].energy(eps)).sum())
     total = 0.0
     for k, law in enumerate(bars.laws):
         sel = bars.law_index == k
         if sel.any():
             total += float((bars.rest[sel] * law.energy(eps[sel])).sum())
+    return total
+
+
+def strain_energy(bars: Bars, cables: list[Cable], u: np.ndarray) -> float:
+    """Total strain energy of strands and cables (nondimensional)."""
+    total = bar_energy(bars, bar_state(bars, u)[0])
     for c in cables:
         total += c.rest * float(c.law.energy(np.array([cable_state(c, u)[0]]))[0])
     return total

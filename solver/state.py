@@ -14,7 +14,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from solver.assemble import Bars, _law_eval, nondimensional
+from solver.assemble import Bars, _law_eval, bar_energy, nondimensional
 from solver.loads import total_forces
 from solver.model import Net
 from solver.pattern import Pattern, pair_values
@@ -152,17 +152,6 @@ def _bar_pass(b: Bars, u: np.ndarray):
     return eps, force, tangent, d, l
 
 
-def _bar_energy(b: Bars, eps: np.ndarray) -> float:
-    if len(b.laws) == 1:
-        return float((b.rest * b.laws[0].energy(eps)).sum())
-    total = 0.0
-    for k, law in enumerate(b.laws):
-        sel = b.law_index == k
-        if sel.any():
-            total += float((b.rest[sel] * law.energy(eps[sel])).sum())
-    return total
-
-
 def evaluate(ns: NetSystem, u: np.ndarray) -> State:
     """Forces, energy and strand states at u, in one pass over the strands."""
     b = ns.bars
@@ -171,7 +160,7 @@ def evaluate(ns: NetSystem, u: np.ndarray) -> State:
     g = np.zeros((ns.n, 3))
     for k in range(3):
         g[:, k] = (np.bincount(b.j, fn[:, k], ns.n) - np.bincount(b.i, fn[:, k], ns.n))
-    energy = _bar_energy(b, eps)
+    energy = bar_energy(b, eps)
     scales = [float(force.max()) if force.size else 0.0]
     cab: tuple = ()
     cs = ns.cable_set
@@ -193,7 +182,7 @@ def evaluate(ns: NetSystem, u: np.ndarray) -> State:
 
 def potential(ns: NetSystem, u: np.ndarray, f_frozen: np.ndarray) -> float:
     """Strain energy minus the work of frozen loads, without forces (for scalar searches)."""
-    energy = _bar_energy(ns.bars, _bar_pass(ns.bars, u)[0])
+    energy = bar_energy(ns.bars, _bar_pass(ns.bars, u)[0])
     cs = ns.cable_set
     if cs.count:
         energy += float((cs.rest * cs.laws_at(cs.strains(u)[0])[2]).sum())
