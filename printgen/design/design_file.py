@@ -69,7 +69,8 @@ def design_from_dict(data: Any, where: str = "design") -> Design:
 
 
 def load_design(path: str | Path, *, scale: float | None = None) -> Design:
-    """Read a design.json file; with `scale`, it must be a design at that scale."""
+    """Read a design.json file (or the report.json holding one); with `scale`, it must be a
+    design at that scale."""
     p = Path(path)
     try:
         data = json.loads(p.read_text("utf-8"))
@@ -77,6 +78,8 @@ def load_design(path: str | Path, *, scale: float | None = None) -> Design:
         raise InputError(f"design file {p} not found; write one with printgen design") from exc
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise InputError(f"design file {p} cannot be read as JSON: {exc}") from exc
+    if isinstance(data, dict) and "design" in data and "net" not in data:
+        data = data["design"]  # a report.json holds the design under "design"
     d = design_from_dict(data, where=str(p))
     if scale is not None and abs(d.scale - scale) > 1e-9 * scale:
         raise InputError(f"design file {p} is a 1:{d.scale:g} design, not 1:{scale:g}; pass "

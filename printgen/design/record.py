@@ -7,11 +7,8 @@ each of `len(layer_heights_mm)` stacked layers.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
-
-from printgen.errors import InputError
 
 
 @dataclass(frozen=True)
@@ -79,24 +76,11 @@ class Design:
         return asdict(self)
 
     @classmethod
-    def from_record(cls, rec: Mapping[str, Any], *, where: str = "design record") -> Design:
+    def from_record(cls, rec: Any, *, where: str = "design record") -> Design:
         """The Design of a `to_dict()` record (the design.json that `printgen make` writes);
-        InputError naming the missing or bad entry otherwise."""
-        try:
-            net = dict(rec["net"])
-            net["strand"] = _section(net["strand"])
-            cables = tuple(CableDesign(**{**c, "section": _section(c["section"])})
-                           for c in rec["cables"])
-            return cls(float(rec["scale"]), str(rec["printer"]), NetDesign(**net), cables)
-        except KeyError as exc:
-            raise InputError(f"{where}: missing entry {exc}; give the design.json that "
-                             "printgen make writes") from exc
-        except (TypeError, ValueError) as exc:
-            raise InputError(f"{where}: {exc}; give the design.json that printgen make "
-                             "writes") from exc
+        InputError naming the missing, unknown or bad entry otherwise."""
+        from printgen.design.design_file import design_from_dict
 
+        return design_from_dict(rec, where=where)
 
-def _section(r: Mapping[str, Any]) -> Section:
-    return Section(float(r["bead_width_mm"]), int(r["beads_across"]),
-                   tuple(float(h) for h in r["layer_heights_mm"]))
 

@@ -80,13 +80,13 @@ def verify(prototype: PrototypeLike, scale: float, design_: Design | str | Path 
     `Design` or the design.json that `make` wrote; without it, the design `make` would print
     is checked."""
     from printgen.check.verify import verify as _verify
-    from printgen.run.verify import load_design
+    from printgen.design.design_file import load_design
 
     p = prototype_of(prototype)
     if design_ is None:
         d = plan(p, scale, printer=printer)
     else:
-        d = design_ if isinstance(design_, Design) else load_design(design_, scale)
+        d = design_ if isinstance(design_, Design) else load_design(design_, scale=scale)
     return _verify(p, d, drag=drag)
 
 

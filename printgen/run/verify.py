@@ -7,7 +7,6 @@ it and one factor of the printed net fitted to it. Output folder (written whole,
 
 from __future__ import annotations
 
-import json
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -24,8 +23,8 @@ from printgen.check.measured import (
     read_measured,
 )
 from printgen.check.verify import Verification, verify
+from printgen.design.design_file import load_design
 from printgen.design.record import Design
-from printgen.errors import InputError
 from printgen.inputs.materials import load_material
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import staged_dir
@@ -39,7 +38,6 @@ from printgen.report.uncertainty import (
     measured_sections,
 )
 
-SCALE_TOL = 1e-9  # relative: --scale must be the design's scale
 TIMINGS = "timings.json"  # wall-clock times, the one file that differs between identical runs
 
 
@@ -58,26 +56,6 @@ class VerifyRun:
     files: list[str]
 
 
-def load_design(path: str | Path, scale: float) -> Design:
-    """The Design in `path` (make's design.json); InputError when it is unreadable or at
-    another scale than `scale`."""
-    p = Path(path)
-    try:
-        rec = json.loads(p.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise InputError(f"--design {p}: cannot read it ({exc}); give the design.json that "
-                         "printgen make wrote") from exc
-    if isinstance(rec, dict) and "design" in rec and "net" not in rec:
-        rec = rec["design"]  # a report.json holds the design under "design"
-    if not isinstance(rec, dict):
-        raise InputError(f"--design {p}: not a design record (a JSON object)")
-    d = Design.from_record(rec, where=f"--design {p}")
-    if abs(d.scale / scale - 1) > SCALE_TOL:
-        raise InputError(f"--design {p} is the design at 1:{d.scale:g}, --scale is {scale:g}; "
-                         f"give --scale {d.scale:g} or the design made at 1:{scale:g}")
-    return d
-
-
 def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
                   out: str | Path, *, measured: str | Path | None = None,
                   fit: str = "stiffness", drag: bool = False, force: bool = False,
@@ -89,7 +67,7 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     say = progress or (lambda _label: None)
     t0 = time.perf_counter()
     p = load_prototype(prototype)
-    d = load_design(design_path, scale)
+    d = load_design(design_path, scale=scale)
     m = read_measured(measured) if measured is not None else None
     load_kw = model_load_kw(p, d, drag)
     say("verification (prototype and model load sweeps)")
