@@ -42,13 +42,14 @@ def design_sections(rep: Report, proto: Prototype, t: ScaledTargets, sel: Select
             continue
         rep.heading(f"Selection: {what.lower()}")
         rep.paragraph(why)
-        rep.table(["#", "material", "E source", "section (mm)", "passes", "stiffness",
-                   "target", "error", "Pi3", "safety factor"],
+        unit = "E*A, N" if what == "Border cables" else "initial membrane, N/m"
+        rep.table(["#", "material", "E source", "section (mm)", "passes", f"stiffness ({unit})",
+                   f"target ({unit})", "stiffness error", "Pi3 deviation", "safety factor (-)"],
                   [_row(i + 1, c) for i, c in enumerate(cands[:SHOW])])
     rep.heading("Printed parts")
     n = design.net
     rows = [["net", n.material.upper(), f"{n.width_mm:g} x {n.height_mm:g}",
-             (f"mesh {n.mesh_x_mm:g} x {n.mesh_y_mm:g}, strand {n.strand.width_mm:g} x "
+             (f"diamond mesh {n.mesh_x_mm:g} x {n.mesh_y_mm:g}, strand {n.strand.width_mm:g} x "
              f"{n.strand.thickness_mm:g} mm, {n.strand.passes} passes")]]
     rows += [[f"cable {c.name}", c.material.upper(), f"{c.length_mm:g} long",
               (f"{c.section.width_mm:g} x {c.section.thickness_mm:g} mm, {c.section.passes} "
@@ -109,8 +110,9 @@ def _sweep_sections(rep: Report, v: Verification, scale: float, band: Band | Non
     idx = [int(np.argmin(np.abs(p.levels - x))) for x in (0.5, 1.0, 1.1)]
     rows = []
     for mm in v.mismatches:
-        rows.append([METRICS[mm.metric]]
-                    + [f"{p.values[mm.metric][i]:.4f} / {m.values[mm.metric][i]:.4f}" for i in idx]
+        rows.append([f"{METRICS[mm.metric]} ({unit_of(mm.metric)})"]
+                    + [f"{fmt_value(mm.metric, p.values[mm.metric][i])} / "
+                       f"{fmt_value(mm.metric, m.values[mm.metric][i])}" for i in idx]
                     + [f"{mm.max_rel:.0%}", f"{mm.rms_rel:.0%}", f"{mm.ratio_high:.2f}",
                        "ok" if mm.ok else "FAIL"])
     rep.table(["quantity (prototype / model)", "h/h_B = 0.5", "1.0", "1.1", "max mismatch",
@@ -137,6 +139,16 @@ def _sweep_sections(rep: Report, v: Verification, scale: float, band: Band | Non
     rep.paragraph(f"Solver: {sum(v.prototype.iterations)} + {sum(v.model.iterations)} Newton "
                   f"iterations over {len(p.levels)} load levels (times in timings.json).",
                   "note")
+
+
+def unit_of(metric: str) -> str:
+    """The unit a METRICS quantity is shown in: strains in %, the rest normalised (-)."""
+    return "%" if metric.startswith("strain") else "-"
+
+
+def fmt_value(metric: str, x: float) -> str:
+    """A METRICS value as shown: strains in % (2 decimals), the rest to 4 decimals."""
+    return f"{x * 100:.2f}" if metric.startswith("strain") else f"{x:.4f}"
 
 
 def _deformed_section(rep: Report, v: Verification) -> None:

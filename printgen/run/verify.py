@@ -22,6 +22,7 @@ from printgen.check.measured import (
     model_predictor,
     read_measured,
 )
+from printgen.check.readings import design_units
 from printgen.check.verify import Verification, verify
 from printgen.design.design_file import load_design
 from printgen.design.record import Design
@@ -68,7 +69,7 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     t0 = time.perf_counter()
     p = load_prototype(prototype)
     d = load_design(design_path, scale=scale)
-    m = read_measured(measured) if measured is not None else None
+    m = read_measured(measured, design_units(d)) if measured is not None else None
     load_kw = model_load_kw(p, d, drag)
     say("verification (prototype and model load sweeps)")
     v = verify(p, d, drag=drag)
@@ -85,7 +86,7 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     record = {"design": d.to_dict(), "verification": v.to_record(),
               "bands": band_record(v, band)}
     if m is not None:
-        measured_sections(rep, m, band, result, text)
+        measured_sections(rep, m, band, result, text, prototype=v.prototype.deformation)
         record["measured"] = measured_record(m, band, result, text)
     record["timings_s"] = {"total": time.perf_counter() - t0, "band": band.seconds}
     files = _write(out, rep, record, d, text, force)
