@@ -33,6 +33,7 @@ class FigureFile:
     caption: str
     png: bytes
     svg: bytes
+    labels: tuple[tuple[str, tuple[str, ...]], ...] = ()  # (axis title, its axis labels)
 
 
 @dataclass
@@ -66,7 +67,9 @@ class Report:
         figure `name` (default: from the caption) for the files beside the report."""
         svg = getattr(png, "svg", None)
         if svg is not None:
-            self.figures.append(FigureFile(name or slug(caption), caption, bytes(png), svg))
+            labels = tuple((t, tuple(names)) for t, names in getattr(png, "labels", ()))
+            self.figures.append(FigureFile(name or slug(caption), caption, bytes(png), svg,
+                                           labels))
         data = base64.b64encode(png).decode("ascii")
         self.blocks.append(f'<figure><img alt="{html.escape(caption)}" '
                            f'src="data:image/png;base64,{data}"><figcaption>'

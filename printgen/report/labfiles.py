@@ -20,6 +20,7 @@ from printgen.check.readings import DEPTH_COLUMN, RAW_COLUMNS, flume_units
 from printgen.check.verify import Verification
 
 DIGITS = 8  # significant digits of every number in the CSV files
+NOISE = 1e-6  # |value| below this (in the column's unit: %, mm, N, kN or -) is written as 0
 CURVES, READINGS, SHEET = "curves.csv", "expected-readings.csv", "measurement-sheet.csv"
 # METRICS key -> (CSV stem with its unit, factor from the record's unit)
 CURVE_COLUMNS = {key: (col, 100.0 if col.endswith("_pct") else 1.0)
@@ -122,4 +123,6 @@ def _csv(header: list[str], cols: list[Any]) -> str:
 
 
 def _num(x: float) -> str:
-    return "" if not math.isfinite(x) else f"{x:.{DIGITS}g}"
+    if not math.isfinite(x):
+        return ""
+    return "0" if abs(x) < NOISE else f"{x:.{DIGITS}g}"  # solver round-off, "-0" included

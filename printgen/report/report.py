@@ -134,7 +134,8 @@ def _sweep_sections(rep: Report, v: Verification, scale: float, band: Band | Non
     rep.figure(verification_figure(p, m, scale, "Normalised deformation against relative "
                                    "loading", band=band),
                "Prototype (black) and printed model (orange"
-               + ("; shaded: the model's uncertainty band)." if band is not None else ")."))
+               + ("; shaded: the model's uncertainty band)." if band is not None else ")."),
+               "verification")
     _deformed_section(rep, v)
     rep.paragraph(f"Solver: {sum(v.prototype.iterations)} + {sum(v.model.iterations)} Newton "
                   f"iterations over {len(p.levels)} load levels (times in timings.json).",
@@ -161,7 +162,7 @@ def _deformed_section(rep: Report, v: Verification) -> None:
         rep.figure(deformed_figure(shapes, SHOWN_LEVEL), "Both nets deformed at h/h_B = "
                    f"{SHOWN_LEVEL:g}, normalised by their own width (x, deflection) and height "
                    "(z); black: border cables. Model node positions at 0.5, 1.0 and 1.1 are in "
-                   "report.json (verification.deformed_shape).")
+                   "report.json (verification.deformed_shape).", "deformed-nets")
     for who, run in (("prototype", v.prototype), ("model", v.model)):
         if run.scene.hold > 0:
             rep.paragraph(f"{who}: unloaded strands stay where they are (held by "

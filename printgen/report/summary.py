@@ -116,8 +116,10 @@ def summary_html(s: dict[str, Any]) -> str:
     lines = [(f'<p class="verdict"><span class="{tag}">{e(s["verdict"])}</span> '
              f'{e(s["reason"] or "the verification was not run")}</p>')]
     if s["band"]:
-        lines.append("<p><b>Uncertainty band:</b> " + "; ".join(
-            f"{e(METRICS[k].split(' (')[0])}: {e(t)}" for k, t in s["band"].items()) + "</p>")
+        lines.append("<p><b>Uncertainty band</b> (where the prototype lies against the "
+                     "model's band):</p><ul>" + "".join(
+                         f"<li>{e(METRICS[k].split(' (')[0])}: {e(t)}</li>"
+                         for k, t in s["band"].items()) + "</ul>")
     parts = "; ".join(
         f"{e(p['part'])}: {e(p['material'])}, {e(p['section'])}"
         + ("" if p["stiffness_error"] is None else

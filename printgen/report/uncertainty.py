@@ -122,7 +122,7 @@ def measured_sections(rep: Report, m: Measurement, band: Band, fit: Fit | None,
         rep.paragraph(_fit_sentence(fit))
     rep.figure(measured_figure(m, band, fit, prototype), "Measured points (black dots) on the "
                "predicted band (orange: model nominal, shaded: band), with the prototype (black "
-               "line), all counted from h/h_B = 0; dashed: fitted.")
+               "line), all counted from h/h_B = 0; dashed: fitted.", "measured")
     if profile and not (fit and fit.at_bound):
         rep.paragraph("To feed it back, save this in a profile folder of your own as "
                       "materials/<name>.toml, add the folder to $PRINTGEN_PROFILES, and name "

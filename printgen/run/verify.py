@@ -1,8 +1,9 @@
 """`printgen verify`: the pre-print check of an existing design (the design.json `make`
 wrote), with its uncertainty band, and optionally a lab's measured loading test compared with
 it and one factor of the printed net fitted to it. Output folder (written whole,
-`outputs.staged_dir`): report.html, report.json, timings.json, and with a stiffness fit
-`<material>-fitted.toml`, the profile that feeds the fit back.
+`outputs.staged_dir`): report.html, report.json, timings.json, the lab's CSV files
+(printgen.report.labfiles), and with a stiffness fit `<material>-fitted.toml`, the profile
+that feeds the fit back.
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import staged_dir
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
+from printgen.report.labfiles import lab_files, lab_record
 from printgen.report.report import verification_sections
 from printgen.report.uncertainty import (
     band_record,
@@ -84,7 +86,7 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     verification_sections(rep, v, None, d.scale, band=band)
     band_sections(rep, v, band)
     record = {"design": d.to_dict(), "verification": v.to_record(),
-              "bands": band_record(v, band)}
+              "bands": band_record(v, band), "lab": lab_record(v, band, d.scale)}
     if m is not None:
         measured_sections(rep, m, band, result, text, prototype=v.prototype.deformation)
         record["measured"] = measured_record(m, band, result, text)
@@ -106,6 +108,7 @@ def _write(out: str | Path, rep: Report, record: dict[str, Any], d: Design, prof
     timings = record.pop("timings_s")
     files = {"report.html": rep.html(), "report.json": dumps(record),
              TIMINGS: dumps({"timings_s": timings})}
+    files.update(lab_files(record["lab"]))  # curves, expected readings, measurement sheet
     if profile:
         files[f"{d.net.material}-fitted.toml"] = profile
     record["timings_s"] = timings
