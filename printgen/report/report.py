@@ -46,6 +46,11 @@ def design_sections(rep: Report, proto: Prototype, t: ScaledTargets, sel: Select
         rep.table(["#", "material", "E source", "section (mm)", "passes", f"stiffness ({unit})",
                    f"target ({unit})", "stiffness error", "Pi3 deviation", "safety factor (-)"],
                   [_row(i + 1, c) for i, c in enumerate(cands[:SHOW])])
+        same = _same_stiffness(cands[:SHOW])
+        if same:
+            rep.paragraph(f"Equivalent rows (#{same.replace('; ', ' and #')}): the same material "
+                          "and bead area laid out differently (beads across x layers), so the "
+                          "same stiffness; the ranking between them is the shape's.", "note")
     rep.heading("Printed parts")
     n = design.net
     rows = [["net", n.material.upper(), f"{n.width_mm:g} x {n.height_mm:g}",
@@ -56,6 +61,17 @@ def design_sections(rep: Report, proto: Prototype, t: ScaledTargets, sel: Select
               f"passes, eyelets {c.eyelet_inner_mm:g}/{c.eyelet_outer_mm:g} mm")]
              for c in design.cables]
     rep.table(["part", "material", "size (mm)", "section"], rows)
+
+
+def _same_stiffness(cands: tuple[Candidate, ...] | list[Candidate]) -> str:
+    """'1-3, 4-5': runs of ranked rows with the same material and section area."""
+    groups, out = {}, []
+    for i, c in enumerate(cands, 1):
+        groups.setdefault((c.material, round(c.section.area_mm2, 9)), []).append(i)
+    for rows in groups.values():
+        if len(rows) > 1:
+            out.append(", ".join(map(str, rows)))
+    return "; ".join(out)
 
 
 def _row(rank: int, c: Candidate) -> list[str]:
