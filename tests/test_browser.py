@@ -193,7 +193,8 @@ def test_no_reference_to_a_file_the_package_lacks(made):
     for bad in ("barrier-physics", "printgen reference", "(issue ", "slicers.md"):
         assert bad not in text, bad
     shipped = {p.name for p in out.rglob("*")} | {p.name for p in ROOT.glob("*")} \
-        | {p.name for p in (ROOT / "examples").iterdir()}
+        | {p.name for p in (ROOT / "examples").iterdir()} \
+        | {p.name for p in (ROOT / "profiles").rglob("*.toml")}  # provenance names profiles
     for name in set(FILE_REF.findall(text)):
         assert name in shipped, name
 

@@ -66,7 +66,7 @@ def axis_labels(fig) -> list[tuple[str, list[str]]]:
     """(title, labels) of every visible axis of `fig` (3D axes give x, y and z)."""
     out = []
     for ax in fig.axes:
-        if not ax.axison:
+        if not getattr(ax, "_axis3don", ax.axison):  # a 3D axes turns its 2D frame off
             continue
         names = [ax.get_xlabel(), ax.get_ylabel()]
         if hasattr(ax, "get_zlabel"):
