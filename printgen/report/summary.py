@@ -10,8 +10,8 @@ from typing import Any
 
 from printgen.check.compare import METRICS
 
-NEXT_PASS = ("Print the parts (G-code files above, or slice the 3MF), assemble them as the "
-             "Assembly section shows, and run the flume test with measurement-sheet.csv; "
+NEXT_PASS = ("Print the parts (the .gcode files, or slice the .3mf files), assemble them as the "
+             "Assembly section below shows, and run the flume test with measurement-sheet.csv; "
              "bring the readings back with printgen verify --measured.")
 NEXT_STIFF = ("Change the net before printing: the model is too stiff. Try a softer material, "
               "fewer passes or a thinner strand (printgen select lists them), or let printgen "
