@@ -165,7 +165,7 @@ def measured_figure(m: Measurement, band: Band, fit: Fit | None,
                     label=f"fitted {fit.kind} {fit.value:.3g}")
         ax.set_xlabel(LOADING)
         ax.set_ylabel(label)
-        ax.set_title(m.columns[key], fontsize=10)
+        ax.set_title(f"column {m.columns[key]}", fontsize=10)
         ax.grid(alpha=0.3)
     axes.flat[0].legend(fontsize=8)
     fig.suptitle("Measured loading test against the prediction")
