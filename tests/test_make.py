@@ -171,3 +171,7 @@ def test_barrier_without_cables_is_verified_at_every_level(tmp_path):
     ver = ctx.record["verification"]
     assert ver["verdict"] in ("PASS", "FAIL") and len(ver["prototype"]["levels"]) == 23
     assert ver["not_converged"] == {"prototype": {}, "model": {}}
+    # the bottom row lies on the bed: no empty "bottom cable elongation" panel (issue 23)
+    panels = [t for f in ctx.report.figures if f.name == "verification" for t, _ in f.labels]
+    assert "mid-height deflection / width" in panels
+    assert not any("bottom cable" in t for t in panels)
