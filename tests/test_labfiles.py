@@ -112,3 +112,19 @@ def test_figures_give_the_same_png_and_svg_twice():
     a, b = draw(), draw()
     assert bytes(a) == bytes(b) and a.svg == b.svg and a.svg.startswith(b"<?xml")
     assert a.labels == [("", ["relative loading h / h_B (-)", ""])]
+
+
+def test_summary_of_a_verify_record_without_selection():
+    """`verify` has the design but no selection: the box names the parts without an error."""
+    from printgen.report.summary import summary_html, summary_record
+
+    d = reference_design_1_40()
+    rec = {"verification": {"verdict": "FAIL", "summary": "model too stiff", "ok": False,
+                            "mismatches": []},
+           "bands": {"verdicts": [{"metric": "deflection", "text": "model stiffer by 20%"}]},
+           "design": d.to_dict()}
+    s = summary_record(rec, "fitted: stiffness 0.8 x")
+    assert s["verdict"] == "FAIL" and s["next"] == "fitted: stiffness 0.8 x"
+    assert [p["stiffness_error"] for p in s["parts"]] == [None, None]
+    box = summary_html(s)
+    assert 'id="summary"' in box and "model stiffer by 20%" in box and "TPE" in box

@@ -44,11 +44,12 @@ def print_totals(gcode: dict[str, Any]) -> dict[str, float]:
     return {k: float(sum(r["print"][k] for r in gcode.values())) for k in keys}
 
 
-def summary_record(record: dict[str, Any]) -> dict[str, Any]:
+def summary_record(record: dict[str, Any], next_step: str = "") -> dict[str, Any]:
     """The summary's numbers: verdict, reason, band verdicts, chosen parts, print totals,
-    next step (report.json "summary")."""
+    next step (report.json "summary"; `next_step` replaces the one chosen from the verdict).
+    The band is record["verification"]["bands"] (make) or record["bands"] (verify)."""
     v = record.get("verification") or {}
-    verdicts = (v.get("bands") or {}).get("verdicts", [])
+    verdicts = (v.get("bands") or record.get("bands") or {}).get("verdicts", [])
     ratios = [m.ratio_high for m in v.get("mismatches", []) if not m.ok]
     if not v:
         nxt = NEXT_NONE
@@ -59,7 +60,7 @@ def summary_record(record: dict[str, Any]) -> dict[str, Any]:
     out: dict[str, Any] = {
         "verdict": v.get("verdict", "not run"), "reason": v.get("summary", ""),
         "band": {b["metric"]: b["text"] for b in verdicts},
-        "parts": chosen_parts(record), "next": nxt}
+        "parts": chosen_parts(record), "next": next_step or nxt}
     if record.get("gcode"):
         out["print"] = print_totals(record["gcode"])
     return out
@@ -67,17 +68,17 @@ def summary_record(record: dict[str, Any]) -> dict[str, Any]:
 
 def chosen_parts(record: dict[str, Any]) -> list[dict[str, Any]]:
     """The net and the border cables as chosen: material, section, passes, stiffness error."""
-    sel, design = record["selection"], record["design"]
+    sel, design = record.get("selection"), record["design"]
     out = []
     net = design["net"]
-    pick = _same_section(sel["net"]["ranked"], net["material"], net["strand"])
+    pick = sel and _same_section(sel["net"]["ranked"], net["material"], net["strand"])
     out.append({"part": "net", "material": net["material"].upper(),
                 "section": (f"strand {_mm(net['strand'])}, mesh {net['mesh_x_mm']:g} x "
                             f"{net['mesh_y_mm']:g} mm"),
                 "stiffness_error": None if pick is None else pick["error"]})
     if design["cables"]:
         c = design["cables"][0]
-        pick = _same_section(sel["cable"]["ranked"], c["material"], c["section"])
+        pick = sel and _same_section(sel["cable"]["ranked"], c["material"], c["section"])
         out.append({"part": f"border cables ({len(design['cables'])})",
                     "material": c["material"].upper(), "section": _mm(c["section"]),
                     "stiffness_error": None if pick is None else pick["error"]})

@@ -34,6 +34,7 @@ from printgen.report.html import Report
 from printgen.report.jsonout import dumps
 from printgen.report.labfiles import lab_files, lab_record
 from printgen.report.report import verification_sections
+from printgen.report.summary import summary_html, summary_record
 from printgen.report.uncertainty import (
     band_record,
     band_sections,
@@ -90,6 +91,9 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     if m is not None:
         measured_sections(rep, m, band, result, text, prototype=v.prototype.deformation)
         record["measured"] = measured_record(m, band, result, text)
+    record["summary"] = summary_record(record, record["measured"]["fit"]["sentence"]
+                                       if m is not None and result else "")
+    rep.lead = summary_html(record["summary"])
     record["timings_s"] = {"total": time.perf_counter() - t0, "band": band.seconds}
     files = _write(out, rep, record, d, text, force)
     return VerifyRun(p, d, v, band, m, result, text, record, files)
