@@ -4,7 +4,7 @@
         [--width-mm W --thickness-mm T | --area-mm2 A] [--gauge-length-mm L]
         [--grip-distance-mm L] [--specimen SIDECAR.toml] [--column ROLE=NAME] [--unit ROLE=UNIT]
         [--window 0.05,0.25 | --window auto] [--preload N [--zero interpolate|first]]
-        [--secant 0.5,1] [--keep-flagged]
+        [--secant 0.5,1] [--flag COLUMN=active-low|active-high|ignore] [--keep-flagged]
         [--strain-source auto|extensometer|crosshead]
         [--machine-stiffness N_PER_MM | --compliance-curve FILE]
         [--strength-only] [--save [--out DIR] [--inherits petg]] [--plot DIR] [--json]
@@ -63,6 +63,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--zero", choices=ZERO_MODES, help=f"preload zero (default {DEFAULT_ZERO}): "
                    "'interpolate' between the samples around the preload, or 'first' sample at "
                    "or above it (as many testers' software does)")
+    p.add_argument("--flag", action="append", default=[], metavar="COLUMN=CONVENTION",
+                   help="how a status column reads: active-low (0 = set, e.g. an end stop with "
+                        "a pull-up), active-high (1 = set) or ignore (default: from the data: "
+                        "a column constant through the test marks nothing, one that changes "
+                        "marks the rows that differ from its start)")
     p.add_argument("--keep-flagged", action="store_true",
                    help="keep samples a tester flag column marks (step loss, end stop, ...) in "
                         "the statistics (default: reported and left out)")
@@ -124,15 +129,15 @@ def run(args: argparse.Namespace) -> int:
         specimen_file=args.specimen, columns=_pairs(args.column, "--column"),
         units=_pairs(args.unit, "--unit"),
         delimiter="\t" if args.delimiter == "tab" else args.delimiter, decimal=args.decimal,
-        strength_only=args.strength_only, conditions=args.conditions)
+        strength_only=args.strength_only, conditions=args.conditions,
+        flags=_pairs(args.flag, "--flag"))
     written = {}
     if args.save or args.out:
-        from printgen.calibrate.profile_writer import write_profile
+        from printgen.calibrate.profile_writer import value_sources, write_profile
 
         path, mat = write_profile(cal, name=args.material, out=args.out, inherits=args.inherits,
                                   date=args.date)
-        e, source = mat.modulus()
-        written = {"profile": str(path), "modulus_gpa": e / 1e9, "modulus_source": source}
+        written = {"profile": str(path), **value_sources(cal, path, mat)}
         if cal.kind == "panel" and mat.panel_law is not None:
             written["panel_law_kappa_kn_per_m_per_m"] = [k / 1e3 for k in mat.panel_law.kappas]
             written["panel_law_knee_strain_percent"] = [k * 100 for k in
