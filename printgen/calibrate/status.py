@@ -63,10 +63,11 @@ def decide(levels: Mapping[str, np.ndarray], chosen: Mapping[str, str], where: s
 def _match(levels: Mapping[str, np.ndarray], chosen: Mapping[str, str], where: str
            ) -> dict[str, str]:
     out = {}
-    for key, conv in chosen.items():
-        conv = conv.strip().lower()
+    for key, given in chosen.items():
+        conv = given.strip().lower() if isinstance(given, str) else repr(given)
         if conv not in CONVENTIONS:
-            raise CalibrationError(f"--flag {key}={conv}: unknown convention; expected one of "
+            raise CalibrationError(f"status column {key!r}: convention {conv!r} (--flag or a "
+                                   f"sidecar [flags] table); expected one of "
                                    f"{', '.join(CONVENTIONS)}")
         hit = [h for h in levels if h.strip().lower() == key.strip().lower()]
         if not hit:
