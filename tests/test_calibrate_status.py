@@ -125,7 +125,8 @@ def test_user_says_the_convention(arduino, capsys):
     assert "--flag endstopp: no status column of that name" in err
     assert "status columns: 'endstop', 'step_loss'" in err
     assert main([*args, "--flag", "endstop=low"]) == 2
-    assert "expected one of active-high, active-low, ignore" in capsys.readouterr().err
+    assert ("status column 'endstop': convention 'low' (--flag or a sidecar [flags] table); "
+            "expected one of active-high, active-low, ignore") in capsys.readouterr().err
     assert main([*args, "--flag", "endstop"]) == 2
     assert "expected NAME=VALUE, e.g. endstop=active-low" in capsys.readouterr().err
 
@@ -147,6 +148,10 @@ def test_sidecar_flags_table_and_an_active_high_event(tmp_path):
     again = calibrate([p], material="x", specimen=spec, options=keep,
                       flags={"step_loss": "active-high"})
     assert again.samples[0].flags[0].startswith("step_loss set at line 902")
+    (tmp_path / "loss.toml").write_text("[flags]\nstep_loss = 1\n")
+    with pytest.raises(CalibrationError, match=r"status column 'step_loss': convention '1' "
+                       r"\(--flag or a sidecar \[flags\] table\); expected one of active-high"):
+        calibrate([p], material="x", specimen=spec)
 
 
 def test_decide_per_column():
