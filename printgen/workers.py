@@ -17,9 +17,12 @@ import multiprocessing
 import os
 import signal
 import threading
+import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
 from typing import Any
+
+from printgen.errors import TimeLimitError
 
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
 HANDLED = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
@@ -112,6 +115,34 @@ def reporting(listener: Callable[[str, float, float], None]) -> Iterator[None]:
         yield
     finally:
         _listener = previous
+
+
+_deadline: float | None = None  # time.time() past which `check_deadline` raises (inherited by
+# forked workers: set before they start)
+
+
+@contextlib.contextmanager
+def deadline(at: float | None) -> Iterator[None]:
+    """Within the block, `check_deadline` raises TimeLimitError once time.time() passes `at`
+    (None: no limit), in this process and in workers forked inside the block."""
+    global _deadline
+    previous, _deadline = _deadline, at
+    try:
+        yield
+    finally:
+        _deadline = previous
+
+
+def seconds_left() -> float | None:
+    """Seconds until the deadline of `deadline` (None without one; may be negative)."""
+    return None if _deadline is None else _deadline - time.time()
+
+
+def check_deadline(what: str) -> None:
+    """Raise TimeLimitError naming `what` when the deadline of `deadline` has passed."""
+    left = seconds_left()
+    if left is not None and left < 0:
+        raise TimeLimitError(f"{what}: past the time limit")
 
 
 def report_progress(task: str, done: float, total: float) -> None:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import math
 import os
 import time
 from collections.abc import Callable, Iterator
@@ -24,6 +25,7 @@ from printgen.design.plan import make_design
 from printgen.design.record import Design
 from printgen.design.selection import Selection, select
 from printgen.design.similitude import ScaledTargets, scale_targets
+from printgen.errors import TimeLimitError
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import MANIFEST, check_destination, staged_dir
 from printgen.report.html import Report
@@ -48,7 +50,7 @@ from printgen.run.steps import (
     verification_sweeps,
     verify_step,
 )
-from printgen.workers import Helper, helper, signals_deferred
+from printgen.workers import Helper, check_deadline, deadline, helper, signals_deferred
 
 log = logging.getLogger(__name__)
 
@@ -118,14 +120,20 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     long_run = progress if est.seconds > LONG_RUN_S else None  # per-level bars when long
     steps = steps if steps is not None else default_steps()
     ctx.progress = progress
-    with staged_dir(out, force=bool(ctx.options.get("force")), meta=meta,
-                    volatile=(TIMINGS,)) as stage, level_bars(long_run), \
+    bound = run_bound(ctx.options)
+    with deadline(time.time() + bound - (time.perf_counter() - t0)), \
+            staged_dir(out, force=bool(ctx.options.get("force")), meta=meta,
+                       volatile=(TIMINGS,)) as stage, level_bars(long_run), \
             verification_ahead(ctx, steps, long_run is None):
         for label, step in steps:
             if progress:
                 progress(label)
             t = time.perf_counter()
-            step(ctx, stage)
+            try:
+                step(ctx, stage)
+                check_deadline(label)
+            except TimeLimitError as exc:
+                raise TimeLimitError(time_limit_line(label, est, bound, t0, ctx.options)) from exc
             ctx.record.setdefault("timings_s", {})[label] = time.perf_counter() - t
         meta.update(provenance(ctx))
         provenance_section(ctx.report, meta)
@@ -176,6 +184,30 @@ def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
     ctx.record["size"] = est.to_record()
     ctx.record.setdefault("timings_s", {})["estimate"] = est.seconds
     return est
+
+
+# Without --time-limit a run is refused when estimated over DEFAULT_LIMIT_S and stopped once
+# it has run DEFAULT_BOUND_FACTOR times that (a loaded machine runs several times slower than
+# the estimate; a run still going then has gone wrong); with --time-limit, stopped at it.
+DEFAULT_BOUND_FACTOR = 5.0
+
+
+def run_bound(options: dict[str, Any]) -> float:
+    """Seconds after which the run stops (see DEFAULT_BOUND_FACTOR)."""
+    limit = options.get("time_limit_s")
+    return float(limit) if limit else DEFAULT_BOUND_FACTOR * DEFAULT_LIMIT_S
+
+
+def time_limit_line(label: str, est: Estimate, bound: float, t0: float,
+                    options: dict[str, Any]) -> str:
+    """The one line of a run stopped at its time limit: step, estimate, time spent, option."""
+    spent = time.perf_counter() - t0
+    which = ("--time-limit" if options.get("time_limit_s") else
+             f"the default bound, {DEFAULT_BOUND_FACTOR:g} x the default limit")
+    return (f"stopped in step '{label}' after {spent:.0f} s, past the time limit of {bound:g} s "
+            f"({which}); the run was estimated at about {est.seconds:.0f} s; nothing written. "
+            f"Raise it with --time-limit {math.ceil(max(spent, bound) * 2 / 60) * 60:g}, or "
+            "coarsen the nets")
 
 
 def default_steps() -> list[tuple[str, Step]]:
