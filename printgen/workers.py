@@ -20,6 +20,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures import TimeoutError as FutureTimeout
 from typing import Any
 
 from printgen.errors import TimeLimitError
@@ -145,6 +146,15 @@ def check_deadline(what: str) -> None:
         raise TimeLimitError(f"{what}: past the time limit")
 
 
+def _result(f: Future) -> Any:
+    """A job's result, waited for no longer than the deadline (`deadline`)."""
+    left = seconds_left()
+    try:
+        return f.result(timeout=None if left is None else max(left, 0.0))
+    except FutureTimeout as exc:
+        raise TimeLimitError("a worker's job: past the time limit") from exc
+
+
 def report_progress(task: str, done: float, total: float) -> None:
     """From inside a job: `task` has reached `done` of `total` (e.g. load level 0.35 of 1.1).
     A no-op unless the caller of `run_jobs` is listening."""
@@ -186,7 +196,7 @@ def run_jobs(jobs: list[tuple]) -> list:
                                initargs=(os.getpid(),))
     try:
         futures = [pool.submit(fn, *args, **kw) for fn, args, kw in jobs]
-        results = [f.result() for f in futures]
+        results = [_result(f) for f in futures]
     except BaseException:
         stop(pool)
         raise

@@ -13,7 +13,7 @@ from rich.console import Console
 from printgen.commands.common import add_json_arg, add_prototype_args, console, emit_json, table
 from printgen.run import api
 from printgen.run.budget import DEFAULT_LIMIT_S
-from printgen.run.make import DEFAULT_BOUND_FACTOR, json_output
+from printgen.run.make import json_output
 
 EXIT_INCOMPLETE = 3  # outputs written, but the verdict rests on fewer load levels than asked
 EXIT_TIME_LIMIT = 4  # stopped at --time-limit (printgen.cli maps TimeLimitError to it)
@@ -34,7 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help=f"refuse runs estimated longer than this and stop the run (exit "
                         f"{EXIT_TIME_LIMIT}, nothing written) once it has run this long "
                         f"(default: refuse over {DEFAULT_LIMIT_S:g} s, about a minute on 2 "
-                        f"cores; stop after {DEFAULT_BOUND_FACTOR * DEFAULT_LIMIT_S:g} s)")
+                        f"cores, and never stop)")
     p.add_argument("--force", action="store_true",
                    help="replace --out even when it holds files printgen did not write")
     add_json_arg(p)
