@@ -105,7 +105,7 @@ def show_summary(ctx, out: Path, seconds: float) -> None:
                   ["item", "choice", "stiffness / result"], rows))
     from printgen.report.summary import summary_lines
 
-    for line in summary_lines(ctx.record["summary"])[1:]:  # the verdict is in the table
+    for line in summary_lines(ctx.record.get("summary") or {})[1:]:  # verdict: in the table
         c.print(line)
     if ctx.record.get("pdf_skipped"):
         c.print(ctx.record["pdf_skipped"])

@@ -140,6 +140,8 @@ def summary_lines(s: dict[str, Any]) -> list[str]:
     """The summary as plain lines for the terminal."""
     from printgen.parts.gcode.estimate import duration
 
+    if not s:
+        return []
     out = [f"{s['verdict']}: {s['reason']}" if s["reason"] else s["verdict"]]
     if "print" in s:
         t = s["print"]
