@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 from printgen.design.screen import Screened
 from printgen.design.search_space import SearchSpace, half_cell_counts
-from printgen.design.selection import MIN_SAFETY_FACTOR
+from printgen.design.selection import CALIBRATE_FIRST, MIN_SAFETY_FACTOR
 
 if TYPE_CHECKING:
     from printgen.design.search import SearchResult
@@ -119,5 +119,5 @@ def choice_reasons(res: SearchResult) -> list[str]:
                f"{s.speed_mm_per_s:.3g} mm/s")
     if s.datasheet:
         out.append(f"the {s.point.material.upper()} law is from a DATASHEET modulus: printed "
-                   "parts are often 2x softer; calibrate it before printing")
+                   f"parts are often 2x softer; {CALIBRATE_FIRST}")
     return out

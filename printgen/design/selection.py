@@ -45,6 +45,8 @@ SCORE_DIGITS = 9  # scores equal to 1e-9 are ties (same E*A, different layout)
 MIN_SPEED_MM_S = 2.0  # slower than this, the flow limit makes the print impractical
 ASSUMED_SAG_RATIO = 0.2  # peak-force estimate: sag / span of a loaded cable or net strip
 OVERFLOW = 1.1  # peak relative loading h / h_B of the loading test
+CALIBRATE_FIRST = ("print the test pieces below and calibrate before printing the barrier "
+                   "(printgen calibrate, then printgen verify)")
 NET_STRAINS = np.linspace(0.01, 0.40, 40)  # strain range over which net laws are compared
 CHECK_STRAINS = (0.05, 0.30)  # net law errors reported at low and high strain
 
@@ -293,7 +295,7 @@ def _rationale(ranked: list[Candidate], what: str) -> str:
                f"{CHECK_STRAINS[0]:.0%} and {best.error_high:+.0%} at {CHECK_STRAINS[1]:.0%} "
                f"strain (RMS log error {best.error_rms:.2f} over 1-40 %)")
     basis = ("a measured printed value" if "measured" in best.modulus_source else
-             "only a DATASHEET modulus (printed parts are often 2x softer: calibrate it)")
+             f"only a DATASHEET modulus (printed parts are often 2x softer): {CALIBRATE_FIRST}")
     others = [c for c in ranked[1:] if c.feasible and c.material != best.material]
     vs = (f" The best other material, {others[0].material_name}, scores {others[0].score:.3f} "
           f"against {best.score:.3f} ({others[0].error:+.1%})." if others else "")
