@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 
+import numpy as np
 import pytest
 from conftest import ROOT
 
@@ -84,3 +85,35 @@ def test_reachable_lists_the_scales_with_a_net_on_target():
             {"scale": 60.0, "per_material": [{"material": "tpu", "on_target": 1}]}]
     assert reachable(recs) == [{"material": "tpu", "scales_on_target": [40.0, 60.0],
                                 "scale_range": [40.0, 60.0]}]
+
+
+COUPON_GAUGE_MM = 50.0  # gauge length of a strand-section coupon (extensometer)
+CALIBRATE_BACK_RTOL = 0.01  # issue 27: a known modulus calibrates back within 1 %
+
+
+def test_strand_section_coupon_export_calibrates_back_to_its_modulus(tmp_path, screened_1_40):
+    """A tensile export of a coupon with the section of the first on-target TPU 85A strand,
+    generated with the datasheet modulus (linear to 2 % strain, then softening), and its
+    sidecar: `calibrate` gives that modulus back."""
+    from printgen.calibrate.pipeline import calibrate
+    from printgen.design.screen import strand_section
+
+    hit = first_on_target(screened_1_40)
+    p = load_prototype(ROOT / "examples" / "realistic_barrier.toml")
+    t = scale_targets(p, 40)
+    ctx = search_context(p, t, default_space(p, t, materials=("tpu-85a",)))
+    sec = strand_section(ctx, hit.point)
+    area_m2 = sec.width_mm * sec.thickness_mm * 1e-6
+    e0 = mats.load_material("tpu-85a").datasheet_modulus
+    strain = np.linspace(0.0, 0.05, 251)
+    stress = np.where(strain < 0.02, e0 * strain, e0 * (0.02 + 0.5 * (strain - 0.02)))
+    for i in range(3):
+        lines = ["Time (s),Load (N),Strain (%)"]
+        lines += [f"{k * 0.1:.3f},{s * area_m2:.9g},{e * 100:.6f}"
+                  for k, (e, s) in enumerate(zip(strain, stress, strict=True))]
+        (tmp_path / f"coupon-{i}.csv").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    (tmp_path / "specimen.toml").write_text(
+        f'kind = "cable"\nwidth_mm = {sec.width_mm:g}\nthickness_mm = {sec.thickness_mm:g}\n'
+        f"gauge_length_mm = {COUPON_GAUGE_MM:g}\n", encoding="utf-8")
+    cal = calibrate([tmp_path], material="tpu-85a-printed")
+    assert cal.modulus.mean == pytest.approx(e0, rel=CALIBRATE_BACK_RTOL)
