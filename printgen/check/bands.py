@@ -62,6 +62,7 @@ class Variant:
     slack: float = 0.0
     mounting: str | None = None
     source: str = ""
+    orientation: str | None = None  # panel-test orientation of the net's law (None: profile's)
 
 
 def mounting_options() -> tuple[str, ...]:
@@ -98,6 +99,7 @@ def model_variants(d: Design, mounting: str | None = None) -> tuple[list[Variant
         out += _cable_variants(d, notes)
     if panel is not None and panel.has_geometry:
         out += _panel_geometry_variant(d, notes)
+        out += _orientation_variants(d)
     opts = mounting_options() if d.cables else ()  # no border cables: bed and banks only
     nominal = mounting or (opts[0] if opts else None)
     out += [Variant(f"mounting: {m}", mounting=m, source="flume mounting option "
@@ -138,6 +140,18 @@ def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
                     source=f"{mat.name} profile [measured.panel_law] conditions")]
 
 
+def _orientation_variants(d: Design) -> list[Variant]:
+    """The panel law read along each mesh diagonal its profile does not record (issue 25:
+    the paper does not say which diagonal its printed panels were loaded along)."""
+    from printgen.check.scenes import ORIENTATIONS
+
+    law = load_material(d.net.material).panel_law
+    recorded = "short" if law.mesh_along_load <= law.mesh_across_load else "long"
+    return [Variant(f"panel test along the {o} diagonal", orientation=o,
+                    source=f"panel-test orientation not stated (profile: {recorded})")
+            for o in ORIENTATIONS if o != recorded]
+
+
 def model_load_kw(p: Prototype, d: Design, drag: bool) -> dict[str, float] | None:
     """The model's load keywords for `sweep`: drag at the Froude-scaled velocity, as `verify`
     loads the model with drag; None for the hydrostatic test."""
@@ -154,7 +168,8 @@ def variant_scene(d: Design, v: Variant, coarsen: int = 1) -> BarrierScene:
         n = d.net
         d = dataclasses.replace(d, net=dataclasses.replace(
             n, mesh_x_mm=n.mesh_x_mm * coarsen, mesh_y_mm=n.mesh_y_mm * coarsen))
-    s = model_scene(d, **({"mounting": v.mounting} if v.mounting else {}))
+    s = model_scene(d, **({"mounting": v.mounting} if v.mounting else {}),
+                    orientation=v.orientation)
     laws = list(s.laws)
     laws[0] = _scaled(laws[0], v.net_factor * coarsen)
     if len(laws) > 1:  # the printed border frame, of the net's material
