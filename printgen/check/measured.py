@@ -5,7 +5,9 @@ The CSV (`,` or `;` separated; with `;`, decimal commas are accepted; lines star
 are comments) has a column `h_over_hb` and any of the columns in `COLUMNS`. Elongations are
 read as what the extension sensors record: counted from h / h_B = 0 (sensors zeroed before
 the water arrives), so they are compared with the predicted curves counted from there too.
-An empty cell is a reading that was not taken.
+An empty cell is a reading that was not taken. A cell `<x` is an upper bound (a source that
+says only "below x", e.g. "negligible, all below 0.5 %"): it counts in the mismatch only by how
+far a prediction exceeds it, and is never used as a value.
 """
 
 from __future__ import annotations
@@ -52,6 +54,13 @@ class Measurement:
     levels: np.ndarray
     values: dict[str, np.ndarray]
     columns: dict[str, str]  # METRICS key -> CSV column
+    bounds: dict[str, np.ndarray] | None = None  # METRICS key -> (k,) upper bounds, NaN: none
+
+    def bound(self, key: str) -> np.ndarray:
+        """(k,) upper bounds of column `key` (NaN where the cell is a value or empty)."""
+        if self.bounds is None or key not in self.bounds:
+            return np.full(len(self.levels), np.nan)
+        return self.bounds[key]
 
 
 def read_measured(path: str | Path) -> Measurement:
@@ -72,12 +81,21 @@ def read_measured(path: str | Path) -> Measurement:
     rows = lines[1:]
     if not rows:
         raise MeasurementError(f"{p}: a header but no data lines; give one line per level")
-    table = np.array([_row(p, n, ln, sep, header) for n, ln in rows])
+    parsed = [_row(p, n, ln, sep, header) for n, ln in rows]
+    table = np.array([[v for v, _ in r] for r in parsed])
+    upper = np.array([[b for _, b in r] for r in parsed])
     data = dict(zip(header, table.T, strict=True))
-    _check_ranges(p, data, [n for n, _ in rows])
+    bounds = dict(zip(header, upper.T, strict=True))
+    _check_ranges(p, {**data, **{c: np.where(np.isnan(bounds[c]), data[c], bounds[c])
+                                 for c in header if c != LEVEL_COLUMN}},
+                  [n for n, _ in rows])
     keys = {COLUMNS[c][0]: c for c in header if c != LEVEL_COLUMN}
     values = {COLUMNS[c][0]: data[c] * COLUMNS[c][1] for c in header if c != LEVEL_COLUMN}
-    return Measurement(str(p), data[LEVEL_COLUMN], values, keys)
+    limits = {COLUMNS[c][0]: bounds[c] * COLUMNS[c][1] for c in header if c != LEVEL_COLUMN}
+    if all(np.all(np.isnan(values[k])) for k in values):
+        raise MeasurementError(f"{p}: only bounds ('<x'), no measured value; give at least "
+                               "one reading")
+    return Measurement(str(p), data[LEVEL_COLUMN], values, keys, limits)
 
 
 def _check_header(p: Path, header: list[str]) -> None:
@@ -95,7 +113,9 @@ def _check_header(p: Path, header: list[str]) -> None:
         raise MeasurementError(f"{p}: no measured column; add any of {', '.join(COLUMNS)}")
 
 
-def _row(p: Path, n: int, line: str, sep: str, header: list[str]) -> list[float]:
+def _row(p: Path, n: int, line: str, sep: str, header: list[str]
+         ) -> list[tuple[float, float]]:
+    """(value, upper bound) per cell: (x, NaN) for a reading, (NaN, x) for `<x`."""
     cells = [c.strip() for c in line.split(sep)]
     if len(cells) != len(header):
         raise MeasurementError(f"{p}, line {n}: {len(cells)} cells for {len(header)} columns "
@@ -103,17 +123,19 @@ def _row(p: Path, n: int, line: str, sep: str, header: list[str]) -> list[float]
     out = []
     for col, cell in zip(header, cells, strict=True):
         if cell == "" and col != LEVEL_COLUMN:
-            out.append(math.nan)  # a reading that was not taken
+            out.append((math.nan, math.nan))  # a reading that was not taken
             continue
-        text = cell.replace(",", ".") if sep == ";" else cell
+        bound = cell.startswith("<") and col != LEVEL_COLUMN
+        text = cell[1:].strip() if bound else cell
+        text = text.replace(",", ".") if sep == ";" else text
         try:
             v = float(text)
         except ValueError:
             v = math.nan
         if not math.isfinite(v):
             raise MeasurementError(f"{p}, line {n}, column {col!r}: {cell!r} is not a finite "
-                                   "number")
-        out.append(v)
+                                   "number (or '<number' for an upper bound)")
+        out.append((math.nan, v) if bound else (v, math.nan))
     return out
 
 
@@ -137,6 +159,7 @@ def _check_ranges(p: Path, data: dict[str, np.ndarray], line_numbers: list[int])
             raise MeasurementError(f"{p}: column {col!r} holds no value; fill or remove it")
 
 
+
 @dataclass(frozen=True)
 class Mismatch:
     """Measured vs predicted for one column: RMS of the difference (model units), and the
@@ -157,17 +180,19 @@ def mismatch(m: Measurement, predicted: dict[str, np.ndarray],
     measured levels), and how many points fall inside the band [lo, hi] when one is given."""
     out = []
     for key, col in m.columns.items():
-        meas, pred = m.values[key], predicted[key]
+        meas, pred, cap = m.values[key], predicted[key], m.bound(key)
         ok = ~np.isnan(meas) & ~np.isnan(pred)
-        diff = meas[ok] - pred[ok]
-        rms = float(np.sqrt(np.mean(diff**2))) if ok.any() else math.nan
-        peak = float(np.abs(meas[ok]).max()) if ok.any() else 0.0
+        capped = ~np.isnan(cap) & ~np.isnan(pred)  # a bound counts by its excess only
+        diff = np.concatenate([meas[ok] - pred[ok], np.maximum(pred[capped] - cap[capped], 0)])
+        rms = float(np.sqrt(np.mean(diff**2))) if diff.size else math.nan
+        peak = float(np.abs(meas[ok]).max()) if ok.any() else (
+            float(np.abs(cap[capped]).max()) if capped.any() else 0.0)  # bounds only: their scale
         inside = 0
         if lo is not None and hi is not None:
             inside = int(np.sum((meas[ok] >= lo[key][ok] - 1e-12)
                                 & (meas[ok] <= hi[key][ok] + 1e-12)))
-        out.append(Mismatch(key, col, rms, rms / peak if peak > 0 else math.nan, int(ok.sum()),
-                            inside))
+        out.append(Mismatch(key, col, rms, rms / peak if peak > 0 else math.nan,
+                            int(ok.sum() + capped.sum()), inside))
     return out
 
 

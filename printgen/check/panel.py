@@ -26,6 +26,7 @@ derivation reports how far it gets (`DerivedLaw.error`) instead of forcing it.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -130,8 +131,8 @@ def analytic_blocked(law: Law, t: PanelTest, strains: np.ndarray) -> np.ndarray:
 def simulate(law: Law, t: PanelTest, strains: np.ndarray) -> PanelCurve:
     """The panel test of a net whose strands follow `law`, solved at each strain in turn
     (each warm-started from the last); SolverError when a strain cannot be reached."""
-    nodes, elements, _, top = _graph(t)
-    length, width = lattice_size(t)
+    _, elements, _, top = _graph(t)
+    width = lattice_size(t)[1]
     out, share = [], 0.0
     for positions, tensions, held in _solve_all(law, t, strains):
         force = _clamp_force(positions, tensions, elements, top)
@@ -206,9 +207,10 @@ def _clamp_force(x: np.ndarray, tensions: np.ndarray, elements: np.ndarray,
 class DerivedLaw:
     """A strand law whose simulated panel test reproduces a measured panel law.
 
-    law : (knees, slopes N) of the strand; curve : its simulated test; target : the measured
-    membrane force per width at curve.strains (N/m); error : largest |simulated - measured|
-    over the strain range, fraction of the measured peak; passes : fixed-point passes run.
+    law : (knees, slopes N) of the strand; curve : its simulated test at the fitted strains
+    and between them; target : the measured membrane force per width at curve.strains (N/m);
+    error : largest |simulated - measured| there, fraction of the measured peak; passes :
+    fixed-point passes run.
     """
 
     law: Law
@@ -225,9 +227,20 @@ def law_strains(knees: tuple[float, ...], points: int = STRAIN_POINTS) -> np.nda
     return np.linspace(top / points, top, points)
 
 
+def refined_knees(knees: tuple[float, ...]) -> tuple[float, ...]:
+    """The measured law's knees plus one inside each segment (its middle, and 1.25 x the last
+    knee): a strand law twice as fine, so that a softening strand can offset the meshes'
+    geometric stiffening (the strands turn toward the load) that a test of the same number
+    of segments cannot."""
+    lo = [0.0, *knees]
+    mids = [(a + b) / 2 for a, b in itertools.pairwise(lo)]
+    extra = [1.25 * knees[-1]] if knees else []
+    return tuple(sorted({*knees, *mids, *extra}))
+
+
 def derive_law(knees: tuple[float, ...], slopes: tuple[float, ...], t: PanelTest,
                strains: np.ndarray | None = None) -> DerivedLaw:
-    """The strand law (same number of segments) whose simulated test `t` gives the membrane
+    """The strand law (on `refined_knees`) whose simulated test `t` gives the membrane
     law n = piecewise(eps; knees, slopes N/m). Starts from the analytic diamond mapping and
     repeats: solve the test, split the clamp force into each law segment's share at the
     solved strand strains (linear in the slopes at fixed geometry), refit the slopes by
@@ -239,18 +252,23 @@ def derive_law(knees: tuple[float, ...], slopes: tuple[float, ...], t: PanelTest
 
     eps = law_strains(knees) if strains is None else np.asarray(strains, float)
     target = piecewise_linear(eps, knees, slopes)
-    law = strand_law_from_membrane(knees, slopes, t.mesh_along, t.mesh_across)
+    fine = refined_knees(knees)
+    fine_slopes = tuple(slopes[int(np.searchsorted(knees, k, side="right"))]
+                        for k in (0.0, *fine))  # the measured slope of each fine segment
+    law = strand_law_from_membrane(fine, fine_slopes, t.mesh_along, t.mesh_across)
     passes = 0
     for passes in range(1, DERIVE_STEPS + 1):
         shares, strand_eps = _segment_shares(law, t, eps)
         new, _ = nnls(shares, target * lattice_size(t)[1])
         new = np.maximum(new, 1e-9 * float(np.max(new)))
-        k_new = tuple(float(np.interp(k, eps, strand_eps)) for k in knees)
+        k_new = tuple(float(np.interp(k, eps, strand_eps)) for k in fine)
         moved = float(np.max(np.abs(new / np.asarray(law[1]) - 1)))
         law = (k_new, tuple(float(s) for s in new))
         if moved < DERIVE_TOL:
             break
-    curve = simulate(law, t, eps)
+    check = np.sort(np.concatenate([eps, (eps[1:] + eps[:-1]) / 2]))  # between the fitted too
+    curve = simulate(law, t, check)
+    target = piecewise_linear(check, knees, slopes)
     err = float(np.max(np.abs(curve.force_per_width - target)) / np.max(np.abs(target)))
     return DerivedLaw(law, curve, target, err, passes)
 
