@@ -294,3 +294,38 @@ def _segment_shares(law: Law, t: PanelTest, eps: np.ndarray) -> tuple[np.ndarray
     return np.array(rows), np.array(mean_eps)
 
 
+
+
+PRINTED_PANEL = (43 * MM, 23 * MM)  # the paper's printed panels: length, clamp width (m)
+
+
+@dataclass(frozen=True)
+class DesignPanel:
+    """A design's net as a printed test panel: the test set-up, the strand law the barrier
+    scene gives its strands, the simulated test and the material's measured panel law at the
+    same strains (N/m per unit width, None when the profile has none)."""
+
+    orientation: str
+    test: PanelTest
+    law: Law
+    curve: PanelCurve
+    measured: np.ndarray | None
+
+
+def design_panel(d, orientation: str, mode: str = "free",
+                 points: int = STRAIN_POINTS) -> DesignPanel:
+    """The simulated panel test of design `d`'s printed net, loaded along its `orientation`
+    diagonal, of the size its material's panel law was tested at (else PRINTED_PANEL)."""
+    from printgen.check.scenes import model_net_law, panel_axes
+    from printgen.inputs.materials import load_material
+
+    n = d.net
+    mat = load_material(n.material)
+    pl = mat.panel_law
+    along, across = panel_axes(n.mesh_x_mm * MM, n.mesh_y_mm * MM, orientation)
+    size = (pl.panel_length, pl.panel_width or PRINTED_PANEL[1]) if pl else PRINTED_PANEL
+    t = PanelTest(along, across, size[0], size[1], mode)
+    law = model_net_law(mat, n, orientation if pl is not None and pl.has_geometry else None)[0]
+    eps = law_strains(pl.knee_strains if pl else (), points)
+    curve = simulate(law, t, eps)
+    return DesignPanel(orientation, t, law, curve, pl.force_per_width(eps) if pl else None)

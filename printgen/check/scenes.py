@@ -249,7 +249,7 @@ def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
     n = d.net
     g = diamond_net(n.width_mm, n.height_mm, n.mesh_x_mm, n.mesh_y_mm)
     mat = load_material(n.material)
-    net_law, how = _model_net_law(mat, n, orientation)
+    net_law, how = model_net_law(mat, n, orientation)
     e, e_src = mat.modulus()
     border_ea = e * n.border_width_mm * n.strand.thickness_mm * MM * MM
     cable_law, rows = None, []
@@ -272,7 +272,7 @@ def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
     return _finish(s, rows, sensors=True)
 
 
-def _model_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
+def model_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
     """The printed net's strand law and how it was found: a panel law with its tested net is
     read along the tested net's `orientation` diagonal (a strand law of the tested strands,
     rescaled to the design's strand section); otherwise the membrane law of the design."""
