@@ -45,6 +45,9 @@ MOUNTINGS = LATERAL  # lateral mounting in the flume ([flume] lateral), the defa
 # long axis; the printed nets' orientation is not stated, and their profile (TPE) records the
 # short diagonal, whose strand modulus matches the datasheet (see `panel_strand_law`).
 ORIENTATIONS = ("short", "long")
+# Direction of the water's force on a node: along the flow (the reference's section 3), or
+# normal to the deformed net (the film lies on the net: `printgen.check.pressure`).
+PRESSURES = ("flow", "normal")
 PROTOTYPE_ORIENTATION = "long"
 # Stiffness holding each free node where it is when its strands carry no load (N/m), as a
 # fraction of rho g A* (the rate at which a node's hydrostatic load grows per metre of head):
@@ -95,6 +98,8 @@ class BarrierScene:
     mounting: str = MOUNTINGS[0]
     hold: float = 0.0
     assumptions: tuple[Assumption, ...] = ()
+    pressure: str = "flow"  # one of PRESSURES: the water's force along the flow or normal
+    rest_nodes: np.ndarray | None = None  # (n, 3) m printed geometry when mounted otherwise
 
 
 def strand_law_from_membrane(knees: tuple[float, ...], slopes: tuple[float, ...],

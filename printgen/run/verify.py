@@ -13,7 +13,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from printgen.check.bands import Band, band_verdicts, model_band, model_load_kw
+from printgen.check.bands import (
+    Band,
+    band_verdicts,
+    free_section,
+    model_band,
+    model_load_kw,
+)
 from printgen.check.measured import (
     Fit,
     Measurement,
@@ -73,7 +79,7 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     say("verification (prototype and model load sweeps)")
     v = verify(p, d, drag=drag)
     say("uncertainty band (model variants)")
-    band = model_band(d, v.model, load_kw=load_kw)
+    band = model_band(d, v.model, load_kw=load_kw, free_section=free_section(p))
     result, text = None, ""
     if m is not None:
         say(f"fit of the net's {fit} to {Path(measured).name}")
