@@ -43,7 +43,7 @@ def test_a_synthetic_measurement_is_recovered():
                                             ("strain_bottom", "strain_top", "strain_mid")},
                         {})
     m = measurement(predict(d, known, probe, LEVELS))
-    fit = fit_measured(d, m, LEVELS, choices=[("walls", None)],
+    fit = fit_measured(d, m, LEVELS, choices=[("walls", None, None)],
                        free=("net_factor", "net_slack"))
     assert fit.explains
     assert fit.params.net_factor == pytest.approx(known.net_factor, rel=RECOVER)
@@ -56,6 +56,6 @@ def test_an_impossible_curve_is_refused():
     d = coarse_design()
     m = measurement({"strain_mid": np.array([0.40, 0.41, 0.42]),
                      "strain_top": np.array([-0.05, -0.05, -0.05])})
-    fit = fit_measured(d, m, LEVELS, choices=[("walls", None)])
+    fit = fit_measured(d, m, LEVELS, choices=[("walls", None, None)])
     assert not fit.explains
     assert "NOT explained" in fit.sentence()

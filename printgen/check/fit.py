@@ -58,6 +58,7 @@ class Params:
     cable_slack: float = 0.0
     mounting: str = MOUNTINGS[0]
     orientation: str | None = None  # None: the orientation the material profile records
+    span: float | None = None  # lateral supports this far apart (m; None: the printed width)
 
     def scaled(self) -> np.ndarray:
         """The continuous parameters on [0, 1] (net_factor on a log scale)."""
@@ -94,7 +95,7 @@ def slackened(law: tuple, slack: float) -> tuple:
 def fit_scene(d: Design, p: Params, coarsen: int = 1) -> BarrierScene:
     """The printed model's scene with parameter set `p` (on the design's mesh x coarsen)."""
     v = Variant("fit", net_factor=p.net_factor, frame_factor=p.net_factor, mounting=p.mounting,
-                orientation=p.orientation)
+                orientation=p.orientation, span=p.span)
     s = variant_scene(d, v, coarsen)
     laws = [slackened(law, p.net_slack) for law in s.laws]
     cables = {k: (nodes, slackened(law, p.cable_slack)) for k, (nodes, law) in s.cables.items()}
@@ -150,17 +151,43 @@ class MultiFit:
     before: list
     after: list
     predicted: dict[str, np.ndarray]
-    choices: dict[tuple[str, str | None], tuple[Params, float]]
+    choices: dict[tuple[str, str | None, float | None], tuple[Params, float]]
     identifiability: Identifiability
     evaluations: int
     explains: bool
+
+    kind = "multi"
+
+    @property
+    def label(self) -> str:
+        p = self.params
+        return (f"fitted: net x {p.net_factor:.3g}, slack {p.net_slack:.1%} / "
+                f"{p.cable_slack:.1%}")
+
+    def to_record(self) -> dict:
+        """The fit in report.json: parameters, bounds, choices, identifiability, mismatches."""
+        ident = self.identifiability
+        return {"kind": self.kind, "explains": self.explains, "sentence": self.sentence(),
+                "params": dataclasses.asdict(self.params),
+                "bounds": {k: {"low": lo, "high": hi, "nominal": nom}
+                           for k, (lo, hi, nom) in BOUNDS.items()},
+                "choices": [{"mounting": k[0], "orientation": k[1], "span_m": k[2],
+                             "params": dataclasses.asdict(p), "objective": o}
+                            for k, (p, o) in self.choices.items()],
+                "identifiability": {"singular_values": ident.singular_values,
+                                    "directions": ident.directions,
+                                    "sensitivity": ident.sensitivity,
+                                    "determined": ident.determined()},
+                "mismatch_nominal": self.before, "mismatch_fitted": self.after,
+                "predicted": self.predicted, "evaluations": self.evaluations}
 
     def sentence(self) -> str:
         p = self.params
         worst = max(mm.rms_rel for mm in self.after)
         what = (f"net law x {p.net_factor:.3g}, net slack {p.net_slack:.2%}, cable slack "
                 f"{p.cable_slack:.2%}, mounting {p.mounting}, orientation "
-                f"{p.orientation or 'as profiled'}")
+                f"{p.orientation or 'as profiled'}, span "
+                f"{'printed width' if p.span is None else f'{p.span * 1e3:g} mm'}")
         if self.explains:
             return (f"explained within the bounds by {what} (worst RMS mismatch {worst:.0%} of "
                     f"the measured peak); determined: {', '.join(self.identifiability.determined()) or 'none'}")
@@ -169,12 +196,23 @@ class MultiFit:
                 "profile is written")
 
 
+PATH_STEP = 0.1  # load path of each fit evaluation: this step, plus the measured levels
+
+
+def fit_levels(m: Measurement) -> np.ndarray:
+    """The load path a fit sweeps: 0 to the highest measured level by PATH_STEP, and every
+    measured level."""
+    top = float(m.levels.max())
+    return np.union1d(np.round(np.arange(0.0, top + 1e-9, PATH_STEP), 10), m.levels)
+
+
 def fit_measured(d: Design, m: Measurement, lv: np.ndarray, *, coarsen: int = 1,
                  load_kw: dict | None = None,
-                 choices: list[tuple[str, str | None]] | None = None,
-                 free: tuple[str, ...] = tuple(BOUNDS)) -> MultiFit:
-    """The bounded fit of the module docstring over every (mounting, orientation) choice
-    (or `choices`), searching the continuous parameters `free` (the others stay nominal);
+                 choices: list[tuple[str, str | None, float | None]] | None = None,
+                 free: tuple[str, ...] = tuple(BOUNDS),
+                 free_section: float | None = None) -> MultiFit:
+    """The bounded fit of the module docstring over every (mounting, orientation, span)
+    choice (or `choices`; span None or `free_section` when given), searching the continuous parameters `free` (the others stay nominal);
     `lv` : the load path swept for each evaluation (0 first, up to the highest measured)."""
     from scipy.optimize import least_squares
 
@@ -186,12 +224,13 @@ def fit_measured(d: Design, m: Measurement, lv: np.ndarray, *, coarsen: int = 1,
         return predict(d, p, m, lv, coarsen, load_kw)
 
     if choices is None:
-        choices = list(itertools.product(MOUNTINGS, ORIENTATIONS))
+        spans = [None] + ([free_section] if free_section is not None else [])
+        choices = list(itertools.product(MOUNTINGS, ORIENTATIONS, spans))
     idx = [list(BOUNDS).index(k) for k in free]
     nominal = run(Params())
-    best: dict[tuple[str, str | None], tuple[Params, float]] = {}
-    for mounting, orientation in choices:
-        base = Params(mounting=mounting, orientation=orientation)
+    best: dict[tuple[str, str | None, float | None], tuple[Params, float]] = {}
+    for mounting, orientation, span in choices:
+        base = Params(mounting=mounting, orientation=orientation, span=span)
 
         def full(y: np.ndarray, base: Params = base) -> np.ndarray:
             x = base.scaled()
@@ -204,7 +243,7 @@ def fit_measured(d: Design, m: Measurement, lv: np.ndarray, *, coarsen: int = 1,
         res = least_squares(res_of, base.scaled()[idx], bounds=(0.0, 1.0), diff_step=STEP,
                             max_nfev=MAX_EVALUATIONS, xtol=XTOL)
         fitted = base.with_scaled(full(res.x))
-        best[(mounting, orientation)] = (fitted, objective(m, run(fitted)))
+        best[(mounting, orientation, span)] = (fitted, objective(m, run(fitted)))
     params = min(best.values(), key=lambda pv: pv[1])[0]
     pred = run(params)
     after = mismatch(m, pred)

@@ -110,8 +110,13 @@ def measured_sections(rep: Report, m: Measurement, band: Band, fit: Fit | None,
     rep.table(cols, rows)
     if fit:
         rep.paragraph(_fit_sentence(fit))
-    rep.figure(measured_figure(m, band, fit), "Measured points (black) on the predicted band "
-               "(orange: nominal line, shaded: band), counted from h/h_B = 0; dashed: fitted.")
+        if fit.kind == "multi":
+            from printgen.report.fitreport import multi_fit_sections
+
+            multi_fit_sections(rep, fit)
+    rep.figure(measured_figure(m, band, fit), "Measured points (black; open triangles: 'below' "
+               "bounds) on the predicted band (orange: nominal line, shaded: band; thin lines: "
+               "each variant), counted from h/h_B = 0; dashed: fitted.")
     if profile:
         rep.paragraph("To feed it back, save this as profiles/materials/<name>.toml (or a folder "
                       "in $PRINTGEN_PROFILES) and name it as the net's material:")
@@ -124,6 +129,8 @@ def _fmt(mm) -> str:
 
 
 def _fit_sentence(fit: Fit) -> str:
+    if fit.kind == "multi":
+        return fit.sentence()
     what = (f"net stiffness {fit.value:.3f} x its profile" if fit.kind == "stiffness"
             else f"initial slack {fit.value:.2%} of the net")
     edge = (" The best value is at the end of the searched range: the measurement is outside "
@@ -140,7 +147,9 @@ def measured_record(m: Measurement, band: Band, fit: Fit | None, profile: str
                            "columns": m.columns, "predicted_nominal": nom,
                            "band_min": lo, "band_max": hi,
                            "mismatch": mismatch(m, nom, lo, hi), "fit": None}
-    if fit:
+    if fit and fit.kind == "multi":
+        rec["fit"] = {**fit.to_record(), "profile": profile}
+    elif fit:
         rec["fit"] = {"kind": fit.kind, "value": fit.value, "at_bound": fit.at_bound,
                       "evaluations": fit.evaluations, "mismatch_nominal": fit.before,
                       "mismatch_fitted": fit.after, "predicted": fit.predicted,
