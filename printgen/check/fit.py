@@ -11,7 +11,8 @@ the same to first order as a rest length (1 + slack) times longer.
 
 For every discrete choice the continuous parameters are searched (scipy's bounded
 least_squares, trust-region reflective, on the parameters scaled to [0, 1]) for the least
-mismatch (`measured.objective`, as a sum of squared weighted residuals: `residuals`). The
+mismatch (`measured.objective`, as a sum of squared weighted residuals: `residuals`): a
+short screen of every choice, then a full search of the SCREEN_KEEP best. The
 best choice is reported with the mismatch before (the nominal model) and after, and with
 what the data determine: the singular values of the scaled residuals' Jacobian at the best
 point and each parameter's sensitivity. The fit "explains" the test when every measured
@@ -43,7 +44,9 @@ BOUNDS = {
 }
 EXPLAINS = 0.15  # issue 25: RMS mismatch below 15 % of the measured peak on every column
 SLACK_SLOPE = 1e-4  # slope of a slack segment / the law's first slope (keeps it solvable)
-MAX_EVALUATIONS = 40  # solver sweeps per discrete choice
+MAX_EVALUATIONS = 15  # least-squares steps for a retained choice (each: 1 + free sweeps)
+SCREEN_EVALUATIONS = 3  # ... for every discrete choice first (a screen)
+SCREEN_KEEP = 2  # choices searched on after the screen
 XTOL = 1e-4  # stop once a step moves the scaled parameters by less than this (relative)
 STEP = 0.01  # finite-difference step of the Jacobians, fraction of each range
 DETERMINED = 0.1  # a singular value above 10 % of the largest: that direction is determined
@@ -212,44 +215,51 @@ def fit_measured(d: Design, m: Measurement, lv: np.ndarray, *, coarsen: int = 1,
                  free: tuple[str, ...] = tuple(BOUNDS),
                  free_section: float | None = None) -> MultiFit:
     """The bounded fit of the module docstring over every (mounting, orientation, span)
-    choice (or `choices`; span None or `free_section` when given), searching the continuous parameters `free` (the others stay nominal);
-    `lv` : the load path swept for each evaluation (0 first, up to the highest measured)."""
+    choice (or `choices`; span None or `free_section` when given), searching the continuous
+    parameters `free` (the others stay nominal); `lv` : the load path swept for each
+    evaluation (0 first, up to the highest measured)."""
     from scipy.optimize import least_squares
 
     lv = np.asarray(lv, float)
-    count = [0]
+    cache: dict[Params, dict[str, np.ndarray]] = {}
 
     def run(p: Params) -> dict[str, np.ndarray]:
-        count[0] += 1
-        return predict(d, p, m, lv, coarsen, load_kw)
+        if p not in cache:
+            cache[p] = predict(d, p, m, lv, coarsen, load_kw)
+        return cache[p]
 
     if choices is None:
         spans = [None] + ([free_section] if free_section is not None else [])
         choices = list(itertools.product(MOUNTINGS, ORIENTATIONS, spans))
     idx = [list(BOUNDS).index(k) for k in free]
     nominal = run(Params())
-    best: dict[tuple[str, str | None, float | None], tuple[Params, float]] = {}
-    for mounting, orientation, span in choices:
-        base = Params(mounting=mounting, orientation=orientation, span=span)
 
-        def full(y: np.ndarray, base: Params = base) -> np.ndarray:
+    def search(base: Params, evaluations: int) -> tuple[Params, float]:
+        def full(y: np.ndarray) -> np.ndarray:
             x = base.scaled()
             x[idx] = y
             return x
 
-        def res_of(y: np.ndarray, base: Params = base) -> np.ndarray:
+        def res_of(y: np.ndarray) -> np.ndarray:
             return residuals(m, run(base.with_scaled(full(y))))
 
         res = least_squares(res_of, base.scaled()[idx], bounds=(0.0, 1.0), diff_step=STEP,
-                            max_nfev=MAX_EVALUATIONS, xtol=XTOL)
+                            max_nfev=evaluations, xtol=XTOL)
         fitted = base.with_scaled(full(res.x))
-        best[(mounting, orientation, span)] = (fitted, objective(m, run(fitted)))
+        return fitted, objective(m, run(fitted))
+
+    screen = len(choices) > SCREEN_KEEP
+    best = {c: search(Params(mounting=c[0], orientation=c[1], span=c[2]),
+                      SCREEN_EVALUATIONS if screen else MAX_EVALUATIONS) for c in choices}
+    if screen:  # the most promising choices, searched on from their screened point
+        for c in sorted(best, key=lambda k: best[k][1])[:SCREEN_KEEP]:
+            best[c] = search(best[c][0], MAX_EVALUATIONS)
     params = min(best.values(), key=lambda pv: pv[1])[0]
     pred = run(params)
     after = mismatch(m, pred)
     ident = _identifiability(m, params, pred, run)
     ok = all(mm.rms_rel < EXPLAINS for mm in after if not math.isnan(mm.rms_rel))
-    return MultiFit(params, mismatch(m, nominal), after, pred, best, ident, count[0], ok)
+    return MultiFit(params, mismatch(m, nominal), after, pred, best, ident, len(cache), ok)
 
 
 def _identifiability(m: Measurement, p: Params, pred: dict[str, np.ndarray], run
