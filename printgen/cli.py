@@ -27,6 +27,7 @@ COMMAND_MODULES = (
     "printgen.commands.design",
     "printgen.commands.verify",
     "printgen.commands.check",
+    "printgen.commands.panel",
     "printgen.commands.bench",
     "printgen.commands.calibrate",
     "printgen.commands.init",

@@ -9,7 +9,9 @@ named `expected_*` (the model's readings on printgen's measurement sheet) are sk
 are columns left empty when others hold values. Elongations are
 read as what the extension sensors record: counted from h / h_B = 0 (sensors zeroed before
 the water arrives), so they are compared with the predicted curves counted from there too.
-An empty cell is a reading that was not taken.
+An empty cell is a reading that was not taken. A cell `<x` is an upper bound (a source that
+says only "below x", e.g. "negligible, all below 0.5 %"): it counts in the mismatch only by how
+far a prediction exceeds it, and is never used as a value.
 """
 
 from __future__ import annotations
@@ -62,6 +64,13 @@ class Measurement:
     levels: np.ndarray
     values: dict[str, np.ndarray]
     columns: dict[str, str]  # METRICS key -> CSV column
+    bounds: dict[str, np.ndarray] | None = None  # METRICS key -> (k,) upper bounds, NaN: none
+
+    def bound(self, key: str) -> np.ndarray:
+        """(k,) upper bounds of column `key` (NaN where the cell is a value or empty)."""
+        if self.bounds is None or key not in self.bounds:
+            return np.full(len(self.levels), np.nan)
+        return self.bounds[key]
 
 
 def read_measured(path: str | Path, units: FlumeUnits | None = None) -> Measurement:
@@ -88,21 +97,33 @@ def read_measured(path: str | Path, units: FlumeUnits | None = None) -> Measurem
     rows = lines[1:]
     if not rows:
         raise MeasurementError(f"{p}: a header but no data lines; give one line per level")
-    table = np.array([_row(p, n, ln, sep, header) for n, ln in rows])
+    parsed = [_row(p, n, ln, sep, header) for n, ln in rows]
+    table = np.array([[v for v, _ in r] for r in parsed])
+    upper = np.array([[b for _, b in r] for r in parsed])
     data = {h: c for h, c in zip(header, table.T, strict=True)
             if not h.startswith(IGNORED_PREFIX)}
+    bounds = {h: c for h, c in zip(header, upper.T, strict=True)
+              if not h.startswith(IGNORED_PREFIX)}
     if units is not None and DEPTH_COLUMN in data:
         data = _level_from_depth(p, data, units)
     read = [c for c in data if c in cols]
     if len(read) > 1:  # a sheet's unfilled columns are dropped; a lone empty one is an error
-        read = [c for c in read if not np.all(np.isnan(data[c]))] or read
-    _check_ranges(p, {c: data[c] for c in [LEVEL_COLUMN, *read]}, [n for n, _ in rows])
+        read = [c for c in read
+                if not (np.all(np.isnan(data[c])) and np.all(np.isnan(bounds[c])))] or read
+    _check_ranges(p, {LEVEL_COLUMN: data[LEVEL_COLUMN],
+                      **{c: np.where(np.isnan(bounds[c]), data[c], bounds[c]) for c in read}},
+                  [n for n, _ in rows])
     keys = {cols[c][0]: c for c in read}
     if len(keys) < len(read):
         raise MeasurementError(f"{p}: two columns measure the same quantity ({', '.join(read)});"
                                " keep one of each")
     values = {cols[c][0]: data[c] * cols[c][1] for c in read}
-    return Measurement(str(p), data[LEVEL_COLUMN], values, keys)
+    limits = {cols[c][0]: bounds[c] * cols[c][1] for c in read}
+    if values and all(np.all(np.isnan(v)) for v in values.values()) \
+            and not all(np.all(np.isnan(b)) for b in limits.values()):
+        raise MeasurementError(f"{p}: only bounds ('<x'), no measured value; give at least "
+                               "one reading")
+    return Measurement(str(p), data[LEVEL_COLUMN], values, keys, limits)
 
 
 def _columns(units: FlumeUnits | None) -> dict[str, tuple[str, float]]:
@@ -155,7 +176,9 @@ def _check_header(p: Path, header: list[str], cols: dict[str, tuple[str, float]]
         raise MeasurementError(f"{p}: no measured column; add any of {', '.join(cols)}")
 
 
-def _row(p: Path, n: int, line: str, sep: str, header: list[str]) -> list[float]:
+def _row(p: Path, n: int, line: str, sep: str, header: list[str]
+         ) -> list[tuple[float, float]]:
+    """(value, upper bound) per cell: (x, NaN) for a reading, (NaN, x) for `<x`."""
     cells = [c.strip() for c in line.split(sep)]
     if len(cells) != len(header):
         raise MeasurementError(f"{p}, line {n}: {len(cells)} cells for {len(header)} columns "
@@ -163,17 +186,19 @@ def _row(p: Path, n: int, line: str, sep: str, header: list[str]) -> list[float]
     out = []
     for col, cell in zip(header, cells, strict=True):
         if cell == "" and col != LEVEL_COLUMN:
-            out.append(math.nan)  # a reading that was not taken
+            out.append((math.nan, math.nan))  # a reading that was not taken
             continue
-        text = cell.replace(",", ".") if sep == ";" else cell
+        bound = cell.startswith("<") and col != LEVEL_COLUMN
+        text = cell[1:].strip() if bound else cell
+        text = text.replace(",", ".") if sep == ";" else text
         try:
             v = float(text)
         except ValueError:
             v = math.nan
         if not math.isfinite(v):
             raise MeasurementError(f"{p}, line {n}, column {col!r}: {cell!r} is not a finite "
-                                   "number")
-        out.append(v)
+                                   "number (or '<number' for an upper bound)")
+        out.append((math.nan, v) if bound else (v, math.nan))
     return out
 
 
@@ -198,6 +223,7 @@ def _check_ranges(p: Path, data: dict[str, np.ndarray], line_numbers: list[int])
             raise MeasurementError(f"{p}: column {col!r} holds no value; fill or remove it")
 
 
+
 @dataclass(frozen=True)
 class Mismatch:
     """Measured vs predicted for one column: RMS of the difference (model units), and the
@@ -218,17 +244,19 @@ def mismatch(m: Measurement, predicted: dict[str, np.ndarray],
     measured levels), and how many points fall inside the band [lo, hi] when one is given."""
     out = []
     for key, col in m.columns.items():
-        meas, pred = m.values[key], predicted[key]
+        meas, pred, cap = m.values[key], predicted[key], m.bound(key)
         ok = ~np.isnan(meas) & ~np.isnan(pred)
-        diff = meas[ok] - pred[ok]
-        rms = float(np.sqrt(np.mean(diff**2))) if ok.any() else math.nan
-        peak = float(np.abs(meas[ok]).max()) if ok.any() else 0.0
+        capped = ~np.isnan(cap) & ~np.isnan(pred)  # a bound counts by its excess only
+        diff = np.concatenate([meas[ok] - pred[ok], np.maximum(pred[capped] - cap[capped], 0)])
+        rms = float(np.sqrt(np.mean(diff**2))) if diff.size else math.nan
+        peak = float(np.abs(meas[ok]).max()) if ok.any() else (
+            float(np.abs(cap[capped]).max()) if capped.any() else 0.0)  # bounds only: their scale
         inside = 0
         if lo is not None and hi is not None:
             inside = int(np.sum((meas[ok] >= lo[key][ok] - 1e-12)
                                 & (meas[ok] <= hi[key][ok] + 1e-12)))
-        out.append(Mismatch(key, col, rms, rms / peak if peak > 0 else math.nan, int(ok.sum()),
-                            inside))
+        out.append(Mismatch(key, col, rms, rms / peak if peak > 0 else math.nan,
+                            int(ok.sum() + capped.sum()), inside))
     return out
 
 
@@ -239,7 +267,7 @@ def objective(m: Measurement, predicted: dict[str, np.ndarray]) -> float:
 
 
 Predictor = Callable[[float], dict[str, np.ndarray]]
-FIT_KINDS = ("stiffness", "slack")
+FIT_KINDS = ("stiffness", "slack", "multi")  # multi: printgen.check.fit (issue 25)
 STIFFNESS_RANGE = (0.2, 5.0)  # net stiffness factors searched: a printed net 5x off is a misprint
 SLACK_RANGE = (0.0, 0.03)  # initial slack searched: 3 % sags visibly, a lab would see it
 XTOL_LOG = 0.005  # stiffness factor known to 0.5 % (bounded Brent on log factor)
@@ -272,7 +300,7 @@ def fit_factor(m: Measurement, predict: Predictor, kind: str = "stiffness") -> F
     `predict(value)` returns the predicted curves at the measured levels (from h / h_B = 0)."""
     from scipy.optimize import minimize_scalar
 
-    if kind not in FIT_KINDS:
+    if kind not in FIT_KINDS[:2]:
         raise InputError(f"fit {kind!r} unknown; choose one of {', '.join(FIT_KINDS)}")
     cache: dict[float, dict[str, np.ndarray]] = {}
 

@@ -158,16 +158,22 @@ def measured_figure(m: Measurement, band: Band, fit: Fit | None,
         if prototype is not None:
             pv = prototype.values[key] - prototype.values[key][0]
             ax.plot(prototype.levels, pv * unit, "k-", lw=1, label="prototype")
+        for i, (name, c) in enumerate(band.variants.items()):  # each variant's own curve
+            ax.plot(band.levels, (c[key] - c[key][0]) * unit, color=f"C{2 + i % 8}", lw=0.8,
+                    alpha=0.8, label=name)
         ax.plot(m.levels, m.values[key] * unit, "ko", ms=4, label="measured")
+        cap = m.bound(key)
+        ax.plot(m.levels, cap * unit, "kv", ms=5, mfc="none", label="measured: below")
         if fit is not None:
             order = np.argsort(m.levels)
-            ax.plot(m.levels[order], fit.predicted[key][order] * unit, "C0--",
-                    label=f"fitted {fit.kind} {fit.value:.3g}")
+            fit_label = getattr(fit, "label", None) or f"fitted {fit.kind} {fit.value:.3g}"
+            ax.plot(m.levels[order], fit.predicted[key][order] * unit, "C0--", lw=2,
+                    label=fit_label)
         ax.set_xlabel(LOADING)
         ax.set_ylabel(label)
         ax.set_title(f"column {m.columns[key]}", fontsize=10)
         ax.grid(alpha=0.3)
-    axes.flat[0].legend(fontsize=8)
+    axes.flat[0].legend(fontsize=6)
     fig.suptitle("Measured loading test against the prediction")
     return _png(fig)
 

@@ -120,9 +120,14 @@ def measured_sections(rep: Report, m: Measurement, band: Band, fit: Fit | None,
     rep.table(cols, rows)
     if fit:
         rep.paragraph(_fit_sentence(fit))
-    rep.figure(measured_figure(m, band, fit, prototype), "Measured points (black dots) on the "
-               "predicted band (orange: model nominal, shaded: band), with the prototype (black "
-               "line), all counted from h/h_B = 0; dashed: fitted.", "measured")
+        if fit.kind == "multi":
+            from printgen.report.fitreport import multi_fit_sections
+
+            multi_fit_sections(rep, fit)
+    rep.figure(measured_figure(m, band, fit, prototype), "Measured points (black dots; open "
+               "triangles: 'below' bounds) on the predicted band (orange: model nominal, shaded: "
+               "band; thin lines: each variant), with the prototype (black line), all counted "
+               "from h/h_B = 0; dashed: fitted.", "measured")
     if profile and not (fit and fit.at_bound):
         rep.paragraph("To feed it back, save this in a profile folder of your own as "
                       "materials/<name>.toml, add the folder to $PRINTGEN_PROFILES, and name "
@@ -136,6 +141,8 @@ def _fmt(mm) -> str:
 
 
 def _fit_sentence(fit: Fit) -> str:
+    if fit.kind == "multi":
+        return fit.sentence()
     what = (f"net stiffness {fit.value:.3f} x its profile" if fit.kind == "stiffness"
             else f"initial slack {fit.value:.2%} of the net")
     edge = (" The best value is at the end of the searched range: the measurement is outside "
@@ -152,7 +159,9 @@ def measured_record(m: Measurement, band: Band, fit: Fit | None, profile: str
                            "columns": m.columns, "predicted_nominal": nom,
                            "band_min": lo, "band_max": hi,
                            "mismatch": mismatch(m, nom, lo, hi), "fit": None}
-    if fit:
+    if fit and fit.kind == "multi":
+        rec["fit"] = {**fit.to_record(), "profile": profile}
+    elif fit:
         rec["fit"] = {"kind": fit.kind, "value": fit.value, "at_bound": fit.at_bound,
                       "evaluations": fit.evaluations, "mismatch_nominal": fit.before,
                       "mismatch_fitted": fit.after, "predicted": fit.predicted,

@@ -323,11 +323,12 @@ def verification_sweeps(prototype: Prototype, design: Design, *, drag: bool = Fa
     (README: Pre-print verification); every load level is solved on both. Needs nothing from
     the other steps, so it can run in a worker process while they run.
     """
-    from printgen.check.bands import model_band, model_load_kw
+    from printgen.check.bands import free_section, model_band, model_load_kw
     from printgen.check.verify import verify
 
     v = verify(prototype, design, drag=drag, counterexample=True)
-    return v, model_band(design, v.model, load_kw=model_load_kw(prototype, design, drag))
+    return v, model_band(design, v.model, load_kw=model_load_kw(prototype, design, drag),
+                         free_section=free_section(prototype))
 
 
 def verification_report(v: Verification, band: Band, scale: float

@@ -14,7 +14,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from printgen.check.bands import Band, band_verdicts, model_band, model_load_kw
+from printgen.check.bands import (
+    Band,
+    band_verdicts,
+    free_section,
+    model_band,
+    model_load_kw,
+)
+from printgen.check.fit import MultiFit, fit_levels, fit_measured
 from printgen.check.measured import (
     Fit,
     Measurement,
@@ -77,12 +84,17 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     say("verification (prototype and model load sweeps)")
     v = verify(p, d, drag=drag)
     say("uncertainty band (model variants)")
-    band = model_band(d, v.model, load_kw=load_kw)
+    band = model_band(d, v.model, load_kw=load_kw, free_section=free_section(p))
     result, text = None, ""
-    if m is not None:
+    if m is not None and fit == "multi":
+        say(f"multi-parameter fit of the printed net to {Path(measured).name}")
+        result = fit_measured(d, m, fit_levels(m), load_kw=load_kw, free_section=free_section(p))
+        text = _multi_profile_text(d, result, Path(measured).name) if result.explains else ""
+    elif m is not None:
         say(f"fit of the net's {fit} to {Path(measured).name}")
         result = fit_factor(m, model_predictor(d, band, m, fit, load_kw=load_kw), fit)
-        text = _profile_text(d, result, Path(measured).name)
+        # a factor at the end of its range explains nothing: no profile to feed back
+        text = "" if result.at_bound else _profile_text(d, result, Path(measured).name)
     rep = Report(f"printgen verify: {p.name} at 1:{d.scale:g}")
     verification_sections(rep, v, None, d.scale, band=band)
     band_sections(rep, v, band)
@@ -97,6 +109,20 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     record["timings_s"] = {"total": time.perf_counter() - t0, "band": band.seconds}
     files = _write(out, rep, record, d, text, force)
     return VerifyRun(p, d, v, band, m, result, text, record, files)
+
+
+def _multi_profile_text(d: Design, fit: MultiFit, source: str) -> str:
+    """The profile of an explained multi-parameter fit: its net law factor (slack and the
+    mounting choices belong to the test's installation, stated as comments)."""
+    p = fit.params
+    mat = load_material(d.net.material)
+    law = mat.panel_law
+    kappas = law.kappas if law is not None and law.has_geometry else None
+    text = fitted_profile(d.net.material, "stiffness", p.net_factor, panel_kappas=kappas,
+                          modulus_gpa=mat.modulus()[0] / 1e9, source=source)
+    return (f"# installation fitted with it (not material): net slack {p.net_slack:.2%}, "
+            f"cable slack {p.cable_slack:.2%}, mounting {p.mounting}, orientation "
+            f"{p.orientation or 'as profiled'}\n" + text)
 
 
 def _profile_text(d: Design, fit: Fit, source: str) -> str:
