@@ -1,14 +1,19 @@
-"""The output folder: files written atomically, and whole runs swapped in as one folder.
+"""The output folder: whole runs swapped in as one folder, and nothing outside it touched.
 
-A `make` run is built in a sibling stage folder (`.OUT.stage.XXXX`) and swapped in as a whole
+A run is built in a sibling stage folder (`.OUT.stage.XXXXXXXX`) and swapped in as a whole
 when every step succeeded: on Linux with `renameat2(RENAME_EXCHANGE)` (one atomic step), else by
-renaming the old folder aside, the stage in, and removing the old one. At every instant the
-output path holds one complete run or the previous one, never a mix, and nothing of an earlier
-run survives a new one. An exclusive lock beside the output (`.OUT.lock`, holding the pid)
-keeps a second run out of the same folder; stale stages of the same output (a run killed with
-SIGKILL) are removed when the next run starts. Each folder carries `manifest.json`: every
-file's sha256 and size, plus what the caller adds (version, inputs, command line), and the
-`volatile` files whose bytes may differ between identical runs (timings).
+renaming the old folder aside (`.OUT.old.XXXXXXXX`), the stage in, and removing the old one. At
+every instant the output path holds one complete run or the previous one, never a mix; if a
+run is killed between the fallback's two renames, the next run to start puts the old folder
+back before anything else, and no run removes an old folder before its own is in place.
+
+What may be replaced: an absent or empty folder, or a printgen output (its manifest reads, and
+the folder holds exactly the files it lists: `manifest.foreign_entry`); anything else needs
+`force`. Never replaced: a symbolic link, a mount point, a folder holding one of the run's
+inputs. An exclusive lock beside the output (`lock.folder_lock`) keeps a second run out of the
+same folder; stale stages of the same output (a run killed with SIGKILL) are removed when the
+next run starts. Stage, aside and lock names are matched literally (an output named `*` is the
+folder `*`, not a pattern).
 """
 
 from __future__ import annotations
@@ -16,104 +21,99 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import errno
-import fcntl
-import hashlib
-import json
+import logging
 import os
+import re
 import secrets
 import shutil
-import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
-from printgen.errors import InputError
+from printgen.outputs.files import FULL_ERRNOS, OutputError, named
+from printgen.outputs.lock import folder_lock
+from printgen.outputs.manifest import foreign_entry, write_manifest
+from printgen.workers import signals_deferred
 
-MANIFEST = "manifest.json"
-MANIFEST_FORMAT = 1
+log = logging.getLogger(__name__)
+
 RENAME_EXCHANGE = 2  # linux/fs.h: atomically exchange two paths
 AT_FDCWD = -100  # linux/fcntl.h: paths relative to the current directory
-CHUNK_BYTES = 1 << 20  # read size when hashing files
-# OS errors caused by the path the user gave (exit 2); the rest are the machine's (exit 1).
-INPUT_ERRNOS = {errno.ENOENT, errno.ENOTDIR, errno.EISDIR, errno.EEXIST, errno.EACCES,
-                errno.EPERM, errno.EROFS, errno.ENAMETOOLONG, errno.ELOOP, errno.EXDEV}
-
-
-class OutputError(InputError):
-    """The output path cannot be used as given (a file, a foreign folder, busy)."""
-
-
-def write_bytes(path: str | Path, data: bytes) -> Path:
-    """Write `data` to `path` via a temp file in the same directory and `os.replace`."""
-    p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, p)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
-        raise
-    return p
-
-
-def write_text(path: str | Path, text: str) -> Path:
-    """Text version of `write_bytes` (UTF-8, newlines as given)."""
-    return write_bytes(path, text.encode("utf-8"))
-
-
-def os_error_exit_code(exc: OSError) -> int:
-    """2 when the path given is at fault (missing, a file, read-only, no permission), else 1."""
-    return 2 if exc.errno in INPUT_ERRNOS else 1
-
-
-def describe_os_error(exc: OSError) -> str:
-    """One line: the path(s) and the OS's reason."""
-    where = " -> ".join(str(p) for p in (exc.filename, exc.filename2) if p is not None)
-    reason = exc.strerror or str(exc)
-    return f"{where}: {reason}" if where else reason
+TOKEN_BYTES = 4  # random hex in stage and aside names
+_trackers: list[list[Path]] = []  # `tracking_swaps` lists: outputs replaced meanwhile
 
 
 @contextlib.contextmanager
 def staged_dir(final: str | Path, *, force: bool = False,
-               meta: dict[str, Any] | None = None,
-               volatile: tuple[str, ...] = ()) -> Iterator[Path]:
+               meta: dict[str, Any] | None = None, volatile: tuple[str, ...] = (),
+               inputs: Iterable[str | Path] = ()) -> Iterator[Path]:
     """Yield an empty stage folder; on success swap it in as the whole of `final`.
 
-    final : the output folder. It must be absent, empty, or an earlier printgen output (it holds
-    `manifest.json`); anything else needs `force`. meta : added to the manifest (the caller may
-    fill it while the stage is being written). volatile : names of files whose bytes may differ
-    between identical runs (at most one: the timings).
-    On an exception (or a signal turned into one) the stage is removed and `final` untouched.
+    final : the output folder (see the module docstring for what may be replaced; `force`
+    allows a folder printgen did not write). meta : added to the manifest (the caller may fill
+    it while the stage is being written). volatile : the timings file, whose bytes differ
+    between identical runs. inputs : the run's input files and folders, none of which may lie
+    inside `final`. On an exception (or a signal turned into one) the stage is removed and
+    `final` untouched.
     """
     dest = Path(os.path.abspath(final))  # "." and "a/.." have a name and a parent this way
-    check_destination(dest, force=force)
+    inputs = list(inputs)
+    check_destination(dest, force=force, inputs=inputs)
     make_parent(dest)
     with folder_lock(dest):
+        restore_orphan(dest)
         remove_stale(dest)
-        stage = dest.parent / f".{dest.name}.stage.{secrets.token_hex(4)}"
+        check_destination(dest, force=force, inputs=inputs)  # as it is now, under the lock
+        stage = dest.parent / f".{dest.name}.stage.{secrets.token_hex(TOKEN_BYTES)}"
         stage.mkdir()  # (not mkdtemp: the folder keeps the user's umask, not 0700)
         try:
-            yield stage
-            write_manifest(stage, meta or {}, volatile)
-            swap_in(stage, dest)
+            try:
+                yield stage
+                write_manifest(stage, meta or {}, volatile)
+            except OSError as exc:  # a full disk fails in write(), which names no file
+                raise (named(exc, stage) if exc.errno in FULL_ERRNOS else exc) from None
+            with signals_deferred():  # a signal now comes after the swap and its cleanup
+                check_destination(dest, force=force, inputs=inputs)
+                swap_in(stage, dest)
+                for done in _trackers:
+                    done.append(dest)
+                shutil.rmtree(stage, ignore_errors=True)
         finally:
             shutil.rmtree(stage, ignore_errors=True)
 
 
-def check_destination(dest: Path, *, force: bool) -> None:
+@contextlib.contextmanager
+def tracking_swaps() -> Iterator[list[Path]]:
+    """Within the block, every output folder a run swaps in is appended to the list yielded
+    (the command line says so when a signal stops it after its swap)."""
+    done: list[Path] = []
+    _trackers.append(done)
+    try:
+        yield done
+    finally:
+        _trackers.remove(done)
+
+
+def check_destination(dest: Path, *, force: bool, inputs: Iterable[str | Path] = ()) -> None:
     """Raise OutputError unless `dest` may be replaced by a new run."""
+    dest = Path(os.path.abspath(dest))
     if dest.is_symlink():
         raise OutputError(f"output {dest} is a symbolic link (to {os.readlink(dest)}); a run "
                           "replaces its folder whole, so give --out the folder itself")
     if dest.exists() and not dest.is_dir():
         raise OutputError(f"output {dest} exists and is not a folder; give --out a new or "
                           "empty folder, or an earlier printgen output")
-    if dest.is_dir() and not force and not (dest / MANIFEST).is_file() and any(dest.iterdir()):
-        raise OutputError(f"output {dest} holds files printgen did not write (no {MANIFEST}); "
-                          "choose a new or empty folder, or pass --force to replace it whole")
+    if dest.is_dir() and os.path.ismount(dest):
+        raise OutputError(f"output {dest} is a mount point: a run replaces its folder whole by "
+                          "renaming, which a mount point cannot be; give --out a folder inside "
+                          f"it, e.g. {dest / 'printgen-out'}")
+    check_inputs_outside(dest, inputs)
+    if dest.is_dir() and not force:
+        foreign = foreign_entry(dest)
+        if foreign is not None:
+            raise OutputError(f"output {dest} is not a printgen output folder: it holds "
+                              f"{foreign}; choose a new or empty folder, or pass --force to "
+                              "replace it whole")
     for parent in dest.parents:
         if parent.exists():
             if not parent.is_dir():
@@ -122,46 +122,57 @@ def check_destination(dest: Path, *, force: bool) -> None:
             break
 
 
+def check_inputs_outside(dest: Path, inputs: Iterable[str | Path]) -> None:
+    """OutputError when an input of the run lies inside `dest` (the run would remove it)."""
+    real = os.path.realpath(dest)
+    for item in inputs:
+        if item is None:
+            continue
+        path = os.path.realpath(item)
+        with contextlib.suppress(ValueError):  # other drive (Windows): not inside
+            if os.path.commonpath([real, path]) == real:
+                raise OutputError(f"input {item} is inside the output folder {dest}, which a run "
+                                  "replaces whole (the input would be deleted); move the input "
+                                  "out or choose another --out")
+
+
 def make_parent(dest: Path) -> None:
     """Create the folder that will hold `dest` (OS errors propagate as one-line OSError)."""
     dest.parent.mkdir(parents=True, exist_ok=True)
 
 
-@contextlib.contextmanager
-def folder_lock(dest: Path) -> Iterator[None]:
-    """Hold an exclusive lock on `.NAME.lock` beside `dest`; raise OutputError naming the pid
-    of the process that holds it. The lock file is removed on release."""
-    path = dest.parent / f".{dest.name}.lock"
-    while True:
-        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            holder = os.pread(fd, 32, 0).decode("ascii", "replace").strip() or "unknown"
-            os.close(fd)
-            raise OutputError(f"output {dest} is being written by another printgen (pid "
-                              f"{holder}); wait for it to finish or choose another --out") from None
-        try:
-            same = os.fstat(fd).st_ino == os.stat(path).st_ino
-        except FileNotFoundError:  # the holder removed it between our open and our lock
-            same = False
-        if same:
-            break
-        os.close(fd)
-    try:
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
-        yield
-    finally:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(path)
-        os.close(fd)
+def _siblings(dest: Path, kind: str) -> list[Path]:
+    """The `.NAME.<kind>.<hex>` folders beside `dest` (names matched literally, links not
+    followed), oldest first."""
+    pattern = re.compile(re.escape(f".{dest.name}.{kind}.") + "[0-9a-f]+")
+    found = []
+    with os.scandir(dest.parent) as it:
+        for e in it:
+            if pattern.fullmatch(e.name) and e.is_dir(follow_symlinks=False):
+                found.append((e.stat(follow_symlinks=False).st_mtime, Path(e.path)))
+    return [p for _, p in sorted(found)]
+
+
+def restore_orphan(dest: Path) -> Path | None:
+    """When `dest` is missing but an aside folder of it is there (a run killed between the
+    fallback's two renames), rename the newest one back to `dest` (call under the lock)."""
+    if os.path.lexists(dest):
+        return None
+    olds = _siblings(dest, "old")
+    if not olds:
+        return None
+    os.rename(olds[-1], dest)
+    log.warning("restored the previous run into %s from %s (a run was stopped while swapping "
+                "its folder in)", dest, olds[-1].name)
+    return olds[-1]
 
 
 def remove_stale(dest: Path) -> list[Path]:
-    """Remove stage and aside folders of `dest` left by killed runs (call under the lock)."""
-    stale = [p for pattern in (f".{dest.name}.stage.*", f".{dest.name}.old.*")
-             for p in dest.parent.glob(pattern) if p.is_dir() and not p.is_symlink()]
+    """Remove stage folders of `dest` left by killed runs, and aside folders once `dest`
+    holds a run (call under the lock, after `restore_orphan`)."""
+    stale = _siblings(dest, "stage")
+    if os.path.isdir(dest) and not os.path.islink(dest):
+        stale += _siblings(dest, "old")
     for p in stale:
         shutil.rmtree(p, ignore_errors=True)
     return stale
@@ -170,12 +181,12 @@ def remove_stale(dest: Path) -> list[Path]:
 def swap_in(stage: Path, dest: Path) -> None:
     """Make `stage` the folder `dest`: exchange atomically when the OS can, else rename the
     old folder aside first. `stage` ends up holding the previous run (or nothing)."""
-    if not dest.exists():
+    if not os.path.lexists(dest):
         os.rename(stage, dest)
         return
     if exchange(stage, dest):
         return
-    aside = dest.parent / f".{dest.name}.old.{os.getpid()}"
+    aside = dest.parent / f".{dest.name}.old.{secrets.token_hex(TOKEN_BYTES)}"
     os.rename(dest, aside)
     try:
         os.rename(stage, dest)
@@ -190,7 +201,7 @@ def exchange(a: Path, b: Path) -> bool:
     system cannot (then the caller falls back to rename-aside). Other OS errors raise."""
     try:
         fn = ctypes.CDLL(None, use_errno=True).renameat2
-    except (AttributeError, OSError):
+    except (AttributeError, OSError, TypeError):
         return False
     fn.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_uint]
     if fn(AT_FDCWD, os.fsencode(a), AT_FDCWD, os.fsencode(b), RENAME_EXCHANGE) == 0:
@@ -199,70 +210,3 @@ def exchange(a: Path, b: Path) -> bool:
     if err in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP):
         return False
     raise OSError(err, os.strerror(err), str(a), None, str(b))
-
-
-def file_digest(path: Path) -> dict[str, Any]:
-    """{"sha256": hex, "bytes": size} of one file."""
-    h, size = hashlib.sha256(), 0
-    with open(path, "rb") as fh:
-        while chunk := fh.read(CHUNK_BYTES):
-            h.update(chunk)
-            size += len(chunk)
-    return {"sha256": h.hexdigest(), "bytes": size}
-
-
-def folder_files(folder: Path) -> list[str]:
-    """Relative POSIX paths of every file under `folder`, sorted."""
-    return sorted(p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file())
-
-
-def write_manifest(folder: Path, meta: dict[str, Any], volatile: tuple[str, ...]) -> dict:
-    """Write `manifest.json`: meta, the volatile names, and every other file's digest.
-
-    Volatile files are listed by name only, so that identical runs give identical manifests.
-    """
-    if len(volatile) > 1:
-        raise ValueError(f"at most one volatile file (the timings), got {volatile}")
-    files = {rel: file_digest(folder / rel) for rel in folder_files(folder)
-             if rel != MANIFEST and rel not in volatile}
-    manifest = {**meta, "format": MANIFEST_FORMAT, "files": files, "volatile": list(volatile)}
-    text = json.dumps(manifest, indent=2, sort_keys=True) + "\n"
-    (folder / MANIFEST).write_text(text, encoding="utf-8")
-    return manifest
-
-
-def read_manifest(folder: Path) -> dict[str, Any]:
-    """The manifest of an output folder; InputError when the folder or manifest is missing."""
-    path = Path(folder) / MANIFEST
-    if not Path(folder).is_dir():
-        raise InputError(f"{folder} is not a folder; give a printgen output folder")
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise InputError(f"{folder} has no {MANIFEST}: it is not a printgen output folder "
-                         "(or was written before manifests existed); run make again") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"{path} is not valid JSON ({exc}); the folder was altered") from None
-    if not isinstance(data, dict) or not isinstance(data.get("files"), dict):
-        raise InputError(f"{path} has no 'files' table; the folder was altered")
-    return data
-
-
-def check_folder(folder: Path) -> list[str]:
-    """What differs between `folder` and its manifest: one line per file, [] when it matches."""
-    folder = Path(folder)
-    m = read_manifest(folder)
-    volatile = set(m.get("volatile", []))
-    present = set(folder_files(folder)) - {MANIFEST}
-    out = []
-    for rel, want in sorted(m["files"].items()):
-        if rel not in present:
-            out.append(f"missing: {rel}")
-            continue
-        got = file_digest(folder / rel)
-        if got != want:
-            out.append(f"changed: {rel} ({got['bytes']} bytes, sha256 {got['sha256'][:12]}; "
-                       f"manifest: {want.get('bytes')} bytes, {str(want.get('sha256'))[:12]})")
-    out += [f"missing: {rel} (volatile)" for rel in sorted(volatile - present)]
-    out += [f"extra: {rel}" for rel in sorted(present - set(m["files"]) - volatile)]
-    return out
