@@ -38,7 +38,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from printgen.run.verify import band_summary, verify_design
+    from printgen.run.verify import band_summary, fitted_name, verify_design
 
     folder = args.design.resolve().parent
     out = args.out or folder.with_name(f"{folder.name}-verify")
@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
     if res.fit is not None:
         c.print(res.record["measured"]["fit"]["sentence"])
         if res.profile_text:
-            name = f"{res.design.net.material}-fitted.toml"
+            name = fitted_name(res.design)
             c.print(f"Feed it back: copy {out / name} into profiles/materials/ (or a folder in "
                     "$PRINTGEN_PROFILES) and use it as the net's material.")
     c.print(f"{len(res.files)} files in {out}/ ; open {out / 'report.html'}")

@@ -56,7 +56,7 @@ def read_input(path: str | Path, what: str = "input file", *,
     try:
         fd = os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0))
     except FileNotFoundError:
-        raise InputFileError(f"{what} {p} not found; check the path (relative to "
+        raise InputFileError(f"file not found: {p} ({what}); check the path (relative to "
                              f"{Path.cwd()})") from None
     except IsADirectoryError:
         raise InputFileError(f"{what} {p} is a folder, not a file; name the file itself") from None
