@@ -62,14 +62,16 @@ def read_input(path: str | Path, what: str = "input file", *,
         raise InputFileError(f"{what} {p} is a folder, not a file; name the file itself") from None
     except OSError as exc:
         raise InputFileError(f"cannot read {what} {p}: {exc.strerror}") from None
+    st = os.fstat(fd)
+    if not stat.S_ISREG(st.st_mode):
+        os.close(fd)
+        raise InputFileError(f"{what} {p} is {kind_of(st.st_mode)}, not a regular file; "
+                             "give a file saved on disk")
+    if st.st_size > limit:
+        os.close(fd)
+        raise InputFileError(f"{what} {p} is {st.st_size:,} bytes, over the {limit:,}-byte "
+                             "limit for this input; is it the right file?")
     with os.fdopen(fd, "rb") as fh:
-        st = os.fstat(fd)
-        if not stat.S_ISREG(st.st_mode):
-            raise InputFileError(f"{what} {p} is {kind_of(st.st_mode)}, not a regular file; "
-                                 "give a file saved on disk")
-        if st.st_size > limit:
-            raise InputFileError(f"{what} {p} is {st.st_size:,} bytes, over the {limit:,}-byte "
-                                 "limit for this input; is it the right file?")
         if hasattr(os, "set_blocking"):
             os.set_blocking(fd, True)
         data = fh.read(limit + 1)

@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from printgen.outputs.files import FULL_ERRNOS, OutputError, named
-from printgen.outputs.lock import folder_lock
+from printgen.outputs.lock import check_lock_path, folder_lock
 from printgen.outputs.manifest import foreign_entry, write_manifest
 from printgen.workers import signals_deferred
 
@@ -108,6 +108,7 @@ def check_destination(dest: Path, *, force: bool, inputs: Iterable[str | Path] =
                           "renaming, which a mount point cannot be; give --out a folder inside "
                           f"it, e.g. {dest / 'printgen-out'}")
     check_inputs_outside(dest, inputs)
+    check_lock_path(dest)
     if dest.is_dir() and not force:
         foreign = foreign_entry(dest)
         if foreign is not None:

@@ -24,7 +24,7 @@ import stat
 from collections.abc import Iterator
 from pathlib import Path
 
-from printgen.outputs.files import OutputError
+from printgen.outputs.files import OutputError, kind_of
 
 NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)  # not on Windows: there a link is checked with lstat
 PID_BYTES = 32  # a pid and a newline, with room to spare
@@ -59,6 +59,20 @@ def folder_lock(dest: Path, backend: str | None = None) -> Iterator[None]:
             os.unlink(lock_path(dest))  # flock: removed while held, so no one locks a ghost
         if how == "flock":
             os.close(fd)
+
+
+def check_lock_path(dest: Path) -> None:
+    """LockError now (before any work) when the lock path of `dest` is there and is not a
+    regular file: a link, a folder or a FIFO planted at its name."""
+    path = lock_path(dest)
+    try:
+        mode = os.lstat(path).st_mode
+    except FileNotFoundError:
+        return
+    if stat.S_ISLNK(mode):
+        raise _not_plain(path, "a symbolic link")
+    if not stat.S_ISREG(mode):
+        raise _not_plain(path, kind_of(mode))
 
 
 def _open(path: Path, flags: int) -> int:
