@@ -108,7 +108,6 @@ def check_destination(dest: Path, *, force: bool, inputs: Iterable[str | Path] =
                           "renaming, which a mount point cannot be; give --out a folder inside "
                           f"it, e.g. {dest / 'printgen-out'}")
     check_inputs_outside(dest, inputs)
-    check_lock_path(dest)
     if dest.is_dir() and not force:
         foreign = foreign_entry(dest)
         if foreign is not None:
@@ -121,6 +120,7 @@ def check_destination(dest: Path, *, force: bool, inputs: Iterable[str | Path] =
                 raise OutputError(f"cannot create output {dest}: {parent} is a file; give "
                                   "--out a path in a folder")
             break
+    check_lock_path(dest)
 
 
 def check_inputs_outside(dest: Path, inputs: Iterable[str | Path]) -> None:

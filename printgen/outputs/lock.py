@@ -67,7 +67,7 @@ def check_lock_path(dest: Path) -> None:
     path = lock_path(dest)
     try:
         mode = os.lstat(path).st_mode
-    except FileNotFoundError:
+    except (FileNotFoundError, NotADirectoryError):
         return
     if stat.S_ISLNK(mode):
         raise _not_plain(path, "a symbolic link")
