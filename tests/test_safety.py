@@ -298,6 +298,21 @@ def test_killed_fallback_swap_is_restored_by_the_next_run(world, capsys):
     assert snapshot(world) == before  # the old folder whole, no stage, no aside, no lock
 
 
+def test_an_aside_outlives_every_run_that_fails(world):
+    out = world / "x" / "out"
+    with staged_dir(out) as stage:
+        (stage / "a.txt").write_text("current")
+    aside = world / "x" / ".out.old.0badc0de"  # left by a run killed after its swap
+    aside.mkdir()
+    (aside / "a.txt").write_text("older")
+    with pytest.raises(RuntimeError), staged_dir(out):
+        raise RuntimeError("a step failed")
+    assert (aside / "a.txt").read_text() == "older"
+    with staged_dir(out) as stage:
+        (stage / "a.txt").write_text("new")
+    assert not aside.exists() and (out / "a.txt").read_text() == "new"
+
+
 def test_fallback_swap_removes_the_old_run_only_after_the_new_is_in(world, monkeypatch):
     out = world / "x" / "out"
     with staged_dir(out) as stage:

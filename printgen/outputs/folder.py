@@ -78,6 +78,7 @@ def staged_dir(final: str | Path, *, force: bool = False,
                 for done in _trackers:
                     done.append(dest)
                 shutil.rmtree(stage, ignore_errors=True)
+                remove_stale(dest, "old")  # earlier runs' asides: the new run is in now
         finally:
             shutil.rmtree(stage, ignore_errors=True)
 
@@ -168,12 +169,10 @@ def restore_orphan(dest: Path) -> Path | None:
     return olds[-1]
 
 
-def remove_stale(dest: Path) -> list[Path]:
-    """Remove stage folders of `dest` left by killed runs, and aside folders once `dest`
-    holds a run (call under the lock, after `restore_orphan`)."""
-    stale = _siblings(dest, "stage")
-    if os.path.isdir(dest) and not os.path.islink(dest):
-        stale += _siblings(dest, "old")
+def remove_stale(dest: Path, kind: str = "stage") -> list[Path]:
+    """Remove the stage folders of `dest` left by killed runs (call under the lock, after
+    `restore_orphan`), or with kind "old" its aside folders (only once a new run is in)."""
+    stale = _siblings(dest, kind)
     for p in stale:
         shutil.rmtree(p, ignore_errors=True)
     return stale
