@@ -50,6 +50,11 @@ def bait_examples(f):
     return f
 
 
+def fuzz_names(f):
+    """The test over random names, the issue's reproductions first."""
+    return bait_examples(given(name=names)(SETTINGS(f)))
+
+
 @pytest.fixture
 def reads(monkeypatch, tmp_path):
     """Every TOML path the profile lookup reads, with a profile folder of our own in front."""
@@ -84,9 +89,7 @@ def accepted_or_refused(call, name: str) -> None:
     assert PLAIN.fullmatch(name), f"{name!r} was accepted"
 
 
-@bait_examples
-@given(name=names)
-@SETTINGS
+@fuzz_names
 def test_profile_lookup_of_every_kind(reads, name):
     root, seen = reads
     seen.clear()
@@ -95,9 +98,7 @@ def test_profile_lookup_of_every_kind(reads, name):
     assert inside_profile_folders(seen, root), seen
 
 
-@bait_examples
-@given(name=names)
-@SETTINGS
+@fuzz_names
 def test_inherits(reads, name):
     root, seen = reads
     seen.clear()
@@ -111,9 +112,7 @@ def test_inherits(reads, name):
     assert inside_profile_folders(seen, root), seen
 
 
-@bait_examples
-@given(name=names)
-@SETTINGS
+@fuzz_names
 def test_prototype_model_names(tmp_path, name):
     from printgen.inputs.prototype import load_prototype
 
@@ -125,9 +124,7 @@ def test_prototype_model_names(tmp_path, name):
         accepted_or_refused(lambda path=path: load_prototype(path), name)
 
 
-@bait_examples
-@given(name=names)
-@SETTINGS
+@fuzz_names
 def test_design_json_names(design_1_40, name):
     from printgen.design.design_file import design_from_dict
     from printgen.run.verify import fitted_name
@@ -149,9 +146,7 @@ def test_design_json_names(design_1_40, name):
         assert "/" not in fitted_name(d) and "\\" not in fitted_name(d)
 
 
-@bait_examples
-@given(name=names)
-@SETTINGS
+@fuzz_names
 def test_calibrate_material_and_profiles_show(tmp_path, capsys, name):
     import argparse
 
