@@ -232,6 +232,19 @@ def test_prototype_profile_names_are_names(world, capsys, key, name):
     assert snapshot(world) == before
 
 
+@pytest.mark.parametrize("argv", [
+    ["make", SIMPLE, "-s", 40, "--printer", "{abs}/outside/tpe2", "--out", "{abs}/x/o"],
+    ["select", SIMPLE, "-s", 40, "--materials", "tpe", "../outside/tpe2"],
+    ["design", SIMPLE, "-s", 40, "--serial", "--materials", "{abs}/outside/tpe2",
+     "--out", "{abs}/x/o"],
+    ["design", SIMPLE, "-s", 40, "--serial", "--printer", "..", "--out", "{abs}/x/o"]])
+def test_printer_and_materials_options_are_names(world, capsys, argv):
+    before = snapshot(world)
+    code, err = cli(capsys, *[str(a).format(abs=world) for a in argv])
+    assert code == 2 and ("--printer: " in err or "--materials: " in err)
+    assert "is not a profile name" in err and snapshot(world) == before
+
+
 def test_profiles_show_and_inherits_do_not_read_outside(world, capsys, monkeypatch, tmp_path):
     code, err = cli(capsys, "profiles", "show", f"../../../../{world}/outside/tpe2")
     assert code == 2 and "is not a profile name" in err

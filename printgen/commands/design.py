@@ -8,7 +8,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from printgen.commands.common import add_json_arg, console, emit_json, table
+from printgen.commands.common import add_json_arg, check_profile_args, console, emit_json, table
 from printgen.design.search import OBJECTIVES, VERIFY_NETS
 from printgen.design.search_choice import short
 from printgen.design.sweep import check_address
@@ -53,6 +53,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_profile_args(args, "printer", "materials")
     if args.scheduler:
         check_address(args.scheduler)
     scales = _scales(args)
