@@ -17,6 +17,7 @@ far a prediction exceeds it, and is never used as a value.
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -28,6 +29,8 @@ from printgen.check.bands import Band, Variant, curves, run_variant
 from printgen.check.readings import DEPTH_COLUMN, RAW_COLUMNS, FlumeUnits
 from printgen.design.record import Design
 from printgen.errors import InputError
+from printgen.inputs.profiles import profile_name
+from printgen.outputs.files import read_input_text
 
 LEVEL_COLUMN = "h_over_hb"
 # CSV column -> (METRICS key of printgen.check.compare, factor from the CSV unit to the key's)
@@ -38,6 +41,7 @@ COLUMNS = {
     "deflection_over_width": ("deflection", 1.0),
     "lowering_over_height": ("lowering", 1.0),
 }
+MEASURED_LIMIT_BYTES = 4 << 20  # a loading test is tens of lines; 4 MiB is surely not one
 MAX_LEVEL = 1.1  # the sweep's last relative loading (overflow): no prediction beyond it
 IGNORED_PREFIX = "expected_"  # columns of the measurement sheet that hold the model's readings
 LEVEL_AGREE = 0.01  # h_over_hb and water_depth_mm / h_B may differ by this much (h / h_B)
@@ -81,10 +85,7 @@ def read_measured(path: str | Path, units: FlumeUnits | None = None) -> Measurem
     model's readings on the measurement sheet) are skipped.
     """
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise MeasurementError(f"{p}: cannot read the measured data: {exc}") from exc
+    text = read_input_text(p, "measured data", limit=MEASURED_LIMIT_BYTES, encoding="utf-8-sig")
     lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines())
              if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
@@ -325,20 +326,23 @@ def fit_factor(m: Measurement, predict: Predictor, kind: str = "stiffness") -> F
 def fitted_profile(material: str, kind: str, value: float, *, panel_kappas: tuple | None,
                    modulus_gpa: float | None, source: str) -> str:
     """TOML text of a material profile that feeds a fitted stiffness factor back: it inherits
-    `material` and scales its panel law (or its measured modulus). None for a slack fit."""
+    `material` (a profile name) and scales its panel law (or its measured modulus). "" for a
+    slack fit."""
+    material = profile_name(material, "fitted profile: inherits")
     if kind != "stiffness":
         return ""
-    lines = [f'# The printed net of {source}, fitted by printgen verify --measured:',
+    shown = json.dumps(source)  # a quoted TOML string: a file name cannot break the syntax
+    lines = [f"# The printed net of {shown}, fitted by printgen verify --measured:",
              f"# effective stiffness {value:.3f} x the '{material}' profile.",
              f'inherits = "{material}"', ""]
-    cond = f"effective law of the printed net fitted to the loading test {source}"
+    cond = json.dumps(f"effective law of the printed net fitted to the loading test {source}")
+    origin = json.dumps(f"printgen verify --measured {source}")
     if panel_kappas:
         kappas = ", ".join(f"{k * value / 1e3:.4g}" for k in panel_kappas)
-        lines += ["[measured.panel_law]", f"kappa_kn_per_m_per_m = [{kappas}]",
-                  f'source = "printgen verify --measured {source}"', f'conditions = "{cond}"']
+        lines += ["[measured.panel_law]", f"kappa_kn_per_m_per_m = [{kappas}]"]
     else:
-        lines += ["[measured.tensile_modulus]", f"value_gpa = {modulus_gpa * value:.4g}",
-                  f'source = "printgen verify --measured {source}"', f'conditions = "{cond}"']
+        lines += ["[measured.tensile_modulus]", f"value_gpa = {modulus_gpa * value:.4g}"]
+    lines += [f"source = {origin}", f"conditions = {cond}"]
     return "\n".join(lines) + "\n"
 
 

@@ -10,7 +10,14 @@ from pathlib import Path
 
 from rich.console import Console
 
-from printgen.commands.common import add_json_arg, add_prototype_args, console, emit_json, table
+from printgen.commands.common import (
+    add_json_arg,
+    add_prototype_args,
+    check_profile_args,
+    console,
+    emit_json,
+    table,
+)
 from printgen.run import api
 from printgen.run.budget import DEFAULT_LIMIT_S
 from printgen.run.make import json_output
@@ -45,6 +52,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_profile_args(args, "printer")
     out = args.out or Path("out") / f"{Path(args.prototype).stem}-1-{args.scale:g}"
     err = Console(stderr=True, highlight=False)
     t0 = time.perf_counter()

@@ -8,7 +8,8 @@ from printgen.commands.common import add_json_arg, console, emit_json, table
 from printgen.errors import ProfileError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
-from printgen.inputs.profiles import KINDS, list_profiles, load_raw, profile_path
+from printgen.inputs.profiles import (KINDS, list_profiles, load_raw, profile_name,
+                                      profile_path)
 from printgen.report.jsonout import jsonable
 
 LOADERS = {"materials": load_material, "printers": load_printer, "prints": load_print_style}
@@ -54,6 +55,7 @@ def _summary(kind: str, name: str) -> str:
 
 
 def run_show(args: argparse.Namespace) -> int:
+    profile_name(args.name, "profiles show")
     kinds = [args.kind] if args.kind else [k for k in KINDS if args.name.lower() in list_profiles(k)]
     if not kinds:
         known = "; ".join(f"{k}: {', '.join(list_profiles(k))}" for k in KINDS)

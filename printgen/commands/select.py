@@ -7,6 +7,7 @@ import argparse
 from printgen.commands.common import (
     add_json_arg,
     add_prototype_args,
+    check_profile_args,
     console,
     emit_json,
     fmt,
@@ -32,6 +33,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_profile_args(args, "printer", "materials")
     proto = load_prototype(args.prototype)
     s = api.select(proto, args.scale, printer=args.printer, materials=args.materials)
     if args.json:

@@ -38,7 +38,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from printgen.run.verify import band_summary, verify_design
+    from printgen.run.verify import band_summary, fitted_name, verify_design
 
     folder = args.design.resolve().parent
     out = args.out or folder.with_name(f"{folder.name}-verify")
@@ -62,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
         if res.profile_text and not res.fit.at_bound:
             from printgen.inputs.profiles import user_folder_hint
 
-            name = f"{res.design.net.material}-fitted.toml"
+            name = fitted_name(res.design)
             c.print(f"Feed it back: {out / name} is the fitted profile; "
                     f"{user_folder_hint('materials', name)}, and use it as the net's material.")
         elif res.fit.at_bound:

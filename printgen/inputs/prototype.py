@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from printgen.errors import InputError
+from printgen.inputs.profiles import profile_name
 from printgen.inputs.schema import Field, load_toml, positive, read_table
 
 DEPTH_OVER_HEIGHT_MAX = 2.0  # flow depth / barrier height: beyond it the barrier is drowned
@@ -119,7 +120,7 @@ def load_prototype(path: str | Path) -> Prototype:
     """Read and validate a prototype TOML file."""
     p = Path(path)
     where = str(p)
-    top = read_table(load_toml(p), TOP, where=where)
+    top = read_table(load_toml(p, "prototype file"), TOP, where=where)
     bar = read_table(top["barrier"], BARRIER, where=f"{where} [barrier]")
     net = read_table(top["net"], NET, where=f"{where} [net]")
     flow = read_table(top["flow"], FLOW, where=f"{where} [flow]")
@@ -134,6 +135,7 @@ def load_prototype(path: str | Path) -> Prototype:
     if (model.get("mesh_x_mm") is None) != (model.get("mesh_y_mm") is None):
         raise InputError(f"{where} [model]: give both mesh_x_mm and mesh_y_mm, or neither (then "
                          "the prototype's mesh is scaled)")
+    _check_profile_names(model, f"{where} [model]")
     depth = flow["depth"] if flow["depth"] is not None else bar["height"]
     if flume and flume.lateral == "eyelets" and not border:
         raise InputError(f"{where} [flume]: lateral = \"eyelets\" anchors the lateral border "
@@ -160,6 +162,15 @@ def load_prototype(path: str | Path) -> Prototype:
         model=ModelPrefs(**{**model, "materials": tuple(model.get("materials") or ())}),
         path=p,
     )
+
+
+def _check_profile_names(model: dict, where: str) -> None:
+    """[model] printer, net_print, cable_print and materials name profiles: names, not paths."""
+    for key in ("printer", "net_print", "cable_print"):
+        if model.get(key) is not None:
+            profile_name(model[key], f"{where}: {key}")
+    for i, name in enumerate(model.get("materials") or ()):
+        profile_name(name, f"{where}: materials[{i}]")
 
 
 def _panel_law(raw: dict | None, where: str):

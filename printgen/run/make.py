@@ -26,6 +26,7 @@ from printgen.design.record import Design
 from printgen.design.selection import Selection, select
 from printgen.design.similitude import ScaledTargets, scale_targets
 from printgen.errors import TimeLimitError
+from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import MANIFEST, check_destination, staged_dir
 from printgen.report.extras import report_files
@@ -112,7 +113,9 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     version, command line) and timings.json (the only file that differs between runs).
     """
     t0 = time.perf_counter()
-    check_destination(Path(out), force=bool((options or {}).get("force")))  # fail fast
+    inputs = [prototype_path, (options or {}).get("design_file"), *search_dirs()]
+    check_destination(Path(out), force=bool((options or {}).get("force")),
+                      inputs=inputs)  # fail fast
     ctx = plan(prototype_path, scale, printer=printer, options=options)
     est = size_check(ctx, steps is None or any(s is verify_step for _, s in steps))
     if progress and est.seconds > LONG_RUN_S:
@@ -124,7 +127,7 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     bound = run_bound(ctx.options)
     with deadline(None if bound is None else time.time() + bound - (time.perf_counter() - t0)), \
             staged_dir(out, force=bool(ctx.options.get("force")), meta=meta,
-                       volatile=(TIMINGS,)) as stage, level_bars(long_run), \
+                       volatile=(TIMINGS,), inputs=inputs) as stage, level_bars(long_run), \
             verification_ahead(ctx, steps, long_run is None):
         for label, step in steps:
             if progress:

@@ -35,8 +35,9 @@ from printgen.check.verify import Verification, verify
 from printgen.design.design_file import load_design
 from printgen.design.record import Design
 from printgen.inputs.materials import load_material
+from printgen.inputs.profiles import profile_name, search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
-from printgen.outputs import staged_dir
+from printgen.outputs import check_destination, staged_dir
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
 from printgen.report.labfiles import lab_files, lab_record
@@ -77,6 +78,8 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     """
     say = progress or (lambda _label: None)
     t0 = time.perf_counter()
+    inputs = [prototype, design_path, measured, *search_dirs()]
+    check_destination(Path(out), force=force, inputs=inputs)  # before any work
     p = load_prototype(prototype)
     d = load_design(design_path, scale=scale)
     m = read_measured(measured, design_units(d)) if measured is not None else None
@@ -107,7 +110,7 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
                                        if m is not None and result else "")
     rep.lead = summary_html(record["summary"])
     record["timings_s"] = {"total": time.perf_counter() - t0, "band": band.seconds}
-    files = _write(out, rep, record, d, text, force)
+    files = _write(out, rep, record, d, text, force, inputs)
     return VerifyRun(p, d, v, band, m, result, text, record, files)
 
 
@@ -133,16 +136,22 @@ def _profile_text(d: Design, fit: Fit, source: str) -> str:
                           modulus_gpa=mat.modulus()[0] / 1e9, source=source)
 
 
+def fitted_name(d: Design) -> str:
+    """File name of the fitted profile, inside the output folder (the material is a profile
+    name, checked when the design was read, so this is one plain file name)."""
+    return f"{profile_name(d.net.material, 'design net.material')}-fitted.toml"
+
+
 def _write(out: str | Path, rep: Report, record: dict[str, Any], d: Design, profile: str,
-           force: bool) -> list[str]:
+           force: bool, inputs: list) -> list[str]:
     timings = record.pop("timings_s")
     files = {"report.html": rep.html(), "report.json": dumps(record),
              TIMINGS: dumps({"timings_s": timings})}
     files.update(lab_files(record["lab"]))  # curves, expected readings, measurement sheet
     if profile:
-        files[f"{d.net.material}-fitted.toml"] = profile
+        files[fitted_name(d)] = profile
     record["timings_s"] = timings
-    with staged_dir(out, force=force, volatile=(TIMINGS,)) as stage:
+    with staged_dir(out, force=force, volatile=(TIMINGS,), inputs=inputs) as stage:
         for name, text in files.items():
             (stage / name).write_text(text)
     return sorted(files)
