@@ -13,7 +13,7 @@ from printgen.check.scenes import model_scene
 from printgen.inputs.printers import load_printer
 from printgen.parts.assembly import CLOSE_TOL_MM, assemble
 from printgen.parts.geometry.attach import DEFAULT_CLEARANCE_MM, holes
-from printgen.parts.geometry.net import diamond_net
+from printgen.barrier.patterns.diamond import diamond_net
 from printgen.run.make import plan
 from printgen.units import MM
 

@@ -18,6 +18,17 @@ def add_prototype_args(p: argparse.ArgumentParser) -> None:
                    help="geometric scale lambda = prototype / model, >= 1 (1:40 -> 40)")
 
 
+def add_load_args(p: argparse.ArgumentParser, what: str) -> None:
+    """--load NAME (a load case of printgen/barrier/loads) and its alias --drag."""
+    from printgen.barrier.loads import DEFAULT, case_names
+
+    p.add_argument("--load", choices=case_names(), default=None,
+                   help=f"{what} under this load case (default {DEFAULT}; drag: hydrostatic + "
+                        "drag at the Froude-scaled velocity)")
+    p.add_argument("--drag", action="store_const", dest="load", const="drag",
+                   help="the same as --load drag")
+
+
 def add_json_arg(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print machine-readable JSON")
 

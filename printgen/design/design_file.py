@@ -12,17 +12,21 @@ import math
 from pathlib import Path
 from typing import Any
 
+from printgen.barrier.patterns import get_pattern
 from printgen.design.record import CableDesign, Design, NetDesign, Section
 from printgen.errors import InputError
 
 
 def _fields(cls: type, data: Any, where: str) -> dict[str, Any]:
-    """`data` as keyword arguments of the dataclass `cls`, or InputError."""
+    """`data` as keyword arguments of the dataclass `cls`, or InputError (a field with a
+    default may be missing: files written before it existed)."""
     if not isinstance(data, dict):
         raise InputError(f"{where}: expected a table of {cls.__name__} fields, got "
                          f"{type(data).__name__}")
     names = [f.name for f in dataclasses.fields(cls)]
-    unknown, missing = sorted(set(data) - set(names)), [n for n in names if n not in data]
+    optional = {f.name for f in dataclasses.fields(cls) if f.default is not dataclasses.MISSING}
+    unknown = sorted(set(data) - set(names))
+    missing = [n for n in names if n not in data and n not in optional]
     if unknown or missing:
         raise InputError(f"{where}: unknown keys {unknown} / missing keys {missing}; allowed: "
                          f"{', '.join(names)} (write it with printgen design or make)")
@@ -55,6 +59,8 @@ def design_from_dict(data: Any, where: str = "design") -> Design:
     for key in ("width_mm", "height_mm", "mesh_x_mm", "mesh_y_mm", "border_width_mm"):
         net[key] = _positive(net[key], f"{where}.net.{key}")
     net["strand"] = _section(net["strand"], f"{where}.net.strand")
+    if "pattern" in net:
+        net["pattern"] = get_pattern(str(net["pattern"])).name
     if not isinstance(kw["cables"], list):
         raise InputError(f"{where}.cables must be a list of cables")
     cables = []

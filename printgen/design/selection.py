@@ -1,5 +1,5 @@
 """Choose a polymer and pass layout for the border cables (axial stiffness E*A) and for the net
-(membrane law from the diamond geometry) against the similitude targets.
+(membrane law from the printed pattern's geometry, `PRINTED_PATTERN`) against the similitude targets.
 
 Every material x layout (beads side by side x stacked layers of the print style) is a
 candidate. Each gets its stiffness error, the Pi3 deviation of its equivalent section, a
@@ -14,15 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from printgen.barrier.patterns import get_pattern
 from printgen.design.record import Section
-from printgen.design.section import (
-    area_m2,
-    diamond_factor,
-    diamond_sin,
-    equal_area_diameter,
-    net_membrane_law,
-    square_factor,
-)
+from printgen.design.section import area_m2, equal_area_diameter, net_membrane_law
 from printgen.design.similitude import ScaledTargets
 from printgen.errors import InputError, PrintabilityError
 from printgen.inputs.laws import piecewise_linear
@@ -35,6 +29,7 @@ from printgen.units import MM, G
 DEFAULT_PRINTER = "generic-350"
 DEFAULT_NET_PRINT = "net-3pass"
 DEFAULT_CABLE_PRINT = "cable-4pass"
+PRINTED_PATTERN = "diamond"  # the pattern of the printed net: what select prices, make prints
 
 MAX_BEADS_ACROSS = {"cable": 6, "net": 2}  # wider strands are no longer "strands"
 MAX_LAYERS = {"cable": 6, "net": 5}
@@ -166,8 +161,7 @@ def peak_strand_force(t: ScaledTargets, mesh_across: float, mesh_along: float) -
     s = ASSUMED_SAG_RATIO
     h_b = t["height"]
     n = 1000.0 * G * OVERFLOW * h_b * h_b / (8 * s) * math.sqrt(1 + 16 * s * s)
-    sin = diamond_sin(mesh_along, mesh_across)
-    return n * mesh_across / (2 * sin)
+    return get_pattern(PRINTED_PATTERN).strand_force(n, mesh_along, mesh_across)
 
 
 def cable_candidate(t: ScaledTargets, m: Material, sec: Section, printer: Printer) -> Candidate:
@@ -191,15 +185,12 @@ def target_net_law(p: Prototype, t: ScaledTargets) -> tuple[tuple[float, ...], t
     """(knee strains, membrane slopes N/m) of the model net's target force-per-width law.
 
     From the prototype's panel law (kappa * L_p scaled by lambda^-2), else from its strand E*A
-    and mesh geometry (square: one strand per mesh across; diamond: `diamond_factor`).
+    and mesh geometry (its pattern's `membrane_factor`).
     """
     if p.net.panel_law is not None:
         knees, kappas = p.net.panel_law[0], p.net.panel_law[1]
         return tuple(knees), tuple(t[f"membrane_{i}"] for i in range(len(kappas)))
-    if p.net.pattern == "square":
-        factor = square_factor(t["mesh_x"])
-    else:
-        factor = diamond_factor(t["mesh_y"], t["mesh_x"])
+    factor = get_pattern(p.net.pattern).membrane_factor(t["mesh_y"], t["mesh_x"])
     return (), (t["strand_ea"] * factor,)
 
 
@@ -213,9 +204,10 @@ def model_mesh(p: Prototype, t: ScaledTargets) -> tuple[float, float]:
 
 def net_candidate(p: Prototype, t: ScaledTargets, m: Material, sec: Section,
                   printer: Printer) -> Candidate:
-    """Score one net candidate: its membrane law (diamond geometry) against the target law."""
+    """Score one net candidate: its membrane law (the printed pattern's geometry) against the
+    target law."""
     mesh_x, mesh_y = model_mesh(p, t)
-    knees, slopes, source = net_membrane_law(m, sec, mesh_y, mesh_x)
+    knees, slopes, source = net_membrane_law(m, sec, mesh_y, mesh_x, PRINTED_PATTERN)
     t_knees, t_slopes = target_net_law(p, t)
     got = piecewise_linear(NET_STRAINS, knees, slopes)
     want = piecewise_linear(NET_STRAINS, t_knees, t_slopes)

@@ -28,7 +28,7 @@ if TYPE_CHECKING:
     from printgen.calibrate.sample import FitOptions
     from printgen.check.verify import Verification
     from printgen.run.design import DesignRun, SearchOptions
-    from printgen.run.make import MakeContext
+    from printgen.run.make import MakeContext, MakeOptions
 
 PrototypeLike = str | Path | Prototype
 
@@ -62,19 +62,38 @@ def plan(prototype: PrototypeLike, scale: float, *, printer: str | None = None) 
 
 
 def make(prototype: str | Path, scale: float, out: str | Path, *,
-         printer: str | None = None, drag: bool = False, step: bool = False,
-         options: dict[str, Any] | None = None,
+         printer: str | None = None, load: str | None = None, drag: bool = False,
+         step: bool = False, options: MakeOptions | None = None,
          progress: Callable[[str], None] | None = None) -> MakeContext:
     """Targets, selection, parts (STL, 3MF, slicer profiles, G-code), the pre-print
-    verification and the report, written into the folder `out` as one whole run."""
+    verification under load case `load` (`printgen.barrier.loads`, default hydrostatic;
+    `drag=True` is `load="drag"`) and the report, written into the folder `out` as one
+    whole run; `options` (`printgen.run.make.MakeOptions`) for the rest."""
+    import dataclasses
+
+    from printgen.run.make import MakeOptions
     from printgen.run.make import make as _make
 
-    opts = {"drag": drag, "step": step, **(options or {})}
+    opts = options or MakeOptions()
+    opts = dataclasses.replace(opts, load=load_name(load or opts.load, drag),
+                               step=step or opts.step)
     return _make(prototype, scale, out, printer=printer, options=opts, progress=progress)
 
 
+def load_name(load: str | None, drag: bool) -> str:
+    """The load case of `load` and its alias `drag` (True: "drag"); InputError when they
+    disagree or `load` names no case."""
+    from printgen.barrier.loads import get_load
+    from printgen.errors import InputError
+
+    if drag and load not in (None, "drag"):
+        raise InputError(f"--drag is --load drag, not --load {load}: give one of them")
+    return get_load("drag" if drag else load).name
+
+
 def verify(prototype: PrototypeLike, scale: float, design_: Design | str | Path | None = None,
-           *, printer: str | None = None, drag: bool = False) -> Verification:
+           *, printer: str | None = None, load: str | None = None,
+           drag: bool = False) -> Verification:
     """The pre-print check: prototype and printed model solved under the same relative
     loading, h/h_B = 0 to 1.1, and compared by their normalised deformations. `design_` is a
     `Design` or the design.json that `make` wrote; without it, the design `make` would print
@@ -87,7 +106,7 @@ def verify(prototype: PrototypeLike, scale: float, design_: Design | str | Path 
         d = plan(p, scale, printer=printer)
     else:
         d = design_ if isinstance(design_, Design) else load_design(design_, scale=scale)
-    return _verify(p, d, drag=drag)
+    return _verify(p, d, load=load_name(load, drag))
 
 
 def design_search(prototype: PrototypeLike, scales: float | Sequence[float], *,

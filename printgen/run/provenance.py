@@ -61,14 +61,14 @@ def provenance(ctx: MakeContext) -> dict[str, Any]:
     used |= {("materials", c.material) for c in d.cables}
     used |= {("prints", c.print_style) for c in d.cables}
     inputs = {"prototype": _digest(ctx.prototype.path)} if ctx.prototype.path else {}
-    if ctx.options.get("design_file"):  # make --design FILE: the design is an input too
-        inputs["design_file"] = _digest(Path(ctx.options["design_file"]))
+    if ctx.options.design_file:  # make --design FILE: the design is an input too
+        inputs["design_file"] = _digest(Path(ctx.options.design_file))
     for kind, name in sorted(used):
         for path in load_raw(kind, name)[1]:
             shown = (Path("profiles") / path.relative_to(BUNDLED)
                      if path.is_relative_to(BUNDLED) else path)
             inputs[f"{kind}/{path.stem}"] = _digest(path, shown)
-    return {"printgen_version": version("printgen"), "command": ctx.options.get("command"),
+    return {"printgen_version": version("printgen"), "command": ctx.options.command,
             "inputs": inputs}
 
 
