@@ -20,12 +20,13 @@ from rich.markup import escape
 from printgen.calibrate.aggregate import MIN_SAMPLES
 from printgen.calibrate.compliance import from_curve, from_stiffness
 from printgen.calibrate.fit import DEFAULT_ZERO, ISO_WINDOW, ZERO_MODES
-from printgen.calibrate.pipeline import Calibration, calibrate
+from printgen.calibrate.pipeline import Calibration
 from printgen.calibrate.record import calibration_record, units
 from printgen.calibrate.sample import DEFAULT_SECANTS, PRELOAD_STEPS, FitOptions, SampleFit
 from printgen.calibrate.specimen import KINDS
 from printgen.commands.common import add_json_arg, console, emit_json, fmt, table
 from printgen.errors import CalibrationError
+from printgen.run import api
 
 PRELOAD_COL = "ΔE % at P∓10%"  # modulus change (%) at 0.9 and 1.1 x the preload
 DIMENSION_OPTIONS = (("width_mm", "width", 1e-3), ("thickness_mm", "thickness", 1e-3),
@@ -119,7 +120,7 @@ def run(args: argparse.Namespace) -> int:
             if getattr(args, opt) is not None}
     if args.kind:
         spec["kind"] = args.kind
-    cal = calibrate(
+    cal = api.calibrate(
         args.files, material=args.material, options=options_from(args), specimen=spec,
         specimen_file=args.specimen, columns=_pairs(args.column, "--column"),
         units=_pairs(args.unit, "--unit"),

@@ -12,7 +12,8 @@ from printgen.commands.common import add_json_arg, console, emit_json, table
 from printgen.design.search import OBJECTIVES, VERIFY_NETS
 from printgen.design.search_choice import short
 from printgen.errors import InputError
-from printgen.run.design import DesignRun, SearchOptions, design_searches, write_outputs
+from printgen.run import api
+from printgen.run.design import DesignRun, SearchOptions, write_outputs
 
 SHOW = 10  # Pareto members shown per scale in the table (all are in report.json)
 
@@ -63,8 +64,9 @@ def run(args: argparse.Namespace) -> int:
         border_beads=_ints(args.border_beads, "--border-beads"), printer=args.printer,
         verify_nets=args.verify_nets, level_step=args.level_step)
     out = args.out or Path("out") / f"{Path(args.prototype).stem}-design"
-    result = design_searches(args.prototype, scales, options=opts, scheduler=args.scheduler,
-                             workers=args.workers, serial=args.serial, progress=not args.json)
+    result = api.design_search(args.prototype, scales, options=opts, scheduler=args.scheduler,
+                               workers=args.workers, serial=args.serial,
+                               progress=not args.json)
     files = write_outputs(result, out, args.scale if args.scale else scales[0])
     if args.json:
         emit_json(result.record)

@@ -44,14 +44,15 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from printgen.run.verify import band_summary, verify_design
+    from printgen.run import api
+    from printgen.run.verify import band_summary
 
     folder = args.design.resolve().parent
     out = args.out or folder.with_name(f"{folder.name}-verify")
     err = Console(stderr=True, highlight=False)
     t0 = time.perf_counter()
     with err.status("reading inputs") as status:
-        res = verify_design(args.prototype, args.scale, args.design, out,
+        res = api.verify_design(args.prototype, args.scale, args.design, out,
                             measured=args.measured, fit=args.fit, load=args.load,
                             force=args.force, progress=lambda s: status.update(f"{s} ..."))
     if args.json:

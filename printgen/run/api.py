@@ -29,6 +29,7 @@ if TYPE_CHECKING:
     from printgen.check.verify import Verification
     from printgen.run.design import DesignRun, SearchOptions
     from printgen.run.make import MakeContext, MakeOptions
+    from printgen.run.verify import VerifyRun
 
 PrototypeLike = str | Path | Prototype
 
@@ -109,9 +110,24 @@ def verify(prototype: PrototypeLike, scale: float, design_: Design | str | Path 
     return _verify(p, d, load=load_name(load, drag))
 
 
+def verify_design(prototype: str | Path, scale: float, design_file: str | Path,
+                  out: str | Path, *, measured: str | Path | None = None,
+                  fit: str = "stiffness", load: str | None = None, drag: bool = False,
+                  force: bool = False, progress: Callable[[str], None] | None = None
+                  ) -> VerifyRun:
+    """`printgen verify`: the pre-print check of a design.json with its uncertainty band,
+    optionally compared with a lab's `measured` loading test and one factor fitted to it,
+    written into the folder `out` (see `printgen.run.verify.verify_design`)."""
+    from printgen.run.verify import verify_design as _verify_design
+
+    return _verify_design(prototype, scale, design_file, out, measured=measured, fit=fit,
+                          load=load_name(load, drag), force=force, progress=progress)
+
+
 def design_search(prototype: PrototypeLike, scales: float | Sequence[float], *,
                   options: SearchOptions | None = None, scheduler: str | None = None,
-                  serial: bool = False) -> DesignRun:
+                  serial: bool = False, workers: int | None = None,
+                  progress: bool = False) -> DesignRun:
     """The inverse design: the printable net that deforms most like the prototype at each
     scale (screened by the membrane law, the best verified with the solver), on a local Dask
     cluster, the cluster at `scheduler`, or serially."""
@@ -119,7 +135,8 @@ def design_search(prototype: PrototypeLike, scales: float | Sequence[float], *,
 
     lams = [float(scales)] if isinstance(scales, int | float) else [float(s) for s in scales]
     return design_searches(prototype, lams, options=options or SearchOptions(),
-                           scheduler=scheduler, serial=serial)
+                           scheduler=scheduler, serial=serial, workers=workers,
+                           progress=progress)
 
 
 def calibrate(paths: Sequence[str | Path], *, material: str,
