@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 import solver
-from printgen.barrier.loads import LoadCase, LoadsAt, Site, get_load
+from printgen.barrier.loads import OVERFLOW, LoadCase, LoadsAt, Site, get_load
 from printgen.check.compare import (
     Deformation,
     Mismatch,
@@ -41,7 +41,6 @@ from printgen.workers import report_progress, run_jobs  # worker lifecycle: grou
 from solver.loads import total_forces
 
 LEVEL_STEP = 0.05  # relative loading step of the sweep (issue: at most 0.05)
-OVERFLOW = 1.1  # last relative loading h / h_B
 PATH_CUTS = 2  # halvings tried before a load level is reported as not converged
 MAX_FAILED_FRACTION = 0.25  # more unconverged levels than this and the sweep is an error
 SHAPE_LEVELS = (0.5, 1.0, 1.1)  # relative loadings whose deformed shapes are kept

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from printgen.barrier.loads import OVERFLOW  # peak relative loading of the loading test
 from printgen.barrier.patterns import get_pattern
 from printgen.design.record import Section
 from printgen.design.section import area_m2, equal_area_diameter, net_membrane_law
@@ -39,7 +40,6 @@ PASS_PENALTY = 0.002  # per pass: prefer shorter prints among equals
 SCORE_DIGITS = 9  # scores equal to 1e-9 are ties (same E*A, different layout)
 MIN_SPEED_MM_S = 2.0  # slower than this, the flow limit makes the print impractical
 ASSUMED_SAG_RATIO = 0.2  # peak-force estimate: sag / span of a loaded cable or net strip
-OVERFLOW = 1.1  # peak relative loading h / h_B of the loading test
 NET_STRAINS = np.linspace(0.01, 0.40, 40)  # strain range over which net laws are compared
 CHECK_STRAINS = (0.05, 0.30)  # net law errors reported at low and high strain
 
@@ -105,10 +105,6 @@ class Selection:
     @property
     def cable(self) -> Candidate | None:
         return self.cables[0] if self.cables and self.cables[0].feasible else None
-
-    @property
-    def net_choice(self) -> Candidate:
-        return self.net[0]
 
     def to_record(self) -> dict:
         """JSON-ready record of the ranked selection (stable keys)."""

@@ -37,8 +37,7 @@ from printgen.report.uncertainty import (
     measured_record,
     measured_sections,
 )
-
-TIMINGS = "timings.json"  # wall-clock times, the one file that differs between identical runs
+from printgen.run.provenance import TIMINGS
 
 
 @dataclass

@@ -18,6 +18,7 @@ import numpy as np
 from printgen.errors import InputError
 
 FLOW = np.array([0.0, 1.0, 0.0])  # flow direction: the water pushes along it
+OVERFLOW = 1.1  # last relative loading h / h_B of the loading test (the water overtops)
 DEFAULT = "hydrostatic"  # the loading test of the reference (barrier-physics.md, section 4)
 Assumption = tuple[str, str, str]  # (what, value, source)
 LoadsAt = Callable[[float], list]  # relative loading r -> the solver's loads
