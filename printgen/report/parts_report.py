@@ -1,10 +1,12 @@
-"""The report's sections of the printable parts: meshes, direct G-code, assembly and toolpath
-previews, each from the record its `make` step returned (printgen.run.steps)."""
+"""The report's sections of `make`'s steps: meshes, direct G-code, assembly and toolpath
+previews, each from the record its step returned (printgen.run.steps), and the run's
+provenance."""
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from printgen.outputs import MANIFEST
 from printgen.report.html import Report
 
 if TYPE_CHECKING:
@@ -59,3 +61,15 @@ def assembly_section(rep: Report, a: Assembly, figures: list[tuple[str, bytes, s
             rep.paragraph("Check after printing:")
             for k, line in enumerate(a.checklist(), 1):
                 rep.paragraph(f"{k}. {line}")
+
+
+def provenance_section(rep: Report, meta: dict[str, Any]) -> None:
+    """The report's provenance: what made this folder (the manifest holds the same)."""
+    rep.heading("Provenance")
+    cmd = meta.get("command")
+    rep.paragraph(f"printgen {meta['printgen_version']}; command: "
+                  f"{' '.join(cmd) if cmd else 'printgen.make() from Python'}. Every file of "
+                  f"this folder and its sha256 are in {MANIFEST}; `printgen check FOLDER` "
+                  "verifies them.")
+    rep.table(["input", "file", "sha256"],
+              [[k, v["path"], v["sha256"]] for k, v in meta["inputs"].items()])

@@ -29,6 +29,7 @@ from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import MANIFEST, check_destination, staged_dir
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
+from printgen.report.parts_report import provenance_section
 from printgen.report.report import design_record, design_sections
 from printgen.run.budget import DEFAULT_LIMIT_S, Estimate, check_budget, level_bars
 from printgen.run.provenance import (  # noqa: F401 (json_output, TIME_KEYS: used via make)
@@ -36,7 +37,6 @@ from printgen.run.provenance import (  # noqa: F401 (json_output, TIME_KEYS: use
     TIMINGS,
     json_output,
     provenance,
-    provenance_section,
     split_timings,
 )
 from printgen.run.steps import (
