@@ -28,15 +28,15 @@ PANEL_MM = (61.0, 47.0, 12.0, 14.0)  # width, height, mesh_x, mesh_y: an odd-siz
 def test_registries_name_each_module_as_its_entry():
     """The command line lists the modules' names without importing them: they must be the
     entries' names."""
-    assert names(patterns_package) == list(patterns()) == ["diamond", "square"]
-    assert names(loads_package) == case_names() == list(load_cases()) == ["drag", "hydrostatic"]
-    assert DEFAULT in load_cases()
+    assert names(patterns_package) == list(patterns())
+    assert names(loads_package) == case_names() == list(load_cases())
+    assert {"diamond", "square"} <= set(patterns()) and {"drag", DEFAULT} <= set(load_cases())
 
 
 def test_unknown_names_are_errors_listing_the_known_ones():
-    with pytest.raises(InputError, match="'hexagon' is not one of diamond, square"):
+    with pytest.raises(InputError, match="'hexagon' is not one of .*diamond, .*square"):
         get_pattern("hexagon")
-    with pytest.raises(InputError, match="'jam' is not one of drag, hydrostatic"):
+    with pytest.raises(InputError, match="'jam' is not one of .*drag, .*hydrostatic"):
         get_load("jam")
     assert get_pattern("water-drop").name == "diamond"  # drawn as diamonds (the assumption says)
     assert get_load(None).name == DEFAULT
