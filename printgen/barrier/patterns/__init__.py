@@ -42,6 +42,15 @@ class NetPattern:
     nodes: Callable[[float, float, float, float], int]
 
 
+def pattern_names() -> tuple[str, ...]:
+    """Every pattern's name, then those drawn as another (`AS_DRAWN`), without importing the
+    patterns: the prototype file's [net] pattern choices."""
+    import printgen.barrier.patterns as package
+    from printgen.barrier.registry import names
+
+    return (*names(package), *AS_DRAWN)
+
+
 def patterns() -> dict[str, NetPattern]:
     """Every pattern, by name."""
     import printgen.barrier.patterns as package
