@@ -8,8 +8,7 @@ from printgen.commands.common import add_json_arg, console, emit_json, table
 from printgen.errors import ProfileError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
-from printgen.inputs.profiles import (KINDS, list_profiles, load_raw, profile_name,
-                                      profile_path)
+from printgen.inputs.profiles import KINDS, list_profiles, load_raw, profile_name, profile_path
 from printgen.report.jsonout import jsonable
 
 LOADERS = {"materials": load_material, "printers": load_printer, "prints": load_print_style}

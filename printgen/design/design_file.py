@@ -12,6 +12,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from printgen.barrier.patterns import get_pattern
 from printgen.design.record import CableDesign, Design, NetDesign, Section
 from printgen.errors import InputError
 from printgen.inputs.profiles import profile_name
@@ -21,12 +22,15 @@ DESIGN_LIMIT_BYTES = 16 << 20  # a design.json is ~2 kB, a report.json holding o
 
 
 def _fields(cls: type, data: Any, where: str) -> dict[str, Any]:
-    """`data` as keyword arguments of the dataclass `cls`, or InputError."""
+    """`data` as keyword arguments of the dataclass `cls`, or InputError (a field with a
+    default may be missing: files written before it existed)."""
     if not isinstance(data, dict):
         raise InputError(f"{where}: expected a table of {cls.__name__} fields, got "
                          f"{type(data).__name__}")
     names = [f.name for f in dataclasses.fields(cls)]
-    unknown, missing = sorted(set(data) - set(names)), [n for n in names if n not in data]
+    optional = {f.name for f in dataclasses.fields(cls) if f.default is not dataclasses.MISSING}
+    unknown = sorted(set(data) - set(names))
+    missing = [n for n in names if n not in data and n not in optional]
     if unknown or missing:
         raise InputError(f"{where}: unknown keys {unknown} / missing keys {missing}; allowed: "
                          f"{', '.join(names)} (write it with printgen design or make)")
@@ -61,6 +65,8 @@ def design_from_dict(data: Any, where: str = "design") -> Design:
     net["strand"] = _section(net["strand"], f"{where}.net.strand")
     for key in ("material", "print_style"):
         net[key] = profile_name(net[key], f"{where}.net.{key}")
+    if "pattern" in net:
+        net["pattern"] = get_pattern(str(net["pattern"])).name
     if not isinstance(kw["cables"], list):
         raise InputError(f"{where}.cables must be a list of cables")
     cables = []

@@ -16,10 +16,8 @@ import numpy as np
 
 from printgen.errors import ProfileError
 from printgen.inputs.laws import piecewise_linear
-from printgen.inputs.profiles import list_profiles, load_raw
+from printgen.inputs.profiles import load_raw
 from printgen.inputs.schema import Field, positive, read_table
-
-PAPER = "Lambert et al. 2023, J. Hydraul. Eng. 149(3), doi:10.1061/JHEND8.HYENG-13070"
 
 PROVENANCE = [
     Field("source", str, help="where the value comes from"),
@@ -127,11 +125,6 @@ class PanelLaw:
         """Panel force per unit width (N/m) at `strain`; zero in compression."""
         slopes = [k * self.panel_length for k in self.kappas]  # N/m per unit strain
         return piecewise_linear(strain, self.knee_strains, slopes)
-
-    def kappa_at(self, strain: float) -> float:
-        """Tangent panel stiffness (N/m per m) at `strain`."""
-        return float(self.kappas[int(np.searchsorted(self.knee_strains, strain, side="right"))])
-
 
 @dataclass(frozen=True)
 class PrintSettings:
@@ -258,8 +251,3 @@ def _number(v: object, where: str, key: str) -> float:
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v):
         raise ProfileError(f"{where}: {key} holds {v!r}, not a finite number")
     return float(v)
-
-
-def all_materials() -> list[Material]:
-    """Every material profile found, loaded and validated."""
-    return [load_material(n) for n in list_profiles("materials")]

@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from printgen.barrier.patterns import pattern_names
 from printgen.errors import InputError
 from printgen.inputs.profiles import profile_name
 from printgen.inputs.schema import Field, load_toml, positive, read_table
@@ -23,7 +24,7 @@ TOP = [Field("name", str), Field("description", str, required=False, default="")
 BARRIER = [positive("width_m", 1000.0), positive("height_m", 100.0),
            Field("anchors", int, lo=0, hi=64, required=False, default=0)]
 NET = [
-    Field("pattern", str, choices=("square", "diamond", "water-drop")),
+    Field("pattern", str, choices=pattern_names()),  # printgen/barrier/patterns, AS_DRAWN
     positive("mesh_x_m", 10.0, help="mesh diagonal (or square side) across the barrier"),
     positive("mesh_y_m", 10.0, help="mesh diagonal (or square side) up the barrier"),
     positive("strand_diameter_mm", 1000.0),

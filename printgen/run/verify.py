@@ -49,8 +49,7 @@ from printgen.report.uncertainty import (
     measured_record,
     measured_sections,
 )
-
-TIMINGS = "timings.json"  # wall-clock times, the one file that differs between identical runs
+from printgen.run.provenance import TIMINGS
 
 
 @dataclass
@@ -70,7 +69,7 @@ class VerifyRun:
 
 def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
                   out: str | Path, *, measured: str | Path | None = None,
-                  fit: str = "stiffness", drag: bool = False, force: bool = False,
+                  fit: str = "stiffness", load: str | None = None, force: bool = False,
                   progress: Callable[[str], None] | None = None) -> VerifyRun:
     """Check the design against the prototype with its band; compare and fit `measured`.
 
@@ -83,9 +82,9 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     p = load_prototype(prototype)
     d = load_design(design_path, scale=scale)
     m = read_measured(measured, design_units(d)) if measured is not None else None
-    load_kw = model_load_kw(p, d, drag)
+    load_kw = model_load_kw(p, d, load)
     say("verification (prototype and model load sweeps)")
-    v = verify(p, d, drag=drag)
+    v = verify(p, d, load=load)
     say("uncertainty band (model variants)")
     band = model_band(d, v.model, load_kw=load_kw, free_section=free_section(p))
     result, text = None, ""
