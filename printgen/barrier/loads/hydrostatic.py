@@ -26,7 +26,7 @@ def loads(s: Any, site: Site) -> LoadsAt:
 
 ASSUMPTION = ("loading", ("hydrostatic rho g (h - z) A* at the current node height, h/h_B = 0 "
               "to 1.1; the folded film adds no stiffness"),
-              "Lambert et al. 2023: nodal hydrostatic loads, loading test behind a folded film "
-              "(Fig. 6a)")
+              ("Lambert et al. 2023: nodal hydrostatic loads, loading test behind a folded "
+               "film (Fig. 6a)"))
 CASE = LoadCase("hydrostatic", "hydrostatic (z at the current node height)", loads,
                 (ASSUMPTION,))
