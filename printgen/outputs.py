@@ -241,11 +241,32 @@ def read_manifest(folder: Path) -> dict[str, Any]:
     except FileNotFoundError:
         raise InputError(f"{folder} has no {MANIFEST}: it is not a printgen output folder "
                          "(or was written before manifests existed); run make again") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"{path} is not valid JSON ({exc}); the folder was altered") from None
+    except (ValueError, UnicodeDecodeError, RecursionError) as exc:  # JSON, digits, nesting
+        raise InputError(f"{path} is not valid JSON ({type(exc).__name__}: "
+                         f"{' '.join(str(exc).split())[:120]}); the folder was altered") from None
     if not isinstance(data, dict) or not isinstance(data.get("files"), dict):
         raise InputError(f"{path} has no 'files' table; the folder was altered")
+    check_manifest_shape(data, path)
     return data
+
+
+def check_manifest_shape(data: dict[str, Any], path: Path) -> None:
+    """InputError unless every entry has the type `write_manifest` gives it: files maps a
+    name to {"sha256": text, "bytes": whole number}; volatile and command are lists of text."""
+    def bad(what: str) -> InputError:
+        return InputError(f"{path}: {what}; the folder was altered (run make again)")
+
+    for name, entry in data["files"].items():
+        if not (isinstance(entry, dict) and isinstance(entry.get("sha256"), str)
+                and type(entry.get("bytes")) is int):
+            raise bad(f"files entry {name[:80]!r} is not {{\"sha256\": ..., \"bytes\": ...}}")
+    for key in ("volatile", "command"):
+        value = data.get(key, [])
+        if value is not None and not (isinstance(value, list)
+                                      and all(isinstance(v, str) for v in value)):
+            raise bad(f"{key!r} is not a list of text")
+    if not isinstance(data.get("printgen_version", ""), str):
+        raise bad("'printgen_version' is not text")
 
 
 def check_folder(folder: Path) -> list[str]:

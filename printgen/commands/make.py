@@ -10,9 +10,15 @@ from pathlib import Path
 
 from rich.console import Console
 
-from printgen.commands.common import add_json_arg, add_prototype_args, console, emit_json, table
+from printgen.commands.common import (
+    add_json_arg,
+    add_prototype_args,
+    add_time_limit_arg,
+    console,
+    emit_json,
+    table,
+)
 from printgen.run import api
-from printgen.run.budget import DEFAULT_LIMIT_S
 from printgen.run.make import json_output
 
 
@@ -27,9 +33,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--step", action="store_true", help="also write STEP files (needs cadquery)")
     p.add_argument("--design", metavar="FILE", type=Path,
                    help="print this design.json (from printgen design) instead of select's")
-    p.add_argument("--time-limit", type=float, default=DEFAULT_LIMIT_S, metavar="SECONDS",
-                   help=f"refuse runs estimated longer than this (default {DEFAULT_LIMIT_S:g} s,"
-                        " about a minute on 2 cores)")
+    add_time_limit_arg(p)
     p.add_argument("--force", action="store_true",
                    help="replace --out even when it holds files printgen did not write")
     add_json_arg(p)

@@ -170,8 +170,9 @@ def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
     """Estimate the run before any of it is done; InputError when it is over the limit
     (options["time_limit_s"], default about a minute on 2 cores)."""
     cores = 1 if os.environ.get("PRINTGEN_SERIAL") else min(2, os.cpu_count() or 1)
-    limit = ctx.options.get("time_limit_s") or DEFAULT_LIMIT_S
-    est = check_budget(ctx.prototype, ctx.design, limit_s=float(limit), cores=cores,
+    limit = ctx.options.get("time_limit_s")
+    est = check_budget(ctx.prototype, ctx.design, cores=cores,
+                       limit_s=DEFAULT_LIMIT_S if limit is None else float(limit),
                        sweep=verifies)
     ctx.record["size"] = est.to_record()
     ctx.record.setdefault("timings_s", {})["estimate"] = est.seconds
