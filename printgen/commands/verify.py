@@ -12,7 +12,14 @@ from pathlib import Path
 from rich.console import Console
 
 from printgen.check.measured import COLUMNS, FIT_KINDS, LEVEL_COLUMN
-from printgen.commands.common import add_json_arg, add_prototype_args, console, emit_json, table
+from printgen.commands.common import (
+    add_json_arg,
+    add_prototype_args,
+    add_time_limit_arg,
+    console,
+    emit_json,
+    table,
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -33,6 +40,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="hydrostatic + drag at the Froude-scaled velocity")
     p.add_argument("--force", action="store_true",
                    help="replace an output folder printgen did not write")
+    add_time_limit_arg(p)
     add_json_arg(p)
     p.set_defaults(func=run)
 
@@ -47,7 +55,8 @@ def run(args: argparse.Namespace) -> int:
     with err.status("reading inputs") as status:
         res = verify_design(args.prototype, args.scale, args.design, out,
                             measured=args.measured, fit=args.fit, drag=args.drag,
-                            force=args.force, progress=lambda s: status.update(f"{s} ..."))
+                            force=args.force, progress=lambda s: status.update(f"{s} ..."),
+                            time_limit_s=args.time_limit)
     if args.json:
         emit_json(res.record)
         return 0

@@ -12,7 +12,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from printgen.design.record import CableDesign, Design, NetDesign, Section
+from printgen.design.record import CABLE_SIDES, CableDesign, Design, NetDesign, Section
 from printgen.errors import InputError
 from printgen.inputs.prototype import MIN_MODEL_MESH_MM
 from printgen.inputs.schema import Field, check_value, parse_data, positive, shown
@@ -33,7 +33,7 @@ SECTION = {"bead_width_mm": positive("bead_width_mm", 10.0, 0.05, si=False),
            "beads_across": Field("beads_across", int, lo=1, hi=1000),
            "layer_heights_mm": Field("layer_heights_mm", list, items=float, max_items=1000)}
 LAYER = positive("layer_heights_mm", 5.0, 0.01, si=False)
-CABLE = {"name": Field("name", str), "material": Field("material", str),
+CABLE = {"name": Field("name", str, choices=CABLE_SIDES), "material": Field("material", str),
          "print_style": Field("print_style", str),
          "length_mm": positive("length_mm", MM_MAX, 1.0, si=False),
          "eyelet_inner_mm": positive("eyelet_inner_mm", 1000.0, 0.05, si=False),
@@ -78,6 +78,9 @@ def design_from_dict(data: Any, where: str = "design") -> Design:
     cables = []
     for i, c in enumerate(kw["cables"]):
         ckw = _fields(CableDesign, c, f"{where}.cables[{i}]", CABLE)
+        if any(ckw["name"] == other.name for other in cables):
+            raise InputError(f"{where}.cables[{i}]: a second {ckw['name']!r} cable; a net has "
+                             f"one cable per side ({', '.join(CABLE_SIDES)})")
         ckw["section"] = _section(ckw["section"], f"{where}.cables[{i}].section")
         cables.append(CableDesign(**ckw))
     return Design(scale=kw["scale"], printer=kw["printer"], net=NetDesign(**net),

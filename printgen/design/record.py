@@ -50,6 +50,9 @@ class NetDesign:
     border_width_mm: float
 
 
+CABLE_SIDES = ("top", "bottom", "left", "right")  # a cable's name: the net side it borders
+
+
 @dataclass(frozen=True)
 class CableDesign:
     """A border cable: a straight strip with an eyelet at each end (mm)."""

@@ -29,7 +29,13 @@ from printgen.outputs import MANIFEST, check_destination, staged_dir
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
 from printgen.report.report import design_record, design_sections
-from printgen.run.budget import DEFAULT_LIMIT_S, Estimate, check_budget, level_bars
+from printgen.run.budget import (
+    DEFAULT_LIMIT_S,
+    Estimate,
+    check_budget,
+    level_bars,
+    sweep_cores,
+)
 from printgen.run.provenance import (  # noqa: F401 (json_output, TIME_KEYS: used via make)
     TIME_KEYS,
     TIMINGS,
@@ -48,7 +54,7 @@ from printgen.run.steps import (
     verification_sweeps,
     verify_step,
 )
-from printgen.workers import Helper, helper, signals_deferred
+from printgen.workers import Helper, cores, helper, signals_deferred
 
 log = logging.getLogger(__name__)
 
@@ -148,7 +154,7 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]], short: b
     that they run while the parts are built here; `sweeps_done` and `verify_step` collect
     them. Only for short runs on 2 cores or more: a long run's per-level progress bars come
     from the sweeps' workers to this process, and on one core there is nothing to gain."""
-    serial = os.environ.get("PRINTGEN_SERIAL") or (os.cpu_count() or 1) < 2
+    serial = os.environ.get("PRINTGEN_SERIAL") or cores() < 2
     if serial or not short or not any(s is verify_step for _, s in steps):
         yield
         return
@@ -169,9 +175,8 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]], short: b
 def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
     """Estimate the run before any of it is done; InputError when it is over the limit
     (options["time_limit_s"], default about a minute on 2 cores)."""
-    cores = 1 if os.environ.get("PRINTGEN_SERIAL") else min(2, os.cpu_count() or 1)
     limit = ctx.options.get("time_limit_s")
-    est = check_budget(ctx.prototype, ctx.design, cores=cores,
+    est = check_budget(ctx.prototype, ctx.design, cores=sweep_cores(),
                        limit_s=DEFAULT_LIMIT_S if limit is None else float(limit),
                        sweep=verifies)
     ctx.record["size"] = est.to_record()
