@@ -17,9 +17,13 @@ import multiprocessing
 import os
 import signal
 import threading
+import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures import TimeoutError as FutureTimeout
 from typing import Any
+
+from printgen.errors import TimeLimitError
 
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
 HANDLED = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
@@ -123,6 +127,43 @@ def reporting(listener: Callable[[str, float, float], None]) -> Iterator[None]:
         _listener = previous
 
 
+_deadline: float | None = None  # time.time() past which `check_deadline` raises (inherited by
+# forked workers: set before they start)
+
+
+@contextlib.contextmanager
+def deadline(at: float | None) -> Iterator[None]:
+    """Within the block, `check_deadline` raises TimeLimitError once time.time() passes `at`
+    (None: no limit), in this process and in workers forked inside the block."""
+    global _deadline
+    previous, _deadline = _deadline, at
+    try:
+        yield
+    finally:
+        _deadline = previous
+
+
+def seconds_left() -> float | None:
+    """Seconds until the deadline of `deadline` (None without one; may be negative)."""
+    return None if _deadline is None else _deadline - time.time()
+
+
+def check_deadline(what: str) -> None:
+    """Raise TimeLimitError naming `what` when the deadline of `deadline` has passed."""
+    left = seconds_left()
+    if left is not None and left < 0:
+        raise TimeLimitError(f"{what}: past the time limit")
+
+
+def _result(f: Future) -> Any:
+    """A job's result, waited for no longer than the deadline (`deadline`)."""
+    left = seconds_left()
+    try:
+        return f.result(timeout=None if left is None else max(left, 0.0))
+    except FutureTimeout as exc:
+        raise TimeLimitError("a worker's job: past the time limit") from exc
+
+
 def report_progress(task: str, done: float, total: float) -> None:
     """From inside a job: `task` has reached `done` of `total` (e.g. load level 0.35 of 1.1).
     A no-op unless the caller of `run_jobs` is listening."""
@@ -164,7 +205,7 @@ def run_jobs(jobs: list[tuple]) -> list:
                                initargs=(os.getpid(),))
     try:
         futures = [pool.submit(fn, *args, **kw) for fn, args, kw in jobs]
-        results = [f.result() for f in futures]
+        results = [_result(f) for f in futures]
     except BaseException:
         stop(pool)
         raise
