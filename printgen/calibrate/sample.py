@@ -58,7 +58,8 @@ class FitOptions:
 
     def __post_init__(self) -> None:
         """Refuse what would fit silently wrong: a preload that is not a positive force, a
-        secant strain that is not a positive strain (nan, -1 %, 0), a window out of order."""
+        secant strain that is not a positive strain (nan, -1 %, 0). (The window is checked
+        where it is fitted: `fit.linear_fit`.)"""
         if self.preload is not None and not (math.isfinite(self.preload) and self.preload > 0):
             raise CalibrationError(f"--preload {self.preload:g} N must be a positive force "
                                    "(the force where strain is zeroed, e.g. 2)")
@@ -66,11 +67,6 @@ class FitOptions:
             if not (math.isfinite(e) and 0 < e <= MAX_STRAIN):
                 raise CalibrationError(f"--secant strain {e * 100:g} % must be a positive strain "
                                        f"up to {MAX_STRAIN * 100:g} % (e.g. 0.5,1)")
-        if self.window is not None:
-            lo, hi = self.window
-            if not (math.isfinite(lo) and math.isfinite(hi) and 0 <= lo < hi <= MAX_STRAIN):
-                raise CalibrationError(f"--window {lo * 100:g},{hi * 100:g} % must be two strains "
-                                       f"0 <= LO < HI <= {MAX_STRAIN * 100:g} % (e.g. 0.05,0.25)")
 
 
 @dataclass(frozen=True)
