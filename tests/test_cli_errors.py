@@ -196,7 +196,8 @@ TOML_CASES = {
                             "not valid TOML"),
     "nested inline tables": (BASE_TEXT.replace("anchors = 4", "anchors = 4\nx = " + "{a = " * 1500
                                                + "1" + "}" * 1500), "nested too deeply"),
-    "materials = [1, 2]": (BASE_TEXT + "materials = [1, 2]\n", "must be a string"),
+    "materials = [1, 2]": (BASE_TEXT + "materials = [1, 2]\n",
+                           "materials[0]: 1 (int) is not a profile name"),
     "20 000 materials": (BASE_TEXT + "materials = [" + '"tpe", ' * 20000 + "]\n",
                          "at most 100 are allowed"),
     "velocity 1e-300": (BASE_TEXT.replace("velocity_m_per_s = 2.2", "velocity_m_per_s = 1e-300"),
@@ -230,9 +231,11 @@ def _design_text(tmp_path, edit) -> str:
 DESIGN_CASES = {
     "5000-digit scale": (lambda d: d.update(scale=0), "not valid JSON"),
     "nested array": (lambda d: d["net"].update(width_mm=[[1.0]]), "is not a number"),
-    "integer material": (lambda d: d["net"].update(material=3), "must be a string"),
+    "integer material": (lambda d: d["net"].update(material=3),
+                         "net.material: 3 (int) is not a profile name"),
     "width_mm 1e300": (lambda d: d["net"].update(width_mm=1e300), "must be <= 10000 mm"),
-    "printer as a list": (lambda d: d.update(printer=["generic-350"]), "must be a string"),
+    "printer as a list": (lambda d: d.update(printer=["generic-350"]),
+                          "printer: ['generic-350'] (list) is not a profile name"),
     "2000 cables": (lambda d: d.update(cables=d["cables"] * 500), "a second 'top' cable"),
     "cable of no side": (lambda d: d["cables"][0].update(name="x"), "is not one of: top"),
 }
@@ -260,10 +263,12 @@ def test_deeply_nested_design_file(capsys, tmp_path):
 
 
 MANIFEST_CASES = {
-    "command not a list": (lambda m: m.update(command=5), "'command' is not a list of text"),
-    "file entry a string": (lambda m: m["files"].update({"a.txt": "abc"}), "files entry 'a.txt'"),
-    "file entry null": (lambda m: m["files"].update({"a.txt": None}), "files entry 'a.txt'"),
-    "volatile = 5": (lambda m: m.update(volatile=5), "'volatile' is not a list of text"),
+    "command not a list": (lambda m: m.update(command=5), "command = 5 is not a list of strings"),
+    "file entry a string": (lambda m: m["files"].update({"a.txt": "abc"}), "file entry 'a.txt'"),
+    "file entry null": (lambda m: m["files"].update({"a.txt": None}), "file entry 'a.txt'"),
+    "volatile = 5": (lambda m: m.update(volatile=5),
+                     "volatile = 5: only ['timings.json'] may be volatile"),
+    "version not text": (lambda m: m.update(printgen_version=5), "'printgen_version' is not text"),
 }
 
 

@@ -105,7 +105,7 @@ def test_exports_are_capped_in_rows_and_unpacked_size(tmp_path, monkeypatch):
     path = _tensile(tmp_path, np.arange(60) * 0.1)
     with pytest.raises(CalibrationError, match="more than 50"):
         read_export(path)
-    monkeypatch.setattr(reader, "MAX_TEXT_BYTES", 1 << 10)
+    monkeypatch.setattr(reader, "EXPORT_LIMIT_BYTES", 1 << 10)
     bomb = tmp_path / "bomb.zip"
     with zipfile.ZipFile(bomb, "w", zipfile.ZIP_DEFLATED) as z:
         z.writestr("rows.csv", "t,f\n" + "0,0\n" * 10_000)  # 40 KB unpacked, ~200 B packed

@@ -9,6 +9,7 @@ file, the line and what was expected.
 from __future__ import annotations
 
 import csv
+import io
 import logging
 import zipfile
 from collections.abc import Mapping
@@ -28,7 +29,8 @@ from printgen.calibrate.columns import (
 )
 from printgen.calibrate.numbers import decimal_of, parse_number
 from printgen.calibrate.status import StatusColumn, decide
-from printgen.errors import CalibrationError
+from printgen.errors import CalibrationError, InputError
+from printgen.outputs.files import INPUT_LIMIT_BYTES, read_input
 
 log = logging.getLogger(__name__)
 
@@ -39,7 +41,7 @@ TEXT_SUFFIXES = (".csv", ".txt", ".tsv", ".dat")
 # calibrate > 120 s; issue 20): a 1 kHz test of 16 minutes has 1 M rows, and the reader takes
 # about 10 s for them; real exports hold 10^3 to 10^5.
 MAX_ROWS = 1_000_000
-MAX_TEXT_BYTES = 64 << 20  # 64 MiB of text: 1 M rows of 64 characters
+EXPORT_LIMIT_BYTES = INPUT_LIMIT_BYTES  # one export, or what a zip of one unpacks to (64 MiB)
 _BOOLEAN = {"true": 1.0, "false": 0.0}  # flag columns written as words
 
 
@@ -91,28 +93,31 @@ def read_text(path: str | Path) -> tuple[str, str]:
     if p.is_dir():
         raise CalibrationError(f"{p}: is a directory; pass it to `printgen calibrate` (which "
                                "reads every export in it) or name the export file")
-    if not p.is_file():
-        raise CalibrationError(f"{p}: file not found; check the path")
+    try:
+        data = read_input(p, "tensile-test export", limit=EXPORT_LIMIT_BYTES)
+    except InputError as exc:
+        raise CalibrationError(str(exc)) from None
     if p.suffix.lower() == ".zip":
-        with zipfile.ZipFile(p) as z:
+        return _unzip(data, p)
+    return _decode(data, p), str(p)
+
+
+def _unzip(data: bytes, p: Path) -> tuple[str, str]:
+    """The one export inside a zip, its uncompressed size capped like a file's."""
+    try:
+        with zipfile.ZipFile(io.BytesIO(data)) as z:
             names = [n for n in z.namelist()
                      if n.lower().endswith(TEXT_SUFFIXES) and not n.startswith("__MACOSX")]
             if len(names) != 1:
                 raise CalibrationError(f"{p}: expected one CSV inside the zip, found {names}")
             with z.open(names[0]) as fh:  # the header's size may lie: read one byte past it
-                data = _capped(fh.read(MAX_TEXT_BYTES + 1), f"{p}:{names[0]}", "unpacks to")
-            return _decode(data, p), f"{p}:{names[0]}"
-    with open(p, "rb") as fh:
-        data = _capped(fh.read(MAX_TEXT_BYTES + 1), str(p), "holds")
-    return _decode(data, p), str(p)
-
-
-def _capped(data: bytes, where: str, verb: str) -> bytes:
-    if len(data) > MAX_TEXT_BYTES:
-        raise CalibrationError(f"{where}: {verb} more than {MAX_TEXT_BYTES >> 20} MiB of text, "
-                               f"more than any tensile export (the limit: {MAX_ROWS:,} rows); "
-                               "split the file or thin its rows")
-    return data
+                text = fh.read(EXPORT_LIMIT_BYTES + 1)
+    except (zipfile.BadZipFile, OSError, NotImplementedError) as exc:
+        raise CalibrationError(f"{p}: not a readable zip archive ({exc})") from None
+    if len(text) > EXPORT_LIMIT_BYTES:
+        raise CalibrationError(f"{p}:{names[0]} unpacks to more than {EXPORT_LIMIT_BYTES:,} "
+                               "bytes, over the limit for one export; is it the right file?")
+    return _decode(text, p), f"{p}:{names[0]}"
 
 
 def _decode(data: bytes, p: Path) -> str:

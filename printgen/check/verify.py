@@ -74,10 +74,17 @@ def loads_function(s: BarrierScene, *, velocity: float | None = None,
     free = np.flatnonzero(~s.fixed)
     strand_per_node = _strand_length(s) / len(s.nodes)
     row_gap = float(np.diff(np.unique(np.round(s.nodes[:, 2], 12))).min())  # node rows apart
+    normal = None
+    if s.pressure == "normal":  # issue 25: the film presses normal to the deformed net
+        from printgen.check.pressure import normal_pressure
+
+        normal = normal_pressure(s.nodes, s.elements[s.element_law == 0], free,
+                                 s.area_per_node, 0.0)
 
     def loads_at(r: float) -> list:
         out = [solver.Hydrostatic(free, s.area_per_node, r * s.height, tuple(FLOW),
-                                  rho=RHO_WATER, g=G)]
+                                  rho=RHO_WATER, g=G) if normal is None
+               else dataclasses.replace(normal, level=r * s.height)]
         if velocity:
             out.append(solver.Drag(free, strand_per_node, strand_diameter, velocity,
                                    r * s.height, tuple(FLOW), rho=RHO_WATER, ramp=row_gap))

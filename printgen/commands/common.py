@@ -10,6 +10,7 @@ from typing import Any
 from rich.console import Console
 from rich.table import Table
 
+from printgen.inputs.profiles import profile_name
 from printgen.report.jsonout import dumps
 
 
@@ -39,6 +40,16 @@ def seconds(text: str) -> float:
         raise argparse.ArgumentTypeError(f"{text} must be a positive number of seconds, e.g. "
                                          "600")
     return value
+
+
+def check_profile_args(args: argparse.Namespace, *options: str) -> None:
+    """ProfileError now, before any work, when --printer, --materials, ... is not a plain
+    profile name (a path, a glob, a hidden file)."""
+    for opt in options:
+        value = getattr(args, opt, None)
+        for name in value if isinstance(value, (list, tuple)) else [value]:
+            if name is not None:
+                profile_name(name, f"--{opt}")
 
 
 def add_json_arg(p: argparse.ArgumentParser) -> None:

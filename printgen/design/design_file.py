@@ -14,17 +14,21 @@ from typing import Any
 
 from printgen.design.record import CABLE_SIDES, CableDesign, Design, NetDesign, Section
 from printgen.errors import InputError
+from printgen.inputs.profiles import profile_name
 from printgen.inputs.prototype import MIN_MODEL_MESH_MM
 from printgen.inputs.schema import Field, check_value, parse_data, positive, shown
+from printgen.outputs.files import read_input_text
+
+DESIGN_LIMIT_BYTES = 16 << 20  # a design.json is ~2 kB, a report.json holding one < 1 MB
 
 # Every number of a design, with its plausible range (mm unless named): the same checks as
 # a prototype file's (printgen.inputs.schema), so a 5000-digit scale, a list for a number or
 # a 1e300 mm net is one InputError, never a failure deep in the geometry.
 MM_MAX = 1e4  # 10 m: longer than any flume model's part
-DESIGN = {"scale": Field("scale", float, lo=1.0, hi=100.0, si=False),
-          "printer": Field("printer", str)}
-NET = {"material": Field("material", str), "print_style": Field("print_style", str),
-       "width_mm": positive("width_mm", MM_MAX, 1.0, si=False),
+# Names (printer, material, print_style) are checked by profiles.profile_name: a name, never
+# a path; a cable's name must also be the side it borders.
+DESIGN = {"scale": Field("scale", float, lo=1.0, hi=100.0, si=False)}
+NET = {"width_mm": positive("width_mm", MM_MAX, 1.0, si=False),
        "height_mm": positive("height_mm", MM_MAX, 1.0, si=False),
        "mesh_x_mm": positive("mesh_x_mm", 1000.0, MIN_MODEL_MESH_MM, si=False),
        "mesh_y_mm": positive("mesh_y_mm", 1000.0, MIN_MODEL_MESH_MM, si=False),
@@ -33,9 +37,8 @@ SECTION = {"bead_width_mm": positive("bead_width_mm", 10.0, 0.05, si=False),
            "beads_across": Field("beads_across", int, lo=1, hi=1000),
            "layer_heights_mm": Field("layer_heights_mm", list, items=float, max_items=1000)}
 LAYER = positive("layer_heights_mm", 5.0, 0.01, si=False)
-CABLE = {"name": Field("name", str, choices=CABLE_SIDES), "material": Field("material", str),
-         "print_style": Field("print_style", str),
-         "length_mm": positive("length_mm", MM_MAX, 1.0, si=False),
+CABLE_NAME = Field("name", str, choices=CABLE_SIDES)
+CABLE = {"length_mm": positive("length_mm", MM_MAX, 1.0, si=False),
          "eyelet_inner_mm": positive("eyelet_inner_mm", 1000.0, 0.05, si=False),
          "eyelet_outer_mm": positive("eyelet_outer_mm", 1000.0, 0.05, si=False)}
 
@@ -73,30 +76,31 @@ def design_from_dict(data: Any, where: str = "design") -> Design:
     kw = _fields(Design, data, where, DESIGN)
     net = _fields(NetDesign, kw["net"], f"{where}.net", NET)
     net["strand"] = _section(net["strand"], f"{where}.net.strand")
+    for key in ("material", "print_style"):
+        net[key] = profile_name(net[key], f"{where}.net.{key}")
     if not isinstance(kw["cables"], list):
         raise InputError(f"{where}.cables must be a list of cables")
     cables = []
     for i, c in enumerate(kw["cables"]):
         ckw = _fields(CableDesign, c, f"{where}.cables[{i}]", CABLE)
+        name = profile_name(ckw["name"], f"{where}.cables[{i}].name", what="cable")
+        ckw["name"] = check_value(name, CABLE_NAME, where=f"{where}.cables[{i}]")
         if any(ckw["name"] == other.name for other in cables):
             raise InputError(f"{where}.cables[{i}]: a second {ckw['name']!r} cable; a net has "
                              f"one cable per side ({', '.join(CABLE_SIDES)})")
         ckw["section"] = _section(ckw["section"], f"{where}.cables[{i}].section")
+        for key in ("material", "print_style"):
+            ckw[key] = profile_name(ckw[key], f"{where}.cables[{i}].{key}")
         cables.append(CableDesign(**ckw))
-    return Design(scale=kw["scale"], printer=kw["printer"], net=NetDesign(**net),
-                  cables=tuple(cables))
+    return Design(scale=kw["scale"], printer=profile_name(kw["printer"], f"{where}.printer"),
+                  net=NetDesign(**net), cables=tuple(cables))
 
 
 def load_design(path: str | Path, *, scale: float | None = None) -> Design:
     """Read a design.json file (or the report.json holding one); with `scale`, it must be a
     design at that scale."""
     p = Path(path)
-    try:
-        text = p.read_text("utf-8")
-    except FileNotFoundError as exc:
-        raise InputError(f"design file {p} not found; write one with printgen design") from exc
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"design file {p} cannot be read as JSON: {exc}") from exc
+    text = read_input_text(p, "design file", limit=DESIGN_LIMIT_BYTES)
     data = parse_data(text, f"design file {p}", "JSON", json.loads)
     if isinstance(data, dict) and "design" in data and "net" not in data:
         data = data["design"]  # a report.json holds the design under "design"
