@@ -10,6 +10,7 @@ The public verbs (`printgen.run.api`), imported on first use so `import printgen
 - ``plan(prototype, scale)`` -> `Design` (the printable design `make` writes)
 - ``make(prototype, scale, out)`` -> `MakeContext` (files in `out`)
 - ``verify(prototype, scale, design=None)`` -> `Verification`
+- ``verify_design(prototype, scale, design_file, out)`` -> `VerifyRun` (printgen verify's folder)
 - ``calibrate(paths, material=...)`` -> `Calibration`
 - ``design_search(prototype, scales)`` -> `DesignRun` (the inverse design, on Dask)
 """
@@ -20,9 +21,10 @@ from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
 
-VERBS = ("targets", "select", "plan", "make", "verify", "calibrate", "design_search")
+VERBS = ("targets", "select", "plan", "make", "verify", "verify_design", "calibrate",
+         "design_search")
 __all__ = ["__version__", "calibrate", "design_search", "make", "plan", "select", "targets",
-           "verify"]
+           "verify", "verify_design"]
 
 if TYPE_CHECKING:
     from printgen.run.api import (
@@ -33,6 +35,7 @@ if TYPE_CHECKING:
         select,
         targets,
         verify,
+        verify_design,
     )
 
 

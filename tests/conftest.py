@@ -75,3 +75,16 @@ def reference_design_1_40():
 @pytest.fixture
 def design_1_40():
     return reference_design_1_40()
+
+
+@pytest.fixture(scope="session")
+def made_1_40(tmp_path_factory):
+    """One whole `make` of the 1:40 example (examples/realistic_barrier.toml) per session,
+    (its MakeContext, its output folder), for every test that only reads the outputs: a
+    test that changes them makes its own run."""
+    from proto_files import REALISTIC
+
+    import printgen.run.make as make_mod
+
+    out = tmp_path_factory.mktemp("make-1-40") / "out"
+    return make_mod.make(REALISTIC, 40, out), out

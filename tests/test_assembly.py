@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 from conftest import EXAMPLES
 
+from printgen.barrier.patterns.diamond import diamond_net
 from printgen.check.scenes import model_scene
 from printgen.inputs.printers import load_printer
 from printgen.parts.assembly import CLOSE_TOL_MM, assemble
 from printgen.parts.geometry.attach import DEFAULT_CLEARANCE_MM, holes
-from printgen.parts.geometry.net import diamond_net
 from printgen.run.make import plan
 from printgen.units import MM
 
@@ -90,7 +90,7 @@ def test_make_shows_the_kit_and_the_toolpath_previews(tmp_path):
     from printgen.run.make import kit_step
 
     ctx = plan(EXAMPLES / "realistic_barrier.toml", 60)
-    kit_step(ctx, tmp_path)
+    rec = kit_step(ctx, tmp_path)
     pngs = sorted(p.name for p in tmp_path.glob("*.png"))
     assert pngs == ["assembly.png", "preview-cable-left.png", "preview-net-whole.png",
                     "preview-net.png"]
@@ -98,4 +98,4 @@ def test_make_shows_the_kit_and_the_toolpath_previews(tmp_path):
     html = ctx.report.html()
     assert "Assembly" in html and "Toolpath previews" in html and "Check after printing" in html
     assert html.count("<img") == 4 and "PASS" in html
-    assert ctx.record["assembly"]["closes"] is True
+    assert rec["assembly"]["closes"] is True

@@ -310,4 +310,5 @@ def test_time_limit_zero_is_refused_by_the_api_too(tmp_path):
     from printgen.errors import InputError
 
     with pytest.raises(InputError, match="must be a positive number of seconds"):
-        make_mod.make(REALISTIC, 40, tmp_path / "o", options={"time_limit_s": 0}, steps=[])
+        make_mod.make(REALISTIC, 40, tmp_path / "o", options=make_mod.MakeOptions(time_limit_s=0),
+                      steps=[])

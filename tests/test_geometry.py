@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 from conftest import reference_design_1_40
 
+from printgen.barrier.patterns.diamond import diamond_net
 from printgen.design.record import Section
 from printgen.errors import GeometryError
 from printgen.parts.geometry.attach import Attachment, holes
 from printgen.parts.geometry.cable import CIRCLE_SEGMENTS, circle_scale
-from printgen.parts.geometry.net import diamond_net
 from printgen.parts.geometry.solid import (
     analytic_cable_volume,
     analytic_net_volume,

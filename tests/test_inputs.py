@@ -18,7 +18,7 @@ from printgen.inputs.prototype import load_prototype
     ({("barrier", "width_m"): float("nan")}, r"width_m = nan is not finite"),
     ({("barrier", "width_m"): "13"}, r"width_m = '13' is not a number"),
     ({("barrier", "height_m"): None}, r"missing key 'height_m'"),
-    ({("net", "pattern"): "hexagon"}, r"pattern = 'hexagon' is not one of: square, diamond"),
+    ({("net", "pattern"): "hexagon"}, r"pattern = 'hexagon' is not one of: diamond, square"),
     ({("net", "mesh_x_m"): 8.0}, r"mesh_x_m = 8 m exceeds half the barrier"),
     ({("net", "panel_law", "kappa_kn_per_m_per_m"): [250.0]}, r"one kappa per segment"),
     ({("net", "panel_law", "knee_strain_percent"): [-20.0]}, r"positive finite numbers"),

@@ -1,5 +1,5 @@
 """The layout by stage (shared/design.md, README "Where things live"): data moves down the flow
-run -> report -> check -> parts -> design -> inputs -> ground floor; a lower stage never imports
+run -> report -> check -> parts -> design -> inputs and barrier -> ground floor; a lower stage never imports
 a higher one, and solver/ never imports printgen. Imports are read with `ast`, so a lazy import
 inside a function counts as much as one at the top of a module."""
 
@@ -16,6 +16,7 @@ from conftest import ROOT
 RANK = {
     "errors": 0, "units": 0, "outputs": 0, "workers": 0,  # ground floor
     "inputs": 1,
+    "barrier": 1,  # beside inputs: the net patterns and load cases, as data
     "calibrate": 2,  # tensile exports -> material profiles: feeds inputs, sits beside design
     "design": 2,
     "parts": 3,
@@ -24,6 +25,7 @@ RANK = {
     "run": 6,
     "commands": 7, "cli": 7, "__main__": 7, "__init__": 7,  # the CLI and the public verbs
 }
+OUTSIDE = {"benchmarks": 7}  # a source checkout's folders: only the CLI may reach them
 TOP_LEVEL_MODULES_MAX = 8  # issue 17: at most 8 modules at printgen/'s top level
 
 
@@ -48,7 +50,26 @@ def imported_modules(path: Path, package: str) -> list[tuple[int, str]]:
             out.append((node.lineno, base))
             out += [(node.lineno, f"{base}.{a.name}") for a in node.names
                     if base == "printgen"]  # `from printgen import outputs`
+        elif isinstance(node, ast.Call) and _is_import_module(node) and node.args:
+            out.append((node.lineno, _literal_prefix(node.args[0])))
     return out
+
+
+def _is_import_module(node: ast.Call) -> bool:
+    """`importlib.import_module(...)` or `import_module(...)`."""
+    f = node.func
+    return (isinstance(f, ast.Attribute) and f.attr == "import_module") or \
+        (isinstance(f, ast.Name) and f.id == "import_module")
+
+
+def _literal_prefix(arg: ast.expr) -> str:
+    """The module a dynamic import names, as far as it is literal: "benchmarks.bench_" of
+    f"benchmarks.bench_{name}"."""
+    if isinstance(arg, ast.Constant) and isinstance(arg.value, str):
+        return arg.value
+    if isinstance(arg, ast.JoinedStr) and arg.values and isinstance(arg.values[0], ast.Constant):
+        return str(arg.values[0].value)
+    return "?"
 
 
 def layout_violations(root: Path) -> list[str]:
@@ -61,6 +82,11 @@ def layout_violations(root: Path) -> list[str]:
         package = module if path.name == "__init__.py" else module.rsplit(".", 1)[0]
         mine = part_of(module.removesuffix(".__init__"))
         for line, name in imported_modules(path, package):
+            top = name.split(".")[0]
+            if top in OUTSIDE and RANK.get(mine, -1) < OUTSIDE[top]:
+                bad.append(f"{rel}:{line}: {mine} (rank {RANK.get(mine)}) imports {name} "
+                           f"(outside printgen, rank {OUTSIDE[top]})")
+                continue
             if name == "printgen" or not name.startswith("printgen."):
                 continue
             theirs = part_of(name)
@@ -78,6 +104,13 @@ def test_no_import_runs_up_the_flow():
     assert layout_violations(ROOT) == []
 
 
+def test_the_benchmarks_import_of_the_bench_command_is_seen():
+    """commands/bench.py loads benchmarks/bench_<name>.py with importlib: the check reads it."""
+    path = ROOT / "printgen" / "commands" / "bench.py"
+    names = [n for _, n in imported_modules(path, "printgen.commands")]
+    assert "benchmarks.bench_" in names
+
+
 def test_every_part_has_a_rank():
     """A new top-level module or folder must be placed in the flow (added to RANK)."""
     names = {p.stem for p in (ROOT / "printgen").iterdir()
@@ -92,9 +125,11 @@ def test_top_level_stays_small():
 
 @pytest.mark.parametrize(("victim", "line", "expected"), [
     ("printgen/inputs/schema.py", "from printgen.run.make import make\n", "inputs (rank 1)"),
-    ("printgen/parts/geometry/net.py", "    from printgen.check import verify\n",
+    ("printgen/parts/geometry/cable.py", "    from printgen.check import verify\n",
      "printgen.check"),
     ("solver/laws.py", "import printgen.units\n", "solver imports printgen.units"),
+    ("printgen/run/budget.py", "    importlib.import_module('benchmarks.bench_make')\n",
+     "outside printgen"),
 ])
 def test_a_wrong_import_is_caught(tmp_path, victim, line, expected):
     """The check fails on a deliberately wrong import in a copy of the tree."""

@@ -19,11 +19,9 @@ REFUSE_WITHIN_S = 15.0  # issue 16: a run too big to do is refused within 15 s
 SLOW_STEP_S = 2.0  # a step that outlasts a time limit of half of it
 
 
-@pytest.fixture(scope="module")
-def made(tmp_path_factory):
-    out = tmp_path_factory.mktemp("make") / "out"
-    ctx = make_mod.make(REALISTIC, 40, out)
-    return ctx, out
+@pytest.fixture
+def made(made_1_40):
+    return made_1_40
 
 
 def test_outputs_are_written(made):
@@ -137,14 +135,24 @@ def test_failed_first_run_writes_nothing(tmp_path):
     assert not (tmp_path / "out").exists()
 
 
-def test_cli_make_json_and_exit_codes(tmp_path, capsys):
-    assert main(["make", str(REALISTIC), "-s", "40", "--out", str(tmp_path / "o"), "--json",
+def test_cli_make_json_and_exit_codes(tmp_path, capsys, monkeypatch):
+    """--json and --drag through the command line; the verification alone, on the coarse
+    simple barrier (the full run of the 1:40 example is `made`)."""
+    from proto_files import SIMPLE
+
+    path = write_variant(tmp_path, {("net", "mesh_x_m"): 0.4, ("net", "mesh_y_m"): 0.4,
+                                    ("model", "mesh_x_mm"): 10.0, ("model", "mesh_y_mm"): 10.0},
+                         base=SIMPLE)
+    verify_only = [s for s in make_mod.default_steps() if s[1] is make_mod.verify_step]
+    monkeypatch.setattr(make_mod, "default_steps", lambda: verify_only)
+    assert main(["make", str(path), "-s", "40", "--out", str(tmp_path / "o"), "--json",
                  "--drag"]) == 0
     rec = json.loads(capsys.readouterr().out)
     assert rec["targets"]["scale"] == 40
     assert rec["timings"]["timings_s"]["total"] > 0
     assert times_outside_timings({k: v for k, v in rec.items() if k != "timings"}) == []
     assert rec["verification"]["load_case"] == "hydrostatic + drag at the Froude-scaled velocity"
+    assert "loading: drag" in [a["what"] for a in rec["verification"]["assumptions"]["model"]]
     assert main(["make", str(REALISTIC), "-s", "40", "--printer", "prusa-mk4",
                  "--out", str(tmp_path / "bad")]) == 2
     assert "exceeds" in capsys.readouterr().err and not (tmp_path / "bad").exists()
@@ -190,11 +198,12 @@ def test_time_limit_stops_the_run_in_its_step(tmp_path, monkeypatch):
     def slow(ctx, stage):
         (stage / "half.txt").write_text("x")
         time.sleep(SLOW_STEP_S)
+        return {}
 
     out = tmp_path / "out"
     with pytest.raises(TimeLimitError) as err:
         make_mod.make(REALISTIC, 40, out, steps=[("slow step", slow)],
-                      options={"time_limit_s": SLOW_STEP_S / 2})
+                      options=make_mod.MakeOptions(time_limit_s=SLOW_STEP_S / 2))
     line = str(err.value)
     assert "\n" not in line and "stopped in step 'slow step'" in line
     assert "estimated at about" in line and "--time-limit" in line

@@ -10,9 +10,9 @@ import textwrap
 
 import pytest
 
-from printgen.outputs import folder as outputs
 from printgen.errors import InputError
 from printgen.outputs import OutputError, check_folder, staged_dir
+from printgen.outputs import folder as outputs
 
 
 def run_into(out, files: dict[str, str], **kw):

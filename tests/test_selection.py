@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 from proto_files import REALISTIC, SIMPLE, write_variant
 
+from printgen.barrier.patterns.diamond import diamond_factor
 from printgen.design.record import Section
-from printgen.design.section import area_m2, diamond_factor, net_membrane_law
+from printgen.design.section import area_m2, net_membrane_law
 from printgen.design.selection import SCORE_DIGITS, select
 from printgen.design.similitude import scale_targets
 from printgen.errors import PrintabilityError

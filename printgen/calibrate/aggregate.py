@@ -28,11 +28,6 @@ class Stats:
     outliers: tuple[int, ...]
     warnings: tuple[str, ...]
 
-    @property
-    def cv(self) -> float | None:
-        return None if self.sd is None or self.mean == 0 else self.sd / abs(self.mean)
-
-
 def summarise(values: list[float] | np.ndarray, *, what: str = "value",
               labels: list[str] | None = None, unit: tuple[str, float] = ("", 1.0)) -> Stats:
     """Mean, SD, count and (from MIN_SAMPLES samples on) flagged outliers of one measured

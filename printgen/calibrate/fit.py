@@ -35,12 +35,6 @@ class LinearFit:
     r2: float
     mode: str  # "window" or "auto"
 
-    @property
-    def x_at_zero(self) -> float:
-        """Strain where the fitted line crosses y = 0 (toe-compensated origin)."""
-        return -self.intercept / self.slope
-
-
 @dataclass(frozen=True)
 class BilinearFit:
     """Continuous two-slope fit: y = a + s1 x + (s2 - s1) max(x - knee, 0)."""

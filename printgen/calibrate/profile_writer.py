@@ -92,20 +92,31 @@ def write_profile(cal: Calibration, *, name: str, out: str | Path | None = None,
                                f"{len(cal.files)} tensile tests"
                                + (f", inheriting {inherits}" if inherits else ""))
     data.setdefault("measured", {}).update(measured_tables(cal, date=date))
-    text = tomli_w.dumps(data)
-    with tempfile.TemporaryDirectory() as tmp:
-        staged = Path(tmp) / "materials" / path.name
-        staged.parent.mkdir(parents=True)
-        staged.write_text(text, encoding="utf-8")
-        with _profiles_first(Path(tmp), root):
-            try:
-                mat = load_material(name)
-            except PrintgenError as exc:
-                raise CalibrationError(f"calibrated profile {path} would not load: {exc}") from exc
+    text, mat = validated_text(data, name=name, root=root, shown=path)
     mode = _mode(path)
     outputs.write_text(path, text)
     os.chmod(path, mode)
     return path, mat
+
+
+def validated_text(data: dict[str, Any], *, name: str, root: Path | None = None,
+                   shown: Path | None = None) -> tuple[str, Material]:
+    """The TOML text of material profile `data` called `name`, and the material it loads as:
+    staged as materials/<name>.toml and read back with `load_material` (`root`'s profiles,
+    then the usual ones, found for its `inherits`); CalibrationError naming `shown` when it
+    would not load."""
+    text = tomli_w.dumps(data)
+    with tempfile.TemporaryDirectory() as tmp:
+        staged = Path(tmp) / "materials" / f"{name.lower()}.toml"
+        staged.parent.mkdir(parents=True)
+        staged.write_text(text, encoding="utf-8")
+        with _profiles_first(Path(tmp), *([root] if root is not None else [])):
+            try:
+                mat = load_material(name)
+            except PrintgenError as exc:
+                raise CalibrationError(f"calibrated profile {shown or staged.name} would not "
+                                       f"load: {exc}") from exc
+    return text, mat
 
 
 def _mode(path: Path) -> int:

@@ -24,17 +24,20 @@ from __future__ import annotations
 
 import dataclasses
 import inspect
-import math
 import time
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
+from printgen.barrier.loads import LoadCase
+from printgen.barrier.patterns import get_pattern
+from printgen.barrier.patterns.diamond import diamond_factor
 from printgen.check.compare import METRICS
 from printgen.check.scenes import BarrierScene, model_scene
-from printgen.check.verify import Run, run_jobs, sweep
+from printgen.check.verify import Run, load_keywords, run_jobs, sweep
 from printgen.design.record import Design
-from printgen.design.section import area_m2, diamond_factor
+from printgen.design.section import area_m2
 from printgen.errors import GeometryError
 from printgen.inputs.materials import load_material
 from printgen.inputs.prototype import Prototype
@@ -155,7 +158,8 @@ def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
     law, n = mat.panel_law, d.net
     tested = diamond_factor(law.mesh_along_load, law.mesh_across_load) * (
         law.strand_width * law.strand_thickness)
-    design = diamond_factor(n.mesh_y_mm * MM, n.mesh_x_mm * MM) * area_m2(n.strand)
+    design = get_pattern(n.pattern).membrane_factor(n.mesh_y_mm * MM, n.mesh_x_mm * MM) * \
+        area_m2(n.strand)
     ratio = tested / design
     if abs(ratio - 1) < SAME:
         notes.append(f"{mat.name} panel law: the design's net is the tested net the profile "
@@ -182,13 +186,10 @@ def free_section(p: Prototype) -> float | None:
     return p.flume.free_section if p.flume is not None else None
 
 
-def model_load_kw(p: Prototype, d: Design, drag: bool) -> dict[str, float] | None:
-    """The model's load keywords for `sweep`: drag at the Froude-scaled velocity, as `verify`
-    loads the model with drag; None for the hydrostatic test."""
-    if not drag:
-        return None
-    return {"velocity": p.velocity / math.sqrt(d.scale),
-            "strand_diameter": d.net.strand.width_mm * MM}
+def model_load_kw(p: Prototype, d: Design, load: str | LoadCase | None = None
+                  ) -> dict[str, Any]:
+    """The model's load keywords for `sweep` under load case `load`, as `verify` loads it."""
+    return load_keywords(p, d, load)[1]
 
 
 def variant_scene(d: Design, v: Variant, coarsen: int = 1) -> BarrierScene:

@@ -17,7 +17,6 @@ far a prediction exceeds it, and is never used as a value.
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -331,25 +330,26 @@ def fit_factor(m: Measurement, predict: Predictor, kind: str = "stiffness") -> F
 
 def fitted_profile(material: str, kind: str, value: float, *, panel_kappas: tuple | None,
                    modulus_gpa: float | None, source: str) -> str:
-    """TOML text of a material profile that feeds a fitted stiffness factor back: it inherits
-    `material` (a profile name) and scales its panel law (or its measured modulus). "" for a
-    slack fit."""
+    """TOML text of the material profile `<material>-fitted` that feeds a fitted stiffness
+    factor back: it inherits `material` and scales its panel law (or its measured modulus);
+    written and checked by calibrate's writer (it must load). "" for a slack fit."""
+    from printgen.calibrate.profile_writer import validated_text
+
     material = profile_name(material, "fitted profile: inherits")
     if kind != "stiffness":
         return ""
-    shown = json.dumps(source)  # a quoted TOML string: a file name cannot break the syntax
-    lines = [f"# The printed net of {shown}, fitted by printgen verify --measured:",
-             f"# effective stiffness {value:.3f} x the '{material}' profile.",
-             f'inherits = "{material}"', ""]
-    cond = json.dumps(f"effective law of the printed net fitted to the loading test {source}")
-    origin = json.dumps(f"printgen verify --measured {source}")
+    prov = {"source": f"printgen verify --measured {source}",
+            "conditions": f"effective law of the printed net fitted to the loading test {source}"}
     if panel_kappas:
-        kappas = ", ".join(f"{k * value / 1e3:.4g}" for k in panel_kappas)
-        lines += ["[measured.panel_law]", f"kappa_kn_per_m_per_m = [{kappas}]"]
+        table = {"panel_law": {"kappa_kn_per_m_per_m": [float(f"{k * value / 1e3:.4g}")
+                                                        for k in panel_kappas]} | prov}
     else:
-        lines += ["[measured.tensile_modulus]", f"value_gpa = {modulus_gpa * value:.4g}"]
-    lines += [f"source = {origin}", f"conditions = {cond}"]
-    return "\n".join(lines) + "\n"
+        table = {"tensile_modulus": {"value_gpa": float(f"{modulus_gpa * value:.4g}")} | prov}
+    data = {"inherits": material,
+            "description": (f"the printed net of {source}, fitted by printgen verify --measured: "
+                            f"effective stiffness {value:.3f} x the '{material}' profile"),
+            "measured": table}
+    return validated_text(data, name=f"{material}-fitted")[0]
 
 
 def model_predictor(d: Design, band: Band, m: Measurement, kind: str = "stiffness", *,

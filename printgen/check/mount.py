@@ -36,6 +36,6 @@ def in_free_section(s: BarrierScene, span: float) -> BarrierScene:
     note = ("mounting span", (f"lateral supports {span * 1e3:g} mm apart (the flume's free "
             f"section) for a net printed {s.width * 1e3:.4g} mm wide: squeezed by {k:.3f} at "
             "rest, strands and cables at their printed rest lengths"),
-            "barrier-physics.md section 4 (free section 300 mm, printed barrier ~330 mm)")
+            "Lambert et al. 2023: 300 mm free section, printed barrier about 330 mm")
     return dataclasses.replace(s, nodes=nodes, rest_nodes=s.nodes, wires=wires,
                                assumptions=(*s.assumptions, note))

@@ -3,7 +3,7 @@ its source ran it (barrier-physics.md, sections 4 and 5; Lambert et al. 2023,
 doi:10.1061/JHEND8.HYENG-13070), and the strand law derived so that the simulated test
 reproduces a measured panel law.
 
-Panel: a diamond net (`parts.geometry.net.diamond_net`) of the net's strands only (no border
+Panel: a diamond net (`barrier.patterns.diamond.diamond_net`) of the net's strands only (no border
 frame), x across the load, z along it, y out of plane (held: the panel lies flat). The clamp
 rows are the panel's bottom and top node rows; the top clamp moves by eps L along z. Two
 boundary conditions, as the sources describe them:
@@ -33,9 +33,9 @@ from dataclasses import dataclass
 import numpy as np
 
 import solver
+from printgen.barrier.patterns.diamond import diamond_net
 from printgen.errors import SolverError
 from printgen.inputs.laws import piecewise_linear
-from printgen.parts.geometry.net import diamond_net
 from printgen.units import MM
 
 MODES = ("blocked", "free")

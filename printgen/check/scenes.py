@@ -3,8 +3,9 @@ printed model as tension-only strand nets, mounted as in the flume and measured 
 three extension sensors of the loading test (Lambert et al. 2023, doi:10.1061/JHEND8.HYENG-13070).
 
 Plane of the net: x across the barrier, z up (from the flume bed), y the flow direction.
-Net strands are the diamond graph's diagonal segments; their force-strain law is the panel
-law turned into a strand law (`strand_law_from_membrane`). With border cables, the cables
+Net strands are the pattern's graph's strand segments (`printgen.barrier.patterns`: the
+diamond's diagonals); their force-strain law is the panel law turned into a strand law by the
+pattern (`NetPattern.strand_law`). With border cables, the cables
 slide through the net's edge nodes between the four corner anchors; the lateral edges are
 held by the flume's side sheets along their whole height (`walls`, the default) or only the
 lateral cables' eyelets are anchored (`eyelets`). Without border cables the net is anchored
@@ -28,17 +29,20 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from printgen.barrier.graph import NetGraph
+from printgen.barrier.loads import FLOW, LoadCase, get_load
+from printgen.barrier.patterns import AS_DRAWN, get_pattern
+from printgen.barrier.patterns.diamond import strand_law as strand_law_from_membrane
 from printgen.design.record import Design
-from printgen.design.section import area_m2, diamond_factor, diamond_sin, net_membrane_law
+from printgen.design.section import area_m2, net_membrane_law
 from printgen.errors import GeometryError
 from printgen.inputs.materials import load_material
 from printgen.inputs.prototype import LATERAL, Prototype
-from printgen.parts.geometry.net import NetGraph, diamond_net
 from printgen.units import MM, RHO_WATER, G
 
 SENSOR_FORCE_N = 1.0  # wire tension of each string potentiometer (reference, section 4)
 SENSOR_EXIT = 0.1  # the potentiometer stands this fraction of the width beyond the right edge
-FLOW = np.array([0.0, 1.0, 0.0])  # flow direction: the water pushes along it
+__all__ = ["FLOW"]  # the flow direction, defined with the load cases (printgen.barrier.loads)
 MOUNTINGS = LATERAL  # lateral mounting in the flume ([flume] lateral), the default first
 # Panel-test orientation (issue 25): the diagonal of the mesh its panel test loaded, the one
 # a panel law is read along. The prototype's 1.33 m panel was loaded along the water-drop's
@@ -100,19 +104,6 @@ class BarrierScene:
     assumptions: tuple[Assumption, ...] = ()
     pressure: str = "flow"  # one of PRESSURES: the water's force along the flow or normal
     rest_nodes: np.ndarray | None = None  # (n, 3) m printed geometry when mounted otherwise
-
-
-def strand_law_from_membrane(knees: tuple[float, ...], slopes: tuple[float, ...],
-                             mesh_along: float, mesh_across: float) -> Law:
-    """Strand force law whose diamond net has the membrane law (knees, slopes N/m).
-
-    Stretching the net by eps along the load strains a strand by eps sin^2(theta), and the
-    strands carry N = (2 / a_across) F sin(theta) per unit width; so the strand law has knees
-    eps_k sin^2(theta) and slopes N' a_across / (2 sin^3(theta)).
-    """
-    sin = diamond_sin(mesh_along, mesh_across)
-    f = 1.0 / (diamond_factor(mesh_along, mesh_across))
-    return tuple(k * sin * sin for k in knees), tuple(s * f for s in slopes)
 
 
 def panel_axes(mesh_a: float, mesh_b: float, orientation: str) -> tuple[float, float]:
@@ -190,39 +181,25 @@ def _scene(name: str, scale: float, g: NetGraph, to_m: float, net_law: Law,
                         rows, centre, top_centre, area, wires, mounting, hold)
 
 
-def square_graph(width_mm: float, height_mm: float, mesh_mm: float) -> NetGraph:
-    """A square-mesh net (strands across and up) as a NetGraph, for square prototypes."""
-    nx, ny = round(width_mm / mesh_mm), round(height_mm / mesh_mm)
-    ii, jj = np.meshgrid(np.arange(nx + 1), np.arange(ny + 1), indexing="ij")
-    nodes = np.column_stack([ii.ravel() * mesh_mm, jj.ravel() * mesh_mm]).astype(float)
-    idx = np.arange((nx + 1) * (ny + 1)).reshape(nx + 1, ny + 1)
-    segs = np.vstack([np.column_stack([idx[:-1].ravel(), idx[1:].ravel()]),
-                      np.column_stack([idx[:, :-1].ravel(), idx[:, 1:].ravel()])])
-    ring = np.concatenate([idx[:, 0], idx[-1, 1:], idx[-2::-1, -1], idx[0, -2:0:-1]])
-    return NetGraph(nodes, segs, np.ones(len(segs), int), [], ring,
-                    (2.0 * mesh_mm, 2.0 * mesh_mm), (2 * nx, 2 * ny))
-
-
 def lateral_mounting(p: Prototype) -> str:
     """The prototype file's `[flume] lateral` (the default when it has no [flume] table)."""
     return p.flume.lateral if p.flume is not None else MOUNTINGS[0]
 
 
 def prototype_scene(p: Prototype, *, mounting: str | None = None,
-                    orientation: str = PROTOTYPE_ORIENTATION) -> BarrierScene:
+                    orientation: str = PROTOTYPE_ORIENTATION,
+                    load: str | LoadCase | None = None) -> BarrierScene:
     """The prototype: net with its panel law (read along the mesh diagonal `orientation`) or
     linear strands, sliding border cables, mounted like the model (`mounting`, default the
-    file's [flume] lateral); its sensor wires only read (a field barrier carries no sensors)."""
+    file's [flume] lateral); its sensor wires only read (a field barrier carries no sensors);
+    `load`: the load case its assumptions state (default hydrostatic)."""
     mounting = mounting or lateral_mounting(p)
-    if p.net.pattern == "square":
-        g = square_graph(p.width / MM, p.height / MM, p.net.mesh_x / MM)
-    else:
-        g = diamond_net(p.width / MM, p.height / MM, p.net.mesh_x / MM, p.net.mesh_y / MM)
+    pattern = get_pattern(p.net.pattern)
+    g = pattern.graph(p.width / MM, p.height / MM, p.net.mesh_x / MM, p.net.mesh_y / MM)
     if p.net.panel_law is not None:
         knees, kappas, length = p.net.panel_law
         along, across = panel_axes(p.net.mesh_x, p.net.mesh_y, orientation)
-        net_law = strand_law_from_membrane(knees, tuple(k * length for k in kappas),
-                                           along, across)
+        net_law = pattern.strand_law(knees, tuple(k * length for k in kappas), along, across)
         law_text = ("panel law " + ", ".join(f"{k / 1e3:g}" for k in kappas) + " kN/m/m"
                     + (" (knees " + ", ".join(f"{k:.0%}" for k in knees) + ")" if knees else "")
                     + f" of a panel loaded along the {along / MM:g} mm ({orientation}) "
@@ -236,23 +213,26 @@ def prototype_scene(p: Prototype, *, mounting: str | None = None,
         cable_law = ((), (p.border.modulus * math.pi / 4 * p.border.diameter**2,))
     s = _scene(f"{p.name}: prototype", 1.0, g, MM, net_law, cable_law, None, mounting)
     src = f"prototype file {p.path.name}" if p.path else "prototype file"
+    drawn = f" (as {AS_DRAWN[p.net.pattern]}s)" if p.net.pattern in AS_DRAWN else ""
     rows = [("net", (f"{p.net.pattern} mesh {p.net.mesh_x / MM:g} x {p.net.mesh_y / MM:g} mm"
-                     f"{'' if p.net.pattern in ('square', 'diamond') else ' (as diamonds)'}, "
-             f"{len(s.nodes)} nodes"), src), ("net strands", law_text, src)]
+                     f"{drawn}, {len(s.nodes)} nodes"), src), ("net strands", law_text, src)]
     if p.border is not None:
         rows.append(("border cables", (f"d = {p.border.diameter / MM:g} mm, E = "
                      f"{p.border.modulus / 1e9:g} GPa, sliding, no pretension"), src))
-    return _finish(s, rows, sensors=False)
+    return _finish(s, rows, sensors=False, load=load)
 
 
 def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
-                orientation: str | None = None) -> BarrierScene:
-    """The printed model: diamond net with the material's (measured) law, printed border frame,
-    cables of the measured modulus, mounted by `mounting`, and the three sensor wires pulling
-    SENSOR_FORCE_N along themselves. `orientation` ("short", "long"): the mesh diagonal the
-    material's panel test loaded (None: the one its profile records)."""
+                orientation: str | None = None,
+                load: str | LoadCase | None = None) -> BarrierScene:
+    """The printed model: its pattern's net with the material's (measured) law, printed
+    border frame, cables of the measured modulus, mounted by `mounting`, and the three sensor
+    wires pulling SENSOR_FORCE_N along themselves. `orientation` ("short", "long"): the mesh
+    diagonal the material's panel test loaded (None: the one its profile records); `load`:
+    the load case its assumptions state (default hydrostatic)."""
     n = d.net
-    g = diamond_net(n.width_mm, n.height_mm, n.mesh_x_mm, n.mesh_y_mm)
+    pattern = get_pattern(n.pattern)
+    g = n.graph()
     mat = load_material(n.material)
     net_law, how = model_net_law(mat, n, orientation)
     e, e_src = mat.modulus()
@@ -268,13 +248,13 @@ def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
                      f"profile materials/{c.material}"))
     s = _scene(f"printed model 1:{d.scale:g}", d.scale, g, MM, net_law, cable_law,
                ((), (border_ea,)), mounting)
-    rows = [("net", (f"diamond mesh {n.mesh_x_mm:g} x {n.mesh_y_mm:g} mm, {len(s.nodes)} "
-             "nodes, rigid junctions"), "design"),
+    rows = [("net", (f"{pattern.name} mesh {n.mesh_x_mm:g} x {n.mesh_y_mm:g} mm, "
+             f"{len(s.nodes)} nodes, rigid junctions"), "design"),
             ("net strands", (f"{mat.name}: {how}, strand {n.strand.width_mm:g} x "
              f"{n.strand.thickness_mm:g} mm"), f"profile materials/{n.material}"),
             ("printed border frame", (f"{n.border_width_mm:g} mm wide, E = {e / 1e9:.3g} GPa "
              f"({e_src})"), f"design; profile materials/{n.material}"), *rows]
-    return _finish(s, rows, sensors=True)
+    return _finish(s, rows, sensors=True, load=load)
 
 
 def model_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
@@ -283,8 +263,10 @@ def model_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
     rescaled to the design's strand section); otherwise the membrane law of the design."""
     law = mat.panel_law
     if law is None or not law.has_geometry or orientation is None:
-        knees, slopes, how = net_membrane_law(mat, n.strand, n.mesh_y_mm * MM, n.mesh_x_mm * MM)
-        return strand_law_from_membrane(knees, slopes, n.mesh_y_mm * MM, n.mesh_x_mm * MM), how
+        knees, slopes, how = net_membrane_law(mat, n.strand, n.mesh_y_mm * MM, n.mesh_x_mm * MM,
+                                              n.pattern)
+        law_of = get_pattern(n.pattern).strand_law
+        return law_of(knees, slopes, n.mesh_y_mm * MM, n.mesh_x_mm * MM), how
     along, across = panel_axes(law.mesh_along_load, law.mesh_across_load, orientation)
     knees, slopes = strand_law_from_membrane(
         law.knee_strains, tuple(k * law.panel_length for k in law.kappas), along, across)
@@ -294,16 +276,17 @@ def model_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
         "diagonal")
 
 
-def _finish(s: BarrierScene, rows: list[Assumption], *, sensors: bool) -> BarrierScene:
+def _finish(s: BarrierScene, rows: list[Assumption], *, sensors: bool,
+            load: str | LoadCase | None) -> BarrierScene:
     """The scene with its sensor wires pulling (model) or only reading (prototype), and the
     assumptions shared by every scene after the scene's own."""
     force = SENSOR_FORCE_N if sensors else 0.0
     wires = {k: dataclasses.replace(w, force=force) for k, w in s.wires.items()}
-    rows = [*rows, *_common_assumptions(s, sensors)]
+    rows = [*rows, *_common_assumptions(s, sensors, get_load(load))]
     return dataclasses.replace(s, wires=wires, assumptions=tuple(rows))
 
 
-def _common_assumptions(s: BarrierScene, sensors: bool) -> list[Assumption]:
+def _common_assumptions(s: BarrierScene, sensors: bool, load: LoadCase) -> list[Assumption]:
     paper = "Lambert et al. 2023"
     out = []
     if s.cables:
@@ -324,9 +307,7 @@ def _common_assumptions(s: BarrierScene, sensors: bool) -> list[Assumption]:
              "width beyond the right edge; reading = change of wire length"),
              (f"{paper}: three 1 N extension sensors (Fig. 6a); routing: README, The flume "
              "test as it is run")),
-            ("loading", ("hydrostatic rho g (h - z) A* at the current node height, h/h_B = 0 "
-             "to 1.1; the folded film adds no stiffness"),
-             f"{paper}: nodal hydrostatic loads, loading test behind a folded film (Fig. 6a)"),
+            *load.assumptions,
             ("initial state", "flat, no pretension, no slack; gravity on the net neglected",
              f"{paper}: no pretension in the main cables at installation")]
     if s.hold > 0:

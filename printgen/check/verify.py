@@ -1,7 +1,7 @@
 """Pre-print verification: the prototype and the printed model, each as a tension-only net
 (`printgen.check.scenes`), loaded hydrostatically from h / h_B = 0 to 1.1 (the reference's loading
-test: water raised behind a folded film), optionally with drag at the Froude-scaled velocity,
-and compared by their normalised deformations over the whole range (printgen.check.compare).
+test: water raised behind a folded film), or another load case of `printgen.barrier.loads`
+(drag at the Froude-scaled velocity), and compared by their normalised deformations over the whole range (printgen.check.compare).
 Also the counter-example the report warns about: the simple barrier with steel at every scale.
 """
 
@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 import solver
+from printgen.barrier.loads import OVERFLOW, LoadCase, LoadsAt, Site, get_load
 from printgen.check.compare import (
     Deformation,
     Mismatch,
@@ -25,7 +26,6 @@ from printgen.check.compare import (
     increments,
 )
 from printgen.check.scenes import (
-    FLOW,
     BarrierScene,
     lateral_mounting,
     model_scene,
@@ -33,9 +33,10 @@ from printgen.check.scenes import (
 )
 from printgen.check.solvernet import build, hold_share, wire_slack
 from printgen.design.record import Design
+from printgen.design.similitude import scale_targets
 from printgen.errors import SolverError
 from printgen.inputs.prototype import Prototype
-from printgen.units import RHO_WATER, G
+from printgen.units import MM
 from printgen.workers import (  # worker lifecycle: ground floor
     check_deadline,
     report_progress,
@@ -44,7 +45,6 @@ from printgen.workers import (  # worker lifecycle: ground floor
 from solver.loads import total_forces
 
 LEVEL_STEP = 0.05  # relative loading step of the sweep (issue: at most 0.05)
-OVERFLOW = 1.1  # last relative loading h / h_B
 PATH_CUTS = 2  # halvings tried before a load level is reported as not converged
 MIN_COMPARED = 2  # levels both barriers must reach (h = 0 and one loaded) for a verdict
 SHAPE_LEVELS = (0.5, 1.0, 1.1)  # relative loadings whose deformed shapes are kept
@@ -66,36 +66,36 @@ def solver_net(s: BarrierScene, *, slack: float = 0.0) -> solver.Net:
     return build(s, slack=slack)[0]
 
 
-def loads_function(s: BarrierScene, *, velocity: float | None = None,
-                   strand_diameter: float = 0.0):
-    """Loads at relative loading r: hydrostatic rho g (r h_B - z) A* on the free nodes at their
-    current height, and drag 0.5 rho v^2 l d when a velocity is given (the sensor wires are
-    part of the net: `solver_net`)."""
+def loads_function(s: BarrierScene, *, load: str | LoadCase | None = None,
+                   site: Site | None = None) -> LoadsAt:
+    """Loads at relative loading r of load case `load` (default hydrostatic) on the scene's
+    free nodes, at `site` (the sensor wires are part of the net: `solver_net`). With the
+    scene's pressure option "normal" the hydrostatic part presses normal to the deformed net
+    (issue 25: the folded film presses normal to the surface) instead of along the flow."""
+    loads_at = get_load(load).loads(s, site)
+    if s.pressure != "normal":
+        return loads_at
+    from printgen.check.pressure import normal_pressure
+
     free = np.flatnonzero(~s.fixed)
-    strand_per_node = _strand_length(s) / len(s.nodes)
-    row_gap = float(np.diff(np.unique(np.round(s.nodes[:, 2], 12))).min())  # node rows apart
-    normal = None
-    if s.pressure == "normal":  # issue 25: the film presses normal to the deformed net
-        from printgen.check.pressure import normal_pressure
+    normal = normal_pressure(s.nodes, s.elements[s.element_law == 0], free, s.area_per_node,
+                             0.0)
 
-        normal = normal_pressure(s.nodes, s.elements[s.element_law == 0], free,
-                                 s.area_per_node, 0.0)
+    def normal_at(r: float) -> list:
+        return [dataclasses.replace(normal, level=r * s.height)
+                if isinstance(f, solver.Hydrostatic) else f for f in loads_at(r)]
 
-    def loads_at(r: float) -> list:
-        out = [solver.Hydrostatic(free, s.area_per_node, r * s.height, tuple(FLOW),
-                                  rho=RHO_WATER, g=G) if normal is None
-               else dataclasses.replace(normal, level=r * s.height)]
-        if velocity:
-            out.append(solver.Drag(free, strand_per_node, strand_diameter, velocity,
-                                   r * s.height, tuple(FLOW), rho=RHO_WATER, ramp=row_gap))
-        return out
-
-    return loads_at
+    return normal_at
 
 
-def _strand_length(s: BarrierScene) -> float:
-    d = s.nodes[s.elements[:, 1]] - s.nodes[s.elements[:, 0]]
-    return float(np.linalg.norm(d, axis=1).sum())
+def load_keywords(p: Prototype, d: Design, load: str | LoadCase | None = None
+                  ) -> tuple[dict[str, Any], dict[str, Any]]:
+    """`sweep`'s load keywords of the prototype and of the model under `load`: the case and
+    each barrier's site, the model's flow velocity its similitude target (v / sqrt(lambda))."""
+    case = get_load(load)
+    proto = Site(p.velocity, p.net.strand_diameter)
+    model = Site(scale_targets(p, d.scale)["velocity"], d.net.strand.width_mm * MM)
+    return {"load": case, "site": proto}, {"load": case, "site": model}
 
 
 @dataclass(frozen=True)
@@ -115,15 +115,16 @@ class Run:
     def shape_record(self) -> dict[str, Any]:
         """The node positions (m, rounded to SHAPE_DECIMALS) at rest and at each kept level."""
         return {"units": "m", "decimals": SHAPE_DECIMALS,
-                "node_order": "the design's net graph (parts.geometry.net.diamond_net)",
+                "node_order": "the design's net graph (NetDesign.graph, by its pattern)",
                 "rest": np.round(self.scene.nodes, SHAPE_DECIMALS) + 0.0,
                 "levels": {f"{lv:g}": np.round(x, SHAPE_DECIMALS) + 0.0
                            for lv, x in sorted(self.shapes.items())}}
 
 
-def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw) -> Run:
-    """Solve the load path; levels that do not converge are kept in `Run.failed` (left out of
-    the comparison); SolverError only when fewer than MIN_COMPARED levels converge."""
+def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw: Any) -> Run:
+    """Solve the load path (`load_kw`: the load case and site of `loads_function`); levels
+    that do not converge are kept in `Run.failed` (left out of the comparison); SolverError
+    only when fewer than MIN_COMPARED levels converge."""
     t0 = time.perf_counter()
     net, ex = build(s, slack=slack)
     loads_at = loads_function(s, **load_kw)
@@ -216,19 +217,18 @@ class Verification:
         }
 
 
-def verify(p: Prototype, d: Design, *, drag: bool = False, lv: np.ndarray | None = None,
-           counterexample: bool = False, mounting: str | None = None) -> Verification:
-    """Sweep both barriers under the same relative loading and compare them; both are mounted
-    by `mounting` (default: the prototype file's [flume] lateral)."""
+def verify(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
+           lv: np.ndarray | None = None, counterexample: bool = False,
+           mounting: str | None = None) -> Verification:
+    """Sweep both barriers under the same relative loading of load case `load` (default
+    hydrostatic) and compare them; both are mounted by `mounting` (default: the prototype
+    file's [flume] lateral)."""
     lv = levels() if lv is None else np.asarray(lv, dtype=float)
     mounting = mounting or lateral_mounting(p)
-    ps, ms = prototype_scene(p, mounting=mounting), model_scene(d, mounting=mounting)
-    kw_p, kw_m, case = {}, {}, "hydrostatic (z at the current node height)"
-    if drag:
-        kw_p = {"velocity": p.velocity, "strand_diameter": p.net.strand_diameter}
-        kw_m = {"velocity": p.velocity / np.sqrt(d.scale),
-                "strand_diameter": d.net.strand.width_mm * 1e-3}
-        case = "hydrostatic + drag at the Froude-scaled velocity"
+    kw_p, kw_m = load_keywords(p, d, load)
+    case = kw_m["load"]
+    ps = prototype_scene(p, mounting=mounting, load=case)
+    ms = model_scene(d, mounting=mounting, load=case)
     jobs = [(sweep, (ms, lv), kw_m), (sweep, (ps, lv), kw_p)]  # the longest first
     if counterexample:
         jobs.append((steel_counterexample, (d.scale,), {}))
@@ -240,8 +240,8 @@ def verify(p: Prototype, d: Design, *, drag: bool = False, lv: np.ndarray | None
         model = _only(model, keep)
     mm = compare(proto.deformation, model.deformation)
     start = compare(increments(proto.deformation), increments(model.deformation))
-    return Verification(case, proto, model, mm, explain(mm), ce[0] if ce else None, start,
-                        len(lv))
+    return Verification(case.title, proto, model, mm, explain(mm), ce[0] if ce else None,
+                        start, len(lv))
 
 
 def _only(run: Run, keep: np.ndarray) -> Run:

@@ -23,13 +23,14 @@ from rich.table import Table
 from printgen.calibrate.aggregate import MIN_SAMPLES
 from printgen.calibrate.compliance import from_curve, from_stiffness
 from printgen.calibrate.fit import DEFAULT_ZERO, ISO_WINDOW, ZERO_MODES
-from printgen.calibrate.pipeline import Calibration, calibrate
+from printgen.calibrate.pipeline import Calibration
 from printgen.calibrate.record import calibration_record, units
 from printgen.calibrate.sample import DEFAULT_SECANTS, PRELOAD_STEPS, FitOptions, SampleFit
 from printgen.calibrate.specimen import KINDS
 from printgen.commands.common import add_json_arg, console, emit_json, fmt, table
 from printgen.errors import CalibrationError
 from printgen.inputs.profiles import profile_name
+from printgen.run import api
 
 WIDEST = 10_000  # characters: a results table's width is measured up to this
 PRELOAD_COL = "ΔE % at P∓10%"  # modulus change (%) at 0.9 and 1.1 x the preload
@@ -132,7 +133,7 @@ def run(args: argparse.Namespace) -> int:
             if getattr(args, opt) is not None}
     if args.kind:
         spec["kind"] = args.kind
-    cal = calibrate(
+    cal = api.calibrate(
         args.files, material=args.material, options=options_from(args), specimen=spec,
         specimen_file=args.specimen, columns=_pairs(args.column, "--column"),
         units=_pairs(args.unit, "--unit"),

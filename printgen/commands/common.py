@@ -50,6 +50,15 @@ def check_profile_args(args: argparse.Namespace, *options: str) -> None:
         for name in value if isinstance(value, (list, tuple)) else [value]:
             if name is not None:
                 profile_name(name, f"--{opt}")
+def add_load_args(p: argparse.ArgumentParser, what: str) -> None:
+    """--load NAME (a load case of printgen/barrier/loads) and its alias --drag."""
+    from printgen.barrier.loads import DEFAULT, case_names
+
+    p.add_argument("--load", choices=case_names(), default=None,
+                   help=f"{what} under this load case (default {DEFAULT}; drag: hydrostatic + "
+                        "drag at the Froude-scaled velocity)")
+    p.add_argument("--drag", action="store_const", dest="load", const="drag",
+                   help="the same as --load drag")
 
 
 def add_json_arg(p: argparse.ArgumentParser) -> None:

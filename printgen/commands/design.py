@@ -13,7 +13,8 @@ from printgen.design.search import OBJECTIVES, VERIFY_NETS
 from printgen.design.search_choice import short
 from printgen.design.sweep import check_address
 from printgen.errors import InputError
-from printgen.run.design import DesignRun, SearchOptions, check_out, design_searches, write_outputs
+from printgen.run import api
+from printgen.run.design import DesignRun, SearchOptions, check_out, write_outputs
 
 SHOW = 10  # Pareto members shown per scale in the table (all are in report.json)
 
@@ -68,8 +69,9 @@ def run(args: argparse.Namespace) -> int:
         verify_nets=args.verify_nets, level_step=args.level_step)
     out = args.out or Path("out") / f"{Path(args.prototype).stem}-design"
     check_out(out, args.prototype)  # before the search
-    result = design_searches(args.prototype, scales, options=opts, scheduler=args.scheduler,
-                             workers=args.workers, serial=args.serial, progress=not args.json)
+    result = api.design_search(args.prototype, scales, options=opts, scheduler=args.scheduler,
+                               workers=args.workers, serial=args.serial,
+                               progress=not args.json)
     files = write_outputs(result, out, args.scale if args.scale else scales[0], args.prototype)
     if args.json:
         emit_json(result.record)

@@ -12,6 +12,7 @@ from rich.console import Console
 
 from printgen.commands.common import (
     add_json_arg,
+    add_load_args,
     add_prototype_args,
     check_profile_args,
     console,
@@ -21,7 +22,7 @@ from printgen.commands.common import (
 )
 from printgen.run import api
 from printgen.run.budget import DEFAULT_LIMIT_S
-from printgen.run.make import json_output
+from printgen.run.make import MakeOptions, json_output
 
 EXIT_INCOMPLETE = 3  # outputs written, but the verdict rests on fewer load levels than asked
 EXIT_TIME_LIMIT = 4  # stopped at --time-limit (printgen.cli maps TimeLimitError to it)
@@ -33,8 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_prototype_args(p)
     p.add_argument("--printer", help="printer profile (default: the prototype's [model] choice)")
     p.add_argument("--out", "-o", type=Path, help="output directory")
-    p.add_argument("--drag", action="store_true",
-                   help="also verify under hydrostatic + drag at the Froude-scaled velocity")
+    add_load_args(p, "verify")
     p.add_argument("--step", action="store_true", help="also write STEP files (needs cadquery)")
     p.add_argument("--design", metavar="FILE", type=Path,
                    help="print this design.json (from printgen design) instead of select's")
@@ -58,11 +58,12 @@ def run(args: argparse.Namespace) -> int:
     err = Console(stderr=True, highlight=False)
     t0 = time.perf_counter()
     with err.status("planning") as status:
-        ctx = api.make(args.prototype, args.scale, out, printer=args.printer, drag=args.drag,
+        ctx = api.make(args.prototype, args.scale, out, printer=args.printer, load=args.load,
                        step=args.step, progress=Progress(status),
-                       options={"force": args.force, "command": getattr(args, "argv", None),
-                                "design_file": args.design,
-                                "time_limit_s": args.time_limit, "pdf": args.pdf})
+                       options=MakeOptions(force=args.force,
+                                           command=getattr(args, "argv", None),
+                                           design_file=args.design,
+                                           time_limit_s=args.time_limit, pdf=args.pdf))
     seconds = time.perf_counter() - t0
     ver = ctx.record.get("verification") or {}
     code = EXIT_INCOMPLETE if ver.get("complete") is False else 0

@@ -14,6 +14,7 @@ from rich.console import Console
 from printgen.check.measured import COLUMNS, FIT_KINDS, LEVEL_COLUMN
 from printgen.commands.common import (
     add_json_arg,
+    add_load_args,
     add_prototype_args,
     add_time_limit_arg,
     console,
@@ -36,8 +37,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "(default: its effective stiffness)")
     p.add_argument("--out", "-o", type=Path,
                    help="output folder (default: beside the design's folder, '<name>-verify')")
-    p.add_argument("--drag", action="store_true",
-                   help="hydrostatic + drag at the Froude-scaled velocity")
+    add_load_args(p, "check")
     p.add_argument("--force", action="store_true",
                    help="replace an output folder printgen did not write")
     add_time_limit_arg(p)
@@ -46,17 +46,18 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from printgen.run.verify import band_summary, fitted_name, verify_design
+    from printgen.run import api
+    from printgen.run.verify import band_summary, fitted_name
 
     folder = args.design.resolve().parent
     out = args.out or folder.with_name(f"{folder.name}-verify")
     err = Console(stderr=True, highlight=False)
     t0 = time.perf_counter()
     with err.status("reading inputs") as status:
-        res = verify_design(args.prototype, args.scale, args.design, out,
-                            measured=args.measured, fit=args.fit, drag=args.drag,
-                            force=args.force, progress=lambda s: status.update(f"{s} ..."),
-                            time_limit_s=args.time_limit)
+        res = api.verify_design(args.prototype, args.scale, args.design, out,
+                                measured=args.measured, fit=args.fit, load=args.load,
+                                force=args.force, progress=lambda s: status.update(f"{s} ..."),
+                                time_limit_s=args.time_limit)
     if args.json:
         emit_json(res.record)
         return 0

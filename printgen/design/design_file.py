@@ -12,6 +12,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from printgen.barrier.patterns import get_pattern
 from printgen.design.record import CABLE_SIDES, CableDesign, Design, NetDesign, Section
 from printgen.errors import InputError
 from printgen.inputs.profiles import profile_name
@@ -45,12 +46,15 @@ CABLE = {"length_mm": positive("length_mm", MM_MAX, 1.0, si=False),
 
 def _fields(cls: type, data: Any, where: str, checks: dict[str, Field]) -> dict[str, Any]:
     """`data` as keyword arguments of the dataclass `cls`, each value of `checks` checked
-    (floats as float), or InputError."""
+    (floats as float), or InputError (a field with a default may be missing: files written
+    before it existed)."""
     if not isinstance(data, dict):
         raise InputError(f"{where}: expected a table of {cls.__name__} fields, got "
                          f"{type(data).__name__}")
     names = [f.name for f in dataclasses.fields(cls)]
-    unknown, missing = sorted(set(data) - set(names)), [n for n in names if n not in data]
+    optional = {f.name for f in dataclasses.fields(cls) if f.default is not dataclasses.MISSING}
+    unknown = sorted(set(data) - set(names))
+    missing = [n for n in names if n not in data and n not in optional]
     if unknown or missing:
         raise InputError(f"{where}: unknown keys {[shown(k) for k in unknown]} / missing keys "
                          f"{missing}; allowed: {', '.join(names)} (write it with printgen "
@@ -78,6 +82,8 @@ def design_from_dict(data: Any, where: str = "design") -> Design:
     net["strand"] = _section(net["strand"], f"{where}.net.strand")
     for key in ("material", "print_style"):
         net[key] = profile_name(net[key], f"{where}.net.{key}")
+    if "pattern" in net:
+        net["pattern"] = get_pattern(str(net["pattern"])).name
     if not isinstance(kw["cables"], list):
         raise InputError(f"{where}.cables must be a list of cables")
     cables = []

@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+from printgen.barrier.patterns import get_pattern
 from printgen.design.record import CableDesign, Design, NetDesign
-from printgen.design.selection import Selection, model_mesh
+from printgen.design.selection import PRINTED_PATTERN, Selection, model_mesh
 from printgen.design.similitude import ScaledTargets
 from printgen.errors import DesignError
 from printgen.inputs.prototype import Prototype
@@ -16,8 +17,8 @@ BORDER_BEADS = 2  # the net's border frame is two beads wide: the cables thread 
 def make_design(prototype: Prototype, targets: ScaledTargets, selection: Selection) -> Design:
     """The Design of the winners of `selection` at the targets' scale (mm).
 
-    Net: the barrier's model width x height rounded to whole half-meshes (the diamond
-    lattice keeps its mesh exact, `printgen.parts.geometry.net`), the model mesh, the winning
+    Net: the barrier's model width x height rounded to the lattice of the printed pattern
+    (the diamond's whole half-meshes keep its mesh exact: its `span`), the model mesh, the winning
     strand section and a border frame of BORDER_BEADS beads. Cables (when the prototype has a
     border): top and bottom span the net's width anchor to anchor (its corner nodes sit on the
     anchors), the lateral ones its height, so the parts meet at every scale.
@@ -27,13 +28,15 @@ def make_design(prototype: Prototype, targets: ScaledTargets, selection: Selecti
         raise DesignError(f"no printable net: {net_c.reasons[0]}")
     mesh_x, mesh_y = model_mesh(prototype, targets)
     mesh_x_mm, mesh_y_mm = round(mesh_x * 1e3, 6), round(mesh_y * 1e3, 6)
-    width = _lattice_span_mm(targets["width"] * 1e3, mesh_x_mm)
-    height = _lattice_span_mm(targets["height"] * 1e3, mesh_y_mm)
+    pattern = get_pattern(PRINTED_PATTERN)
+    width = pattern.span(targets["width"] * 1e3, mesh_x_mm)
+    height = pattern.span(targets["height"] * 1e3, mesh_y_mm)
     net = NetDesign(material=net_c.material, print_style=selection.net_print,
                     width_mm=round(width, 6), height_mm=round(height, 6),
                     mesh_x_mm=mesh_x_mm, mesh_y_mm=mesh_y_mm,
                     strand=net_c.section,
-                    border_width_mm=BORDER_BEADS * net_c.section.bead_width_mm)
+                    border_width_mm=BORDER_BEADS * net_c.section.bead_width_mm,
+                    pattern=pattern.name)
     cables: tuple[CableDesign, ...] = ()
     if selection.cables:
         c = selection.cables[0]
@@ -49,7 +52,3 @@ def make_design(prototype: Prototype, targets: ScaledTargets, selection: Selecti
                                  ("right", height)))
     return Design(scale=targets.scale, printer=selection.printer, net=net, cables=cables)
 
-
-def _lattice_span_mm(length_mm: float, diagonal_mm: float) -> float:
-    """`length_mm` rounded to whole half-diagonals (the rule of `diamond_net`), mm."""
-    return round(2 * length_mm / diagonal_mm) * diagonal_mm / 2

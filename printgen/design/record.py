@@ -8,7 +8,10 @@ each of `len(layer_heights_mm)` stacked layers.
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from printgen.barrier.graph import NetGraph
 
 
 @dataclass(frozen=True)
@@ -38,7 +41,8 @@ class Section:
 
 @dataclass(frozen=True)
 class NetDesign:
-    """Diamond net: panel size, mesh diagonals (x across, y up), strand section, border."""
+    """A printed net: panel size, mesh diagonals (x across, y up), strand section, border
+    frame, and its pattern (`printgen.barrier.patterns`; a design file without one: diamond)."""
 
     material: str
     print_style: str
@@ -48,6 +52,14 @@ class NetDesign:
     mesh_y_mm: float
     strand: Section
     border_width_mm: float
+    pattern: str = "diamond"
+
+    def graph(self) -> NetGraph:
+        """The net's centre-line graph (mm), built by its pattern."""
+        from printgen.barrier.patterns import get_pattern
+
+        return get_pattern(self.pattern).graph(self.width_mm, self.height_mm, self.mesh_x_mm,
+                                               self.mesh_y_mm)
 
 
 CABLE_SIDES = ("top", "bottom", "left", "right")  # a cable's name: the net side it borders

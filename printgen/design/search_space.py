@@ -3,7 +3,7 @@
 A candidate is a `NetPoint`, a small frozen record that a sweep task evaluates on its own (so
 the results do not depend on where it runs). The mesh is parameterised by whole half-diagonals
 across and up the panel (nx, ny): every candidate's diagonals fit the model panel exactly
-(mesh_x = 2 W / nx, mesh_y = 2 H / ny), as `parts.geometry.net.diamond_net` builds it.
+(mesh_x = 2 W / nx, mesh_y = 2 H / ny), as `barrier.patterns.diamond.diamond_net` builds it.
 
 The bounds default to the printer's pass limits (`selection.MAX_BEADS_ACROSS`, `MAX_LAYERS`) and
 to each mesh diagonal within +-`MESH_TOLERANCE` of the scaled prototype's (Pi2 = a / h_B); the

@@ -1,5 +1,5 @@
 """Choose a polymer and pass layout for the border cables (axial stiffness E*A) and for the net
-(membrane law from the diamond geometry) against the similitude targets.
+(membrane law from the printed pattern's geometry, `PRINTED_PATTERN`) against the similitude targets.
 
 Every material x layout (beads side by side x stacked layers of the print style) is a
 candidate. Each gets its stiffness error, the Pi3 deviation of its equivalent section, a
@@ -14,15 +14,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from printgen.barrier.loads import OVERFLOW  # peak relative loading of the loading test
+from printgen.barrier.patterns import get_pattern
 from printgen.design.record import Section
-from printgen.design.section import (
-    area_m2,
-    diamond_factor,
-    diamond_sin,
-    equal_area_diameter,
-    net_membrane_law,
-    square_factor,
-)
+from printgen.design.section import area_m2, equal_area_diameter, net_membrane_law
 from printgen.design.similitude import ScaledTargets
 from printgen.errors import InputError, PrintabilityError
 from printgen.inputs.laws import piecewise_linear
@@ -34,6 +29,7 @@ from printgen.units import MM, G
 DEFAULT_PRINTER = "generic-350"
 DEFAULT_NET_PRINT = "net-3pass"
 DEFAULT_CABLE_PRINT = "cable-4pass"
+PRINTED_PATTERN = "diamond"  # the pattern of the printed net: what select prices, make prints
 
 MAX_BEADS_ACROSS = {"cable": 6, "net": 2}  # wider strands are no longer "strands"
 MAX_LAYERS = {"cable": 6, "net": 5}
@@ -43,7 +39,6 @@ PASS_PENALTY = 0.002  # per pass: prefer shorter prints among equals
 SCORE_DIGITS = 9  # scores equal to 1e-9 are ties (same E*A, different layout)
 MIN_SPEED_MM_S = 2.0  # slower than this, the flow limit makes the print impractical
 ASSUMED_SAG_RATIO = 0.2  # peak-force estimate: sag / span of a loaded cable or net strip
-OVERFLOW = 1.1  # peak relative loading h / h_B of the loading test
 CALIBRATE_FIRST = ("print the test pieces below and calibrate before printing the barrier "
                    "(printgen calibrate, then printgen verify)")
 NET_STRAINS = np.linspace(0.01, 0.40, 40)  # strain range over which net laws are compared
@@ -113,10 +108,6 @@ class Selection:
     def cable(self) -> Candidate | None:
         return self.cables[0] if self.cables and self.cables[0].feasible else None
 
-    @property
-    def net_choice(self) -> Candidate:
-        return self.net[0]
-
     def to_record(self) -> dict:
         """JSON-ready record of the ranked selection (stable keys)."""
         return {
@@ -168,8 +159,7 @@ def peak_strand_force(t: ScaledTargets, mesh_across: float, mesh_along: float) -
     s = ASSUMED_SAG_RATIO
     h_b = t["height"]
     n = 1000.0 * G * OVERFLOW * h_b * h_b / (8 * s) * math.sqrt(1 + 16 * s * s)
-    sin = diamond_sin(mesh_along, mesh_across)
-    return n * mesh_across / (2 * sin)
+    return get_pattern(PRINTED_PATTERN).strand_force(n, mesh_along, mesh_across)
 
 
 def cable_candidate(t: ScaledTargets, m: Material, sec: Section, printer: Printer) -> Candidate:
@@ -193,15 +183,12 @@ def target_net_law(p: Prototype, t: ScaledTargets) -> tuple[tuple[float, ...], t
     """(knee strains, membrane slopes N/m) of the model net's target force-per-width law.
 
     From the prototype's panel law (kappa * L_p scaled by lambda^-2), else from its strand E*A
-    and mesh geometry (square: one strand per mesh across; diamond: `diamond_factor`).
+    and mesh geometry (its pattern's `membrane_factor`).
     """
     if p.net.panel_law is not None:
         knees, kappas = p.net.panel_law[0], p.net.panel_law[1]
         return tuple(knees), tuple(t[f"membrane_{i}"] for i in range(len(kappas)))
-    if p.net.pattern == "square":
-        factor = square_factor(t["mesh_x"])
-    else:
-        factor = diamond_factor(t["mesh_y"], t["mesh_x"])
+    factor = get_pattern(p.net.pattern).membrane_factor(t["mesh_y"], t["mesh_x"])
     return (), (t["strand_ea"] * factor,)
 
 
@@ -215,9 +202,10 @@ def model_mesh(p: Prototype, t: ScaledTargets) -> tuple[float, float]:
 
 def net_candidate(p: Prototype, t: ScaledTargets, m: Material, sec: Section,
                   printer: Printer) -> Candidate:
-    """Score one net candidate: its membrane law (diamond geometry) against the target law."""
+    """Score one net candidate: its membrane law (the printed pattern's geometry) against the
+    target law."""
     mesh_x, mesh_y = model_mesh(p, t)
-    knees, slopes, source = net_membrane_law(m, sec, mesh_y, mesh_x)
+    knees, slopes, source = net_membrane_law(m, sec, mesh_y, mesh_x, PRINTED_PATTERN)
     t_knees, t_slopes = target_net_law(p, t)
     got = piecewise_linear(NET_STRAINS, knees, slopes)
     want = piecewise_linear(NET_STRAINS, t_knees, t_slopes)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 from printgen.errors import InputError
 from printgen.inputs.prototype import Prototype
@@ -72,6 +73,15 @@ class ScaledTargets:
             "flow": self.flow,
             "warnings": list(self.flow.warnings),
         }
+
+
+FORCE_EXPONENT = -3  # a force scales as lambda^-3 (Froude similitude, same fluid density)
+
+
+def to_prototype(value: Any, exponent: float, scale: float) -> Any:
+    """A model quantity (a number or an array) of lambda exponent `exponent` at the
+    prototype's scale: value x lambda^-exponent (e.g. a force x lambda^3)."""
+    return value * scale ** -exponent
 
 
 def check_scale(scale: float) -> float:

@@ -22,7 +22,6 @@ from printgen.inputs.schema import Field, positive, read_table
 # Materials one selection or design search weighs at most: each costs ~3 ms in select and a
 # grid of sections in the search (20 000 names made select run > 60 s; issue 20).
 MAX_MATERIALS = 100
-PAPER = "Lambert et al. 2023, J. Hydraul. Eng. 149(3), doi:10.1061/JHEND8.HYENG-13070"
 
 PROVENANCE = [
     Field("source", str, help="where the value comes from", multiline=True),
@@ -130,11 +129,6 @@ class PanelLaw:
         """Panel force per unit width (N/m) at `strain`; zero in compression."""
         slopes = [k * self.panel_length for k in self.kappas]  # N/m per unit strain
         return piecewise_linear(strain, self.knee_strains, slopes)
-
-    def kappa_at(self, strain: float) -> float:
-        """Tangent panel stiffness (N/m per m) at `strain`."""
-        return float(self.kappas[int(np.searchsorted(self.knee_strains, strain, side="right"))])
-
 
 @dataclass(frozen=True)
 class PrintSettings:
@@ -276,7 +270,3 @@ def material_names(chosen: tuple[str, ...] | None, preferred: tuple[str, ...] = 
                            "[model] materials")
     return names
 
-
-def all_materials() -> list[Material]:
-    """Every material profile found, loaded and validated."""
-    return [load_material(n) for n in list_profiles("materials")]

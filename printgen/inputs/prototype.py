@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from printgen.barrier.patterns import pattern_names
 from printgen.errors import InputError
 from printgen.inputs.materials import MAX_MATERIALS
 from printgen.inputs.profiles import profile_name
@@ -37,7 +38,7 @@ TOP = [Field("name", str),
 BARRIER = [positive("width_m", 1000.0, MIN_BARRIER_M), positive("height_m", 100.0, MIN_BARRIER_M),
            Field("anchors", int, lo=0, hi=64, required=False, default=0)]
 NET = [
-    Field("pattern", str, choices=("square", "diamond", "water-drop")),
+    Field("pattern", str, choices=pattern_names()),  # printgen/barrier/patterns, AS_DRAWN
     positive("mesh_x_m", 10.0, MIN_MESH_M,
              help="mesh diagonal (or square side) across the barrier"),
     positive("mesh_y_m", 10.0, MIN_MESH_M, help="mesh diagonal (or square side) up the barrier"),

@@ -18,7 +18,6 @@ from printgen.design.record import Design
 from printgen.errors import GeometryError
 from printgen.inputs.printers import Printer
 from printgen.parts.geometry.attach import Attachment, attachment_for, corner_nodes, holes
-from printgen.parts.geometry.net import diamond_net
 
 CLOSE_TOL_MM = 0.1  # issue 12: attachment points and anchor spacing agree to 0.1 mm
 SIDE_ANCHORS = {"bottom": (0, 1), "right": (1, 2), "top": (3, 2), "left": (0, 3)}
@@ -120,7 +119,7 @@ class Assembly:
 def assemble(design: Design, printer: Printer) -> Assembly:
     """The kit of `design`: anchors at the net's corner nodes, each cable on its side."""
     n = design.net
-    g = diamond_net(n.width_mm, n.height_mm, n.mesh_x_mm, n.mesh_y_mm)
+    g = n.graph()
     att = attachment_for(design, hole_compensation_mm=printer.hole_compensation_mm)
     hs = holes(n, g, att)
     anchors = g.nodes_mm[corner_nodes(g)]

@@ -10,6 +10,7 @@ from printgen.check.bands import Band
 from printgen.check.compare import METRICS, Deformation
 from printgen.check.measured import Fit, Measurement
 from printgen.check.scenes import BarrierScene
+from printgen.design.similitude import FORCE_EXPONENT, to_prototype
 from printgen.errors import PrintgenError
 
 DPI = 110
@@ -98,10 +99,12 @@ def verification_figure(proto: Deformation, model: Deformation, scale: float,
         ax.set_axis_off()
     ax = axes.flat[-1]
     ax.plot(proto.levels, proto.max_cable_tension / 1e3, "k-", label="prototype cables")
-    ax.plot(model.levels, model.max_cable_tension * scale**3 / 1e3, "C1--",
+    ax.plot(model.levels, to_prototype(model.max_cable_tension, FORCE_EXPONENT, scale) / 1e3,
+            "C1--",
             label=f"model cables x {scale:g}^3")
     ax.plot(proto.levels, proto.max_strand_tension / 1e3, "b-", label="prototype strands")
-    ax.plot(model.levels, model.max_strand_tension * scale**3 / 1e3, "c--",
+    ax.plot(model.levels, to_prototype(model.max_strand_tension, FORCE_EXPONENT, scale) / 1e3,
+            "c--",
             label=f"model strands x {scale:g}^3")
     ax.set_title("max tension, prototype scale", fontsize=10)
     ax.set_xlabel(LOADING)

@@ -11,7 +11,7 @@ from printgen.check.bands import Band
 from printgen.check.verify import CounterExample, Verification
 from printgen.design.record import Design
 from printgen.design.selection import Candidate, Selection
-from printgen.design.similitude import ScaledTargets
+from printgen.design.similitude import FORCE_EXPONENT, ScaledTargets, to_prototype
 from printgen.inputs.prototype import Prototype
 from printgen.report.html import Report
 
@@ -20,8 +20,9 @@ SHOWN_LEVEL = 1.0  # relative loading of the 3D picture of both deformed nets
 
 
 def design_sections(rep: Report, proto: Prototype, t: ScaledTargets, sel: Selection,
-                    design: Design) -> None:
-    """Targets, flow checks, the ranked selection and the chosen design."""
+                    design: Design, *, design_file: str | None = None) -> None:
+    """Targets, flow checks, the ranked selection and the chosen design (that of
+    `design_file`, printgen design's, when given)."""
     rep.paragraph(f"Prototype: {proto.name} ({proto.description}). Model scale 1:{t.scale:g}. "
                   "Similitude of Lambert et al. (2023), J. Hydraul. Eng. 149(3), "
                   "doi:10.1061/JHEND8.HYENG-13070: Froude scaling with stiffness scaled too.")
@@ -61,6 +62,9 @@ def design_sections(rep: Report, proto: Prototype, t: ScaledTargets, sel: Select
               f"passes, eyelets {c.eyelet_inner_mm:g}/{c.eyelet_outer_mm:g} mm")]
              for c in design.cables]
     rep.table(["part", "material", "size (mm)", "section"], rows)
+    if design_file:
+        rep.paragraph(f"The printed parts are the design of {design_file} "
+                      "(printgen design), not the selection's choice above.")
 
 
 def _same_stiffness(cands: tuple[Candidate, ...] | list[Candidate]) -> str:
@@ -145,10 +149,10 @@ def _sweep_sections(rep: Report, v: Verification, scale: float, band: Band | Non
     rep.table(["max tension at h/h_B = 1.1", "prototype (kN)", f"model x {scale:g}^3 (kN)",
                "model (N)"],
               [["net strands", f"{p.max_strand_tension[-1] / 1e3:.1f}",
-                f"{m.max_strand_tension[-1] * scale**3 / 1e3:.1f}",
+                f"{to_prototype(m.max_strand_tension[-1], FORCE_EXPONENT, scale) / 1e3:.1f}",
                 f"{m.max_strand_tension[-1]:.3g}"],
                ["border cables", f"{p.max_cable_tension[-1] / 1e3:.1f}",
-                f"{m.max_cable_tension[-1] * scale**3 / 1e3:.1f}",
+                f"{to_prototype(m.max_cable_tension[-1], FORCE_EXPONENT, scale) / 1e3:.1f}",
                 f"{m.max_cable_tension[-1]:.3g}"]])
     rep.figure(verification_figure(p, m, scale, "Normalised deformation against relative "
                                    "loading", band=band),

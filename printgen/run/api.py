@@ -28,7 +28,8 @@ if TYPE_CHECKING:
     from printgen.calibrate.sample import FitOptions
     from printgen.check.verify import Verification
     from printgen.run.design import DesignRun, SearchOptions
-    from printgen.run.make import MakeContext
+    from printgen.run.make import MakeContext, MakeOptions
+    from printgen.run.verify import VerifyRun
 
 PrototypeLike = str | Path | Prototype
 
@@ -62,19 +63,38 @@ def plan(prototype: PrototypeLike, scale: float, *, printer: str | None = None) 
 
 
 def make(prototype: str | Path, scale: float, out: str | Path, *,
-         printer: str | None = None, drag: bool = False, step: bool = False,
-         options: dict[str, Any] | None = None,
+         printer: str | None = None, load: str | None = None, drag: bool = False,
+         step: bool = False, options: MakeOptions | None = None,
          progress: Callable[[str], None] | None = None) -> MakeContext:
     """Targets, selection, parts (STL, 3MF, slicer profiles, G-code), the pre-print
-    verification and the report, written into the folder `out` as one whole run."""
+    verification under load case `load` (`printgen.barrier.loads`, default hydrostatic;
+    `drag=True` is `load="drag"`) and the report, written into the folder `out` as one
+    whole run; `options` (`printgen.run.make.MakeOptions`) for the rest."""
+    import dataclasses
+
+    from printgen.run.make import MakeOptions
     from printgen.run.make import make as _make
 
-    opts = {"drag": drag, "step": step, **(options or {})}
+    opts = options or MakeOptions()
+    opts = dataclasses.replace(opts, load=load_name(load or opts.load, drag),
+                               step=step or opts.step)
     return _make(prototype, scale, out, printer=printer, options=opts, progress=progress)
 
 
+def load_name(load: str | None, drag: bool) -> str:
+    """The load case of `load` and its alias `drag` (True: "drag"); InputError when they
+    disagree or `load` names no case."""
+    from printgen.barrier.loads import get_load
+    from printgen.errors import InputError
+
+    if drag and load not in (None, "drag"):
+        raise InputError(f"--drag is --load drag, not --load {load}: give one of them")
+    return get_load("drag" if drag else load).name
+
+
 def verify(prototype: PrototypeLike, scale: float, design_: Design | str | Path | None = None,
-           *, printer: str | None = None, drag: bool = False) -> Verification:
+           *, printer: str | None = None, load: str | None = None,
+           drag: bool = False) -> Verification:
     """The pre-print check: prototype and printed model solved under the same relative
     loading, h/h_B = 0 to 1.1, and compared by their normalised deformations. `design_` is a
     `Design` or the design.json that `make` wrote; without it, the design `make` would print
@@ -87,12 +107,29 @@ def verify(prototype: PrototypeLike, scale: float, design_: Design | str | Path 
         d = plan(p, scale, printer=printer)
     else:
         d = design_ if isinstance(design_, Design) else load_design(design_, scale=scale)
-    return _verify(p, d, drag=drag)
+    return _verify(p, d, load=load_name(load, drag))
+
+
+def verify_design(prototype: str | Path, scale: float, design_file: str | Path,
+                  out: str | Path, *, measured: str | Path | None = None,
+                  fit: str = "stiffness", load: str | None = None, drag: bool = False,
+                  force: bool = False, progress: Callable[[str], None] | None = None,
+                  time_limit_s: float | None = None) -> VerifyRun:
+    """`printgen verify`: the pre-print check of a design.json with its uncertainty band,
+    optionally compared with a lab's `measured` loading test and one factor fitted to it,
+    written into the folder `out` (see `printgen.run.verify.verify_design`); refused when
+    estimated longer than `time_limit_s` (None: the budget's default)."""
+    from printgen.run.verify import verify_design as _verify_design
+
+    return _verify_design(prototype, scale, design_file, out, measured=measured, fit=fit,
+                          load=load_name(load, drag), force=force, progress=progress,
+                          time_limit_s=time_limit_s)
 
 
 def design_search(prototype: PrototypeLike, scales: float | Sequence[float], *,
                   options: SearchOptions | None = None, scheduler: str | None = None,
-                  serial: bool = False) -> DesignRun:
+                  serial: bool = False, workers: int | None = None,
+                  progress: bool = False) -> DesignRun:
     """The inverse design: the printable net that deforms most like the prototype at each
     scale (screened by the membrane law, the best verified with the solver), on a local Dask
     cluster, the cluster at `scheduler`, or serially."""
@@ -100,7 +137,8 @@ def design_search(prototype: PrototypeLike, scales: float | Sequence[float], *,
 
     lams = [float(scales)] if isinstance(scales, int | float) else [float(s) for s in scales]
     return design_searches(prototype, lams, options=options or SearchOptions(),
-                           scheduler=scheduler, serial=serial)
+                           scheduler=scheduler, serial=serial, workers=workers,
+                           progress=progress)
 
 
 def calibrate(paths: Sequence[str | Path], *, material: str,

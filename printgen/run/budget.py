@@ -19,6 +19,7 @@ import os
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
+from printgen.barrier.patterns import get_pattern
 from printgen.design.record import Design
 from printgen.errors import InputError
 from printgen.inputs.prototype import Prototype
@@ -88,24 +89,16 @@ class Estimate:
                 "cores": self.cores}
 
 
-def diamond_nodes(width: float, height: float, mesh_x: float, mesh_y: float) -> int:
-    """Nodes of `printgen.parts.geometry.net.diamond_net` (any length unit)."""
-    nx, ny = max(round(2 * width / mesh_x), 1), max(round(2 * height / mesh_y), 1)
-    odd_corners = sum((i + j) % 2 for i in (0, nx) for j in (0, ny))  # kept as nodes too
-    return ((nx + 1) * (ny + 1) + 1) // 2 + odd_corners
-
-
 def prototype_nodes(p: Prototype, factor: float = 1.0) -> int:
     """Nodes of the prototype scene with its meshes `factor` times coarser."""
     ax, ay = p.net.mesh_x * factor, p.net.mesh_y * factor
-    if p.net.pattern == "square":
-        return (round(p.width / ax) + 1) * (round(p.height / ax) + 1)
-    return diamond_nodes(p.width, p.height, ax, ay)
+    return get_pattern(p.net.pattern).nodes(p.width, p.height, ax, ay)
 
 
 def model_nodes(d: Design, factor: float = 1.0) -> int:
     n = d.net
-    return diamond_nodes(n.width_mm, n.height_mm, n.mesh_x_mm * factor, n.mesh_y_mm * factor)
+    return get_pattern(n.pattern).nodes(n.width_mm, n.height_mm, n.mesh_x_mm * factor,
+                                        n.mesh_y_mm * factor)
 
 
 def sweep_cores() -> int:

@@ -3,7 +3,7 @@ profiles, direct G-code, verification, report; every file staged and moved into 
 directory only when every step succeeded (a failed run leaves the previous outputs intact).
 
 Steps are plain functions `step(ctx, stage)` (printgen.run.steps) run in order; each adds
-files under `stage` and numbers to `ctx.record`. The verification, the longest and needing
+files under `stage` and returns its records, which `make` puts into report.json. The verification, the longest and needing
 nothing from the others, starts in a worker process at the beginning and its step collects it.
 """
 
@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from printgen.barrier.loads import DEFAULT as DEFAULT_LOAD
 from printgen.design.design_file import load_design
 from printgen.design.plan import make_design
 from printgen.design.record import Design
@@ -32,6 +33,7 @@ from printgen.outputs import MANIFEST, check_destination, staged_dir
 from printgen.report.extras import report_files
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
+from printgen.report.parts_report import provenance_section
 from printgen.report.report import design_record, design_sections
 from printgen.run.budget import (
     DEFAULT_LIMIT_S,
@@ -45,7 +47,6 @@ from printgen.run.provenance import (  # noqa: F401 (json_output, TIME_KEYS: use
     TIMINGS,
     json_output,
     provenance,
-    provenance_section,
     split_timings,
 )
 from printgen.run.steps import (
@@ -63,45 +64,66 @@ from printgen.workers import Helper, check_deadline, cores, deadline, helper, si
 log = logging.getLogger(__name__)
 
 
+@dataclass(frozen=True)
+class MakeOptions:
+    """How `make` runs (what the command line gives).
+
+    load : the verification's load case (printgen/barrier/loads); step : also write STEP;
+    design_file : print this design.json instead of the selection's choice; time_limit_s :
+    refuse runs estimated longer; force : replace a folder printgen did not write;
+    command : the command line, recorded in the manifest; pdf : also print report.pdf.
+    """
+
+    load: str = DEFAULT_LOAD
+    step: bool = False
+    design_file: str | Path | None = None
+    time_limit_s: float | None = None  # None: refused only when estimated over DEFAULT_LIMIT_S
+    force: bool = False
+    command: list[str] | None = None
+    pdf: bool = False
+
+
 @dataclass
 class MakeContext:
-    """What the steps share: inputs, the chosen design, the report being built."""
+    """What the steps share: inputs, the chosen design, the report being built; `record`
+    holds the steps' returned records (written by `make` only)."""
 
     prototype: Prototype
     targets: ScaledTargets
     selection: Selection
     design: Design
     report: Report
-    options: dict[str, Any]
+    options: MakeOptions = field(default_factory=MakeOptions)
     record: dict[str, Any] = field(default_factory=dict)
     files: list[str] = field(default_factory=list)
     progress: Callable[[str], None] | None = None  # a step's finer progress (STEP per part)
     background: dict[str, Future] = field(default_factory=dict)  # jobs running in `helper`
     helper: Helper | None = None  # the helper process of a short run (`verification_ahead`)
     toolpaths: dict[str, Any] = field(default_factory=dict)  # per part, built once per run
+    volumes_mm3: dict[str, float] = field(default_factory=dict)  # per part's mesh (parts step)
 
 
-Step = Callable[[MakeContext, Path], None]
+Step = Callable[[MakeContext, Path], dict[str, Any]]  # its records, by report.json key
 
 
 def plan(prototype_path: str | Path, scale: float, *, printer: str | None = None,
-         options: dict[str, Any] | None = None) -> MakeContext:
+         options: MakeOptions | None = None) -> MakeContext:
     """Targets, selection and design: the fast, file-free part of `make`."""
+    options = options or MakeOptions()
     proto = load_prototype(prototype_path)
     t = scale_targets(proto, scale)
     sel = select(proto, t, printer=printer)
     design = make_design(proto, t, sel)
-    design_file = (options or {}).get("design_file")
+    design_file = options.design_file
     if design_file:  # the net of `printgen design` (its design.json) instead of select's
         design = load_design(design_file, scale=t.scale)
     rep = Report(f"printgen: {proto.name} at 1:{t.scale:g}")
-    design_sections(rep, proto, t, sel, design)
-    ctx = MakeContext(proto, t, sel, design, rep, options or {})
+    shown = Path(design_file).name if design_file else None
+    design_sections(rep, proto, t, sel, design, design_file=shown)
+    ctx = MakeContext(proto, t, sel, design, rep, options)
     ctx.record.update(design_record(proto, t, sel, design))
-    if design_file:
-        ctx.record["design_file"] = Path(design_file).name
-        rep.paragraph(f"The printed parts are the design of {Path(design_file).name} "
-                      "(printgen design), not the selection's choice above.")
+    if shown:
+        ctx.record["design_file"] = shown
     return ctx
 
 
@@ -110,18 +132,17 @@ LONG_RUN_S = 30.0  # runs estimated longer than this show their estimate and pro
 
 def make(prototype_path: str | Path, scale: float, out: str | Path, *,
          printer: str | None = None, steps: list[tuple[str, Step]] | None = None,
-         options: dict[str, Any] | None = None,
+         options: MakeOptions | None = None,
          progress: Callable[[str], None] | None = None) -> MakeContext:
     """Run every step into a stage folder and swap it in as the whole of `out`.
 
-    options: "force" (replace a folder printgen did not write), "command" (the command line,
-    recorded in the manifest), "drag", "step". `out` gets manifest.json (files, inputs,
-    version, command line) and timings.json (the only file that differs between runs).
+    `out` gets manifest.json (files, inputs, version, command line) and timings.json (the
+    only file that differs between runs).
     """
     t0 = time.perf_counter()
-    inputs = [prototype_path, (options or {}).get("design_file"), *search_dirs()]
-    check_destination(Path(out), force=bool((options or {}).get("force")),
-                      inputs=inputs)  # fail fast
+    options = options or MakeOptions()
+    inputs = [prototype_path, options.design_file, *search_dirs()]
+    check_destination(Path(out), force=options.force, inputs=inputs)  # fail fast
     ctx = plan(prototype_path, scale, printer=printer, options=options)
     est = size_check(ctx, steps is None or any(s is verify_step for _, s in steps))
     if progress and est.seconds > LONG_RUN_S:
@@ -132,7 +153,7 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     ctx.progress = progress
     bound = run_bound(ctx.options)
     with deadline(None if bound is None else time.time() + bound - (time.perf_counter() - t0)), \
-            staged_dir(out, force=bool(ctx.options.get("force")), meta=meta,
+            staged_dir(out, force=ctx.options.force, meta=meta,
                        volatile=(TIMINGS,), inputs=inputs) as stage, level_bars(long_run), \
             verification_ahead(ctx, steps, long_run is None):
         for label, step in steps:
@@ -140,7 +161,7 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
                 progress(label)
             t = time.perf_counter()
             try:
-                step(ctx, stage)
+                ctx.record.update(step(ctx, stage))
                 check_deadline(label)
             except TimeLimitError as exc:
                 raise TimeLimitError(time_limit_line(label, exc, est, bound, t0)) from exc
@@ -152,7 +173,7 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
             (stage / name).write_bytes(data)
             ctx.files.append(name)
         (stage / "report.html").write_text(ctx.report.html())
-        if ctx.options.get("pdf"):
+        if ctx.options.pdf:
             report_pdf(ctx, stage, progress)
         ctx.record["files"] = sorted([*ctx.files, "report.html", "report.json", "design.json",
                                       MANIFEST, TIMINGS])
@@ -194,8 +215,7 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]], short: b
     with helper() as h:
         ctx.helper = h
         ctx.background["verification sweeps"] = ctx.helper.submit(
-            timed, verification_sweeps, ctx.prototype, ctx.design,
-            drag=bool(ctx.options.get("drag")))
+            timed, verification_sweeps, ctx.prototype, ctx.design, load=ctx.options.load)
         try:
             with signals_deferred():  # a signal meanwhile would be lost in trimesh's imports
                 preload_parts()
@@ -207,8 +227,8 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]], short: b
 
 def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
     """Estimate the run before any of it is done; InputError when it is over the limit
-    (options["time_limit_s"], default about a minute on 2 cores)."""
-    limit = ctx.options.get("time_limit_s")
+    (options.time_limit_s, default about a minute on 2 cores)."""
+    limit = ctx.options.time_limit_s
     est = check_budget(ctx.prototype, ctx.design, cores=sweep_cores(),
                        limit_s=DEFAULT_LIMIT_S if limit is None else float(limit),
                        sweep=verifies)
@@ -217,12 +237,12 @@ def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
     return est
 
 
-def run_bound(options: dict[str, Any]) -> float | None:
+def run_bound(options: MakeOptions) -> float | None:
     """Seconds after which the run stops: --time-limit when given. Without it a run is only
     refused when estimated over DEFAULT_LIMIT_S, never stopped: a shared machine can run
     many times slower than the estimate (the 1:40 example, estimated at 7 s, took 6 min
     under a load of 20 on 2 cores), and a run that does finish should not be lost."""
-    limit = options.get("time_limit_s")
+    limit = options.time_limit_s
     return float(limit) if limit else None
 
 

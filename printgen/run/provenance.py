@@ -8,8 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from printgen.outputs import MANIFEST, file_digest
-from printgen.report.html import Report
+from printgen.outputs import file_digest
 
 if TYPE_CHECKING:
     from printgen.run.make import MakeContext
@@ -61,28 +60,16 @@ def provenance(ctx: MakeContext) -> dict[str, Any]:
     used |= {("materials", c.material) for c in d.cables}
     used |= {("prints", c.print_style) for c in d.cables}
     inputs = {"prototype": _digest(ctx.prototype.path)} if ctx.prototype.path else {}
-    if ctx.options.get("design_file"):  # make --design FILE: the design is an input too
-        inputs["design_file"] = _digest(Path(ctx.options["design_file"]))
+    if ctx.options.design_file:  # make --design FILE: the design is an input too
+        inputs["design_file"] = _digest(Path(ctx.options.design_file))
     for kind, name in sorted(used):
         for path in load_raw(kind, name)[1]:
             shown = (Path("profiles") / path.relative_to(BUNDLED)
                      if path.is_relative_to(BUNDLED) else path)
             inputs[f"{kind}/{path.stem}"] = _digest(path, shown)
-    return {"printgen_version": version("printgen"), "command": ctx.options.get("command"),
+    return {"printgen_version": version("printgen"), "command": ctx.options.command,
             "inputs": inputs}
 
 
 def _digest(path: Path, shown: Path | None = None) -> dict[str, Any]:
     return {"path": str(shown or path), "sha256": file_digest(Path(path))["sha256"]}
-
-
-def provenance_section(rep: Report, meta: dict[str, Any]) -> None:
-    """The report's provenance: what made this folder (the manifest holds the same)."""
-    rep.heading("Provenance")
-    cmd = meta.get("command")
-    rep.paragraph(f"printgen {meta['printgen_version']}; command: "
-                  f"{' '.join(cmd) if cmd else 'printgen.make() from Python'}. Every file of "
-                  f"this folder and its sha256 are in {MANIFEST}; `printgen check FOLDER` "
-                  "verifies them.")
-    rep.table(["input", "file", "sha256"],
-              [[k, v["path"], v["sha256"]] for k, v in meta["inputs"].items()])

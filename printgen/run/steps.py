@@ -1,7 +1,8 @@
 """The steps of `printgen make`: plain functions `step(ctx, stage)` that add files under
-`stage`, numbers to `ctx.record` and sections to `ctx.report` (the pipeline is
-`printgen.run.make`). The verification's sections are built by `verification_blocks`, which
-`make` runs in a worker process from the start of the run while the other steps run here.
+`stage` and return their records (report.json key -> record); their report sections are
+built in printgen/report from those records (the pipeline is `printgen.run.make`). The
+verification's sweeps (`verification_sweeps`) and its sections (`verification_report`) run
+in a helper process from the start of the run while the other steps run here.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ import numpy as np
 from printgen.errors import TimeLimitError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
+from printgen.report.parts_report import assembly_section, gcode_section, meshes_section
 from printgen.workers import seconds_left
 
 HELPER_SWEEPS = "helper: verification sweeps"  # timings_s keys of work done in the helper
@@ -61,17 +63,16 @@ def part_toolpath(ctx: MakeContext, name: str, part: Any, printer: Printer) -> T
     return ctx.toolpaths[name]
 
 
-def gcode_step(ctx: MakeContext, stage: Path) -> None:
+def gcode_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     """Direct G-code for the net and each cable, checked by read-back against the design."""
     from printgen.parts.gcode.estimate import print_estimate
     from printgen.parts.gcode.readback import read_gcode_text
     from printgen.parts.gcode.writer import gcode_text
-    from printgen.report.summary import print_rows
 
     d = ctx.design
     printer = load_printer(d.printer)
     parts = [("net", d.net)] + [(f"cable-{c.name}", c) for c in d.cables]
-    rows, rec = [], {}
+    rec = {}
     for name, part in parts:
         mat = load_material(part.material)
         t0 = time.perf_counter()
@@ -83,7 +84,7 @@ def gcode_step(ctx: MakeContext, stage: Path) -> None:
         path.write_text(text)
         ctx.files.append(path.name)
         err = back.volume_mm3 / tp.volume_mm3 - 1
-        stl = ctx.record.get("parts", {}).get(name, {}).get("volume_mm3")
+        stl = ctx.volumes_mm3.get(name)
         vs_stl = back.volume_mm3 / stl - 1 if stl else None
         retractions = text.count(f"E-{mat.print.retract_length_mm:.5f}")
         rec[name] = {"file": path.name, "layers": len(back.layer_z_mm),
@@ -91,20 +92,11 @@ def gcode_step(ctx: MakeContext, stage: Path) -> None:
                      "readback_error": err, "readback_vs_stl": vs_stl,
                      "retractions": retractions, "seconds": seconds,
                      "print": print_estimate(tp, printer, mat).to_record()}
-        rows.append([name, path.name, str(len(back.layer_z_mm)), f"{tp.volume_mm3:.1f}",
-                     f"{err:+.2%}", "-" if vs_stl is None else f"{vs_stl:+.2%}",
-                     str(retractions)])  # times go to timings.json: the report is reproducible
-    ctx.record["gcode"] = rec
-    ctx.report.heading("Direct G-code")
-    ctx.report.paragraph("Every net strand is one straight extrusion through the crossings, the "
-                         "strand families alternate per pass; the G-code is read back and its "
-                         "extruded volume compared with the toolpath's.")
-    ctx.report.table(["part", "file", "layers", "volume (mm^3)", "read-back error",
-                      "read back vs STL", "retractions"], rows)
-    ctx.report.table(*print_rows(rec))
+    gcode_section(ctx.report, rec)
+    return {"gcode": rec}
 
 
-def kit_step(ctx: MakeContext, stage: Path) -> None:
+def kit_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     """How the kit goes together (labelled picture, checks after printing) and top views of
     the direct toolpaths per pass (the net's corner and a cable's eyelet)."""
     from printgen.parts.assembly import assemble
@@ -114,7 +106,7 @@ def kit_step(ctx: MakeContext, stage: Path) -> None:
 
     d = ctx.design
     if not d.cables:
-        return
+        return {}
     printer = load_printer(d.printer)
     a = assemble(d, printer)
     net_tp = part_toolpath(ctx, "net", d.net, printer)  # its attachment is a.attachment
@@ -124,25 +116,14 @@ def kit_step(ctx: MakeContext, stage: Path) -> None:
     load_pyplot()
     sweeps_done(ctx)  # the figures: see there
     figs = kit_figures(a, outline, net_tp, cable_tp, c.name)
-    ctx.report.heading("Assembly")
-    problems = a.problems()
-    ctx.report.verdict(not problems, "; ".join(problems) or
-                       "the kit closes: cables as long as the net's sides, every loop on its "
-                       "cable's line with the stated clearance")
-    for name, png, caption in figs:
+    for name, png, _caption in figs:
         (stage / name).write_bytes(png)
         ctx.files.append(name)
-        if name == "preview-net.png":
-            ctx.report.heading("Toolpath previews")
-        ctx.report.figure(png, caption, name.removesuffix(".png"))
-        if name == "assembly.png":
-            ctx.report.paragraph("Check after printing:")
-            for k, line in enumerate(a.checklist(), 1):
-                ctx.report.paragraph(f"{k}. {line}")
-    ctx.record["assembly"] = a.to_record()
+    assembly_section(ctx.report, a, figs)
+    return {"assembly": a.to_record()}
 
 
-def slicer_step(ctx: MakeContext, stage: Path) -> None:
+def slicer_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     """PrusaSlicer .ini for every part and CuraEngine settings for the cables."""
     from printgen.parts.slicer.cura import cura_cfg_text
     from printgen.parts.slicer.prusa import prusa_ini_text
@@ -161,10 +142,10 @@ def slicer_step(ctx: MakeContext, stage: Path) -> None:
             cfg.write_text(cura_cfg_text(kind, part, printer, style, mat))
             written.append(cfg.name)
     ctx.files += written
-    ctx.record["slicer_profiles"] = written
+    return {"slicer_profiles": written}
 
 
-def parts_step(ctx: MakeContext, stage: Path) -> None:
+def parts_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     """Watertight meshes of every part: STL, a 3MF carrying its PrusaSlicer settings, and
     STEP when asked (--step, needs cadquery; the progress line names each part's STEP)."""
     from printgen.parts.slicer.prusa import prusa_ini_text
@@ -172,30 +153,25 @@ def parts_step(ctx: MakeContext, stage: Path) -> None:
     d = ctx.design
     printer = load_printer(d.printer)
     parts = _mesh_parts(d, printer.hole_compensation_mm)
-    rows, rec, cables = [], {}, []
+    rec, cables = {}, []
     for k, (name, kind, part, solid, outline, analytic) in enumerate(parts, 1):
         body = solid(part)
         if kind == "cable":
             cables.append((name, body))
-        if ctx.options.get("step") and ctx.progress:
+        if ctx.options.step and ctx.progress:
             ctx.progress(f"STEP {name} ({k} of {len(parts)})")
-        rec[name], row = _write_part(stage, name, kind, part, body, printer,
-                                     outline if ctx.options.get("step") else None,
-                                     analytic(part))
+        rec[name] = _write_part(stage, name, kind, part, body, printer,
+                                outline if ctx.options.step else None, analytic(part))
         ctx.files += rec[name]["files"]
-        rows.append(row)
+        ctx.volumes_mm3[name] = rec[name]["volume_mm3"]
     if cables:  # every cable on one plate: one print job, with the cables' settings
         c = d.cables[0]
         ini = prusa_ini_text("cable", c, printer, load_print_style(c.print_style),
                              load_material(c.material))
         rec["cables-plate"] = _write_plate(stage, cables, printer, ini)
         ctx.files.append("cables-plate.3mf")
-    ctx.record["parts"] = rec
-    ctx.report.heading("Meshes")
-    ctx.report.paragraph("One watertight body per part (STL, and a 3MF that opens in "
-                         "PrusaSlicer with the part's settings), placed on the printer bed.")
-    ctx.report.table(["part", "size on bed (mm)", "volume mm^3", "vs analytic", "triangles",
-                      "turned (deg)"], rows)
+    meshes_section(ctx.report, rec)
+    return {"parts": rec}
 
 
 def _mesh_parts(d: Design, comp: float) -> list[tuple]:
@@ -220,9 +196,9 @@ def _mesh_parts(d: Design, comp: float) -> list[tuple]:
 
 
 def _write_part(stage: Path, name: str, kind: str, part, body, printer, outline,
-                expected: float) -> tuple[dict[str, Any], list[str]]:
+                expected: float) -> dict[str, Any]:
     """Place `body` on the bed and write its STL, 3MF (and STEP from `outline` when given);
-    (its record, its row of the report's table)."""
+    its record."""
     from printgen.parts.export import place_mesh, prusa_config_from_ini, stl_bytes, threemf_bytes
     from printgen.parts.slicer.prusa import prusa_ini_text
 
@@ -245,9 +221,7 @@ def _write_part(stage: Path, name: str, kind: str, part, body, printer, outline,
            "volume_error": volume / expected - 1, "size_mm": np.round(size, 4),
            "triangles": len(mesh.faces), "watertight": bool(mesh.is_watertight),
            "bed_angle_deg": angle}
-    row = [name, f"{size[0]:.1f} x {size[1]:.1f} x {size[2]:.2f}", f"{mesh.volume:.1f}",
-           f"{volume / expected - 1:+.2%}", str(len(mesh.faces)), f"{angle:g}"]
-    return rec, row
+    return rec
 
 
 def _write_plate(stage: Path, cables: list[tuple[str, Any]], printer, ini: str
@@ -265,7 +239,7 @@ def part_thickness(kind: str, part) -> float:
     return (part.strand if kind == "net" else part.section).thickness_mm
 
 
-def verify_step(ctx: MakeContext, stage: Path) -> None:
+def verify_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     """Prototype vs model over the loading sweep, the model's uncertainty band
     (printgen.check.bands), and the steel counter-example: the sections and record of
     `verification_report`, collected from the helper process `make` started the sweeps in,
@@ -276,12 +250,11 @@ def verify_step(ctx: MakeContext, stage: Path) -> None:
         (blocks, figures, record), seconds = _collect(pending)
         ctx.record.setdefault("timings_s", {})[HELPER_REPORT] = seconds
     else:
-        v, band = verification_sweeps(ctx.prototype, ctx.design,
-                                      drag=bool(ctx.options.get("drag")))
+        v, band = verification_sweeps(ctx.prototype, ctx.design, load=ctx.options.load)
         blocks, figures, record = verification_report(v, band, ctx.targets.scale)
     ctx.report.blocks.extend(blocks)
     ctx.report.figures.extend(figures)
-    ctx.record["verification"] = record
+    return {"verification": record}
 
 
 def sweeps_done(ctx: MakeContext) -> None:
@@ -315,7 +288,7 @@ def timed(fn: Callable, /, *args: Any, **kwargs: Any) -> tuple[Any, float]:
     return fn(*args, **kwargs), time.perf_counter() - t
 
 
-def verification_sweeps(prototype: Prototype, design: Design, *, drag: bool = False
+def verification_sweeps(prototype: Prototype, design: Design, *, load: str | None = None
                         ) -> tuple[Verification, Band]:
     """Both barriers' load sweeps compared, and the model's uncertainty band.
 
@@ -326,8 +299,8 @@ def verification_sweeps(prototype: Prototype, design: Design, *, drag: bool = Fa
     from printgen.check.bands import free_section, model_band, model_load_kw
     from printgen.check.verify import verify
 
-    v = verify(prototype, design, drag=drag, counterexample=True)
-    return v, model_band(design, v.model, load_kw=model_load_kw(prototype, design, drag),
+    v = verify(prototype, design, load=load, counterexample=True)
+    return v, model_band(design, v.model, load_kw=model_load_kw(prototype, design, load),
                          free_section=free_section(prototype))
 
 

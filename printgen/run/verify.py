@@ -50,8 +50,7 @@ from printgen.report.uncertainty import (
     measured_sections,
 )
 from printgen.run.budget import DEFAULT_LIMIT_S, Work, check_budget, sweep_cores
-
-TIMINGS = "timings.json"  # wall-clock times, the one file that differs between identical runs
+from printgen.run.provenance import TIMINGS
 
 
 @dataclass
@@ -71,9 +70,9 @@ class VerifyRun:
 
 def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
                   out: str | Path, *, measured: str | Path | None = None,
-                  fit: str = "stiffness", drag: bool = False, force: bool = False,
+                  fit: str = "stiffness", load: str | None = None, force: bool = False,
                   progress: Callable[[str], None] | None = None,
-                  time_limit_s: float = DEFAULT_LIMIT_S) -> VerifyRun:
+                  time_limit_s: float | None = None) -> VerifyRun:
     """Check the design against the prototype with its band; compare and fit `measured`.
 
     Every input is read and checked before the first solve, so a bad file costs nothing; so
@@ -87,11 +86,12 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     p = load_prototype(prototype)
     d = load_design(design_path, scale=scale)
     m = read_measured(measured, design_units(d)) if measured is not None else None
-    check_budget(p, d, limit_s=time_limit_s, cores=sweep_cores(),
+    limit = DEFAULT_LIMIT_S if time_limit_s is None else time_limit_s
+    check_budget(p, d, limit_s=limit, cores=sweep_cores(),
                  work=Work(parts=False, fit=m is not None, model_follows=False))
-    load_kw = model_load_kw(p, d, drag)
+    load_kw = model_load_kw(p, d, load)
     say("verification (prototype and model load sweeps)")
-    v = verify(p, d, drag=drag)
+    v = verify(p, d, load=load)
     say("uncertainty band (model variants)")
     band = model_band(d, v.model, load_kw=load_kw, free_section=free_section(p))
     result, text = None, ""

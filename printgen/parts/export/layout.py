@@ -34,12 +34,6 @@ class Placement:
     mesh: trimesh.Trimesh
     angle_deg: float
 
-    @property
-    def footprint_mm(self) -> tuple[float, float]:
-        lo, hi = self.mesh.bounds
-        return float(hi[0] - lo[0]), float(hi[1] - lo[1])
-
-
 def usable_bed_mm(printer: Printer) -> np.ndarray:
     """(2,) float, mm: the bed less its margin on every side."""
     return np.array([printer.bed_x_mm, printer.bed_y_mm]) - 2 * printer.bed_margin_mm

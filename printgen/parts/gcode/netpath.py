@@ -20,6 +20,7 @@ import itertools
 
 import numpy as np
 
+from printgen.barrier.graph import NetGraph
 from printgen.design.record import NetDesign, Section
 from printgen.errors import ProfileError
 from printgen.inputs.materials import Material
@@ -39,14 +40,13 @@ from printgen.parts.gcode.toolpath import (
     speeds,
 )
 from printgen.parts.geometry.attach import CORNER_EXTRA_RINGS, Attachment, Hole, holes
-from printgen.parts.geometry.net import NetGraph, diamond_net
 
 
 def net_toolpath(net: NetDesign, printer: Printer, style: PrintStyle, material: Material, *,
                  crossing_flow_factor: float | None = None,
                  attachment: Attachment | None = None) -> Toolpath:
     """Toolpath of the whole net, one layer per pass (see the module docstring)."""
-    g = diamond_net(net.width_mm, net.height_mm, net.mesh_x_mm, net.mesh_y_mm)
+    g = net.graph()
     hs = [] if attachment is None else holes(net, g, attachment)
     angle, centre = check_part("net", net, printer, style,
                                reach_mm=max((h.outer_r_mm for h in hs), default=0.0))
@@ -234,7 +234,7 @@ def net_volume_budget(net: NetDesign, style: PrintStyle, *,
                       crossing_flow_factor: float | None = None) -> VolumeBudget:
     """Designed volumes of the net (analytic, rectangular sections)."""
     f = style.crossing_flow_factor if crossing_flow_factor is None else crossing_flow_factor
-    g = diamond_net(net.width_mm, net.height_mm, net.mesh_x_mm, net.mesh_y_mm)
+    g = net.graph()
     sec = net.strand
     t = sec.thickness_mm
     w = sec.width_mm

@@ -19,7 +19,6 @@ from printgen.errors import PrintabilityError, ProfileError
 from printgen.inputs.materials import Material
 from printgen.inputs.printers import Printer, PrintStyle, check_pass
 from printgen.parts.geometry.attach import border_beads as border_bead
-from printgen.parts.geometry.net import diamond_net
 
 TRAVEL, BORDER, STRAND_PLUS, STRAND_MINUS, CABLE_STRIP, EYELET, COMB = 0, 1, 2, 3, 4, 5, 6
 KIND_NAMES = {TRAVEL: "travel", BORDER: "border", STRAND_PLUS: "strand+",
@@ -146,8 +145,7 @@ def check_part(part_kind: str, part: NetDesign | CableDesign, printer: Printer,
                                 f"{printer.max_height_mm:g} mm build height of {printer.key}")
     if part_kind == "net":
         check_pass(printer, border_bead(part)[1], sec.layer_heights_mm[0], where=f"{where} border")
-        size = np.array(diamond_net(part.width_mm, part.height_mm, part.mesh_x_mm,
-                                    part.mesh_y_mm).size_mm) \
+        size = np.array(part.graph().size_mm) \
             + 2 * max(part.border_width_mm / 2, reach_mm)
     else:
         ring_w = ring_layout(part, printer.hole_compensation_mm)[1]

@@ -22,9 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from printgen.barrier.graph import NetGraph
 from printgen.design.record import Design, NetDesign
 from printgen.errors import GeometryError
-from printgen.parts.geometry.net import NetGraph
 
 DEFAULT_CLEARANCE_MM = 0.3  # issue 12: at least 0.3 mm each side of the strip in a loop
 CORNER_EXTRA_RINGS = 1  # full bead rings around the pin hole, inside the border's detour

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from printgen.barrier.graph import NetGraph
 from printgen.design.record import CableDesign, NetDesign
 from printgen.errors import GeometryError
 from printgen.parts.geometry.attach import Attachment, Hole, attachment_for, holes
@@ -28,7 +29,6 @@ from printgen.parts.geometry.cable import (
     circle_points,
     require_shapely,
 )
-from printgen.parts.geometry.net import NetGraph, diamond_net
 
 if TYPE_CHECKING:  # pragma: no cover
     import trimesh
@@ -46,7 +46,7 @@ def _graph(net: NetDesign) -> NetGraph:
     check_positive_mm(net.strand.width_mm, "net strand width")
     check_positive_mm(net.strand.thickness_mm, "net strand thickness")
     check_positive_mm(net.border_width_mm, "net border width")
-    g = diamond_net(net.width_mm, net.height_mm, net.mesh_x_mm, net.mesh_y_mm)
+    g = net.graph()
     a, b = g.mesh_mm
     w, bw = net.strand.width_mm, net.border_width_mm
     spacing = a * b / np.hypot(a, b)  # between neighbouring parallel strands

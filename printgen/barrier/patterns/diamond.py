@@ -1,58 +1,70 @@
-"""Diamond-net centre-line graph in the print plane (mm), shared by the solver scenes, the
-meshes and the toolpaths.
+"""The diamond net: strands on both diagonals of each mesh, the printed model's pattern.
 
 Lattice: strand crossings at (i * a/2, j * b/2) with i + j even, where a is the mesh diagonal
 along x (across the barrier) and b the diagonal along y (up the barrier). Strands are straight
 lines of slope +b/a (family +1) and -b/a (family -1) from border to border; a border strand
 (family 0) runs around the perimeter through every boundary node and the four corners. The
-mesh diagonals are kept exact: the panel size is rounded to whole half-diagonals and the
-difference is reported in `size_error_mm`.
+mesh diagonals are kept exact: the panel size is rounded to whole half-diagonals (`span`).
+
+Membrane law: under a stretch eps along the load (transverse strain blocked, as in the panel
+test) a strand at angle theta to the cross direction strains eps sin^2(theta); with
+2 / a_across strands per unit width, the force per unit width is
+N = 2 E A sin^3(theta) / a_across * eps.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
 
 import numpy as np
 
+from printgen.barrier.graph import NetGraph, check_lengths
+from printgen.barrier.patterns import Law, NetPattern
 from printgen.errors import GeometryError
 
 MIN_HALF_CELLS = 2  # fewer half-meshes across than this is not a net
 
 
-@dataclass(frozen=True)
-class NetGraph:
-    """Centre lines of a diamond net.
+def diamond_sin(mesh_along: float, mesh_across: float) -> float:
+    """sin(theta) of a diamond strand, theta its angle to the cross direction."""
+    return (mesh_along / 2) / math.hypot(mesh_along / 2, mesh_across / 2)
 
-    nodes_mm : (n, 2) float, mm; x across, y up; origin at the lower-left corner
-    segments : (m, 2) int, node indices of straight pieces between neighbouring nodes
-    family : (m,) int, +1 / -1 diagonal strand families, 0 border
-    strands : list of (k,) int arrays, each a straight diagonal strand, border to border
-    border : (p,) int, closed perimeter loop of node indices (first node not repeated)
-    mesh_mm : (a, b) diagonals; half_cells : (nx, ny) half-diagonals across and up
+
+def diamond_factor(mesh_along: float, mesh_across: float) -> float:
+    """2 sin^3(theta) / a_across (1/m) of a diamond net loaded along `mesh_along`."""
+    sin = diamond_sin(mesh_along, mesh_across)
+    return 2 * sin**3 / mesh_across
+
+
+def strand_law(knees: tuple[float, ...], slopes: tuple[float, ...], mesh_along: float,
+               mesh_across: float) -> Law:
+    """Strand force law whose diamond net has the membrane law (knees, slopes N/m).
+
+    Stretching the net by eps along the load strains a strand by eps sin^2(theta), and the
+    strands carry N = (2 / a_across) F sin(theta) per unit width; so the strand law has knees
+    eps_k sin^2(theta) and slopes N' a_across / (2 sin^3(theta)).
     """
+    sin = diamond_sin(mesh_along, mesh_across)
+    f = 1.0 / (diamond_factor(mesh_along, mesh_across))
+    return tuple(k * sin * sin for k in knees), tuple(s * f for s in slopes)
 
-    nodes_mm: np.ndarray
-    segments: np.ndarray
-    family: np.ndarray
-    strands: list[np.ndarray]
-    border: np.ndarray
-    mesh_mm: tuple[float, float]
-    half_cells: tuple[int, int]
 
-    @property
-    def size_mm(self) -> tuple[float, float]:
-        return float(self.nodes_mm[:, 0].max()), float(self.nodes_mm[:, 1].max())
+def strand_force(n: float, mesh_along: float, mesh_across: float) -> float:
+    """Strand tension (N) under a membrane force `n` N/m along the load: 2 / a_across
+    strands per unit width carry it, each at sin(theta) to the cross direction."""
+    return n * mesh_across / (2 * diamond_sin(mesh_along, mesh_across))
 
-    @property
-    def on_border(self) -> np.ndarray:
-        mask = np.zeros(len(self.nodes_mm), dtype=bool)
-        mask[self.border] = True
-        return mask
 
-    def segment_lengths_mm(self) -> np.ndarray:
-        d = self.nodes_mm[self.segments[:, 1]] - self.nodes_mm[self.segments[:, 0]]
-        return np.hypot(d[:, 0], d[:, 1])
+def span(length: float, diagonal: float) -> float:
+    """`length` rounded to whole half-diagonals (the rule of `diamond_net`)."""
+    return round(2 * length / diagonal) * diagonal / 2
+
+
+def diamond_nodes(width: float, height: float, mesh_x: float, mesh_y: float) -> int:
+    """Nodes of `diamond_net` (any length unit)."""
+    nx, ny = max(round(2 * width / mesh_x), 1), max(round(2 * height / mesh_y), 1)
+    odd_corners = sum((i + j) % 2 for i in (0, nx) for j in (0, ny))  # kept as nodes too
+    return ((nx + 1) * (ny + 1) + 1) // 2 + odd_corners
 
 
 def diamond_net(width_mm: float, height_mm: float, mesh_x_mm: float, mesh_y_mm: float) -> NetGraph:
@@ -60,10 +72,7 @@ def diamond_net(width_mm: float, height_mm: float, mesh_x_mm: float, mesh_y_mm: 
 
     The panel is nx = round(2 W / a) half-diagonals wide and ny = round(2 H / b) high.
     """
-    for label, v in (("width", width_mm), ("height", height_mm),
-                     ("mesh_x", mesh_x_mm), ("mesh_y", mesh_y_mm)):
-        if not np.isfinite(v) or v <= 0:
-            raise GeometryError(f"net {label} = {v!r} mm must be a positive finite length")
+    check_lengths(width=width_mm, height=height_mm, mesh_x=mesh_x_mm, mesh_y=mesh_y_mm)
     nx, ny = round(2 * width_mm / mesh_x_mm), round(2 * height_mm / mesh_y_mm)
     if min(nx, ny) < MIN_HALF_CELLS:
         raise GeometryError(
@@ -120,3 +129,7 @@ def _border_loop(index: np.ndarray, nx: int, ny: int) -> np.ndarray:
     ring = ([(i, 0) for i in range(nx + 1)] + [(nx, j) for j in range(1, ny + 1)]
             + [(i, ny) for i in range(nx - 1, -1, -1)] + [(0, j) for j in range(ny - 1, 0, -1)])
     return np.array([index[i, j] for i, j in ring if index[i, j] >= 0])
+
+
+PATTERN = NetPattern("diamond", diamond_net, diamond_factor, strand_law, strand_force,
+                     span, diamond_nodes)

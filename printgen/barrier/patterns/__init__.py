@@ -1,0 +1,70 @@
+"""Net patterns: how a mesh of strands turns into a graph, a membrane law and a node count.
+
+Each module here defines `PATTERN`, a `NetPattern`; `get_pattern(name)` finds it (a new
+pattern is one module plus its test). Lengths of the graph in mm, of the laws in m.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from printgen.barrier.graph import NetGraph
+from printgen.errors import InputError
+
+Law = tuple[tuple[float, ...], tuple[float, ...]]  # (strain knees, force slopes)
+# Prototype patterns drawn as another (the prototype file's [net] pattern), said so in the
+# verification's assumptions.
+AS_DRAWN = {"water-drop": "diamond"}
+
+
+@dataclass(frozen=True)
+class NetPattern:
+    """A net pattern as data: its functions of the mesh (a_along: mesh along the load, i.e.
+    up the barrier; a_across: across it).
+
+    graph(width_mm, height_mm, mesh_x_mm, mesh_y_mm) : the NetGraph of a panel about that size
+    membrane_factor(a_along, a_across) : 1/m, membrane stiffness (N/m) per strand E*A (N)
+    strand_law(knees, slopes N/m, a_along, a_across) : the strand law (knees, N) whose net
+      has the membrane law
+    strand_force(n, a_along, a_across) : N, the strand tension under a membrane force n N/m
+      along the load
+    span(length, mesh) : `length` rounded to the lattice of `mesh` (any unit)
+    nodes(width, height, mesh_x, mesh_y) : nodes of `graph` (any length unit)
+    """
+
+    name: str
+    graph: Callable[[float, float, float, float], NetGraph]
+    membrane_factor: Callable[[float, float], float]
+    strand_law: Callable[[tuple[float, ...], tuple[float, ...], float, float], Law]
+    strand_force: Callable[[float, float, float], float]
+    span: Callable[[float, float], float]
+    nodes: Callable[[float, float, float, float], int]
+
+
+def pattern_names() -> tuple[str, ...]:
+    """Every pattern's name, then those drawn as another (`AS_DRAWN`), without importing the
+    patterns: the prototype file's [net] pattern choices."""
+    import printgen.barrier.patterns as package
+    from printgen.barrier.registry import names
+
+    return (*names(package), *AS_DRAWN)
+
+
+def patterns() -> dict[str, NetPattern]:
+    """Every pattern, by name."""
+    import printgen.barrier.patterns as package
+    from printgen.barrier.registry import entries
+
+    return entries(package, "PATTERN")
+
+
+def get_pattern(name: str) -> NetPattern:
+    """The pattern called `name` (or the one it is drawn as, `AS_DRAWN`); InputError
+    listing the known ones otherwise."""
+    known = patterns()
+    found = known.get(AS_DRAWN.get(name, name))
+    if found is None:
+        raise InputError(f"net pattern {name!r} is not one of {', '.join(known)}; add "
+                         "printgen/barrier/patterns/<name>.py or use a known one")
+    return found

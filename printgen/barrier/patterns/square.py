@@ -1,0 +1,70 @@
+"""The square net: strands across and up the barrier (the simple barrier of the scale series,
+Lambert et al. 2023, doi:10.1061/JHEND8.HYENG-13070). Its mesh is the square's side
+`mesh_x` (both ways). Under a stretch eps along the load the strands up the barrier strain
+eps and carry it, one per mesh across: N = E A / a_across * eps; the strands across carry
+nothing (transverse strain blocked)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from printgen.barrier.graph import NetGraph, check_lengths
+from printgen.barrier.patterns import Law, NetPattern
+from printgen.errors import GeometryError
+
+MIN_MESHES = 1  # at least one mesh each way
+
+
+def square_factor(mesh_across: float) -> float:
+    """1 / a_across (1/m): a square net's strands along the load, one per mesh."""
+    return 1.0 / mesh_across
+
+
+def membrane_factor(mesh_along: float, mesh_across: float) -> float:
+    return square_factor(mesh_across)
+
+
+def strand_force(n: float, mesh_along: float, mesh_across: float) -> float:
+    """Strand tension (N) under a membrane force `n` N/m: one strand per a_across carries it."""
+    return n * mesh_across
+
+
+def strand_law(knees: tuple[float, ...], slopes: tuple[float, ...], mesh_along: float,
+               mesh_across: float) -> Law:
+    """Strand law of a square net with membrane law (knees, slopes N/m): the strands along
+    the load strain as the net (same knees) and each carries a_across of its width."""
+    return tuple(knees), tuple(s * mesh_across for s in slopes)
+
+
+def span(length: float, mesh: float) -> float:
+    """`length` rounded to whole meshes (the rule of `square_graph`)."""
+    return round(length / mesh) * mesh
+
+
+def square_nodes(width: float, height: float, mesh_x: float, mesh_y: float) -> int:
+    """Nodes of `square_graph` (any length unit; the mesh is `mesh_x` both ways)."""
+    return (round(width / mesh_x) + 1) * (round(height / mesh_x) + 1)
+
+
+def square_graph(width_mm: float, height_mm: float, mesh_x_mm: float,
+                 mesh_y_mm: float | None = None) -> NetGraph:
+    """A square-mesh net (strands across and up) of side `mesh_x_mm` as a NetGraph."""
+    mesh_mm = mesh_x_mm
+    check_lengths(width=width_mm, height=height_mm, mesh_x=mesh_mm)
+    nx, ny = round(width_mm / mesh_mm), round(height_mm / mesh_mm)
+    if min(nx, ny) < MIN_MESHES:
+        raise GeometryError(f"net {width_mm:g} x {height_mm:g} mm holds {nx} x {ny} square "
+                            f"meshes of {mesh_mm:g} mm; need at least {MIN_MESHES} each way: "
+                            "use a smaller mesh or a larger panel")
+    ii, jj = np.meshgrid(np.arange(nx + 1), np.arange(ny + 1), indexing="ij")
+    nodes = np.column_stack([ii.ravel() * mesh_mm, jj.ravel() * mesh_mm]).astype(float)
+    idx = np.arange((nx + 1) * (ny + 1)).reshape(nx + 1, ny + 1)
+    segs = np.vstack([np.column_stack([idx[:-1].ravel(), idx[1:].ravel()]),
+                      np.column_stack([idx[:, :-1].ravel(), idx[:, 1:].ravel()])])
+    ring = np.concatenate([idx[:, 0], idx[-1, 1:], idx[-2::-1, -1], idx[0, -2:0:-1]])
+    return NetGraph(nodes, segs, np.ones(len(segs), int), [], ring,
+                    (2.0 * mesh_mm, 2.0 * mesh_mm), (2 * nx, 2 * ny))
+
+
+PATTERN = NetPattern("square", square_graph, membrane_factor, strand_law, strand_force,
+                     span, square_nodes)
