@@ -13,6 +13,7 @@ import logging
 import os
 import sys
 from concurrent.futures.process import BrokenProcessPool
+from typing import NoReturn
 
 from printgen.errors import PrintgenError, TimeLimitError
 from printgen.outputs import describe_os_error, os_error_exit_code, tracking_swaps
@@ -34,11 +35,23 @@ COMMAND_MODULES = (
 )
 
 
+class UsageError(PrintgenError):
+    """The command line itself is wrong: a missing or unknown option, a bad value."""
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse, with its errors as one line and a hint (like every other error), not a
+    usage block: `UsageError` for `main` to print."""
+
+    def error(self, message: str) -> NoReturn:
+        raise UsageError(f"{self.prog}: error: {message}; see `{self.prog} --help`")
+
+
 def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
     """The parser of every command, or with `argv` naming one (its first word that is not an
     option) of that command alone: the others' imports (scipy.optimize for calibrate, ...)
     would only delay it (each module registers the command of its own name)."""
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="printgen",
         description="Stiffness-scaled, printable flexible-barrier models for flume experiments.",
     )
@@ -63,6 +76,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         parser = build_parser(argv)
         args = parser.parse_args(argv)
+    except UsageError as exc:
+        return _fail(str(exc), 2)
     except KeyboardInterrupt:
         print("printgen: interrupted (Ctrl-C)", file=sys.stderr)
         return 130

@@ -47,6 +47,15 @@ class Interrupted(BaseException):
         return 128 + self.signum
 
 
+def cores() -> int:
+    """CPU cores this process may run on: its affinity (a container's or `taskset`'s share),
+    else the machine's count."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
 def _raise(signum: int, _frame: Any) -> None:
     raise Interrupted(signum)
 
@@ -179,7 +188,7 @@ def run_jobs(jobs: list[tuple]) -> list:
     On any exception or signal in the parent the workers are killed before it propagates.
     """
     global _sink
-    workers = min(len(jobs), os.cpu_count() or 1)
+    workers = min(len(jobs), cores())
     if workers < 2 or os.environ.get("PRINTGEN_SERIAL"):
         _sink = _listener
         try:

@@ -182,3 +182,133 @@ def test_check_command(capsys, tmp_path):
     assert rep["differences"][1] == "extra: stray.txt"
     code, _, err = run(capsys, "check", tmp_path)
     assert code == 2 and "no manifest.json" in one_line(err)
+
+
+# Issue 20: bad inputs that ended as "internal error" exit 1 (or passed silently), each now
+# one line and exit 2, at the input stage (nothing is solved or written).
+BASE_TEXT = REALISTIC.read_text()
+TOML_CASES = {
+    "width_m 400 digits": (BASE_TEXT.replace("width_m = 13.2", "width_m = " + "9" * 400),
+                           "too large for a number"),
+    "anchors 400 digits": (BASE_TEXT.replace("anchors = 4", "anchors = " + "9" * 400),
+                           "too large for a number"),
+    "anchors 5000 digits": (BASE_TEXT.replace("anchors = 4", "anchors = " + "9" * 5000),
+                            "not valid TOML"),
+    "nested inline tables": (BASE_TEXT.replace("anchors = 4", "anchors = 4\nx = " + "{a = " * 1500
+                                               + "1" + "}" * 1500), "nested too deeply"),
+    "materials = [1, 2]": (BASE_TEXT + "materials = [1, 2]\n",
+                           "materials[0]: 1 (int) is not a profile name"),
+    "20 000 materials": (BASE_TEXT + "materials = [" + '"tpe", ' * 20000 + "]\n",
+                         "at most 100 are allowed"),
+    "velocity 1e-300": (BASE_TEXT.replace("velocity_m_per_s = 2.2", "velocity_m_per_s = 1e-300"),
+                        "must be >= 0.01 m/s"),
+    "mesh_x_m 5e-324": (BASE_TEXT.replace("mesh_x_m = 0.63", "mesh_x_m = 5e-324"),
+                        "must be >= 0.001 m"),
+    "[model] mesh_x_mm 1e-9": (BASE_TEXT.replace("mesh_x_mm = 20.6", "mesh_x_mm = 1e-9"),
+                               "must be >= 0.5 mm"),
+    "froude_min > froude_max": (BASE_TEXT.replace("froude_min = 0.5", "froude_min = 2.0"),
+                                "froude_min = 2 is above froude_max = 1.4"),
+    "control characters in the name": (BASE_TEXT.replace('name = "Realistic', 'name = "\\u001b[31m'),
+                                       "control character U+001B"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(TOML_CASES))
+def test_bad_prototype_values_are_one_line_exit_2(capsys, tmp_path, case):
+    text, message = TOML_CASES[case]
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    code, out, err = run(capsys, "select", path, "--scale", 40)
+    assert code == 2 and out == "" and message in one_line(err), err
+
+
+def _design_text(tmp_path, edit) -> str:
+    d = api.plan(REALISTIC, 40).to_dict()
+    edit(d)
+    return json.dumps(d)
+
+
+DESIGN_CASES = {
+    "5000-digit scale": (lambda d: d.update(scale=0), "not valid JSON"),
+    "nested array": (lambda d: d["net"].update(width_mm=[[1.0]]), "is not a number"),
+    "integer material": (lambda d: d["net"].update(material=3),
+                         "net.material: 3 (int) is not a profile name"),
+    "width_mm 1e300": (lambda d: d["net"].update(width_mm=1e300), "must be <= 10000 mm"),
+    "printer as a list": (lambda d: d.update(printer=["generic-350"]),
+                          "printer: ['generic-350'] (list) is not a profile name"),
+    "2000 cables": (lambda d: d.update(cables=d["cables"] * 500), "a second 'top' cable"),
+    "cable of no side": (lambda d: d["cables"][0].update(name="x"), "is not one of: top"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(DESIGN_CASES))
+def test_bad_design_files_are_one_line_exit_2(capsys, tmp_path, case):
+    edit, message = DESIGN_CASES[case]
+    text = _design_text(tmp_path, edit)
+    if case == "5000-digit scale":
+        text = text.replace('"scale": 0', '"scale": ' + "4" * 5000)
+    design = tmp_path / "design.json"
+    design.write_text(text)
+    code, out, err = run(capsys, "verify", REALISTIC, "-s", 40, "--design", design,
+                         "--out", tmp_path / "v")
+    assert code == 2 and out == "" and message in one_line(err), err
+    assert not (tmp_path / "v").exists()
+
+
+def test_deeply_nested_design_file(capsys, tmp_path):
+    design = tmp_path / "design.json"
+    design.write_text("[" * 100_000 + "]" * 100_000)
+    code, _, err = run(capsys, "verify", REALISTIC, "-s", 40, "--design", design)
+    assert code == 2 and "nested too deeply" in one_line(err)
+
+
+MANIFEST_CASES = {
+    "command not a list": (lambda m: m.update(command=5), "command = 5 is not a list of strings"),
+    "file entry a string": (lambda m: m["files"].update({"a.txt": "abc"}), "file entry 'a.txt'"),
+    "file entry null": (lambda m: m["files"].update({"a.txt": None}), "file entry 'a.txt'"),
+    "volatile = 5": (lambda m: m.update(volatile=5),
+                     "volatile = 5: only ['timings.json'] may be volatile"),
+    "version not text": (lambda m: m.update(printgen_version=5), "'printgen_version' is not text"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(MANIFEST_CASES))
+def test_bad_manifest_entries_are_one_line_exit_2(capsys, tmp_path, case):
+    edit, message = MANIFEST_CASES[case]
+    (tmp_path / "a.txt").write_text("x")
+    manifest = {"format": 1, "files": {"a.txt": {"sha256": "0" * 64, "bytes": 1}},
+                "volatile": [], "command": ["printgen"], "printgen_version": "0"}
+    edit(manifest)
+    (tmp_path / "manifest.json").write_text(json.dumps(manifest))
+    code, _, err = run(capsys, "check", tmp_path)
+    assert code == 2 and message in one_line(err), err
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["targets", REALISTIC], "the following arguments are required: --scale/-s"),
+    (["make", REALISTIC, "-s", "40", "--time-limit", "abc"], "'abc' is not a number of seconds"),
+    (["frobnicate"], "invalid choice: 'frobnicate'"),
+])
+def test_argparse_errors_are_one_line_with_a_hint(capsys, argv, message):
+    code, out, err = run(capsys, *argv)
+    line = one_line(err)
+    assert code == 2 and out == "" and message in line and "--help`" in line, err
+
+
+@pytest.mark.parametrize("command", ["make", "verify"])
+@pytest.mark.parametrize("limit", ["0", "-1", "nan", "inf"])
+def test_time_limit_must_be_positive_seconds(capsys, tmp_path, command, limit):
+    argv = [command, REALISTIC, "-s", "40", "--time-limit", limit, "--out", tmp_path / "o"]
+    if command == "verify":
+        argv += ["--design", tmp_path / "never-read.json"]
+    code, _, err = run(capsys, *argv)
+    assert code == 2 and "must be a positive number of seconds" in one_line(err), err
+    assert not (tmp_path / "o").exists()
+
+
+def test_time_limit_zero_is_refused_by_the_api_too(tmp_path):
+    from printgen.errors import InputError
+
+    with pytest.raises(InputError, match="must be a positive number of seconds"):
+        make_mod.make(REALISTIC, 40, tmp_path / "o", options=make_mod.MakeOptions(time_limit_s=0),
+                      steps=[])

@@ -13,8 +13,8 @@ from printgen.inputs.prototype import load_prototype
 
 @pytest.mark.parametrize("edit, message", [
     ({("barrier", "colour"): "red"}, r"unknown key 'colour'; allowed keys: anchors, height_m"),
-    ({("barrier", "width_m"): -13.2}, r"width_m = -13.2 is out of range: it must be > 0 m"),
-    ({("barrier", "width_m"): 0.0}, r"width_m = 0.0 is out of range: it must be > 0 m"),
+    ({("barrier", "width_m"): -13.2}, r"width_m = -13.2 is out of range: it must be >= 0.1 m"),
+    ({("barrier", "width_m"): 0.0}, r"width_m = 0.0 is out of range: it must be >= 0.1 m"),
     ({("barrier", "width_m"): float("nan")}, r"width_m = nan is not finite"),
     ({("barrier", "width_m"): "13"}, r"width_m = '13' is not a number"),
     ({("barrier", "height_m"): None}, r"missing key 'height_m'"),

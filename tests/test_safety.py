@@ -105,10 +105,10 @@ def cli(capsys, *argv) -> tuple[int, str]:
 def made(tmp_path_factory):
     """One real `printgen make` output of the small example (its design, report and manifest;
     no parts: they add nothing here), shared by the cases needing it."""
-    from printgen.run.make import make
+    from printgen.run.make import MakeOptions, make
 
     out = tmp_path_factory.mktemp("made") / "out"
-    make(SIMPLE, 40, out, steps=[], options={"command": ["printgen", "make"]})  # plan only
+    make(SIMPLE, 40, out, steps=[], options=MakeOptions(command=["printgen", "make"]))  # plan only
     return out
 
 

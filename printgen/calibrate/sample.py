@@ -9,6 +9,7 @@ section 2).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -36,6 +37,7 @@ from printgen.errors import CalibrationError
 
 DEFAULT_SECANTS = (0.005, 0.01)  # strain where secant moduli are reported (0.5 %, 1 %)
 PRELOAD_STEPS = (0.9, 1.1)  # preload factors for the modulus's sensitivity (+-10 %)
+MAX_STRAIN = 10.0  # 1000 %: beyond any specimen's elongation, a strain given in the wrong unit
 
 
 @dataclass(frozen=True)
@@ -53,6 +55,18 @@ class FitOptions:
     bilinear: bool = True
     zero: str = DEFAULT_ZERO
     keep_flagged: bool = False
+
+    def __post_init__(self) -> None:
+        """Refuse what would fit silently wrong: a preload that is not a positive force, a
+        secant strain that is not a positive strain (nan, -1 %, 0). (The window is checked
+        where it is fitted: `fit.linear_fit`.)"""
+        if self.preload is not None and not (math.isfinite(self.preload) and self.preload > 0):
+            raise CalibrationError(f"--preload {self.preload:g} N must be a positive force "
+                                   "(the force where strain is zeroed, e.g. 2)")
+        for e in self.secant_strains:
+            if not (math.isfinite(e) and 0 < e <= MAX_STRAIN):
+                raise CalibrationError(f"--secant strain {e * 100:g} % must be a positive strain "
+                                       f"up to {MAX_STRAIN * 100:g} % (e.g. 0.5,1)")
 
 
 @dataclass(frozen=True)

@@ -221,6 +221,12 @@ def _check_ranges(p: Path, data: dict[str, np.ndarray], line_numbers: list[int])
                                    f"outside {lo:g} to {hi:g}; check the unit of the column")
         if np.all(np.isnan(v)):
             raise MeasurementError(f"{p}: column {col!r} holds no value; fill or remove it")
+        if np.all(v[~np.isnan(v)] == 0):  # its mismatch is relative to its peak: nothing to fit
+            raise MeasurementError(f"{p}: column {col!r} holds only zeros: nothing to compare or "
+                                   "fit (a sensor not connected?); fill or remove it")
+    if not np.any(lv > 0):
+        raise MeasurementError(f"{p}: every {LEVEL_COLUMN} is 0: the net was never loaded, so "
+                               "there is nothing to compare or fit")
 
 
 

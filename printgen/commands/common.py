@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from typing import Any
 
@@ -17,6 +18,28 @@ def add_prototype_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("prototype", help="prototype barrier TOML (see examples/)")
     p.add_argument("--scale", "-s", type=float, required=True, metavar="LAMBDA",
                    help="geometric scale lambda = prototype / model, >= 1 (1:40 -> 40)")
+
+
+def add_time_limit_arg(p: argparse.ArgumentParser) -> None:
+    """--time-limit SECONDS: the run's estimate must fit it (printgen.run.budget)."""
+    from printgen.run.budget import DEFAULT_LIMIT_S
+
+    p.add_argument("--time-limit", type=seconds, default=DEFAULT_LIMIT_S, metavar="SECONDS",
+                   help=f"refuse runs estimated longer than this (default {DEFAULT_LIMIT_S:g} s,"
+                        " about a minute on 2 cores)")
+
+
+def seconds(text: str) -> float:
+    """An argparse type: a positive, finite number of seconds (0, -1 and nan are refused, not
+    taken as the default)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"{text} must be a positive number of seconds, e.g. "
+                                         "600")
+    return value
 
 
 def check_profile_args(args: argparse.Namespace, *options: str) -> None:

@@ -17,6 +17,7 @@ from printgen.commands.common import (
     check_profile_args,
     console,
     emit_json,
+    seconds,
     table,
 )
 from printgen.run import api
@@ -37,7 +38,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--step", action="store_true", help="also write STEP files (needs cadquery)")
     p.add_argument("--design", metavar="FILE", type=Path,
                    help="print this design.json (from printgen design) instead of select's")
-    p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
+    p.add_argument("--time-limit", type=seconds, default=None, metavar="SECONDS",
                    help=f"refuse runs estimated longer than this and stop the run (exit "
                         f"{EXIT_TIME_LIMIT}, nothing written) once it has run this long "
                         f"(default: refuse over {DEFAULT_LIMIT_S:g} s, about a minute on 2 "

@@ -16,6 +16,7 @@ from printgen.commands.common import (
     add_json_arg,
     add_load_args,
     add_prototype_args,
+    add_time_limit_arg,
     console,
     emit_json,
     table,
@@ -39,6 +40,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_load_args(p, "check")
     p.add_argument("--force", action="store_true",
                    help="replace an output folder printgen did not write")
+    add_time_limit_arg(p)
     add_json_arg(p)
     p.set_defaults(func=run)
 
@@ -53,8 +55,9 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     with err.status("reading inputs") as status:
         res = api.verify_design(args.prototype, args.scale, args.design, out,
-                            measured=args.measured, fit=args.fit, load=args.load,
-                            force=args.force, progress=lambda s: status.update(f"{s} ..."))
+                                measured=args.measured, fit=args.fit, load=args.load,
+                                force=args.force, progress=lambda s: status.update(f"{s} ..."),
+                                time_limit_s=args.time_limit)
     if args.json:
         emit_json(res.record)
         return 0

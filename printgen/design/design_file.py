@@ -1,29 +1,53 @@
 """design.json: a `Design` as a file (`Design.to_dict()`), written by `printgen design` and
 `printgen make`, read back by `printgen make --design FILE`.
 
-Unknown or missing keys are errors naming the allowed keys; lengths must be positive.
+Unknown or missing keys are errors naming the allowed keys; every value is type- and
+range-checked with the schema of the prototype files (`printgen.inputs.schema`).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import json
-import math
 from pathlib import Path
 from typing import Any
 
 from printgen.barrier.patterns import get_pattern
-from printgen.design.record import CableDesign, Design, NetDesign, Section
+from printgen.design.record import CABLE_SIDES, CableDesign, Design, NetDesign, Section
 from printgen.errors import InputError
 from printgen.inputs.profiles import profile_name
+from printgen.inputs.prototype import MIN_MODEL_MESH_MM
+from printgen.inputs.schema import Field, check_value, parse_data, positive, shown
 from printgen.outputs.files import read_input_text
 
 DESIGN_LIMIT_BYTES = 16 << 20  # a design.json is ~2 kB, a report.json holding one < 1 MB
 
+# Every number of a design, with its plausible range (mm unless named): the same checks as
+# a prototype file's (printgen.inputs.schema), so a 5000-digit scale, a list for a number or
+# a 1e300 mm net is one InputError, never a failure deep in the geometry.
+MM_MAX = 1e4  # 10 m: longer than any flume model's part
+# Names (printer, material, print_style) are checked by profiles.profile_name: a name, never
+# a path; a cable's name must also be the side it borders.
+DESIGN = {"scale": Field("scale", float, lo=1.0, hi=100.0, si=False)}
+NET = {"width_mm": positive("width_mm", MM_MAX, 1.0, si=False),
+       "height_mm": positive("height_mm", MM_MAX, 1.0, si=False),
+       "mesh_x_mm": positive("mesh_x_mm", 1000.0, MIN_MODEL_MESH_MM, si=False),
+       "mesh_y_mm": positive("mesh_y_mm", 1000.0, MIN_MODEL_MESH_MM, si=False),
+       "border_width_mm": positive("border_width_mm", 100.0, 0.05, si=False)}
+SECTION = {"bead_width_mm": positive("bead_width_mm", 10.0, 0.05, si=False),
+           "beads_across": Field("beads_across", int, lo=1, hi=1000),
+           "layer_heights_mm": Field("layer_heights_mm", list, items=float, max_items=1000)}
+LAYER = positive("layer_heights_mm", 5.0, 0.01, si=False)
+CABLE_NAME = Field("name", str, choices=CABLE_SIDES)
+CABLE = {"length_mm": positive("length_mm", MM_MAX, 1.0, si=False),
+         "eyelet_inner_mm": positive("eyelet_inner_mm", 1000.0, 0.05, si=False),
+         "eyelet_outer_mm": positive("eyelet_outer_mm", 1000.0, 0.05, si=False)}
 
-def _fields(cls: type, data: Any, where: str) -> dict[str, Any]:
-    """`data` as keyword arguments of the dataclass `cls`, or InputError (a field with a
-    default may be missing: files written before it existed)."""
+
+def _fields(cls: type, data: Any, where: str, checks: dict[str, Field]) -> dict[str, Any]:
+    """`data` as keyword arguments of the dataclass `cls`, each value of `checks` checked
+    (floats as float), or InputError (a field with a default may be missing: files written
+    before it existed)."""
     if not isinstance(data, dict):
         raise InputError(f"{where}: expected a table of {cls.__name__} fields, got "
                          f"{type(data).__name__}")
@@ -32,36 +56,29 @@ def _fields(cls: type, data: Any, where: str) -> dict[str, Any]:
     unknown = sorted(set(data) - set(names))
     missing = [n for n in names if n not in data and n not in optional]
     if unknown or missing:
-        raise InputError(f"{where}: unknown keys {unknown} / missing keys {missing}; allowed: "
-                         f"{', '.join(names)} (write it with printgen design or make)")
-    return dict(data)
-
-
-def _positive(value: Any, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or \
-            not math.isfinite(value) or value <= 0:
-        raise InputError(f"{where} = {value!r} must be a positive number (mm)")
-    return float(value)
+        raise InputError(f"{where}: unknown keys {[shown(k) for k in unknown]} / missing keys "
+                         f"{missing}; allowed: {', '.join(names)} (write it with printgen "
+                         "design or make)")
+    out = dict(data)
+    for key, f in checks.items():
+        value = check_value(out[key], f, where=where)
+        out[key] = float(value) if f.kind is float else value
+    return out
 
 
 def _section(data: Any, where: str) -> Section:
-    kw = _fields(Section, data, where)
-    beads = kw["beads_across"]
-    if isinstance(beads, bool) or not isinstance(beads, int) or beads < 1:
-        raise InputError(f"{where}.beads_across = {beads!r} must be a whole number >= 1")
+    kw = _fields(Section, data, where, SECTION)
     layers = kw["layer_heights_mm"]
-    if not isinstance(layers, list) or not layers:
-        raise InputError(f"{where}.layer_heights_mm = {layers!r} must be a list of heights (mm)")
-    return Section(_positive(kw["bead_width_mm"], f"{where}.bead_width_mm"), beads,
-                   tuple(_positive(h, f"{where}.layer_heights_mm") for h in layers))
+    if not layers:
+        raise InputError(f"{where}: layer_heights_mm = [] must list the layer heights (mm)")
+    return Section(kw["bead_width_mm"], kw["beads_across"],
+                   tuple(float(check_value(h, LAYER, where=where)) for h in layers))
 
 
 def design_from_dict(data: Any, where: str = "design") -> Design:
     """Rebuild a Design from `Design.to_dict()` output."""
-    kw = _fields(Design, data, where)
-    net = _fields(NetDesign, kw["net"], f"{where}.net")
-    for key in ("width_mm", "height_mm", "mesh_x_mm", "mesh_y_mm", "border_width_mm"):
-        net[key] = _positive(net[key], f"{where}.net.{key}")
+    kw = _fields(Design, data, where, DESIGN)
+    net = _fields(NetDesign, kw["net"], f"{where}.net", NET)
     net["strand"] = _section(net["strand"], f"{where}.net.strand")
     for key in ("material", "print_style"):
         net[key] = profile_name(net[key], f"{where}.net.{key}")
@@ -71,15 +88,17 @@ def design_from_dict(data: Any, where: str = "design") -> Design:
         raise InputError(f"{where}.cables must be a list of cables")
     cables = []
     for i, c in enumerate(kw["cables"]):
-        ckw = _fields(CableDesign, c, f"{where}.cables[{i}]")
+        ckw = _fields(CableDesign, c, f"{where}.cables[{i}]", CABLE)
+        name = profile_name(ckw["name"], f"{where}.cables[{i}].name", what="cable")
+        ckw["name"] = check_value(name, CABLE_NAME, where=f"{where}.cables[{i}]")
+        if any(ckw["name"] == other.name for other in cables):
+            raise InputError(f"{where}.cables[{i}]: a second {ckw['name']!r} cable; a net has "
+                             f"one cable per side ({', '.join(CABLE_SIDES)})")
         ckw["section"] = _section(ckw["section"], f"{where}.cables[{i}].section")
         for key in ("material", "print_style"):
             ckw[key] = profile_name(ckw[key], f"{where}.cables[{i}].{key}")
-        ckw["name"] = profile_name(ckw["name"], f"{where}.cables[{i}].name", what="cable")
-        for key in ("length_mm", "eyelet_inner_mm", "eyelet_outer_mm"):
-            ckw[key] = _positive(ckw[key], f"{where}.cables[{i}].{key}")
         cables.append(CableDesign(**ckw))
-    return Design(scale=_positive(kw["scale"], f"{where}.scale"), printer=profile_name(kw["printer"], f"{where}.printer"),
+    return Design(scale=kw["scale"], printer=profile_name(kw["printer"], f"{where}.printer"),
                   net=NetDesign(**net), cables=tuple(cables))
 
 
@@ -88,10 +107,7 @@ def load_design(path: str | Path, *, scale: float | None = None) -> Design:
     design at that scale."""
     p = Path(path)
     text = read_input_text(p, "design file", limit=DESIGN_LIMIT_BYTES)
-    try:
-        data = json.loads(text)
-    except (json.JSONDecodeError, RecursionError) as exc:
-        raise InputError(f"design file {p} cannot be read as JSON: {exc}") from exc
+    data = parse_data(text, f"design file {p}", "JSON", json.loads)
     if isinstance(data, dict) and "design" in data and "net" not in data:
         data = data["design"]  # a report.json holds the design under "design"
     d = design_from_dict(data, where=str(p))

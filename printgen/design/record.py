@@ -62,6 +62,9 @@ class NetDesign:
                                                self.mesh_y_mm)
 
 
+CABLE_SIDES = ("top", "bottom", "left", "right")  # a cable's name: the net side it borders
+
+
 @dataclass(frozen=True)
 class CableDesign:
     """A border cable: a straight strip with an eyelet at each end (mm)."""

@@ -23,9 +23,8 @@ from printgen.design.selection import (
 )
 from printgen.design.similitude import ScaledTargets
 from printgen.errors import InputError
-from printgen.inputs.materials import Material, load_material
+from printgen.inputs.materials import Material, load_material, material_names
 from printgen.inputs.printers import Printer, PrintStyle, load_print_style, load_printer
-from printgen.inputs.profiles import list_profiles
 from printgen.inputs.prototype import Prototype
 
 MESH_TOLERANCE = 0.25  # default bounds: each diagonal within +-25 % of the scaled prototype's
@@ -116,7 +115,7 @@ def default_space(p: Prototype, t: ScaledTargets, *, materials: tuple[str, ...] 
         raise InputError(f"mesh tolerance {tolerance:g} must be in [0, 1) (0.25 = +-25 %)")
     ax, ay = t["mesh_x"] * 1e3, t["mesh_y"] * 1e3
     space = SearchSpace(
-        materials=tuple(materials or p.model.materials or list_profiles("materials")),
+        materials=material_names(materials, p.model.materials),
         beads=tuple(range(1, MAX_BEADS_ACROSS["net"] + 1)),
         layers=tuple(range(1, MAX_LAYERS["net"] + 1)),
         mesh_x_mm=mesh_x_mm or (ax * (1 - tolerance), ax * (1 + tolerance)),

@@ -21,9 +21,8 @@ from printgen.design.section import area_m2, equal_area_diameter, net_membrane_l
 from printgen.design.similitude import ScaledTargets
 from printgen.errors import InputError, PrintabilityError
 from printgen.inputs.laws import piecewise_linear
-from printgen.inputs.materials import Material, load_material
+from printgen.inputs.materials import Material, load_material, material_names
 from printgen.inputs.printers import Printer, PrintStyle, check_pass, load_print_style, load_printer
-from printgen.inputs.profiles import list_profiles
 from printgen.inputs.prototype import Prototype
 from printgen.units import MM, G
 
@@ -232,8 +231,7 @@ def select(p: Prototype, t: ScaledTargets, *, printer: str | None = None,
            materials: tuple[str, ...] | None = None) -> Selection:
     """Rank every material x layout for cables and net; best feasible first."""
     printer_obj = load_printer(printer or p.model.printer or DEFAULT_PRINTER)
-    names = materials or p.model.materials or tuple(list_profiles("materials"))
-    mats = [load_material(n) for n in names]
+    mats = [load_material(n) for n in material_names(materials, p.model.materials)]
     net_style = load_print_style(p.model.net_print or DEFAULT_NET_PRINT)
     cable_style = load_print_style(p.model.cable_print or DEFAULT_CABLE_PRINT)
     for style, comp in ((net_style, "net"), (cable_style, "cable")):

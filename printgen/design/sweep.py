@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import ipaddress
 import logging
-import os
 import re
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import ExitStack, contextmanager
@@ -24,6 +23,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from printgen.errors import InputError
+from printgen.workers import cores
 
 log = logging.getLogger(__name__)
 
@@ -105,8 +105,10 @@ def open_runner(*, scheduler: str | None = None, workers: int | None = None,
     if serial:
         yield Runner(None, "serial (this process)", progress)
         return
-    if workers is not None and workers < 1:
-        raise InputError(f"--workers {workers} must be >= 1")
+    if workers is not None and not 1 <= workers <= cores():
+        raise InputError(f"--workers {workers} must be from 1 to {cores()}, the cores this "
+                         "machine gives printgen (more workers than cores only compete for "
+                         "them); leave it out to use every core")
     if scheduler:
         check_address(scheduler)  # before the (slow) import of distributed
     distributed = _distributed()
@@ -124,7 +126,7 @@ def open_runner(*, scheduler: str | None = None, workers: int | None = None,
                                  "`dask scheduler` or leave out --scheduler") from exc
             where = f"Dask scheduler {scheduler}"
         else:
-            n = workers or os.cpu_count() or 1
+            n = workers or cores()
             cluster = stack.enter_context(distributed.LocalCluster(
                 n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                 silence_logs=logging.CRITICAL))

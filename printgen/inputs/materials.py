@@ -16,12 +16,16 @@ import numpy as np
 
 from printgen.errors import ProfileError
 from printgen.inputs.laws import piecewise_linear
-from printgen.inputs.profiles import load_raw
+from printgen.inputs.profiles import list_profiles, load_raw
 from printgen.inputs.schema import Field, positive, read_table
 
+# Materials one selection or design search weighs at most: each costs ~3 ms in select and a
+# grid of sections in the search (20 000 names made select run > 60 s; issue 20).
+MAX_MATERIALS = 100
+
 PROVENANCE = [
-    Field("source", str, help="where the value comes from"),
-    Field("conditions", str, help="specimen and test conditions"),
+    Field("source", str, help="where the value comes from", multiline=True),
+    Field("conditions", str, help="specimen and test conditions", multiline=True),
     Field("date", str, required=False),
     Field("files", list, required=False, default=[]),
     Field("n_samples", int, lo=1, required=False),
@@ -72,7 +76,7 @@ PRINT = [
 ]
 TOP = [
     Field("name", str),
-    Field("description", str, required=False, default=""),
+    Field("description", str, required=False, default="", multiline=True),
     Field("family", str, choices=("rigid", "flexible")),
     positive("density_g_per_cm3", 25.0),
     Field("datasheet", dict),
@@ -251,3 +255,18 @@ def _number(v: object, where: str, key: str) -> float:
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v):
         raise ProfileError(f"{where}: {key} holds {v!r}, not a finite number")
     return float(v)
+
+
+def material_names(chosen: tuple[str, ...] | None, preferred: tuple[str, ...] = (),
+                   where: str = "--materials") -> tuple[str, ...]:
+    """The materials to weigh: `chosen` (the command line), else `preferred` (the prototype's
+    [model] materials), else every material profile found; repeats dropped, at most
+    MAX_MATERIALS (ProfileError beyond, before any is loaded)."""
+    names = tuple(dict.fromkeys(chosen or preferred or list_profiles("materials")))
+    if len(names) > MAX_MATERIALS:
+        src = where if chosen else "[model] materials" if preferred else "the profile folders"
+        raise ProfileError(f"{len(names)} materials to weigh (from {src}); at most "
+                           f"{MAX_MATERIALS}: name the few to consider with --materials or "
+                           "[model] materials")
+    return names
+

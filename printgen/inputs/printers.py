@@ -17,7 +17,7 @@ HOLE_COMPENSATION_MM = 0.2
 
 PRINTER = [
     Field("name", str),
-    Field("description", str, required=False, default=""),
+    Field("description", str, required=False, default="", multiline=True),
     positive("nozzle_diameter_mm", 3.0, si=False),
     positive("filament_diameter_mm", 3.5, si=False),
     positive("bed_x_mm", 2000.0, si=False),
@@ -33,12 +33,12 @@ PRINTER = [
           default=HOLE_COMPENSATION_MM,
           help="added to every hole diameter (eyelets, net loops): FDM holes print small"),
     Field("gcode_flavor", str, choices=("marlin2", "marlin", "reprap", "klipper"), si=False),
-    Field("start_gcode", str, required=False, default=""),
-    Field("end_gcode", str, required=False, default=""),
+    Field("start_gcode", str, required=False, default="", multiline=True),
+    Field("end_gcode", str, required=False, default="", multiline=True),
 ]
 PRINT_STYLE = [
     Field("name", str),
-    Field("description", str, required=False, default=""),
+    Field("description", str, required=False, default="", multiline=True),
     Field("component", str, choices=("net", "cable")),
     positive("bead_width_mm", 5.0, si=False),
     positive("first_layer_height_mm", 2.0, si=False),

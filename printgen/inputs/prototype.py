@@ -12,47 +12,67 @@ from pathlib import Path
 
 from printgen.barrier.patterns import pattern_names
 from printgen.errors import InputError
+from printgen.inputs.materials import MAX_MATERIALS
 from printgen.inputs.profiles import profile_name
 from printgen.inputs.schema import Field, load_toml, positive, read_table
 
 DEPTH_OVER_HEIGHT_MAX = 2.0  # flow depth / barrier height: beyond it the barrier is drowned
+# Smallest plausible values (file units): far below any real barrier, net or flow, and far
+# above the 1e-300 or 5e-324 that would reach the maths as a zero in disguise (issue 20).
+MIN_BARRIER_M = 0.1  # a prototype barrier 10 cm wide or high
+MIN_MESH_M = 1e-3  # a 1 mm mesh (real nets: 0.1-0.6 m; the model is printed at 1/lambda)
+MIN_DIAMETER_MM = 0.1  # a 0.1 mm strand or cable
+MIN_MODULUS_GPA = 1e-3  # 1 MPa: softer than any cable, rope or printed polymer
+MIN_PANEL_M = 0.01  # a 1 cm test panel
+MIN_VELOCITY_M_PER_S = 0.01  # 1 cm/s: water that barely moves
+MIN_DEPTH_M = 0.01  # 1 cm of flow
+MIN_DENSITY_KG_PER_M3 = 500.0  # lighter than any water or debris mixture
+MIN_FLUME_M = 0.01  # a 1 cm wide flume
+MIN_MODEL_MESH_MM = 0.5  # a printed mesh diagonal narrower than one bead of a 0.4 mm nozzle
 
-TOP = [Field("name", str), Field("description", str, required=False, default=""),
+TOP = [Field("name", str),
+       Field("description", str, required=False, default="", multiline=True),
        Field("barrier", dict), Field("net", dict), Field("border", dict, required=False),
        Field("flow", dict), Field("flume", dict, required=False),
        Field("model", dict, required=False, default={})]
-BARRIER = [positive("width_m", 1000.0), positive("height_m", 100.0),
+BARRIER = [positive("width_m", 1000.0, MIN_BARRIER_M), positive("height_m", 100.0, MIN_BARRIER_M),
            Field("anchors", int, lo=0, hi=64, required=False, default=0)]
 NET = [
     Field("pattern", str, choices=pattern_names()),  # printgen/barrier/patterns, AS_DRAWN
-    positive("mesh_x_m", 10.0, help="mesh diagonal (or square side) across the barrier"),
-    positive("mesh_y_m", 10.0, help="mesh diagonal (or square side) up the barrier"),
-    positive("strand_diameter_mm", 1000.0),
-    positive("strand_modulus_gpa", 500.0, required=False),
+    positive("mesh_x_m", 10.0, MIN_MESH_M,
+             help="mesh diagonal (or square side) across the barrier"),
+    positive("mesh_y_m", 10.0, MIN_MESH_M, help="mesh diagonal (or square side) up the barrier"),
+    positive("strand_diameter_mm", 1000.0, MIN_DIAMETER_MM),
+    positive("strand_modulus_gpa", 500.0, MIN_MODULUS_GPA, required=False),
     Field("pretension_n", float, lo=0.0, hi=1e9, required=False, default=0.0),
     Field("panel_law", dict, required=False),
 ]
-PANEL_LAW = [Field("knee_strain_percent", list, required=False, default=[]),
-             Field("kappa_kn_per_m_per_m", list), positive("panel_length_m", 100.0),
+PANEL_LAW = [Field("knee_strain_percent", list, required=False, default=[], items=float),
+             Field("kappa_kn_per_m_per_m", list, items=float),
+             positive("panel_length_m", 100.0, MIN_PANEL_M),
              Field("source", str, required=False, default="")]
-BORDER = [positive("diameter_mm", 1000.0), positive("modulus_gpa", 500.0),
+BORDER = [positive("diameter_mm", 1000.0, MIN_DIAMETER_MM),
+          positive("modulus_gpa", 500.0, MIN_MODULUS_GPA),
           Field("sliding", bool, required=False, default=True),
           Field("pretension_n", float, lo=0.0, hi=1e9, required=False, default=0.0)]
-FLOW = [positive("velocity_m_per_s", 50.0), positive("depth_m", 100.0, required=False),
-        positive("density_kg_per_m3", 3000.0, required=False, default=1000.0, si=False)]
+FLOW = [positive("velocity_m_per_s", 50.0, MIN_VELOCITY_M_PER_S),
+        positive("depth_m", 100.0, MIN_DEPTH_M, required=False),
+        positive("density_kg_per_m3", 3000.0, MIN_DENSITY_KG_PER_M3, required=False,
+                 default=1000.0, si=False)]
 LATERAL = ("walls", "eyelets")  # lateral mounting of the barrier in the flume, default first
-FLUME = [positive("width_m", 10.0), positive("max_discharge_l_per_s", 1e5),
-         positive("free_section_m", 10.0, required=False),
+FLUME = [positive("width_m", 10.0, MIN_FLUME_M), positive("max_discharge_l_per_s", 1e5),
+         positive("free_section_m", 10.0, MIN_DEPTH_M, required=False),
          positive("froude_min", 10.0, si=False), positive("froude_max", 10.0, si=False),
          Field("lateral", str, choices=LATERAL, required=False, default=LATERAL[0],
                help="walls: side sheets hold the lateral edges; eyelets: only the cables' ends")]
-MODEL = [positive("mesh_x_mm", 1000.0, si=False, required=False,
+MODEL = [positive("mesh_x_mm", 1000.0, MIN_MODEL_MESH_MM, si=False, required=False,
                   help="printed mesh across (default: the prototype's mesh_x_m scaled)"),
-         positive("mesh_y_mm", 1000.0, si=False, required=False,
+         positive("mesh_y_mm", 1000.0, MIN_MODEL_MESH_MM, si=False, required=False,
                   help="printed mesh up (default: the prototype's mesh_y_m scaled)"),
          Field("printer", str, required=False), Field("net_print", str, required=False),
          Field("cable_print", str, required=False),
-         Field("materials", list, required=False, default=[])]
+         # each entry is checked by _check_profile_names (a name, never a path or a number)
+         Field("materials", list, required=False, default=[], max_items=MAX_MATERIALS)]
 
 
 @dataclass(frozen=True)
@@ -132,12 +152,15 @@ def load_prototype(path: str | Path) -> Prototype:
     border = top["border"] and BorderSpec(**read_table(top["border"], BORDER,
                                                        where=f"{where} [border]"))
     flume = top["flume"] and FlumeSpec(**read_table(top["flume"], FLUME, where=f"{where} [flume]"))
+    _check_profile_names(top["model"], f"{where} [model]")  # the names' one check, first
     model = read_table(top["model"], MODEL, where=f"{where} [model]") if top["model"] else {}
     if (model.get("mesh_x_mm") is None) != (model.get("mesh_y_mm") is None):
         raise InputError(f"{where} [model]: give both mesh_x_mm and mesh_y_mm, or neither (then "
                          "the prototype's mesh is scaled)")
-    _check_profile_names(model, f"{where} [model]")
     depth = flow["depth"] if flow["depth"] is not None else bar["height"]
+    if flume and flume.froude_min > flume.froude_max:
+        raise InputError(f"{where} [flume]: froude_min = {flume.froude_min:g} is above "
+                         f"froude_max = {flume.froude_max:g}; give the flume's range low to high")
     if flume and flume.lateral == "eyelets" and not border:
         raise InputError(f"{where} [flume]: lateral = \"eyelets\" anchors the lateral border "
                          "cables at their eyelets, but the barrier has no [border] cables; set "
@@ -165,12 +188,16 @@ def load_prototype(path: str | Path) -> Prototype:
     )
 
 
-def _check_profile_names(model: dict, where: str) -> None:
-    """[model] printer, net_print, cable_print and materials name profiles: names, not paths."""
+def _check_profile_names(model: object, where: str) -> None:
+    """[model] printer, net_print, cable_print and materials name profiles: names, not paths
+    (checked on the raw table, before read_table, so that a name is refused by this one rule)."""
+    if not isinstance(model, dict):
+        return  # read_table names the wrong type
     for key in ("printer", "net_print", "cable_print"):
         if model.get(key) is not None:
             profile_name(model[key], f"{where}: {key}")
-    for i, name in enumerate(model.get("materials") or ()):
+    materials = model.get("materials")
+    for i, name in enumerate(materials if isinstance(materials, list) else ()):
         profile_name(name, f"{where}: materials[{i}]")
 
 
@@ -200,6 +227,7 @@ CROSS_CHECKS = (
     "[net.panel_law]: increasing knees, one kappa per segment (knees + 1), all > 0 and < 1e9",
     "[net]: strand_modulus_gpa or a [net.panel_law] is required",
     "[flume] lateral = \"eyelets\" needs a [border] table (the eyelets are the cables' ends)",
+    "[flume] froude_min <= froude_max",
     "[model] mesh_x_mm and mesh_y_mm: both or neither (neither: the prototype's mesh scaled)",
 )
 

@@ -8,7 +8,9 @@ field keeps its file unit (`si=False`, used for millimetre print settings).
 from __future__ import annotations
 
 import math
+import reprlib
 import tomllib
+import unicodedata
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,6 +42,9 @@ class Field:
     choices: tuple[str, ...] = ()
     si: bool = True
     help: str = ""
+    items: type | None = None  # list fields: the type of every element (str or float)
+    max_items: int | None = None  # list fields: at most this many elements
+    multiline: bool = False  # str fields: line breaks and tabs allowed (G-code, descriptions)
 
     @property
     def name(self) -> str:
@@ -50,9 +55,42 @@ class Field:
         return split_unit_key(self.key)[2]
 
 
-def positive(key: str, hi: float | None = None, **kw: Any) -> Field:
-    """A float that must be > 0 (and <= hi)."""
+def positive(key: str, hi: float | None = None, least: float | None = None, **kw: Any
+             ) -> Field:
+    """A float that must be > 0 (and <= hi); with `least`, >= least: the smallest physically
+    plausible value, which also keeps 1e-300 or 5e-324 (a zero in disguise) out of the maths."""
+    if least is not None:
+        return Field(key, float, lo=least, hi=hi, **kw)
     return Field(key, float, lo=0.0, hi=hi, lo_open=True, **kw)
+
+
+def shown(value: Any) -> str:
+    """`value` as a short repr for an error message (a 5000-digit integer, a deep table or a
+    long list would otherwise make the one line a page, or fail to print at all)."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 64:
+        return f"<an integer of {value.bit_length() * math.log10(2):.0f} digits>"
+    try:
+        return _SHORT.repr(value)
+    except (RecursionError, ValueError):
+        return f"<a {type(value).__name__}>"
+
+
+_SHORT = reprlib.Repr()
+_SHORT.maxlevel, _SHORT.maxstring, _SHORT.maxother, _SHORT.maxlist, _SHORT.maxdict = 2, 40, 40, 4, 4
+
+
+def parse_data(text: str, where: str, what: str = "TOML", parse: Any = tomllib.loads) -> Any:
+    """`parse(text)` (TOML by default, or `json.loads`), with what no data file of printgen
+    holds refused as one InputError: syntax errors, tables nested too deeply for the parser
+    (RecursionError) and integers longer than Python converts (4300 digits, ValueError)."""
+    try:
+        return parse(text)
+    except RecursionError:
+        raise InputError(f"{where}: tables or lists nested too deeply to read as {what}; no "
+                         "printgen file nests more than a few levels") from None
+    except ValueError as exc:  # TOMLDecodeError, JSONDecodeError, too many digits
+        raise InputError(f"{where}: not valid {what}: {' '.join(str(exc).split())[:200]}; fix "
+                         "the file's syntax") from None
 
 
 def load_toml(path: str | Path, what: str = "TOML file") -> dict[str, Any]:
@@ -64,10 +102,7 @@ def load_toml(path: str | Path, what: str = "TOML file") -> dict[str, Any]:
         hint = f" such as {', '.join(str(x) for x in some)}" if some else ""
         raise InputError(f"{p} is a folder, not a TOML file; give the file itself{hint}")
     text = read_input_text(p, what, limit=TOML_LIMIT_BYTES)
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{p}: not valid TOML: {exc}; fix the file's syntax") from exc
+    return parse_data(text, str(p))
 
 
 def read_table(data: Any, fields: Sequence[Field], *, where: str) -> dict[str, Any]:
@@ -97,26 +132,64 @@ def read_table(data: Any, fields: Sequence[Field], *, where: str) -> dict[str, A
 
 def check_value(value: Any, f: Field, *, where: str) -> Any:
     """Type- and range-check one value; convert to SI when the field asks for it."""
-    label = f"{where}: {f.key} = {value!r}"
+    label = f"{where}: {f.key} = {shown(value)}"
     if f.kind in (float, int):
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise InputError(f"{label} is not a number; write a plain number in {f.unit or 'units'}")
-        if f.kind is int and not isinstance(value, int):
-            raise InputError(f"{label} must be a whole number")
-        if not math.isfinite(value):
-            raise InputError(f"{label} is not finite; write a finite number")
-        check_range(float(value), f, label)
+        x = number(value, label, f.unit, whole=f.kind is int)
+        check_range(x, f, label)
         _, factor, _ = split_unit_key(f.key)
         return (value * factor if f.si else value) if f.kind is float else int(value)
     if f.kind is str:
         if not isinstance(value, str):
             raise InputError(f"{label} must be a string")
+        check_text(value, label, multiline=f.multiline)
         if f.choices and value not in f.choices:
             raise InputError(f"{label} is not one of: {', '.join(f.choices)}")
         return value
     if not isinstance(value, f.kind):
         raise InputError(f"{label} must be a {f.kind.__name__}")
+    if f.kind is list:
+        check_items(value, f, label)
     return value
+
+
+def number(value: Any, label: str, unit: str = "", *, whole: bool = False) -> float:
+    """`value` as a finite float, or InputError: not a number (a string, a bool, a list), not
+    a whole number when `whole`, not finite, or an integer too large for a float (400 digits)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InputError(f"{label} is not a number; write a plain number in {unit or 'units'}")
+    if whole and not isinstance(value, int):
+        raise InputError(f"{label} must be a whole number")
+    try:
+        x = float(value)
+    except OverflowError:
+        raise InputError(f"{label} is too large for a number; write one below 1e308") from None
+    if not math.isfinite(x):
+        raise InputError(f"{label} is not finite; write a finite number")
+    return x
+
+
+def check_text(text: str, label: str, *, multiline: bool = False) -> None:
+    """InputError when `text` holds a control character (an escape, a NUL, a bell; a line
+    break or tab too unless `multiline`): it would reach report.html and the plots raw."""
+    allowed = "\n\t\r" if multiline else ""
+    bad = next((c for c in text if unicodedata.category(c) == "Cc" and c not in allowed), None)
+    if bad is not None:
+        raise InputError(f"{label} holds the control character U+{ord(bad):04X}; write plain "
+                         "text" + ("" if multiline else " on one line"))
+
+
+def check_items(values: list, f: Field, label: str) -> None:
+    """A list field: at most `f.max_items` elements, each of type `f.items` when given."""
+    if f.max_items is not None and len(values) > f.max_items:
+        raise InputError(f"{label} has {len(values)} entries; at most {f.max_items} are allowed")
+    for i, v in enumerate(values):
+        where = f"{label}: entry {i + 1} ({shown(v)})"
+        if f.items is str:
+            if not isinstance(v, str):
+                raise InputError(f"{where} must be a string (a name in quotes)")
+            check_text(v, where)
+        elif f.items is float:
+            number(v, where, f.unit)
 
 
 def check_range(value: float, f: Field, label: str) -> None:

@@ -11,8 +11,8 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import secrets
 import stat
-import tempfile
 from pathlib import Path
 
 from printgen.errors import InputError
@@ -95,7 +95,9 @@ def write_bytes(path: str | Path, data: bytes) -> Path:
     """Write `data` to `path` via a temp file in the same directory and `os.replace`."""
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.name}.", suffix=".tmp")
+    tmp = p.parent / f".{p.name}.{secrets.token_hex(4)}.tmp"
+    # 0o666 less the umask, as any file the user writes (mkstemp would force 0600)
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o666)
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)

@@ -108,8 +108,9 @@ def read_manifest(folder: Path) -> dict[str, Any]:
     raw = read_input(path, "manifest", limit=MANIFEST_LIMIT_BYTES)
     try:
         data = json.loads(raw.decode("utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as exc:
-        raise InputError(f"{path} is not valid JSON ({exc}); the folder was altered") from None
+    except (ValueError, UnicodeDecodeError, RecursionError) as exc:  # JSON, digits, nesting
+        raise InputError(f"{path} is not valid JSON ({type(exc).__name__}: "
+                         f"{' '.join(str(exc).split())[:120]}); the folder was altered") from None
     problem = schema_problem(data)
     if problem:
         raise InputError(f"{path}: {problem}; it is not a printgen manifest (or was altered)")
@@ -128,17 +129,25 @@ def schema_problem(data: Any) -> str | None:
         return "no 'files' table"
     for rel, entry in files.items():
         if not _entry_ok(entry) or not _relative_ok(rel):
-            return f"file entry {rel!r}: {entry!r} is not {{'sha256': hex, 'bytes': size}}"
+            return f"file entry {rel[:80]!r}: {_short(entry)} is not {{'sha256': hex, 'bytes': size}}"
     volatile = data.get("volatile", [])
     if not isinstance(volatile, list) or any(v != TIMINGS for v in volatile):
-        return f"volatile = {volatile!r}: only [{TIMINGS!r}] may be volatile"
+        return f"volatile = {_short(volatile)}: only [{TIMINGS!r}] may be volatile"
     command = data.get("command")
     if command is not None and not (isinstance(command, list)
                                     and all(isinstance(c, str) for c in command)):
-        return f"command = {command!r} is not a list of strings"
+        return f"command = {_short(command)} is not a list of strings"
+    if not isinstance(data.get("printgen_version", ""), str):
+        return "'printgen_version' is not text"
     if fmt >= 2 and not isinstance(data.get(DIGEST_KEY), str):
         return f"no {DIGEST_KEY!r} (format {fmt} has one)"
     return None
+
+
+def _short(value: Any) -> str:
+    """repr of a value read from the manifest, cut to one short line."""
+    text = " ".join(repr(value).split())
+    return text if len(text) <= 80 else text[:77] + "..."
 
 
 def _entry_ok(entry: Any) -> bool:

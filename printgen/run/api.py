@@ -113,15 +113,17 @@ def verify(prototype: PrototypeLike, scale: float, design_: Design | str | Path 
 def verify_design(prototype: str | Path, scale: float, design_file: str | Path,
                   out: str | Path, *, measured: str | Path | None = None,
                   fit: str = "stiffness", load: str | None = None, drag: bool = False,
-                  force: bool = False, progress: Callable[[str], None] | None = None
-                  ) -> VerifyRun:
+                  force: bool = False, progress: Callable[[str], None] | None = None,
+                  time_limit_s: float | None = None) -> VerifyRun:
     """`printgen verify`: the pre-print check of a design.json with its uncertainty band,
     optionally compared with a lab's `measured` loading test and one factor fitted to it,
-    written into the folder `out` (see `printgen.run.verify.verify_design`)."""
+    written into the folder `out` (see `printgen.run.verify.verify_design`); refused when
+    estimated longer than `time_limit_s` (None: the budget's default)."""
     from printgen.run.verify import verify_design as _verify_design
 
     return _verify_design(prototype, scale, design_file, out, measured=measured, fit=fit,
-                          load=load_name(load, drag), force=force, progress=progress)
+                          load=load_name(load, drag), force=force, progress=progress,
+                          time_limit_s=time_limit_s)
 
 
 def design_search(prototype: PrototypeLike, scales: float | Sequence[float], *,

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import os
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
@@ -22,7 +23,7 @@ from printgen.barrier.patterns import get_pattern
 from printgen.design.record import Design
 from printgen.errors import InputError
 from printgen.inputs.prototype import Prototype
-from printgen.workers import reporting
+from printgen.workers import cores, reporting
 
 # About a minute of `make` on 2 cores (issue 16); the bundled simple barrier
 # (examples/simple_barrier.toml, free top) is estimated at ~45 s and takes ~45 s.
@@ -44,7 +45,12 @@ MESH_S_PER_SEGMENT = 1e-4  # meshes step per model net segment (simple 1:40: 496
 # them): make of the 1:40 example measures ~3.9 s (bench make) to ~5 s (README's demo), which
 # the sum of the constants below puts at ~7 s (was 9.5 s: 2.4x the measured run).
 CABLE_PARTS_S = 1.0  # the four cables, their eyelets and plate
+CABLE_PART_S = CABLE_PARTS_S / 4  # one cable: mesh, 3MF, slicer profile, G-code, its place
 FIXED_S = 1.5  # planning, slicer profiles, G-code, previews, report
+# verify --measured: the fit's bounded Brent search runs this many sweeps of the model on the
+# band's net (coarsened COARSENED_BY each way, so about COARSENED_BY^2 fewer nodes)
+FIT_SWEEPS = 20
+COARSENED_BY = 2
 BASE_MEMORY_B = 150e6  # Python, numpy, scipy and the geometry libraries
 MEMORY_B_PER_NODE = 20e3  # sparse factor, path results kept per level (1998 nodes: +39 MB)
 COARSEN_MAX = 1000.0  # search bound for the mesh factor that fits
@@ -95,19 +101,41 @@ def model_nodes(d: Design, factor: float = 1.0) -> int:
                                         n.mesh_y_mm * factor)
 
 
+def sweep_cores() -> int:
+    """Cores the verification's two sweeps (prototype, model) run on: 1 under
+    PRINTGEN_SERIAL, else up to 2."""
+    return 1 if os.environ.get("PRINTGEN_SERIAL") else min(2, cores())
+
+
 def sweep_seconds(nodes: int) -> float:
     """One net over the load path on one core."""
     return SWEEP_S_AT_REFERENCE * (nodes / REFERENCE_NODES) ** SWEEP_EXPONENT
 
 
+@dataclass(frozen=True)
+class Work:
+    """What a command runs: `sweep` the verification, `parts` the printable files (make),
+    `fit` a measured test's fit (verify --measured)."""
+
+    sweep: bool = True
+    parts: bool = True
+    fit: bool = False
+    model_follows: bool = True  # the model's mesh is the prototype's scaled (not a design's)
+
+
+MAKE = Work()
+
+
 def estimate(p: Prototype, d: Design, *, cores: int, sweep: bool = True,
-             proto_factor: float = 1.0, model_factor: float = 1.0) -> Estimate:
-    """The run's size (`sweep`: the verification runs); the factors coarsen the prototype's or
-    the model's meshes."""
+             proto_factor: float = 1.0, model_factor: float = 1.0,
+             work: Work | None = None) -> Estimate:
+    """The run's size (`sweep`: the verification runs; `work`: what else, default make's);
+    the factors coarsen the prototype's or the model's meshes."""
+    work = work or Work(sweep=sweep)
     m_nodes = model_nodes(d, model_factor)
+    slow = 1.0 if d.cables else FREE_TOP_MODEL_FACTOR
     nets: tuple[NetSize, ...] = ()
-    if sweep:
-        slow = 1.0 if d.cables else FREE_TOP_MODEL_FACTOR
+    if work.sweep:
         nets = tuple(NetSize(name, n, 3 * n, factor * sweep_seconds(n), MEMORY_B_PER_NODE * n)
                      for name, n, factor in (("prototype", prototype_nodes(p, proto_factor), 1.0),
                                              ("model", m_nodes, slow)))
@@ -117,22 +145,27 @@ def estimate(p: Prototype, d: Design, *, cores: int, sweep: bool = True,
         nominal = sum(times) if cores < 2 else max(times)
         bands = max(BANDS_MIN_S, BANDS_FACTOR * nets[1].seconds)
         verify = VERIFY_FIXED_S + nominal + bands
-    segments = 2 * m_nodes
-    parts = FIXED_S + MESH_S_PER_SEGMENT * segments + (CABLE_PARTS_S if d.cables else 0.0)
+        if work.fit:
+            verify += FIT_SWEEPS * slow * sweep_seconds(m_nodes / COARSENED_BY**2)
+    segments = 2 * m_nodes if work.parts else 0
+    parts = (FIXED_S + MESH_S_PER_SEGMENT * segments + CABLE_PART_S * len(d.cables)
+             if work.parts else 0.0)
     memory = BASE_MEMORY_B + sum(n.memory_b for n in nets)
     return Estimate(nets, segments, parts + verify, memory, cores)
 
 
 def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
-                 sweep: bool = True) -> Estimate:
+                 sweep: bool = True, work: Work | None = None) -> Estimate:
     """Return the estimate; raise InputError with the estimate, the limit, the option that
-    raises it and the least coarsening of the meshes that fits, when it is over the limit."""
+    raises it and the least coarsening of the meshes that fits, when it is over the limit.
+    `work`: what the command runs (default make's, with the verification when `sweep`)."""
     if not (math.isfinite(limit_s) and limit_s > 0):
         raise InputError(f"--time-limit {limit_s:g} s must be a positive number of seconds")
-    est = estimate(p, d, cores=cores, sweep=sweep)
+    work = work or Work(sweep=sweep)
+    est = estimate(p, d, cores=cores, work=work)
     if est.seconds <= limit_s:
         return est
-    fix = coarsest_fix(p, d, limit_s=limit_s, cores=cores, sweep=sweep)
+    fix = coarsest_fix(p, d, limit_s=limit_s, cores=cores, work=work)
     which = ("the default, about a minute of make on 2 cores" if limit_s == DEFAULT_LIMIT_S
              else "from --time-limit")
     raise InputError(f"this run is too big: {est.summary()}; the limit is {limit_s:g} s "
@@ -141,20 +174,21 @@ def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
 
 
 def coarsest_fix(p: Prototype, d: Design, *, limit_s: float, cores: int,
-                 sweep: bool = True) -> str:
+                 work: Work = MAKE) -> str:
     """The smallest uniform coarsening of the meshes that fits `limit_s`, as advice."""
-    user_model = p.model.mesh_x_mm is not None
+    user_model = p.model.mesh_x_mm is not None or not work.model_follows
     model_scales = not user_model  # the model mesh follows the prototype's unless [model] sets it
 
     def fits(f: float) -> bool:
-        return estimate(p, d, cores=cores, sweep=sweep, proto_factor=f,
+        return estimate(p, d, cores=cores, work=work, proto_factor=f,
                         model_factor=f if model_scales else 1.0).seconds <= limit_s
 
     lo, hi = 1.0, COARSEN_MAX
     if not fits(hi):
-        if user_model and estimate(p, d, cores=cores, sweep=sweep, proto_factor=hi,
+        if user_model and estimate(p, d, cores=cores, work=work, proto_factor=hi,
                                    model_factor=hi).seconds <= limit_s:
-            return "coarsen [model] mesh_x_mm / mesh_y_mm as well as the prototype's net"
+            return ("coarsen [model] mesh_x_mm / mesh_y_mm (or the design's mesh) as well as "
+                    "the prototype's net")
         return "no mesh coarsening alone fits; raise --time-limit"
     for _ in range(40):  # bisection to 1e-12 of the range
         mid = math.sqrt(lo * hi)

@@ -35,7 +35,13 @@ from printgen.report.html import Report
 from printgen.report.jsonout import dumps
 from printgen.report.parts_report import provenance_section
 from printgen.report.report import design_record, design_sections
-from printgen.run.budget import DEFAULT_LIMIT_S, Estimate, check_budget, level_bars
+from printgen.run.budget import (
+    DEFAULT_LIMIT_S,
+    Estimate,
+    check_budget,
+    level_bars,
+    sweep_cores,
+)
 from printgen.run.provenance import (  # noqa: F401 (json_output, TIME_KEYS: used via make)
     TIME_KEYS,
     TIMINGS,
@@ -53,7 +59,7 @@ from printgen.run.steps import (
     verification_sweeps,
     verify_step,
 )
-from printgen.workers import Helper, check_deadline, deadline, helper, signals_deferred
+from printgen.workers import Helper, check_deadline, cores, deadline, helper, signals_deferred
 
 log = logging.getLogger(__name__)
 
@@ -202,7 +208,7 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]], short: b
     that they run while the parts are built here; `sweeps_done` and `verify_step` collect
     them. Only for short runs on 2 cores or more: a long run's per-level progress bars come
     from the sweeps' workers to this process, and on one core there is nothing to gain."""
-    serial = os.environ.get("PRINTGEN_SERIAL") or (os.cpu_count() or 1) < 2
+    serial = os.environ.get("PRINTGEN_SERIAL") or cores() < 2
     if serial or not short or not any(s is verify_step for _, s in steps):
         yield
         return
@@ -222,9 +228,9 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]], short: b
 def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
     """Estimate the run before any of it is done; InputError when it is over the limit
     (options.time_limit_s, default about a minute on 2 cores)."""
-    cores = 1 if os.environ.get("PRINTGEN_SERIAL") else min(2, os.cpu_count() or 1)
-    limit = ctx.options.time_limit_s or DEFAULT_LIMIT_S
-    est = check_budget(ctx.prototype, ctx.design, limit_s=float(limit), cores=cores,
+    limit = ctx.options.time_limit_s
+    est = check_budget(ctx.prototype, ctx.design, cores=sweep_cores(),
+                       limit_s=DEFAULT_LIMIT_S if limit is None else float(limit),
                        sweep=verifies)
     ctx.record["size"] = est.to_record()
     ctx.record.setdefault("timings_s", {})["estimate"] = est.seconds

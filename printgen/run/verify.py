@@ -49,6 +49,7 @@ from printgen.report.uncertainty import (
     measured_record,
     measured_sections,
 )
+from printgen.run.budget import DEFAULT_LIMIT_S, Work, check_budget, sweep_cores
 from printgen.run.provenance import TIMINGS
 
 
@@ -70,10 +71,13 @@ class VerifyRun:
 def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
                   out: str | Path, *, measured: str | Path | None = None,
                   fit: str = "stiffness", load: str | None = None, force: bool = False,
-                  progress: Callable[[str], None] | None = None) -> VerifyRun:
+                  progress: Callable[[str], None] | None = None,
+                  time_limit_s: float | None = None) -> VerifyRun:
     """Check the design against the prototype with its band; compare and fit `measured`.
 
-    Every input is read and checked before the first solve, so a bad file costs nothing.
+    Every input is read and checked before the first solve, so a bad file costs nothing; so
+    is the run's size (`printgen.run.budget`): InputError when its estimate passes
+    `time_limit_s`.
     """
     say = progress or (lambda _label: None)
     t0 = time.perf_counter()
@@ -82,6 +86,9 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     p = load_prototype(prototype)
     d = load_design(design_path, scale=scale)
     m = read_measured(measured, design_units(d)) if measured is not None else None
+    limit = DEFAULT_LIMIT_S if time_limit_s is None else time_limit_s
+    check_budget(p, d, limit_s=limit, cores=sweep_cores(),
+                 work=Work(parts=False, fit=m is not None, model_follows=False))
     load_kw = model_load_kw(p, d, load)
     say("verification (prototype and model load sweeps)")
     v = verify(p, d, load=load)
