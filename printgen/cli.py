@@ -29,6 +29,7 @@ COMMAND_MODULES = (
     "printgen.commands.check",
     "printgen.commands.bench",
     "printgen.commands.calibrate",
+    "printgen.commands.init",
 )
 
 

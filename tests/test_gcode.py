@@ -214,8 +214,11 @@ def _checker(path, *args):
     return r.returncode, json.loads(r.stdout), r.stderr.strip().splitlines()[-1]
 
 
-def test_direct_net_gcode_passes_the_checker(net_setup, tmp_path):
+@pytest.mark.parametrize("material_key", [None, "tpu-85a"])  # the design's TPE; a datasheet TPU
+def test_direct_net_gcode_passes_the_checker(net_setup, tmp_path, material_key):
     net, printer, style, material = net_setup
+    if material_key:  # same net in a datasheet flexible (retraction off, 1.5 mm3/s)
+        material = load_material(material_key)
     p = material.print
     tp = net_toolpath(net, printer, style, material, crossing_flow_factor=1.0)
     path = write_gcode(tmp_path / "net.gcode", tp, printer, material)
@@ -258,7 +261,7 @@ def test_direct_cable_gcode_passes_the_checker(cable_setup, tmp_path):
 
 def test_benchmark_writes_json_and_meets_the_goal(tmp_path):
     r = subprocess.run([sys.executable, "-m", "benchmarks.bench_gcode", "--out", str(tmp_path),
-                        "--repeat", "1"], cwd=ROOT, capture_output=True, text=True, check=False,
+                        "--repeat", "1", "--json"], cwd=ROOT, capture_output=True, text=True, check=False,
                        timeout=120)
     assert r.returncode == 0, r.stderr  # exit 1 when the 1 s goal is missed
     report = json.loads(r.stdout)

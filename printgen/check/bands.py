@@ -105,7 +105,7 @@ def model_variants(d: Design, mounting: str | None = None) -> tuple[list[Variant
     if not opts:
         notes.append("mounting: the model scene has one mounting only; no mounting variant")
     out.append(Variant(f"initial slack {SLACK_MAX:.0%}", slack=SLACK_MAX,
-                       source="printed net hung with 0 to 1 % slack (issue 10)"))
+                       source="printed net hung with 0 to 1 % slack (printgen; README: Uncertainty band)"))
     return out, notes
 
 

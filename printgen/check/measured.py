@@ -1,8 +1,12 @@
 """A lab's loading test brought back to the pre-print check: read its CSV, compare it with the
-predicted curves, and fit the one factor of the printed net that best explains it (issue 10).
+predicted curves, and fit the one factor of the printed net that best explains it.
 
 The CSV (`,` or `;` separated; with `;`, decimal commas are accepted; lines starting with `#`
-are comments) has a column `h_over_hb` and any of the columns in `COLUMNS`. Elongations are
+are comments) has a column `h_over_hb` and any of the columns in `COLUMNS`; given the printed
+model's lengths, also the raw readings in mm (`water_depth_mm` for the level, the sensors'
+wire change, deflection and top lowering: printgen.check.readings.RAW_COLUMNS). Columns
+named `expected_*` (the model's readings on printgen's measurement sheet) are skipped, and so
+are columns left empty when others hold values. Elongations are
 read as what the extension sensors record: counted from h / h_B = 0 (sensors zeroed before
 the water arrives), so they are compared with the predicted curves counted from there too.
 An empty cell is a reading that was not taken.
@@ -19,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from printgen.check.bands import Band, Variant, curves, run_variant
+from printgen.check.readings import DEPTH_COLUMN, RAW_COLUMNS, FlumeUnits
 from printgen.design.record import Design
 from printgen.errors import InputError
 
@@ -29,13 +34,18 @@ COLUMNS = {
     "top_cable_elongation_pct": ("strain_top", 0.01),
     "mid_height_elongation_pct": ("strain_mid", 0.01),
     "deflection_over_width": ("deflection", 1.0),
+    "lowering_over_height": ("lowering", 1.0),
 }
 MAX_LEVEL = 1.1  # the sweep's last relative loading (overflow): no prediction beyond it
+IGNORED_PREFIX = "expected_"  # columns of the measurement sheet that hold the model's readings
+LEVEL_AGREE = 0.01  # h_over_hb and water_depth_mm / h_B may differ by this much (h / h_B)
+RAW_LIMIT_MM = 1000.0  # a raw reading beyond +-1 m is not a flume model's: check the unit
 LIMITS = {  # plausible range of each column (CSV units): beyond it the unit is wrong
     "bottom_cable_elongation_pct": (-100.0, 100.0),
     "top_cable_elongation_pct": (-100.0, 100.0),
     "mid_height_elongation_pct": (-100.0, 100.0),
     "deflection_over_width": (-2.0, 2.0),
+    "lowering_over_height": (-2.0, 2.0),
 }
 
 
@@ -54,8 +64,13 @@ class Measurement:
     columns: dict[str, str]  # METRICS key -> CSV column
 
 
-def read_measured(path: str | Path) -> Measurement:
-    """Read and check a measured loading test (see the module docstring for the format)."""
+def read_measured(path: str | Path, units: FlumeUnits | None = None) -> Measurement:
+    """Read and check a measured loading test (see the module docstring for the format).
+
+    With `units` (the printed model's lengths, printgen.check.readings) the raw columns in mm
+    (RAW_COLUMNS, and DEPTH_COLUMN for the level) are read too; `expected_*` columns (the
+    model's readings on the measurement sheet) are skipped.
+    """
     p = Path(path)
     try:
         text = p.read_text(encoding="utf-8-sig")
@@ -68,20 +83,65 @@ def read_measured(path: str | Path) -> Measurement:
                                f"any of {', '.join(COLUMNS)}, then one line per level")
     sep = ";" if ";" in lines[0][1] else ","
     header = [h.strip().lower() for h in lines[0][1].split(sep)]
-    _check_header(p, header)
+    cols = _columns(units)
+    _check_header(p, header, cols, units)
     rows = lines[1:]
     if not rows:
         raise MeasurementError(f"{p}: a header but no data lines; give one line per level")
     table = np.array([_row(p, n, ln, sep, header) for n, ln in rows])
-    data = dict(zip(header, table.T, strict=True))
-    _check_ranges(p, data, [n for n, _ in rows])
-    keys = {COLUMNS[c][0]: c for c in header if c != LEVEL_COLUMN}
-    values = {COLUMNS[c][0]: data[c] * COLUMNS[c][1] for c in header if c != LEVEL_COLUMN}
+    data = {h: c for h, c in zip(header, table.T, strict=True)
+            if not h.startswith(IGNORED_PREFIX)}
+    if units is not None and DEPTH_COLUMN in data:
+        data = _level_from_depth(p, data, units)
+    read = [c for c in data if c in cols]
+    if len(read) > 1:  # a sheet's unfilled columns are dropped; a lone empty one is an error
+        read = [c for c in read if not np.all(np.isnan(data[c]))] or read
+    _check_ranges(p, {c: data[c] for c in [LEVEL_COLUMN, *read]}, [n for n, _ in rows])
+    keys = {cols[c][0]: c for c in read}
+    if len(keys) < len(read):
+        raise MeasurementError(f"{p}: two columns measure the same quantity ({', '.join(read)});"
+                               " keep one of each")
+    values = {cols[c][0]: data[c] * cols[c][1] for c in read}
     return Measurement(str(p), data[LEVEL_COLUMN], values, keys)
 
 
-def _check_header(p: Path, header: list[str]) -> None:
-    allowed = [LEVEL_COLUMN, *COLUMNS]
+def _columns(units: FlumeUnits | None) -> dict[str, tuple[str, float]]:
+    """Readable columns -> (METRICS key, factor to its unit): COLUMNS, and with `units` the
+    raw columns in mm."""
+    if units is None:
+        return dict(COLUMNS)
+    return {**COLUMNS, **{c: (k, 1.0 / units.length_mm(k)) for c, k in RAW_COLUMNS.items()}}
+
+
+def _level_from_depth(p: Path, data: dict[str, np.ndarray], units: FlumeUnits
+                      ) -> dict[str, np.ndarray]:
+    """h_over_hb from the water depth in mm (h_B = the net's height), checked against an
+    h_over_hb column when both are given."""
+    level = data.pop(DEPTH_COLUMN) / units.height_mm
+    given = data.get(LEVEL_COLUMN)
+    if given is not None:
+        ok = ~np.isnan(level)
+        if np.any(np.abs(level[ok] - given[ok]) > LEVEL_AGREE):
+            i = int(np.flatnonzero(ok & (np.abs(np.nan_to_num(level) - given) > LEVEL_AGREE))[0])
+            raise MeasurementError(
+                f"{p}: {DEPTH_COLUMN} {level[i] * units.height_mm:g} mm is h/h_B = {level[i]:.3f}"
+                f" (h_B = {units.height_mm:g} mm) but {LEVEL_COLUMN} says {given[i]:g}; fix "
+                "one or leave the depth cell empty")
+        return data
+    if np.any(np.isnan(level)):
+        raise MeasurementError(f"{p}: an empty {DEPTH_COLUMN} cell; give the depth of every "
+                               "reading (or an h_over_hb column)")
+    return {LEVEL_COLUMN: level, **data}
+
+
+def _check_header(p: Path, header: list[str], cols: dict[str, tuple[str, float]],
+                  units: FlumeUnits | None) -> None:
+    header = [h for h in header if not h.startswith(IGNORED_PREFIX)]
+    if units is not None and DEPTH_COLUMN in header and LEVEL_COLUMN not in header:
+        header = [LEVEL_COLUMN if h == DEPTH_COLUMN else h for h in header]
+    elif units is not None:
+        header = [h for h in header if h != DEPTH_COLUMN]
+    allowed = [LEVEL_COLUMN, *cols]
     for h in header:
         if h not in allowed:
             raise MeasurementError(f"{p}: unknown column {h!r}; allowed: {', '.join(allowed)}")
@@ -92,7 +152,7 @@ def _check_header(p: Path, header: list[str]) -> None:
         raise MeasurementError(f"{p}: missing column {LEVEL_COLUMN!r} (relative loading "
                                f"h / h_B); columns found: {', '.join(header)}")
     if len(header) < 2:
-        raise MeasurementError(f"{p}: no measured column; add any of {', '.join(COLUMNS)}")
+        raise MeasurementError(f"{p}: no measured column; add any of {', '.join(cols)}")
 
 
 def _row(p: Path, n: int, line: str, sep: str, header: list[str]) -> list[float]:
@@ -124,7 +184,8 @@ def _check_ranges(p: Path, data: dict[str, np.ndarray], line_numbers: list[int])
         i = int(bad[0])
         raise MeasurementError(f"{p}, line {line_numbers[i]}: {LEVEL_COLUMN} = {lv[i]:g} outside "
                                f"0 to {MAX_LEVEL:g} (the predicted range; h / h_B, not mm)")
-    for col, (lo, hi) in LIMITS.items():
+    limits = {**LIMITS, **{c: (-RAW_LIMIT_MM, RAW_LIMIT_MM) for c in RAW_COLUMNS}}
+    for col, (lo, hi) in limits.items():
         if col not in data:
             continue
         v = data[col]

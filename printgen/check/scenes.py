@@ -262,28 +262,34 @@ def _finish(s: BarrierScene, rows: list[Assumption], *, sensors: bool) -> Barrie
 
 
 def _common_assumptions(s: BarrierScene, sensors: bool) -> list[Assumption]:
-    ref = "barrier-physics.md"
+    paper = "Lambert et al. 2023"
     out = []
     if s.cables:
         held = ("lateral edges held by the side sheets along their whole height"
                 if s.mounting == "walls" else "lateral cables held only at their eyelets")
         out.append(("mounting", (f"{s.mounting}: {held}; top and bottom cables on the four "
-                     "corner anchors"), f"[flume] lateral (default walls: {ref} section 4)"))
+                     "corner anchors"),
+                    (f"[flume] lateral (default walls: {paper}, the 1:40 model fixed to the "
+                     "flume's side sheets; README: Pre-print verification, Mounting)")))
     else:
         out.append(("mounting", "anchored on the bed and the banks, top free",
-                    f"scene simple-free-top ({ref} section 7)"))
+                    ("printgen's scene simple-free-top (README: Pre-print verification, barriers "
+                     "without border cables)")))
     wire = (f"{SENSOR_FORCE_N:g} N along each wire" if sensors
             else "read only (no sensors on a field barrier)")
     out += [("sensor wires", (f"bottom, top and mid-height rows, {wire}; anchored at the left "
              f"edge node, over the row's nodes, to the potentiometer {SENSOR_EXIT:.0%} of the "
-             "width beyond the right edge; reading = change of wire length"), f"{ref} section 4"),
+             "width beyond the right edge; reading = change of wire length"),
+             (f"{paper}: three 1 N extension sensors (Fig. 6a); routing: README, The flume "
+             "test as it is run")),
             ("loading", ("hydrostatic rho g (h - z) A* at the current node height, h/h_B = 0 "
-             "to 1.1; the folded film adds no stiffness"), f"{ref} sections 3 and 4"),
+             "to 1.1; the folded film adds no stiffness"),
+             f"{paper}: nodal hydrostatic loads, loading test behind a folded film (Fig. 6a)"),
             ("initial state", "flat, no pretension, no slack; gravity on the net neglected",
-             f"{ref} section 4")]
+             f"{paper}: no pretension in the main cables at installation")]
     if s.hold > 0:
         out.append(("unloaded strands", (f"stay where they are: each free node held at rest by "
                     f"{s.hold:.3g} N/m ({HOLD_FRACTION:g} x rho g A*), a regularisation of the "
                     "dry, slack net above the water (a mechanism otherwise)"),
-                    "printgen (issue 10); its force share is reported"))
+                    "printgen (README: barriers without border cables); its force share is reported"))
     return out

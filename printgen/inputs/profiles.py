@@ -27,6 +27,16 @@ def search_dirs() -> list[Path]:
     return [*extra, BUNDLED]
 
 
+def user_folder_hint(kind: str, file_name: str) -> str:
+    """Where a user puts a profile of their own: the first folder of $PRINTGEN_PROFILES, or
+    one to create and name there (never the installation's bundled profiles/)."""
+    extra = [p for p in os.environ.get("PRINTGEN_PROFILES", "").split(os.pathsep) if p]
+    if extra:
+        return f"copy it to {Path(extra[0]) / kind / file_name} ($PRINTGEN_PROFILES)"
+    return (f"copy it to a profile folder of your own, e.g. ~/printgen-profiles/{kind}/"
+            f"{file_name}, and set PRINTGEN_PROFILES=~/printgen-profiles")
+
+
 def profile_path(kind: str, name: str) -> Path:
     """Path of profile `name` of `kind` (case-insensitive file stem), first match wins."""
     if kind not in KINDS:

@@ -1,8 +1,9 @@
 """`printgen verify`: the pre-print check of an existing design (the design.json `make`
 wrote), with its uncertainty band, and optionally a lab's measured loading test compared with
 it and one factor of the printed net fitted to it. Output folder (written whole,
-`outputs.staged_dir`): report.html, report.json, timings.json, and with a stiffness fit
-`<material>-fitted.toml`, the profile that feeds the fit back.
+`outputs.staged_dir`): report.html, report.json, timings.json, the lab's CSV files
+(printgen.report.labfiles), and with a stiffness fit `<material>-fitted.toml`, the profile
+that feeds the fit back.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from printgen.check.measured import (
     model_predictor,
     read_measured,
 )
+from printgen.check.readings import design_units
 from printgen.check.verify import Verification, verify
 from printgen.design.design_file import load_design
 from printgen.design.record import Design
@@ -30,7 +32,9 @@ from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import staged_dir
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
+from printgen.report.labfiles import lab_files, lab_record
 from printgen.report.report import verification_sections
+from printgen.report.summary import summary_html, summary_record
 from printgen.report.uncertainty import (
     band_record,
     band_sections,
@@ -68,7 +72,7 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     t0 = time.perf_counter()
     p = load_prototype(prototype)
     d = load_design(design_path, scale=scale)
-    m = read_measured(measured) if measured is not None else None
+    m = read_measured(measured, design_units(d)) if measured is not None else None
     load_kw = model_load_kw(p, d, drag)
     say("verification (prototype and model load sweeps)")
     v = verify(p, d, drag=drag)
@@ -83,10 +87,13 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     verification_sections(rep, v, None, d.scale, band=band)
     band_sections(rep, v, band)
     record = {"design": d.to_dict(), "verification": v.to_record(),
-              "bands": band_record(v, band)}
+              "bands": band_record(v, band), "lab": lab_record(v, band, d.scale)}
     if m is not None:
-        measured_sections(rep, m, band, result, text)
+        measured_sections(rep, m, band, result, text, prototype=v.prototype.deformation)
         record["measured"] = measured_record(m, band, result, text)
+    record["summary"] = summary_record(record, record["measured"]["fit"]["sentence"]
+                                       if m is not None and result else "")
+    rep.lead = summary_html(record["summary"])
     record["timings_s"] = {"total": time.perf_counter() - t0, "band": band.seconds}
     files = _write(out, rep, record, d, text, force)
     return VerifyRun(p, d, v, band, m, result, text, record, files)
@@ -105,6 +112,7 @@ def _write(out: str | Path, rep: Report, record: dict[str, Any], d: Design, prof
     timings = record.pop("timings_s")
     files = {"report.html": rep.html(), "report.json": dumps(record),
              TIMINGS: dumps({"timings_s": timings})}
+    files.update(lab_files(record["lab"]))  # curves, expected readings, measurement sheet
     if profile:
         files[f"{d.net.material}-fitted.toml"] = profile
     record["timings_s"] = timings
