@@ -33,6 +33,9 @@ class NetSystem:
                                [c.nodes for c in self.cables])
         self.damping = self._damping()
         self.loads: list = []
+        # each strand's slope just above zero strain: its stiffness once a slack strand pulls
+        self.first_slope = np.array([law.slopes[0] for law in self.bars.laws])[
+            self.bars.law_index] if len(self.bars.laws) else np.zeros(0)
 
     def _damping(self) -> np.ndarray:
         """CSR data of D = (graph Laplacian, weights 1 / rest length) x I3, scaled to a mean
