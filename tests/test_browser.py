@@ -61,7 +61,7 @@ def made(tmp_path_factory):
     """One whole `make` of the 1:40 example for the module, with report.pdf when Chromium is
     there: (output folder, the run's context)."""
     out = tmp_path_factory.mktemp("browser") / "out"
-    ctx = make_mod.make(REALISTIC, 40, out, options={"pdf": True})
+    ctx = make_mod.make(REALISTIC, 40, out, options=make_mod.MakeOptions(pdf=True))
     return out, ctx
 
 

@@ -107,7 +107,7 @@ def test_a_part_larger_than_the_bed_is_rejected_before_writing(cables, printer, 
     long = dataclasses.replace(cables[0], length_mm=600.0)
     out = tmp_path / "long.3mf"
     with pytest.raises(PrintabilityError, match=r"part 606\.0 x 6\.0 mm does not fit the usable "
-                       r"340 x 340 mm .* not even turned diagonally .* larger bed .* split"):
+                       r"340 x 340 mm .* not even turned diagonally .* larger bed .* larger lambda"):
         write_plate(out, [("cable-long", cable_solid(long))], printer)
     assert not out.exists() and not list(tmp_path.iterdir())
 

@@ -226,24 +226,3 @@ def test_incomplete_verification_exits_3_with_outputs(tmp_path, monkeypatch, cap
     code = main(["make", str(REALISTIC), "-s", "40", "--out", str(tmp_path / "o")])
     assert code == make_cmd.EXIT_INCOMPLETE and code not in (0, 2)
     assert "rests on 20 of 23 load levels" in capsys.readouterr().err
-
-
-ESTIMATE_FACTOR = 2.0  # issue 28: the size estimate within x2 of the measured make
-LOADED = 2.0  # load average per core above which a wall-clock comparison says nothing
-
-
-def test_estimate_is_within_a_factor_two_of_the_run_on_both_examples(made, tmp_path):
-    """The estimate (printgen/run/budget.py) against the measured make of both examples (one
-    make each: the realistic one is the module's); skipped on a machine so loaded that wall
-    time is no measure of the run."""
-    import os
-
-    from proto_files import SIMPLE
-
-    if os.getloadavg()[0] > LOADED * (os.cpu_count() or 1):
-        pytest.skip(f"load average {os.getloadavg()[0]:.1f}: wall times say nothing")
-    simple = make_mod.make(SIMPLE, 40, tmp_path / "simple")
-    for ctx in (made[0], simple):
-        t = ctx.record["timings_s"]
-        ratio = t["total"] / t["estimate"]
-        assert 1 / ESTIMATE_FACTOR <= ratio <= ESTIMATE_FACTOR, (ctx.prototype.name, t)
