@@ -92,7 +92,8 @@ def _starts(history: list[tuple[float, np.ndarray]], target: float) -> list[np.n
     return [u2, u2 + (u2 - u1) * ((target - l2) / (l2 - l1))]
 
 
-def solve_path(net: Net, loads_at: Callable[[float], Sequence], levels: Sequence[float], *,
+def solve_path(net: Net, loads_at: Callable[[float], Sequence],
+               levels: Sequence[float] | np.ndarray, *,
                tol: float = TOL_FORCE, max_iter: int = MAX_ITER, strict: bool = False,
                max_cuts: int = MAX_CUTS, skip_failed: bool = False,
                method: str = "fast") -> list[Result]:

@@ -72,7 +72,7 @@ def loads_function(s: BarrierScene, *, velocity: float | None = None,
     row_gap = float(np.diff(np.unique(np.round(s.nodes[:, 2], 12))).min())  # node rows apart
 
     def loads_at(r: float) -> list:
-        out = [solver.Hydrostatic(free, s.area_per_node, r * s.height, tuple(FLOW),
+        out: list[solver.Hydrostatic | solver.Drag] = [solver.Hydrostatic(free, s.area_per_node, r * s.height, tuple(FLOW),
                                   rho=RHO_WATER, g=G)]
         if velocity:
             out.append(solver.Drag(free, strand_per_node, strand_diameter, velocity,
@@ -206,7 +206,7 @@ def verify(p: Prototype, d: Design, *, drag: bool = False, lv: np.ndarray | None
         kw_m = {"velocity": p.velocity / np.sqrt(d.scale),
                 "strand_diameter": d.net.strand.width_mm * 1e-3}
         case = "hydrostatic + drag at the Froude-scaled velocity"
-    jobs = [(sweep, (ms, lv), kw_m), (sweep, (ps, lv), kw_p)]  # the longest first
+    jobs: list[tuple] = [(sweep, (ms, lv), kw_m), (sweep, (ps, lv), kw_p)]  # longest first
     if counterexample:
         jobs.append((steel_counterexample, (d.scale,), {}))
     model, proto, *ce = run_jobs(jobs)

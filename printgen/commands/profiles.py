@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Callable
+from typing import Any
 
 from printgen.commands.common import add_json_arg, console, emit_json, table
 from printgen.errors import ProfileError
@@ -11,7 +13,8 @@ from printgen.inputs.printers import load_print_style, load_printer
 from printgen.inputs.profiles import KINDS, list_profiles, profile_path, searched
 from printgen.report.jsonout import jsonable
 
-LOADERS = {"materials": load_material, "printers": load_printer, "prints": load_print_style}
+LOADERS: dict[str, Callable[[str], Any]] = {
+    "materials": load_material, "printers": load_printer, "prints": load_print_style}
 
 
 def register(sub: argparse._SubParsersAction) -> None:
