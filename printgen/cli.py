@@ -14,7 +14,7 @@ import os
 import sys
 from concurrent.futures.process import BrokenProcessPool
 
-from printgen import __version__
+import printgen
 from printgen.errors import PrintgenError
 from printgen.outputs import describe_os_error, os_error_exit_code
 from printgen.workers import Interrupted, signals_raise
@@ -43,7 +43,7 @@ def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
         description="Stiffness-scaled, printable flexible-barrier models for flume experiments.",
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
-    parser.add_argument("--version", action="version", version=f"printgen {__version__}")
+    parser.add_argument("--version", action="version", version=f"printgen {printgen.__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     words = [a for a in argv or [] if not a.startswith("-") or a in ("-h", "--help")]

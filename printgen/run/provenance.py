@@ -10,7 +10,7 @@ import platform
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from printgen import __version__
+import printgen
 from printgen.outputs import MANIFEST, file_digest
 from printgen.report.html import Report
 
@@ -74,7 +74,7 @@ def provenance(ctx: MakeContext) -> dict[str, Any]:
             shown = (Path("profiles") / path.relative_to(BUNDLED)
                      if path.is_relative_to(BUNDLED) else path)
             inputs[f"{kind}/{path.stem}"] = _digest(path, shown)
-    return {"printgen_version": __version__, "command": ctx.options.get("command"),
+    return {"printgen_version": printgen.__version__, "command": ctx.options.get("command"),
             "inputs": inputs, "environment": environment(ctx.record)}
 
 
