@@ -108,7 +108,8 @@ def test_cli_end_to_end(tmp_path, cable_files, capsys, monkeypatch):
     assert main(args) == 0
     rec = json.loads(capsys.readouterr().out)
     assert_allclose(rec["modulus_GPa"]["mean"], MODULI.mean() / 1e9, rtol=FIT_RTOL)
-    assert rec["written"]["modulus_source"] == "measured"
+    assert rec["written"]["modulus_source"] == "measured: this calibration (5 files)"
+    assert rec["written"]["failure_stress_source"] == "measured: this calibration (5 files)"
     assert (tmp_path / "plots" / "petg-lab.png").stat().st_size > 10_000
     monkeypatch.setenv("PRINTGEN_PROFILES", str(out))
     assert main(["profiles", "show", "petg-lab", "--json"]) == 0

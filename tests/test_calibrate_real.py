@@ -49,9 +49,17 @@ def test_bluehill_moduli_match_the_machine(folder):
     assert_allclose(ours, machine, rtol=MACHINE_FILE_RTOL)
     assert_allclose(ours.mean(), machine.mean(), rtol=MACHINE_MEAN_RTOL)
     assert cal.samples[0].strain_source.startswith("extensometer")
-    # Same files, ISO window: past the linear part, so far below the machine's steepest fit.
+    assert not any("machine's own" in w or "modulus window" in w for w in cal.warnings)
+    assert cal.window_summary.endswith("in 10 of 10 files")
+    # Same files, ISO window: past the linear part, so far below the machine's steepest fit;
+    # said twice: against the machine's value, and against the curve itself.
     iso = calibrate(files, material="cf")
     assert all(s.modulus < (1 - ISO_BELOW) * s.machine_modulus for s in iso.samples)
+    diff = [w for w in iso.warnings if "differs from the machine's own" in w]
+    assert len(diff) == 1 and "in 10 of 10 files" in diff[0] and "--window auto" in diff[0]
+    assert any(w.startswith("modulus window 0.05-0.25 %: past the linear part") and
+               "in 10 of 10 files" in w for w in iso.warnings)
+    assert all(s.window_check.position == "past the linear part" for s in iso.samples)
 
 
 def test_bluehill_dimensions_and_strength_from_the_header():

@@ -15,7 +15,9 @@ from pathlib import Path
 from typing import Any
 
 from printgen.calibrate.aggregate import Stats, spread_only, summarise
+from printgen.calibrate.checks import machine_warning, window_warnings
 from printgen.calibrate.fit import BREAK_DROP
+from printgen.calibrate.groups import Group, by_orientation, mixed_warning, orientation
 from printgen.calibrate.inputs import expand
 from printgen.calibrate.plausible import check_stress
 from printgen.calibrate.reader import NoTableError, read_export
@@ -26,6 +28,7 @@ from printgen.calibrate.sample import (
     analyse,
     flag_notes,
     peak_and_strength,
+    status_record,
 )
 from printgen.calibrate.specimen import (
     KINDS,
@@ -51,6 +54,7 @@ class StrengthSample:
     flags: tuple[str, ...] = ()
     columns: dict[str, str] = field(default_factory=dict)  # role -> header used
     notes: tuple[str, ...] = ()
+    status: dict[str, dict[str, object]] = field(default_factory=dict)  # column -> convention
 
 
 @dataclass(frozen=True)
@@ -83,6 +87,9 @@ class Calibration:
     preload_change: tuple[float | None, ...] | None = None  # mean at PRELOAD_STEPS x preload
     excluded: tuple[str, ...] = ()  # flagged files left out of the statistics
     skipped: tuple[str, ...] = ()  # directory files that hold no table
+    window_summary: str = ""  # how the modulus window sits on the curves (checks.py)
+    orientations: dict[str, str | None] = field(default_factory=dict)  # file -> orientation
+    groups: tuple[Group, ...] = ()  # per orientation, when the files mix them
 
     @property
     def files(self) -> tuple[str, ...]:
@@ -97,12 +104,14 @@ def calibrate(paths: Sequence[str | Path], *, material: str, options: FitOptions
               specimen: Mapping[str, Any] | None = None, specimen_file: str | Path | None = None,
               columns: Mapping[str, str] | None = None, units: Mapping[str, str] | None = None,
               delimiter: str | None = None, decimal: str | None = None,
-              strength_only: bool = False, conditions: str = "") -> Calibration:
+              strength_only: bool = False, conditions: str = "",
+              flags: Mapping[str, str] | None = None) -> Calibration:
     """Fit every export in `paths` (files, or directories: every export in them; one
     material, one specimen type) and summarise.
 
     specimen : dimension options in SI (width, thickness, area, gauge_length, grip_distance)
     and `kind`; they fill what the files' metadata lines do not give.
+    flags : status column -> convention (status.CONVENTIONS); default: decided from the data.
     """
     if not paths:
         raise CalibrationError("no tensile-test exports given")
@@ -115,15 +124,17 @@ def calibrate(paths: Sequence[str | Path], *, material: str, options: FitOptions
     fits: list[SampleFit] = []
     strengths: list[StrengthSample] = []
     skipped: list[str] = []
+    orient: dict[str, str | None] = {}
     for path, in_dir in files:
         try:
-            rec, spec = _load(path, specimen or {}, specimen_file, columns, units, delimiter,
-                              decimal)
+            rec, spec = _load(path, specimen or {}, specimen_file,
+                              (columns, units, flags), delimiter, decimal)
         except NoTableError:
             if not in_dir:
                 raise
             skipped.append(str(path))
             continue
+        orient[rec.path] = orientation(rec.path, rec.metadata)
         if strength_only:
             strengths.append(_strength_sample(rec, spec))
         else:
@@ -136,7 +147,7 @@ def calibrate(paths: Sequence[str | Path], *, material: str, options: FitOptions
                                "specimen type at a time")
     cal = Calibration(material=material, kind=kinds.pop(), options=opt, samples=tuple(fits),
                       strength_samples=tuple(strengths), conditions=conditions,
-                      warnings=tuple(notes), skipped=tuple(skipped))
+                      warnings=tuple(notes), skipped=tuple(skipped), orientations=orient)
     return _summarise(cal)
 
 
@@ -146,15 +157,19 @@ def _strength_sample(rec, spec) -> StrengthSample:
         raise CalibrationError(f"{rec.path}: --strength-only needs a force column")
     check_stress(rec, spec, strength)
     return StrengthSample(rec.path, spec, peak, strength, flag_notes(rec), dict(rec.names),
-                          rec.notes)
+                          rec.notes, status_record(rec))
 
 
-def _load(path: Path, spec_opts, specimen_file, columns, units, delimiter, decimal):
+def _load(path: Path, spec_opts, specimen_file, choices, delimiter, decimal):
+    """(record, specimen) of one export; `choices`: the columns, units and status conventions
+    the options give (they win over the sidecar's)."""
     side_path = Path(specimen_file) if specimen_file else find_sidecar(path)
     side = read_sidecar(side_path) if side_path else {}
-    cols = {**side.get("columns", {}), **(columns or {})}
-    unit_map = {**side.get("units", {}), **(units or {})}
-    rec = read_export(path, columns=cols, units=unit_map, delimiter=delimiter, decimal=decimal)
+    cols, unit_map, flag_map = ({**side.get(k, {}), **(given or {})}
+                                for k, given in zip(("columns", "units", "flags"), choices,
+                                                    strict=True))
+    rec = read_export(path, columns=cols, units=unit_map, delimiter=delimiter, decimal=decimal,
+                      flags=flag_map)
     spec = resolve(from_metadata(rec.metadata, rec.path), dict(spec_opts), side,
                    sidecar_path=str(side_path) if side_path else None)
     return rec, spec
@@ -180,9 +195,13 @@ def _summarise(cal: Calibration) -> Calibration:
     (mu, mf), (su, sf) = _units(cal)
     mod = strength = panel = elong = change = None
     bil: dict[str, Stats] = {}
+    summary = ""
     if fits:
         mod = summarise([s.modulus for s in fits], what="modulus", labels=labels, unit=(mu, mf))
         warns += mod.warnings
+        window = window_text(cal.options)
+        more, summary = window_warnings(fits, window, (mu, mf))
+        warns += [w for w in [machine_warning(fits, window, (mu, mf))] if w] + more
         with_bil = [s for s in fits if s.bilinear is not None]
         if with_bil:
             bil = {k: summarise([getattr(s.bilinear, k) for s in with_bil], what=f"bilinear {k}")
@@ -198,9 +217,19 @@ def _summarise(cal: Calibration) -> Calibration:
     elif vals:
         warns.append("strength not computed: cross-section (or panel width) unknown for "
                      f"{sum(v is None for v in vals)} file(s)")
+    groups = by_orientation([*fits, *forces], cal.orientations)
+    warns += [w for w in [mixed_warning(groups, (mu, mf), (su, sf))] if w]
     return replace(cal, modulus=mod, strength=strength, bilinear=bil, panel=panel,
-                   warnings=tuple(dict.fromkeys(warns)), elongation=elong,
-                   preload_change=change, excluded=tuple(s.path for s in flagged if not keep))
+                   warnings=tuple(dict.fromkeys(warns)), elongation=elong, groups=groups,
+                   preload_change=change, excluded=tuple(s.path for s in flagged if not keep),
+                   window_summary=summary)
+
+
+def window_text(o: FitOptions) -> str:
+    """The modulus window as said in warnings: '0.05-0.25 %' or 'auto (15 % of the rise)'."""
+    if o.window is None:
+        return f"auto ({o.auto_span:.0%} of the rise to the peak)"
+    return f"{o.window[0] * 100:g}-{o.window[1] * 100:g} %"
 
 
 def _units(cal: Calibration) -> tuple[tuple[str, float], tuple[str, float]]:

@@ -65,6 +65,12 @@ def measured_tables(cal: Calibration, *, date: str | None = None) -> dict[str, d
 def write_profile(cal: Calibration, *, name: str, out: str | Path | None = None,
                   inherits: str | None = None, date: str | None = None) -> tuple[Path, Material]:
     """Write (or update) `<dir>/materials/<name>.toml`; return its path and the loaded material."""
+    if cal.groups:
+        raise CalibrationError(
+            "the files mix specimen orientations ("
+            + ", ".join(f"{g.label}: {len(g.files)} files" for g in cal.groups)
+            + "); a profile holds one: calibrate and save one orientation at a time (name only "
+            "its files, e.g. xy-*)")
     root = output_dir(out)
     path = root / "materials" / f"{name.lower()}.toml"
     data = _existing(path)
@@ -92,8 +98,50 @@ def write_profile(cal: Calibration, *, name: str, out: str | Path | None = None,
                 mat = load_material(name)
             except PrintgenError as exc:
                 raise CalibrationError(f"calibrated profile {path} would not load: {exc}") from exc
+    mode = _mode(path)
     outputs.write_text(path, text)
+    os.chmod(path, mode)
     return path, mat
+
+
+def _mode(path: Path) -> int:
+    """The mode a plain `open(path, "w")` leaves: an existing file's own, else 0666 less the
+    umask (the temp file `outputs.write_text` renames into place is 0600)."""
+    if path.is_file():
+        return path.stat().st_mode & 0o7777
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
+def value_sources(cal: Calibration, path: Path, mat: Material) -> dict[str, Any]:
+    """The written profile's modulus and failure stress, each with its own source: this
+    calibration, an earlier one kept in the same file, inherited from a parent profile, or a
+    datasheet. A value this calibration did not measure is never called measured here."""
+    own = tomllib.loads(path.read_text(encoding="utf-8"))
+    wrote = set(measured_tables(cal))
+    e, _ = mat.modulus()
+    stress, _ = mat.failure_stress()
+    return {"modulus_gpa": e / 1e9,
+            "modulus_source": _source("tensile_modulus", mat.measured_modulus, wrote, own, cal),
+            "failure_stress_mpa": stress / 1e6,
+            "failure_stress_source": _source("failure_stress", mat.measured_failure_stress,
+                                             wrote, own, cal)}
+
+
+def _source(key: str, measured: Any, wrote: set[str], own: dict[str, Any],
+            cal: Calibration) -> str:
+    parent = own.get("inherits")
+    if key in wrote:
+        return f"measured: this calibration ({len(cal.files)} files)"
+    why = " (--strength-only)" if key == "tensile_modulus" and cal.strength_samples else ""
+    if measured is not None:
+        when = f", {measured.date}" if measured.date else ""
+        where = ("earlier in this profile" if key in own.get("measured", {})
+                 else f"inherited from {parent}")
+        return f"{where}: {measured.source}{when}; not measured by this calibration{why}"
+    sheet = "this profile's datasheet" if "datasheet" in own else f"datasheet of {parent}"
+    return f"{sheet}; not measured by this calibration{why}"
 
 
 def _existing(path: Path) -> dict[str, Any]:

@@ -19,7 +19,6 @@ import numpy as np
 
 from printgen.calibrate.columns import (
     ROLES,
-    is_flag_name,
     is_units_row,
     normalise_unit,
     role_of,
@@ -28,6 +27,7 @@ from printgen.calibrate.columns import (
     unit_factor,
 )
 from printgen.calibrate.numbers import decimal_of, parse_number
+from printgen.calibrate.status import StatusColumn, decide
 from printgen.errors import CalibrationError
 
 log = logging.getLogger(__name__)
@@ -68,11 +68,16 @@ class TestRecord:
     lines: np.ndarray = field(default_factory=lambda: np.zeros(0, int))  # file line per row
     assumed: frozenset[str] = frozenset()  # roles whose unit the file does not give
     alternatives: dict[str, tuple[str, ...]] = field(default_factory=dict)  # role -> others
-    notes: tuple[str, ...] = ()  # how columns were chosen when several could serve a role
-    flags: dict[str, np.ndarray] = field(default_factory=dict)  # flag column -> bool per row
+    notes: tuple[str, ...] = ()  # how columns were chosen, status conventions assumed
+    status: tuple[StatusColumn, ...] = ()  # tester status columns (see status.py)
 
     def has(self, role: str) -> bool:
         return role in self.channels
+
+    @property
+    def flags(self) -> dict[str, np.ndarray]:
+        """Status column -> bool per row: the event is set."""
+        return {c.name: c.on for c in self.status}
 
 
 def read_text(path: str | Path) -> tuple[str, str]:
@@ -104,9 +109,11 @@ def _decode(data: bytes, p: Path) -> str:
 
 def read_export(path: str | Path, *, columns: Mapping[str, str] | None = None,
                 units: Mapping[str, str] | None = None, delimiter: str | None = None,
-                decimal: str | None = None) -> TestRecord:
+                decimal: str | None = None, flags: Mapping[str, str] | None = None
+                ) -> TestRecord:
     """Read an export; `columns` maps a role to a header name or 1-based index, `units` a role
-    to the unit of its column (overriding the file)."""
+    to the unit of its column (overriding the file), `flags` a status column to its
+    convention (status.CONVENTIONS; default: decided from the data)."""
     text, where = read_text(path)
     lines = text.splitlines()
     delim = delimiter or _sniff_delimiter(lines, where)
@@ -134,9 +141,11 @@ def read_export(path: str | Path, *, columns: Mapping[str, str] | None = None,
         channels[role] = data[:, j] * unit_factor(role, unit, where=f"{where}: column {col!r}")
         names[role] = col
     meta = tuple(m for n, r in rows[:meta_end] if (m := _meta(n, r, dec)) is not None)
+    status, status_notes = decide(_levels(headers, data, set(roles.values())), flags or {},
+                                  where)
     return TestRecord(where, channels, names, tuple(headers), meta, delim, dec,
-                      rows[start][0], line_no, frozenset(assumed), alternatives, tuple(notes),
-                      _flags(headers, data, set(roles.values())))
+                      rows[start][0], line_no, frozenset(assumed), alternatives,
+                      (*notes, *status_notes), status)
 
 
 def _column_units(headers: list[str], unit_row: list[str] | None, ncols: int
@@ -151,17 +160,14 @@ def _column_units(headers: list[str], unit_row: list[str] | None, ncols: int
     return out
 
 
-def _flags(headers: list[str], data: np.ndarray, used: set[int]) -> dict[str, np.ndarray]:
-    """Tester flag columns: unused columns holding only 0 and 1 (a column of ones only counts
-    when its name says flag, stop, loss, ...: otherwise it is a constant such as a cycle)."""
+def _levels(headers: list[str], data: np.ndarray, used: set[int]) -> dict[str, np.ndarray]:
+    """Candidate status columns: unused columns holding only 0 and 1, with their values."""
     out = {}
     for j, h in enumerate(headers):
         col = data[:, j] if data.size else np.zeros(0)
         if j in used or col.size < 2 or not np.all((col == 0) | (col == 1)):
             continue
-        if np.all(col == 1) and not is_flag_name(h):
-            continue
-        out[h] = col == 1
+        out[h] = col
     return out
 
 

@@ -60,8 +60,10 @@ def sample_record(s: SampleFit, cal: Calibration) -> dict[str, Any]:
         "specimen": {k: v for k, v in vars(s.specimen).items() if v is not None},
         "columns": s.columns, "elongation_at_break_percent": _pct(s.elongation_at_break),
         "preload_sensitivity": preload_record(cal, s.preload_change, s.preload_moduli),
-        "flags": list(s.flags), "excluded": s.path in cal.excluded,
+        "flags": list(s.flags), "status_columns": s.status, "excluded": s.path in cal.excluded,
     }
+    if s.window_check is not None:
+        rec["window_check"] = s.window_check.record((mu, mf))
     if s.kappa is not None:
         rec["kappa_kn_per_m_per_m"] = s.kappa / 1e3
     if s.machine_modulus is not None:
@@ -85,13 +87,18 @@ def calibration_record(cal: Calibration) -> dict[str, Any]:
         "strength_samples": [{"file": s.path, "peak_force_n": s.peak_force,
                               f"strength_{su}": None if s.strength is None else s.strength / sf,
                               "columns": s.columns, "flags": list(s.flags),
-                              "excluded": s.path in cal.excluded}
+                              "status_columns": s.status, "excluded": s.path in cal.excluded}
                              for s in cal.strength_samples],
         f"modulus_{mu}": stats_record(cal.modulus, mf),
         "modulus_preload_sensitivity": preload_record(cal, cal.preload_change),
         f"strength_{su}": stats_record(cal.strength, sf),
         "elongation_at_break_percent": stats_record(cal.elongation, 1e-2),
         "excluded": list(cal.excluded), "skipped": list(cal.skipped),
+        "window_check": cal.window_summary or None,
+        "orientations": {g.label: {"files": list(g.files),
+                                   f"modulus_{mu}": stats_record(g.modulus, mf),
+                                   f"strength_{su}": stats_record(g.strength, sf)}
+                         for g in cal.groups},
         "warnings": list(cal.warnings),
     }
     if cal.panel is not None:

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from printgen.calibrate.checks import WindowCheck, check_window
 from printgen.calibrate.compliance import Compliance
 from printgen.calibrate.fit import (
     DEFAULT_ZERO,
@@ -30,6 +31,7 @@ from printgen.calibrate.fit import (
 from printgen.calibrate.plausible import check_modulus, check_stress
 from printgen.calibrate.reader import TestRecord
 from printgen.calibrate.specimen import Specimen, machine_modulus
+from printgen.calibrate.status import set_text
 from printgen.errors import CalibrationError
 
 DEFAULT_SECANTS = (0.005, 0.01)  # strain where secant moduli are reported (0.5 %, 1 %)
@@ -72,7 +74,9 @@ class SampleFit:
     preload_moduli: tuple[float | None, ...] | None = None  # at PRELOAD_STEPS x the preload
     flags: tuple[str, ...] = ()  # tester flags set during the test (see flag_notes)
     columns: dict[str, str] = field(default_factory=dict)  # role -> header used
-    notes: tuple[str, ...] = ()  # how columns were chosen
+    notes: tuple[str, ...] = ()  # how columns were chosen, status conventions assumed
+    status: dict[str, dict[str, object]] = field(default_factory=dict)  # column -> convention
+    window_check: WindowCheck | None = None  # the modulus window against the curve
 
     @property
     def preload_change(self) -> tuple[float | None, ...] | None:
@@ -129,18 +133,26 @@ def analyse(rec: TestRecord, spec: Specimen, opt: FitOptions) -> SampleFit:
     return SampleFit(rec.path, spec, source, lin, bil, secants, peak, strength,
                      machine_modulus(rec.metadata), x_branch, y_branch,
                      None if k is None else float(x[k] - x0), moduli,
-                     flag_notes(rec, x - x0), dict(rec.names), rec.notes)
+                     flag_notes(rec, x - x0), dict(rec.names), rec.notes, status_record(rec),
+                     check_window(x_branch, y_branch, lin, opt.auto_span))
+
+
+def status_record(rec: TestRecord) -> dict[str, dict[str, object]]:
+    """Each status column's convention, who decided it, and how many rows it marks."""
+    return {c.name: c.record() for c in rec.status}
 
 
 def flag_notes(rec: TestRecord, strain: np.ndarray | None = None) -> tuple[str, ...]:
-    """One note per tester flag column set during the test: where it first is set."""
+    """One note per tester status column set during the test: where it first is set (and
+    how it reads, when not the usual 1 = set)."""
     out = []
-    for name, on in rec.flags.items():
-        if not on.any():
+    for col in rec.status:
+        if not col.on.any():
             continue
-        i = int(np.argmax(on))
+        i = int(np.argmax(col.on))
         at = f", {strain[i] * 100:.3g} % strain" if strain is not None else ""
-        out.append(f"{name} set at line {rec.lines[i]}{at} ({int(on.sum())} rows)")
+        out.append(f"{col.name} set at line {rec.lines[i]}{at} ({int(col.on.sum())} rows"
+                   f"{set_text(col)})")
     return tuple(out)
 
 

@@ -3,7 +3,8 @@
 Kinds: `cable` (printed strand, width x thickness), `dogbone` (narrow section width x thickness),
 `panel` (net panel: width across and length along the load). Sidecar: `<export>.toml` beside
 the export, or `specimen.toml` in its folder, or the file given with --specimen; keys are the
-fields of `SIDECAR` (mm), plus optional `[columns]` and `[units]` tables (role -> name/unit).
+fields of `SIDECAR` (mm), plus optional `[columns]` and `[units]` tables (role -> name/unit) and
+a `[flags]` table (status column -> active-high, active-low or ignore).
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ SIDECAR = [
     positive("grip_distance_mm", 1e4, si=False, required=False),
     Field("columns", dict, required=False, default={}),
     Field("units", dict, required=False, default={}),
+    Field("flags", dict, required=False, default={}),
 ]
 DIMENSIONS = ("width", "thickness", "area", "gauge_length", "grip_distance")
 # Metadata key patterns (lower case) per dimension; the first match wins.
@@ -115,7 +117,7 @@ def find_sidecar(export: Path) -> Path | None:
 def read_sidecar(path: Path) -> dict[str, Any]:
     """The sidecar's keys: dimensions in SI, `kind`, `columns`, `units`."""
     t = read_table(load_toml(path), SIDECAR, where=str(path))
-    out: dict[str, Any] = {k: t[k] for k in ("kind", "columns", "units") if t[k]}
+    out: dict[str, Any] = {k: t[k] for k in ("kind", "columns", "units", "flags") if t[k]}
     for dim in DIMENSIONS:
         key = "area_mm2" if dim == "area" else f"{dim}_mm"
         if t[key] is not None:

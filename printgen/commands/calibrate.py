@@ -4,7 +4,7 @@
         [--width-mm W --thickness-mm T | --area-mm2 A] [--gauge-length-mm L]
         [--grip-distance-mm L] [--specimen SIDECAR.toml] [--column ROLE=NAME] [--unit ROLE=UNIT]
         [--window 0.05,0.25 | --window auto] [--preload N [--zero interpolate|first]]
-        [--secant 0.5,1] [--keep-flagged]
+        [--secant 0.5,1] [--flag COLUMN=active-low|active-high|ignore] [--keep-flagged]
         [--strain-source auto|extensometer|crosshead]
         [--machine-stiffness N_PER_MM | --compliance-curve FILE]
         [--strength-only] [--save [--out DIR] [--inherits petg]] [--plot DIR] [--json]
@@ -15,7 +15,10 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from rich.console import Console
 from rich.markup import escape
+from rich.measure import Measurement
+from rich.table import Table
 
 from printgen.calibrate.aggregate import MIN_SAMPLES
 from printgen.calibrate.compliance import from_curve, from_stiffness
@@ -27,6 +30,7 @@ from printgen.calibrate.specimen import KINDS
 from printgen.commands.common import add_json_arg, console, emit_json, fmt, table
 from printgen.errors import CalibrationError
 
+WIDEST = 10_000  # characters: a results table's width is measured up to this
 PRELOAD_COL = "ΔE % at P∓10%"  # modulus change (%) at 0.9 and 1.1 x the preload
 DIMENSION_OPTIONS = (("width_mm", "width", 1e-3), ("thickness_mm", "thickness", 1e-3),
                      ("area_mm2", "area", 1e-6), ("gauge_length_mm", "gauge_length", 1e-3),
@@ -63,6 +67,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--zero", choices=ZERO_MODES, help=f"preload zero (default {DEFAULT_ZERO}): "
                    "'interpolate' between the samples around the preload, or 'first' sample at "
                    "or above it (as many testers' software does)")
+    p.add_argument("--flag", action="append", default=[], metavar="COLUMN=CONVENTION",
+                   help="how a status column reads: active-low (0 = set, e.g. an end stop with "
+                        "a pull-up), active-high (1 = set) or ignore (default: from the data: "
+                        "a column constant through the test marks nothing, one that changes "
+                        "marks the rows that differ from its start)")
     p.add_argument("--keep-flagged", action="store_true",
                    help="keep samples a tester flag column marks (step loss, end stop, ...) in "
                         "the statistics (default: reported and left out)")
@@ -124,15 +133,15 @@ def run(args: argparse.Namespace) -> int:
         specimen_file=args.specimen, columns=_pairs(args.column, "--column"),
         units=_pairs(args.unit, "--unit"),
         delimiter="\t" if args.delimiter == "tab" else args.delimiter, decimal=args.decimal,
-        strength_only=args.strength_only, conditions=args.conditions)
+        strength_only=args.strength_only, conditions=args.conditions,
+        flags=_pairs(args.flag, "--flag", "endstop=active-low"))
     written = {}
     if args.save or args.out:
-        from printgen.calibrate.profile_writer import write_profile
+        from printgen.calibrate.profile_writer import value_sources, write_profile
 
         path, mat = write_profile(cal, name=args.material, out=args.out, inherits=args.inherits,
                                   date=args.date)
-        e, source = mat.modulus()
-        written = {"profile": str(path), "modulus_gpa": e / 1e9, "modulus_source": source}
+        written = {"profile": str(path), **value_sources(cal, path, mat)}
         if cal.kind == "panel" and mat.panel_law is not None:
             written["panel_law_kappa_kn_per_m_per_m"] = [k / 1e3 for k in mat.panel_law.kappas]
             written["panel_law_knee_strain_percent"] = [k * 100 for k in
@@ -162,14 +171,15 @@ def show(cal: Calibration, written: dict) -> None:
                 f"max {su}", "break %", f"machine {mu}", "diff", "flags"]
         rows = [[escape(c) for c in _sample_row(s, cal, mf, sf)] for s in cal.samples]
         cols, rows = _drop_empty(cols, rows, (PRELOAD_COL, f"machine {mu}", "diff", "flags"))
-        out.print(table(escape(f"{cal.material}: {cal.kind} specimens, strain from "
-                               f"{'; '.join(cal.strain_sources)}{_zero_text(cal)}"), cols, rows))
+        _print_whole(out, table(escape(f"{cal.material}: {cal.kind} specimens, strain from "
+                                       f"{'; '.join(cal.strain_sources)}{_zero_text(cal)}"),
+                                cols, rows))
     elif cal.strength_samples:
         rows = [[escape(Path(s.path).name), f"{s.peak_force:.2f}",
                  fmt(None if s.strength is None else s.strength / sf),
                  escape(_flag_text(s, cal))] for s in cal.strength_samples]
-        out.print(table(escape(f"{cal.material}: strength only (force-only files)"),
-                        ["file", "peak N", f"strength {su}", "flags"], rows))
+        _print_whole(out, table(escape(f"{cal.material}: strength only (force-only files)"),
+                                ["file", "peak N", f"strength {su}", "flags"], rows))
     for what, st, f, u in (("kappa (window)" if panel else "modulus", cal.modulus, mf, mu),
                            ("strength", cal.strength, sf, su),
                            ("elongation at break", cal.elongation, 1e-2, "%")):
@@ -178,6 +188,8 @@ def show(cal: Calibration, written: dict) -> None:
             n = f"n = {st.n}" + (": spread only" if st.n < MIN_SAMPLES else "")
             extra = _preload_text(cal) if st is cal.modulus else ""
             out.print(f"[bold]{what}[/]: {st.mean / f:.4g} ± {sd} {u} ({n}){extra}")
+            if st is cal.modulus and cal.window_summary:
+                out.print(escape(f"  {cal.window_summary}"))
     if cal.panel is not None:
         p = cal.panel
         out.print(f"[bold]panel law[/]: kappa {p.kappa1.mean / 1e3:.4g} kN/m/m up to "
@@ -200,6 +212,13 @@ def _sample_row(s: SampleFit, cal: Calibration, mf: float, sf: float) -> list[st
             fmt(None if s.elongation_at_break is None else s.elongation_at_break * 100),
             fmt(None if m is None else m / mf),
             "-" if m is None else f"{s.modulus / m - 1:+.1%}", _flag_text(s, cal)]
+
+
+def _print_whole(out: Console, t: Table) -> None:
+    """Print a results table whole: file names (specimens must be told apart) and numbers are
+    never cut short; the console widens to the table (a narrow terminal wraps its lines)."""
+    out.width = max(out.width, Measurement.get(out, out.options.update_width(WIDEST), t).maximum)
+    out.print(t)
 
 
 def _drop_empty(cols: list[str], rows: list[list[str]], optional: tuple[str, ...]
@@ -249,11 +268,11 @@ def _floats(text: str, opt: str, n: int | None = None) -> list[float]:
     return vals
 
 
-def _pairs(items: list[str], opt: str) -> dict[str, str]:
+def _pairs(items: list[str], opt: str, example: str = "force=Kraft") -> dict[str, str]:
     out = {}
     for item in items:
         key, sep, value = item.partition("=")
         if not sep or not key.strip() or not value.strip():
-            raise CalibrationError(f"{opt} {item!r}: expected ROLE=VALUE, e.g. force=Kraft")
+            raise CalibrationError(f"{opt} {item!r}: expected NAME=VALUE, e.g. {example}")
         out[key.strip().lower()] = value.strip()
     return out
