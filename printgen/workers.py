@@ -74,6 +74,8 @@ def start_method(plat: Platform | None = None) -> str:
     if "forkserver" in plat.start_methods and plat.system != "darwin":
         return "forkserver"
     return "spawn"
+
+
 class Interrupted(BaseException):
     """A signal asked the run to stop (a BaseException, like KeyboardInterrupt, so that no
     `except Exception` swallows it)."""
