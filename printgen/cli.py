@@ -15,7 +15,7 @@ import sys
 from concurrent.futures.process import BrokenProcessPool
 
 import printgen
-from printgen.errors import PrintgenError
+from printgen.errors import PrintgenError, TimeLimitError
 from printgen.outputs import describe_os_error, os_error_exit_code
 from printgen.workers import Interrupted, signals_raise
 
@@ -82,6 +82,8 @@ def run_command(args: argparse.Namespace, name: str) -> int:
     try:
         with signals_raise():
             return int(args.func(args) or 0)
+    except TimeLimitError as exc:
+        return _fail(f"{name}: {exc}", 4)  # commands/make.py EXIT_TIME_LIMIT
     except PrintgenError as exc:
         return _fail(f"{name}: error: {exc}", 2)
     except Interrupted as exc:

@@ -35,3 +35,8 @@ class CalibrationError(InputError):
 
 class SolverError(PrintgenError):
     """The cable-net solver did not converge where the caller required it."""
+
+
+class TimeLimitError(PrintgenError):
+    """A run went past its time limit (`make --time-limit`): stopped, nothing written. The
+    CLI exits 4 (not 2: the input may be valid, the run only takes longer)."""

@@ -21,10 +21,14 @@ import os
 import signal
 import sys
 import threading
+import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures import TimeoutError as FutureTimeout
 from dataclasses import dataclass
 from typing import Any
+
+from printgen.errors import TimeLimitError
 
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
 SIGNAL_NAMES = ("SIGINT", "SIGTERM", "SIGHUP")  # the stop signals; SIGHUP is POSIX only
@@ -136,11 +140,11 @@ def _main_thread() -> bool:
     return threading.current_thread() is threading.main_thread()
 
 
-def init_worker(plat: Platform, sink: Any = None) -> None:
+def init_worker(plat: Platform, sink: Any = None, at: float | None = None) -> None:
     """Pool initializer: die with the parent, leave signals to the parent, report progress to
-    `sink` (the parent's queue, or None)."""
-    global _inherited, _sink
-    _inherited, _sink = plat, sink
+    `sink` (the parent's queue, or None), keep the parent's deadline `at` (`deadline`)."""
+    global _inherited, _sink, _deadline
+    _inherited, _sink, _deadline = plat, sink, at
     for s in plat.signals:
         signal.signal(s, signal.SIG_IGN)
     if plat.pdeathsig:
@@ -191,6 +195,43 @@ def reporting(listener: Callable[[str, float, float], None]) -> Iterator[None]:
         _listener = previous
 
 
+_deadline: float | None = None  # time.time() past which `check_deadline` raises (handed to
+# workers by `init_worker`: set before their pool is made)
+
+
+@contextlib.contextmanager
+def deadline(at: float | None) -> Iterator[None]:
+    """Within the block, `check_deadline` raises TimeLimitError once time.time() passes `at`
+    (None: no limit), in this process and in workers whose pool is made inside the block."""
+    global _deadline
+    previous, _deadline = _deadline, at
+    try:
+        yield
+    finally:
+        _deadline = previous
+
+
+def seconds_left() -> float | None:
+    """Seconds until the deadline of `deadline` (None without one; may be negative)."""
+    return None if _deadline is None else _deadline - time.time()
+
+
+def check_deadline(what: str) -> None:
+    """Raise TimeLimitError naming `what` when the deadline of `deadline` has passed."""
+    left = seconds_left()
+    if left is not None and left < 0:
+        raise TimeLimitError(f"{what}: past the time limit")
+
+
+def _result(f: Future) -> Any:
+    """A job's result, waited for no longer than the deadline (`deadline`)."""
+    left = seconds_left()
+    try:
+        return f.result(timeout=None if left is None else max(left, 0.0))
+    except FutureTimeout as exc:
+        raise TimeLimitError("a worker's job: past the time limit") from exc
+
+
 def report_progress(task: str, done: float, total: float) -> None:
     """From inside a job: `task` has reached `done` of `total` (e.g. load level 0.35 of 1.1).
     A no-op unless the caller of `run_jobs` is listening."""
@@ -226,13 +267,13 @@ def run_jobs(jobs: list[tuple]) -> list:
     ctx = multiprocessing.get_context(start_method(plat))
     queue = ctx.SimpleQueue() if _listener else None
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=init_worker,
-                               initargs=(plat, queue))
+                               initargs=(plat, queue, _deadline))
     try:
         futures = [pool.submit(fn, *args, **kw) for fn, args, kw in jobs]
         if queue is not None:  # started once the workers are: fork only a one-thread process
             reader = threading.Thread(target=_drain, args=(queue, _listener), daemon=True)
             reader.start()
-        results = [f.result() for f in futures]
+        results = [_result(f) for f in futures]
     except BaseException:
         stop(pool)
         raise
@@ -250,7 +291,7 @@ class Helper:
         plat = platform()
         self.pool = ProcessPoolExecutor(
             max_workers=1, mp_context=multiprocessing.get_context(start_method(plat)),
-            initializer=init_worker, initargs=(plat,))
+            initializer=init_worker, initargs=(plat, None, _deadline))
         self.futures: list[Future] = []
 
     def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> Future:

@@ -214,8 +214,11 @@ def _checker(path, *args):
     return r.returncode, json.loads(r.stdout), r.stderr.strip().splitlines()[-1]
 
 
-def test_direct_net_gcode_passes_the_checker(net_setup, tmp_path):
+@pytest.mark.parametrize("material_key", [None, "tpu-85a"])  # the design's TPE; a datasheet TPU
+def test_direct_net_gcode_passes_the_checker(net_setup, tmp_path, material_key):
     net, printer, style, material = net_setup
+    if material_key:  # same net in a datasheet flexible (retraction off, 1.5 mm3/s)
+        material = load_material(material_key)
     p = material.print
     tp = net_toolpath(net, printer, style, material, crossing_flow_factor=1.0)
     path = write_gcode(tmp_path / "net.gcode", tp, printer, material)

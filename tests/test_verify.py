@@ -133,3 +133,23 @@ def test_free_top_curves_match_a_tight_sliding_wire_reference(coarse_simple):
         if peak > 0:
             diff = np.abs(fast.deformation.values[key][at] - v[at]).max()
             assert diff <= CURVE_TOL * peak, key
+
+
+def test_unconverged_level_is_left_out_and_reported(monkeypatch):
+    """Issue 28: a level the solver does not reach is listed, left out of the comparison, and
+    the record says the verdict rests on fewer levels than asked (no SolverError)."""
+    import solver
+
+    original = solver.solve_path
+
+    def one_fails(net, loads_at, levels, **kw):
+        out = original(net, loads_at, levels, **kw)
+        return [dataclasses.replace(r, converged=False, reason="forced") if r.level == 0.5
+                else r for r in out]
+
+    monkeypatch.setattr(solver, "solve_path", one_fails)
+    p, d = _design(REALISTIC)
+    v = verify(p, d, lv=np.array([0.0, 0.5, 1.0]))
+    rec = v.to_record()
+    assert v.model.failed == {0.5: "forced"} and list(v.model.deformation.levels) == [0.0, 1.0]
+    assert rec["levels_asked"] == 3 and rec["levels_compared"] == 2 and not rec["complete"]

@@ -125,15 +125,38 @@ def show(result: DesignRun, out: Path, files: list[str]) -> None:
         c.print(table(f"1:{r.scale:g}: Pareto set ({len(r.pareto)} of {len(sc)} candidates; "
                       f"* chosen)", ["#", "net (material beads x layers, mesh, border)", obj, "k small strain", "dPi2", "dPi3",
                                      "print min", "SF"], rows))
+        c.print(table(f"1:{r.scale:g}: per material (on target: +-30 % at SF >= 1.5)",
+                      ["material", "printable", "on target", "best net", "k", "SF",
+                       "first on target", "k", "SF"],
+                      [_material_row(row) for row in
+                       result.record["scales"][f"{r.scale:g}"]["per_material"]]))
         for line in r.reasons:
             c.print(f"- {line}")
     if len(result.results) > 1:
+        for row in result.record["reachable"]:
+            rng = row["scale_range"]
+            c.print(f"- {row['material'].upper()}: "
+                    + (f"on target at 1:{', 1:'.join(f'{s:g}' for s in row['scales_on_target'])}"
+                       f" (lambda {rng[0]:g}-{rng[1]:g} of the series)" if rng else
+                       "on target at none of the scales"))
         c.print(table("Scale series: the best net at each scale",
                       ["scale", "net", "k small strain", "mismatch", "select's", "dPi2", "dPi3",
                        "binding"], [_series_row(row) for row in result.record["series"]]))
     c.print(f"ran on {result.where}; {len(files)} files in {out}/ "
             f"(design.json -> printgen make --design)")
     sys.stdout.flush()
+
+
+def _material_row(row: dict) -> list[str]:
+    def net(c: dict | None) -> list[str]:
+        if c is None:
+            return ["none", "-", "-"]
+        return [f"{c['beads_across']}x{c['layers']}, {c['mesh_x_mm']:.3g}x{c['mesh_y_mm']:.3g} mm",
+                f"{c['error_small_strain']:+.0%}", f"{c['safety_factor']:.1f}"]
+
+    name = row["material"].upper() + (" (datasheet)" if row["datasheet"] else "")
+    return [name, str(row["feasible"]), str(row["on_target"]), *net(row["best"]),
+            *net(row["first_on_target"])]
 
 
 def _series_row(row: dict) -> list[str]:

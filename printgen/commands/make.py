@@ -15,6 +15,9 @@ from printgen.run import api
 from printgen.run.budget import DEFAULT_LIMIT_S
 from printgen.run.make import json_output
 
+EXIT_INCOMPLETE = 3  # outputs written, but the verdict rests on fewer load levels than asked
+EXIT_TIME_LIMIT = 4  # stopped at --time-limit (printgen.cli maps TimeLimitError to it)
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("make", help="targets, selection, parts, slicer profiles, G-code, "
@@ -27,9 +30,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--step", action="store_true", help="also write STEP files (needs cadquery)")
     p.add_argument("--design", metavar="FILE", type=Path,
                    help="print this design.json (from printgen design) instead of select's")
-    p.add_argument("--time-limit", type=float, default=DEFAULT_LIMIT_S, metavar="SECONDS",
-                   help=f"refuse runs estimated longer than this (default {DEFAULT_LIMIT_S:g} s,"
-                        " about a minute on 2 cores)")
+    p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
+                   help=f"refuse runs estimated longer than this and stop the run (exit "
+                        f"{EXIT_TIME_LIMIT}, nothing written) once it has run this long "
+                        f"(default: refuse over {DEFAULT_LIMIT_S:g} s, about a minute on 2 "
+                        f"cores, and never stop)")
     p.add_argument("--force", action="store_true",
                    help="replace --out even when it holds files printgen did not write")
     add_json_arg(p)
@@ -47,11 +52,17 @@ def run(args: argparse.Namespace) -> int:
                                 "design_file": args.design,
                                 "time_limit_s": args.time_limit})
     seconds = time.perf_counter() - t0
+    ver = ctx.record.get("verification") or {}
+    code = EXIT_INCOMPLETE if ver.get("complete") is False else 0
     if args.json:
         emit_json(json_output(ctx.record))
-        return 0
+        return code
     show_summary(ctx, out, seconds)
-    return 0
+    if code:
+        err.print(f"printgen make: the verdict rests on {ver['levels_compared']} of "
+                  f"{ver['levels_asked']} load levels (the others did not converge: see the "
+                  f"report); exit {code}")
+    return code
 
 
 class Progress:

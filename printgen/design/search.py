@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from printgen.design.pareto import pareto_mask
+from printgen.design.per_material import target_sentence
 from printgen.design.plan import make_design
 from printgen.design.record import Design, NetDesign
 from printgen.design.screen import Screened, screen_batch, strand_section
@@ -211,4 +212,4 @@ def search(p: Prototype, scale: float, runner: Runner, *, objective: str = "defo
                        None if chosen is None else candidate_design(ctx, screened[chosen].point,
                                                                      base),
                        (), binding, closest)
-    return dataclasses.replace(res, reasons=tuple(choice_reasons(res)))
+    return dataclasses.replace(res, reasons=(*choice_reasons(res), *target_sentence(screened)))

@@ -13,12 +13,12 @@ from typing import TYPE_CHECKING
 
 from printgen.design.screen import Screened
 from printgen.design.search_space import SearchSpace, half_cell_counts
-from printgen.design.selection import MIN_SAFETY_FACTOR
+from printgen.design.selection import CALIBRATE_FIRST, MIN_SAFETY_FACTOR, NET_ON_TARGET
 
 if TYPE_CHECKING:
     from printgen.design.search import SearchResult
 
-SMALL_STRAIN_TOLERANCE = 0.30  # on target: small-strain membrane stiffness within +-30 %
+SMALL_STRAIN_TOLERANCE = NET_ON_TARGET  # on target: small-strain membrane stiffness within +-30 %
 LABELS = {"strength": f"strength (safety factor < {MIN_SAFETY_FACTOR} at the overflow force)",
           "print": "printability (bead, layer or flow limits of the printer and material)",
           "bed": "bed size (the panel does not fit the printer)",
@@ -119,5 +119,5 @@ def choice_reasons(res: SearchResult) -> list[str]:
                f"{s.speed_mm_per_s:.3g} mm/s")
     if s.datasheet:
         out.append(f"the {s.point.material.upper()} law is from a DATASHEET modulus: printed "
-                   "parts are often 2x softer; calibrate it before printing")
+                   f"parts are often 2x softer; {CALIBRATE_FIRST}")
     return out

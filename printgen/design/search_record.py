@@ -10,6 +10,7 @@ import json
 from collections import Counter
 from typing import Any
 
+from printgen.design.per_material import per_material
 from printgen.design.screen import Screened
 from printgen.design.search import SearchResult, VerifyScore
 from printgen.design.search_choice import SMALL_STRAIN_TOLERANCE
@@ -53,6 +54,7 @@ def result_record(res: SearchResult) -> dict[str, Any]:
         "chosen_within_small_strain_tolerance": within,
         "reasons": list(res.reasons), "binding_constraints": list(res.binding),
         "closest_feasible": None if res.closest is None else sc[res.closest].to_record(),
+        "per_material": per_material(sc),
         "select_pick": {**_with_score(res.select_screened, res.select_score),
                         "design": res.select_design.to_dict()},
         "mismatch_lower_than_select": lower,

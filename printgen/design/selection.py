@@ -45,8 +45,11 @@ SCORE_DIGITS = 9  # scores equal to 1e-9 are ties (same E*A, different layout)
 MIN_SPEED_MM_S = 2.0  # slower than this, the flow limit makes the print impractical
 ASSUMED_SAG_RATIO = 0.2  # peak-force estimate: sag / span of a loaded cable or net strip
 OVERFLOW = 1.1  # peak relative loading h / h_B of the loading test
+CALIBRATE_FIRST = ("print the test pieces below and calibrate before printing the barrier "
+                   "(printgen calibrate, then printgen verify)")
 NET_STRAINS = np.linspace(0.01, 0.40, 40)  # strain range over which net laws are compared
 CHECK_STRAINS = (0.05, 0.30)  # net law errors reported at low and high strain
+NET_ON_TARGET = 0.30  # a net within +-30 % of the small-strain target is on target (as design)
 
 
 @dataclass(frozen=True)
@@ -260,7 +263,29 @@ def select(p: Prototype, t: ScaledTargets, *, printer: str | None = None,
         raise PrintabilityError(f"no material and pass layout can print the net on "
                                 f"{printer_obj.key}: {nets[0].reasons[0]}")
     return Selection(tuple(cables), tuple(nets), _rationale(cables, "cable"),
-                     _rationale(nets, "net"), printer_obj.key, net_style.key, cable_style.key)
+                     _rationale(nets, "net") + _per_material(nets), printer_obj.key,
+                     net_style.key, cable_style.key)
+
+
+def _per_material(ranked: list[Candidate]) -> str:
+    """Sentences: each material's best printable net, and the first (best-ranked) net within
+    +-NET_ON_TARGET at SF >= MIN_SAFETY_FACTOR, if any (with the prototype's scaled mesh)."""
+    best: dict[str, Candidate] = {}
+    for c in ranked:
+        if c.feasible:
+            best.setdefault(c.material_name, c)
+    parts = [f"{name} {c.section.width_mm:g} x {c.section.thickness_mm:g} mm ({c.error:+.0%}, "
+             f"SF {c.safety_factor:.1f})" for name, c in best.items()]
+    out = " Best net per material: " + "; ".join(parts) + "."
+    hit = next((c for c in ranked if c.feasible and abs(c.error) <= NET_ON_TARGET), None)
+    if hit is None:
+        return out + (f" No material gives a net within +-{NET_ON_TARGET:.0%} at the scaled "
+                      "prototype mesh; printgen design also searches the mesh.")
+    out += (f" First within +-{NET_ON_TARGET:.0%} at SF >= {MIN_SAFETY_FACTOR}: "
+            f"{hit.material_name} {hit.section.width_mm:g} x {hit.section.thickness_mm:g} mm "
+            f"({hit.error:+.0%}).")
+    return out + (f" It rests on a datasheet modulus: {CALIBRATE_FIRST}."
+                  if hit.modulus_source == "datasheet" else "")
 
 
 def _rank(cands: list[Candidate]) -> list[Candidate]:
@@ -293,7 +318,7 @@ def _rationale(ranked: list[Candidate], what: str) -> str:
                f"{CHECK_STRAINS[0]:.0%} and {best.error_high:+.0%} at {CHECK_STRAINS[1]:.0%} "
                f"strain (RMS log error {best.error_rms:.2f} over 1-40 %)")
     basis = ("a measured printed value" if "measured" in best.modulus_source else
-             "only a DATASHEET modulus (printed parts are often 2x softer: calibrate it)")
+             f"only a DATASHEET modulus (printed parts are often 2x softer): {CALIBRATE_FIRST}")
     others = [c for c in ranked[1:] if c.feasible and c.material != best.material]
     vs = (f" The best other material, {others[0].material_name}, scores {others[0].score:.3f} "
           f"against {best.score:.3f} ({others[0].error:+.1%})." if others else "")

@@ -46,9 +46,19 @@ PANEL_LAW = [
     positive("mesh_across_load_mm", 1e4, required=False),
     *PROVENANCE,
 ]
-DATASHEET = [positive("tensile_modulus_gpa", 500.0), positive("failure_stress_mpa", 5000.0),
-             Field("source", str)]
+DATASHEET = [
+    positive("tensile_modulus_gpa", 500.0), positive("failure_stress_mpa", 5000.0),
+    Field("source", str, help="manufacturer, product, document and its date"),
+    Field("test_standard", str, required=False, default="",
+          help="the datasheet's test standard, e.g. ISO 527 or ASTM D638"),
+    Field("modulus_basis", str, required=False, default="",
+          help="how the modulus was read off the datasheet when it is not a tensile modulus"),
+    positive("elongation_at_break_percent", 5000.0, required=False, si=False),
+    Field("shore_hardness_a", float, lo=0.0, hi=100.0, required=False, si=False),
+]
 PRINT = [
+    Field("source", str, required=False, default="",
+          help="where the print settings come from (datasheet, or which are printgen's)"),
     Field("filament_type", str, si=False),
     positive("nozzle_temperature_deg_c", 500.0, si=False),
     positive("first_layer_nozzle_temperature_deg_c", 500.0, si=False),
@@ -139,6 +149,17 @@ class PrintSettings:
     fan_max_percent: float
     retract_length_mm: float
     retract_speed_mm_per_s: float
+    source: str = ""
+
+
+@dataclass(frozen=True)
+class Datasheet:
+    """What a datasheet states besides modulus and strength (file units; None: not stated)."""
+
+    test_standard: str = ""
+    modulus_basis: str = ""
+    elongation_at_break_percent: float | None = None
+    shore_hardness_a: float | None = None
 
 
 @dataclass(frozen=True)
@@ -158,6 +179,7 @@ class Material:
     panel_law: PanelLaw | None = None
     description: str = ""
     files: tuple[Path, ...] = field(default=())
+    sheet: Datasheet = field(default=Datasheet())
 
     def modulus(self) -> tuple[float, str]:
         """(E in Pa, 'measured' or 'datasheet'), measured preferred."""
@@ -198,6 +220,8 @@ def load_material(name: str) -> Material:
         panel_law=_panel_law(measured.get("panel_law"), where),
         description=top["description"],
         files=tuple(files),
+        sheet=Datasheet(sheet["test_standard"], sheet["modulus_basis"],
+                        sheet["elongation_at_break_percent"], sheet["shore_hardness_a"]),
     )
 
 

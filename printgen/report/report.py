@@ -105,6 +105,9 @@ def _sweep_sections(rep: Report, v: Verification, scale: float, band: Band | Non
         for level, why in run.failed.items():
             rep.verdict(False, f"{who}: no converged state at h/h_B = {level:g}, left out of the "
                                f"comparison: {why}")
+    if not v.complete:
+        rep.paragraph(f"The verdict rests on {v.compared} of {v.asked} load levels: the others "
+                      "did not converge on one barrier or both (above); `make` exits 3.")
     p, m = v.prototype.deformation, v.model.deformation
     idx = [int(np.argmin(np.abs(p.levels - x))) for x in (0.5, 1.0, 1.1)]
     rows = []

@@ -39,8 +39,11 @@ BANDS_MIN_S = 2.5
 FREE_TOP_MODEL_FACTOR = 3.5
 VERIFY_FIXED_S = 1.5  # worker start, the steel counter-example, the comparison
 MESH_S_PER_SEGMENT = 1e-4  # meshes step per model net segment (simple 1:40: 4962 in 0.46 s)
-CABLE_PARTS_S = 2.5  # the four cables, their eyelets and plate (1:40: 2.9 s meshes in all)
-FIXED_S = 2.5  # planning, slicer profiles, G-code, previews, report (1:40: ~1.6 s)
+# The parts' steps got faster (toolpaths built once, verification in a helper process beside
+# them): make of the 1:40 example measures ~3.9 s (bench make) to ~5 s (README's demo), which
+# the sum of the constants below puts at ~7 s (was 9.5 s: 2.4x the measured run).
+CABLE_PARTS_S = 1.0  # the four cables, their eyelets and plate
+FIXED_S = 1.5  # planning, slicer profiles, G-code, previews, report
 BASE_MEMORY_B = 150e6  # Python, numpy, scipy and the geometry libraries
 MEMORY_B_PER_NODE = 20e3  # sparse factor, path results kept per level (1998 nodes: +39 MB)
 COARSEN_MAX = 1000.0  # search bound for the mesh factor that fits

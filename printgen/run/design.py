@@ -23,6 +23,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from printgen.design.per_material import reachable
 from printgen.design.search import (
     SearchResult,
     VerifyScore,
@@ -121,9 +122,10 @@ def design_searches(prototype: str | Path | Prototype, scales: list[float], *,
 
 def design_record(p: Prototype, results: list[SearchResult], o: SearchOptions) -> dict:
     """The report.json of a call: every scale's record and the series table."""
+    recs = {f"{r.scale:g}": result_record(r) for r in results}
     return {"prototype": p.name, "objective": o.objective,
             "level_step": o.level_step, "verify_nets": o.verify_nets,
-            "scales": {f"{r.scale:g}": result_record(r) for r in results},
+            "scales": recs, "reachable": reachable(list(recs.values())),
             "series": [series_row(r) for r in results]}
 
 

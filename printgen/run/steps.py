@@ -9,13 +9,17 @@ from __future__ import annotations
 import contextlib
 import time
 from collections.abc import Callable
+from concurrent.futures import Future
+from concurrent.futures import TimeoutError as FutureTimeout
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from printgen.errors import TimeLimitError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
+from printgen.workers import seconds_left
 
 HELPER_SWEEPS = "helper: verification sweeps"  # timings_s keys of work done in the helper
 HELPER_REPORT = "helper: verification figures and tables"
@@ -264,7 +268,7 @@ def verify_step(ctx: MakeContext, stage: Path) -> None:
     sweeps_done(ctx)
     pending = ctx.background.pop("verification report", None)
     if pending is not None:
-        (blocks, record), seconds = pending.result()
+        (blocks, record), seconds = _collect(pending)
         ctx.record.setdefault("timings_s", {})[HELPER_REPORT] = seconds
     else:
         v, band = verification_sweeps(ctx.prototype, ctx.design,
@@ -282,11 +286,21 @@ def sweeps_done(ctx: MakeContext) -> None:
     pending = ctx.background.pop("verification sweeps", None)
     if pending is not None and ctx.helper is not None:
         t = time.perf_counter()
-        (v, band), seconds = pending.result()
+        (v, band), seconds = _collect(pending)
         times = ctx.record.setdefault("timings_s", {})
         times[HELPER_SWEEPS], times[WAIT_SWEEPS] = seconds, time.perf_counter() - t
         ctx.background["verification report"] = ctx.helper.submit(
             timed, verification_report, v, band, ctx.targets.scale)
+
+
+def _collect(pending: Future) -> Any:
+    """A helper job's result, waiting no longer than the run's deadline
+    (`printgen.workers.deadline`): past it, TimeLimitError (the helper is then stopped)."""
+    left = seconds_left()
+    try:
+        return pending.result(timeout=None if left is None else max(left, 0.0))
+    except FutureTimeout as exc:
+        raise TimeLimitError("the verification's sweeps: past the time limit") from exc
 
 
 def timed(fn: Callable, /, *args: Any, **kwargs: Any) -> tuple[Any, float]:
