@@ -308,7 +308,13 @@ def goals(results: list[dict], paths: list[dict], tent: dict | None,
 def run(out: Path, sizes: list[int], with_paths: bool = True) -> dict:
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    results = [bench_size(s) for s in sizes]
+    results = []
+    for k, size in enumerate(sizes, 1):  # progress on stderr: the largest size takes minutes
+        print(f"[{k}/{len(sizes)}] mesh x{size} ({time.perf_counter() - t0:.0f} s so far)",
+              file=sys.stderr, flush=True)
+        results.append(bench_size(size))
+    if with_paths:
+        print("verification load paths ...", file=sys.stderr, flush=True)
     captured = capture_verification_paths() if with_paths else []
     paths = bench_paths(captured)
     tent = bench_tent(captured[0][0], captured[0][3].get("tol", GOAL_TOL)) if captured else None
@@ -330,11 +336,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sizes", type=int, nargs="+", default=list(SIZES),
                     help="mesh refinements: 1 = 61 x 21, 2 = 121 x 41, 4 = 241 x 81, 8 = 481 x 161")
     ap.add_argument("--no-paths", action="store_true", help="skip the verification load paths")
+    ap.add_argument("--json", action="store_true", help="print the goals as JSON")
     a = ap.parse_args(argv)
     report = run(a.out, a.sizes, not a.no_paths)
     for res in report["sizes"]:
         for r in res["runs"]:
             err = r.get("error")
+            if "skipped" in r:  # e.g. OpenSeesPy not installed: say so, not "nan s"
+                print(f"{res['size']:9s} {r['tool']:40s} skipped: {r['skipped']}")
+                continue
             print(f"{res['size']:9s} {r['tool']:40s} tol {r.get('tol', '-')!s:6s} "
                   f"{r.get('time_s', float('nan')):7.2f} s  it {r.get('iterations', '-')!s:4s} "
                   f"fact {r.get('factorizations', '-')!s:4s} error "
@@ -349,7 +359,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"OpenSeesPy / printgen at {pair['size']}, {len(pair['ratios'])} alternating pairs, "
               f"1 BLAS thread: median {pair['median']:.1f}x (range {pair['min']:.1f}-"
               f"{pair['max']:.1f}x)")
-    print(json.dumps(report["goals"], indent=1))
+    if a.json:
+        print(json.dumps(report["goals"], indent=1))
+    else:
+        for key, value in report["goals"].items():
+            print(f"goal {key}: {value}")
+        print(f"all numbers: {a.out / 'bench_solver.json'}")
     return 0
 
 

@@ -30,9 +30,13 @@ def run() -> Verification:
     p, m = v.prototype.deformation, v.model.deformation
     # every elongation grows with the water level above half height, in both barriers
     half = p.levels >= 0.5
-    for key in ("strain_bottom", "strain_top", "deflection", "lowering"):
+    for key in ("strain_bottom", "strain_top", "deflection"):
         assert np.all(np.diff(p.values[key][half]) > 0), key
+    for key in ("strain_bottom", "strain_top", "deflection", "lowering"):
         assert np.all(np.diff(m.values[key][half]) > 0), key
+    # the prototype's top centre lowers to ~0.12 of its height near h/h_B = 0.8, then rises a
+    # little as the net (panel law along the meshes' long axis, issue 25) bulges downstream
+    assert 0.08 < p.values["lowering"].max() < 0.16
     # the 1 N sensor wires pull along themselves: no deflection before the water arrives
     assert abs(m.values["deflection"][0]) < 0.01 and p.values["deflection"][0] == 0.0
     # prototype at overflow: a flexible barrier, mid-height deflection 10-30 % of its width

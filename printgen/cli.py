@@ -16,7 +16,7 @@ from concurrent.futures.process import BrokenProcessPool
 
 import printgen
 from printgen.errors import PrintgenError, TimeLimitError
-from printgen.outputs import describe_os_error, os_error_exit_code
+from printgen.outputs import describe_os_error, os_error_exit_code, tracking_swaps
 from printgen.workers import Interrupted, signals_raise
 
 # One entry per command module; a module may register several subcommands.
@@ -28,9 +28,11 @@ COMMAND_MODULES = (
     "printgen.commands.design",
     "printgen.commands.verify",
     "printgen.commands.check",
+    "printgen.commands.panel",
     "printgen.commands.bench",
     "printgen.commands.calibrate",
     "printgen.commands.example",
+    "printgen.commands.init",
 )
 
 
@@ -79,31 +81,41 @@ def main(argv: list[str] | None = None) -> int:
 
 def run_command(args: argparse.Namespace, name: str) -> int:
     """Call the command's function and turn every way it can end into one line and a code."""
-    try:
-        with signals_raise():
-            return int(args.func(args) or 0)
-    except TimeLimitError as exc:
-        return _fail(f"{name}: {exc}", 4)  # commands/make.py EXIT_TIME_LIMIT
-    except PrintgenError as exc:
-        return _fail(f"{name}: error: {exc}", 2)
-    except Interrupted as exc:
-        return _fail(f"{name}: stopped by {exc.name}; outputs left as they were", exc.exit_code)
-    except KeyboardInterrupt:
-        return _fail(f"{name}: stopped by SIGINT; outputs left as they were", 130)
-    except OSError as exc:
-        return _fail(f"{name}: error: {describe_os_error(exc)}", os_error_exit_code(exc))
-    except MemoryError:
-        return _fail(f"{name}: error: out of memory; use a coarser mesh or a larger machine", 1)
-    except BrokenProcessPool:
-        return _fail(f"{name}: error: a worker process died (killed, or out of memory: see "
-                     "`dmesg`); outputs left as they were; try again, or a coarser mesh", 1)
-    except Exception as exc:
-        if os.environ.get("PRINTGEN_DEBUG"):
-            raise
-        text = " ".join(str(exc).split())[:300]
-        return _fail(f"{name}: internal error: {type(exc).__name__}: {text}; this is a bug in "
-                     f"printgen, please report it to {REPORT_URL} "
-                     "(PRINTGEN_DEBUG=1 shows the traceback)", 1)
+    with tracking_swaps() as replaced:
+        try:
+            with signals_raise():
+                return int(args.func(args) or 0)
+        except TimeLimitError as exc:
+            return _fail(f"{name}: {exc}", 4)  # commands/make.py EXIT_TIME_LIMIT
+        except PrintgenError as exc:
+            return _fail(f"{name}: error: {exc}", 2)
+        except Interrupted as exc:
+            return _fail(_stopped(name, exc.name, replaced), exc.exit_code)
+        except KeyboardInterrupt:
+            return _fail(_stopped(name, "SIGINT", replaced), 130)
+        except OSError as exc:
+            return _fail(f"{name}: error: {describe_os_error(exc)}", os_error_exit_code(exc))
+        except MemoryError:
+            return _fail(f"{name}: error: out of memory; use a coarser mesh or a larger machine",
+                         1)
+        except BrokenProcessPool:
+            return _fail(f"{name}: error: a worker process died (killed, or out of memory: see "
+                         "`dmesg`); outputs left as they were; try again, or a coarser mesh", 1)
+        except Exception as exc:
+            if os.environ.get("PRINTGEN_DEBUG"):
+                raise
+            text = " ".join(str(exc).split())[:300]
+            return _fail(f"{name}: internal error: {type(exc).__name__}: {text}; this is a bug "
+                         f"in printgen, please report it to {REPORT_URL} "
+                         "(PRINTGEN_DEBUG=1 shows the traceback)", 1)
+
+
+def _stopped(name: str, signal_name: str, replaced: list) -> str:
+    """The line for a run stopped by a signal: before or after its folder was swapped in."""
+    if replaced:
+        return (f"{name}: stopped by {signal_name} after the run was complete: {replaced[-1]} "
+                "holds its new outputs (printgen check verifies them)")
+    return f"{name}: stopped by {signal_name}; outputs left as they were"
 
 
 def _fail(line: str, code: int) -> int:

@@ -1,6 +1,9 @@
 """The HTML report in a real browser (issue 13): headless Chromium renders it, every image
 loads, and the page logs no error. The screenshot is kept in `artifacts/` (ignored by git) for
-a person to look at; CI keeps it as an artifact.
+a person to look at; CI keeps it as an artifact. What a lab takes to the flume (issue 23):
+the summary box in the first screen, every axis labelled with its unit, no reference to a file
+the package lacks, report.pdf with pages and text, and the CSV files holding report.json's
+numbers.
 
 Without Chromium the test skips locally and fails under CI (`require_tool`); `scripts/setup.sh
 --with-slicers` installs Debian's `chromium` when run as root.
@@ -8,10 +11,12 @@ Without Chromium the test skips locally and fails under CI (`require_tool`); `sc
 
 from __future__ import annotations
 
+import csv
 import json
 import re
 import subprocess
 
+import numpy as np
 import pytest
 from conftest import ROOT, require_tool
 from proto_files import REALISTIC
@@ -52,11 +57,17 @@ window.addEventListener("load", function () {
 
 
 @pytest.fixture(scope="module")
-def report(tmp_path_factory):
+def made(tmp_path_factory):
+    """One whole `make` of the 1:40 example for the module, with report.pdf when Chromium is
+    there: (output folder, the run's context)."""
     out = tmp_path_factory.mktemp("browser") / "out"
-    fast = [s for s in make_mod.default_steps() if s[1] is not make_mod.verify_step]
-    make_mod.make(REALISTIC, 40, out, steps=fast)  # the figures of parts and previews
-    return out / "report.html"
+    ctx = make_mod.make(REALISTIC, 40, out, options={"pdf": True})
+    return out, ctx
+
+
+@pytest.fixture(scope="module")
+def report(made):
+    return made[0] / "report.html"
 
 
 def chromium(exe: str, tmp_path, *args: str) -> subprocess.CompletedProcess:
@@ -111,3 +122,156 @@ def test_the_probe_sees_a_broken_image_and_an_error(tmp_path):
     assert probe["broken"] == ["gone"]
     assert any("missing.png" in e for e in probe["errors"])
     assert any("undefinedCall" in e for e in probe["errors"])
+
+
+FIRST_SCREEN = (1400, 1000)  # px: the summary box ends within the first screen at this width
+BOX_PROBE = """<script>
+window.addEventListener("load", function () {
+  var box = document.getElementById("summary").getBoundingClientRect();
+  var probe = document.createElement("pre");
+  probe.id = "printgen-probe";
+  probe.textContent = JSON.stringify({top: box.top, bottom: box.bottom,
+                                      width: window.innerWidth});
+  document.body.appendChild(probe);
+});
+</script>"""
+UNIT = re.compile(r"\(([^()]+)\)$")  # an axis label ends with its unit in parentheses
+MIN_PDF_PAGES = 5  # the 1:40 report prints on well over five A4/Letter pages
+CSV_TOL = 1e-7  # the CSV files keep 8 significant digits
+CSV_ZERO = 1e-6  # ... and write values below labfiles.NOISE as 0
+# file names a report may mention: an output file, or a file of the package (README, examples)
+FILE_REF = re.compile(r"\b[\w.-]+\.(?:md|csv|json|gcode|toml|png|svg|ini|cfg|3mf|stl|step|pdf"
+                      r"|html)\b")
+
+
+def test_summary_box_is_in_the_first_screen(report, tmp_path):
+    exe = require_tool("chromium")
+    probed = tmp_path / "box.html"
+    probed.write_text(report.read_text().replace("<head>", "<head>" + BOX_PROBE, 1))
+    w, h = FIRST_SCREEN
+    run = chromium(exe, tmp_path, f"--window-size={w},{h}", "--dump-dom", probed.as_uri())
+    box = probe_of(run)
+    assert box["width"] == w
+    assert 0 <= box["top"] < box["bottom"] <= h, box
+    text = report.read_text()
+    start = text.index('id="summary"')
+    assert start < text.index("<h2>Similitude targets</h2>")
+    summary = text[start:text.index("</section>", start)]
+    for what in ("FAIL", "Uncertainty band</b>", "Chosen:", "stiffness", "Printing:", " g ",
+                 "Next:"):
+        assert what in summary, what
+
+
+def test_every_plot_axis_has_a_label_with_a_unit(made):
+    out, ctx = made
+    figures = ctx.report.figures
+    assert len(figures) >= 6  # kit, previews, verification, deformed nets
+    for f in figures:
+        assert f.labels, f.name
+        for title, names in f.labels:
+            for name in names:
+                assert UNIT.search(name), f"{f.name}, axis {title!r}: label {name!r}"
+        assert (out / "figures").is_dir()
+    written = sorted(p.name for p in (out / "figures").iterdir())
+    assert len(written) == 2 * len(figures)
+    assert all(n.endswith((".png", ".svg")) for n in written)
+    panels = [t for f in figures if f.name == "verification" for t, _ in f.labels]
+    assert any("elongation" in t for t in panels)
+
+
+def test_strains_are_in_percent_and_the_band_cells_read(report):
+    text = report.read_text()
+    assert "bottom cable elongation (%)" in text or "(sensor wire, strain) (%)" in text
+    assert re.search(r"\d\.\d{2} \(band -?\d+\.\d{2} to -?\d+\.\d{2}\)", text)
+    assert "stiffness (E*A, N)" in text and "stiffness (initial membrane, N/m)" in text
+
+
+def test_no_reference_to_a_file_the_package_lacks(made):
+    out, _ = made
+    text = re.sub(r'src="data:[^"]*"', "", (out / "report.html").read_text())
+    text = re.sub(r"<[^>]+>", " ", text)
+    for bad in ("barrier-physics", "printgen reference", "(issue ", "slicers.md"):
+        assert bad not in text, bad
+    shipped = {p.name for p in out.rglob("*")} | {p.name for p in ROOT.glob("*")} \
+        | {p.name for p in (ROOT / "examples").iterdir()} \
+        | {p.name for p in (ROOT / "profiles").rglob("*.toml")}  # provenance names profiles
+    for name in set(FILE_REF.findall(text)):
+        assert name in shipped, name
+
+
+def test_report_pdf_has_pages_and_text(made):
+    require_tool("chromium")
+    pypdf = pytest.importorskip("pypdf")
+    out, _ = made
+    pdf = out / "report.pdf"
+    assert pdf.is_file() and "report.pdf" in json.loads((out / "manifest.json").read_text())[
+        "files"]
+    reader = pypdf.PdfReader(pdf)
+    assert len(reader.pages) >= MIN_PDF_PAGES
+    first = reader.pages[0].extract_text()
+    assert "Summary" in first and "FAIL" in first
+
+
+def _read_csv(path) -> dict[str, list[float]]:
+    lines = [ln for ln in path.read_text().splitlines() if not ln.startswith("#")]
+    rows = list(csv.reader(lines))
+    return {h: [float(r[i]) if r[i] else float("nan") for r in rows[1:]]
+            for i, h in enumerate(rows[0])}
+
+
+def test_csv_files_hold_the_numbers_of_report_json(made):
+    out, _ = made
+    rec = json.loads((out / "report.json").read_text())
+    ver, bands = rec["verification"], rec["verification"]["bands"]
+    levels = np.array(bands["levels"])
+    curves = _read_csv(out / "curves.csv")
+    np.testing.assert_allclose(curves["h_over_hb"], levels, rtol=CSV_TOL)
+    proto_lv = np.array(ver["prototype"]["levels"])
+    at = [int(np.argmin(abs(proto_lv - x))) for x in levels]
+    pairs = {"mid_height_elongation_prototype_pct": (ver["prototype"]["values"]["strain_mid"],
+                                                     100.0, at),
+             "deflection_over_width_band_min": (bands["min"]["deflection"], 1.0, None),
+             "top_cable_elongation_band_max_pct": (bands["max"]["strain_top"], 100.0, None),
+             "lowering_over_height_model": (ver["model"]["values"]["lowering"], 1.0, at)}
+    for col, (ref, f, idx) in pairs.items():
+        want = np.array(ref, dtype=float)[idx] * f if idx else np.array(ref, dtype=float) * f
+        np.testing.assert_allclose(curves[col], want, rtol=CSV_TOL, atol=CSV_ZERO, err_msg=col)
+    reads = _read_csv(out / "expected-readings.csv")
+    lab = rec["verification"]["lab"]
+    row_mm = lab["units"]["sensor_row_mm"]["mid"]
+    nominal = np.array(bands["nominal"]["strain_mid"])
+    np.testing.assert_allclose(reads["mid_sensor_nominal_mm"], (nominal - nominal[0]) * row_mm,
+                               rtol=CSV_TOL, atol=CSV_ZERO)
+    np.testing.assert_allclose(reads["water_depth_mm"], levels * lab["units"]["height_mm"],
+                               rtol=CSV_TOL)
+    np.testing.assert_allclose(reads["max_strand_tension_n"],
+                               np.array(ver["model"]["max_strand_tension_n"])[at], rtol=CSV_TOL,
+                               atol=CSV_ZERO)
+
+
+def test_the_filled_measurement_sheet_reads_back(made, tmp_path):
+    """The sheet filled with its own expected nominal readings reads as the model's curves."""
+    from printgen.check.measured import read_measured
+    from printgen.check.readings import FlumeUnits
+
+    out, _ = made
+    lab = json.loads((out / "report.json").read_text())["verification"]["lab"]
+    u = lab["units"]
+    units = FlumeUnits(u["width_mm"], u["height_mm"], u["sensor_row_mm"])
+    lines = (out / "measurement-sheet.csv").read_text().splitlines()
+    header = lines[1].split(",")
+    filled = [lines[0], lines[1]]
+    for line in lines[2:]:
+        cells = line.split(",")
+        for i, h in enumerate(header):
+            if h.endswith("_mm") and not h.startswith("expected_") and h != "water_depth_mm":
+                cells[i] = cells[header.index(f"expected_{h[:-3]}_nominal_mm")]
+        filled.append(",".join(cells))
+    sheet = tmp_path / "filled.csv"
+    sheet.write_text("\n".join(filled) + "\n")
+    m = read_measured(sheet, units)
+    nominal = np.array(lab["readings"]["mid_sensor_mm"]["nominal"]) / u["sensor_row_mm"]["mid"]
+    np.testing.assert_allclose(m.values["strain_mid"], nominal, rtol=CSV_TOL,
+                               atol=CSV_ZERO / u["sensor_row_mm"]["mid"])
+    assert set(m.values) == {"strain_bottom", "strain_top", "strain_mid", "deflection",
+                             "lowering"}

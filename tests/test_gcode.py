@@ -261,7 +261,7 @@ def test_direct_cable_gcode_passes_the_checker(cable_setup, tmp_path):
 
 def test_benchmark_writes_json_and_meets_the_goal(tmp_path):
     r = subprocess.run([sys.executable, "-m", "benchmarks.bench_gcode", "--out", str(tmp_path),
-                        "--repeat", "1"], cwd=ROOT, capture_output=True, text=True, check=False,
+                        "--repeat", "1", "--json"], cwd=ROOT, capture_output=True, text=True, check=False,
                        timeout=120)
     assert r.returncode == 0, r.stderr  # exit 1 when the 1 s goal is missed
     report = json.loads(r.stdout)

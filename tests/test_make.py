@@ -12,7 +12,7 @@ from proto_files import REALISTIC, write_variant
 import printgen.run.make as make_mod
 from printgen.cli import main
 from printgen.errors import PrintgenError, TimeLimitError
-from printgen.outputs import check_folder
+from printgen.outputs import check_folder, folder_files
 from printgen.report.jsonout import dumps
 
 REFUSE_WITHIN_S = 15.0  # issue 16: a run too big to do is refused within 15 s
@@ -28,7 +28,7 @@ def made(tmp_path_factory):
 
 def test_outputs_are_written(made):
     ctx, out = made
-    names = sorted(p.name for p in out.iterdir())
+    names = folder_files(out)  # figures/ holds each figure as PNG and SVG
     assert names == ctx.record["files"]
     for part in ["net", "cable-top", "cable-bottom", "cable-left", "cable-right"]:
         assert f"{part}.gcode" in names and f"{part}.prusa.ini" in names
@@ -55,8 +55,8 @@ def test_same_input_gives_byte_identical_files(made, tmp_path):
     """Every file but the volatile timings.json, and `--json` but its "timings" key."""
     ctx, out = made
     again = make_mod.make(REALISTIC, 40, tmp_path / "again")
-    names = sorted(p.name for p in out.iterdir())
-    assert names == sorted(p.name for p in (tmp_path / "again").iterdir())
+    names = folder_files(out)
+    assert names == folder_files(tmp_path / "again")
     volatile = json.loads((out / "manifest.json").read_text())["volatile"]
     assert volatile == ["timings.json"]
     for name in set(names) - set(volatile):
@@ -85,7 +85,7 @@ def test_simple_after_realistic_leaves_only_the_simple_run(tmp_path):
     make_mod.make(REALISTIC, 40, out, steps=fast)
     assert (out / "cable-left.gcode").exists()
     ctx = make_mod.make(SIMPLE, 40, out, steps=fast)
-    assert sorted(p.name for p in out.iterdir()) == ctx.record["files"]
+    assert folder_files(out) == ctx.record["files"]
     assert not any(p.name.startswith("cable") for p in out.iterdir())
     assert check_folder(out) == [] and [p.name for p in tmp_path.iterdir()] == ["out"]
 
@@ -118,7 +118,7 @@ def test_failed_step_leaves_previous_outputs_intact(made, tmp_path, monkeypatch)
     out = tmp_path / "out"
     fast = [s for s in make_mod.default_steps() if not s[0].startswith("verification")]
     make_mod.make(REALISTIC, 40, out, steps=fast)
-    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    before = {name: (out / name).read_bytes() for name in folder_files(out)}
 
     def broken(ctx, stage):
         (stage / "half-written.gcode").write_text("G1 X1")
@@ -127,7 +127,7 @@ def test_failed_step_leaves_previous_outputs_intact(made, tmp_path, monkeypatch)
     steps = [*fast, ("broken", broken)]
     with pytest.raises(PrintgenError, match="forced failure"):
         make_mod.make(REALISTIC, 40, out, steps=steps)
-    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+    assert {name: (out / name).read_bytes() for name in folder_files(out)} == before
     assert [p.name for p in tmp_path.iterdir()] == ["out"]  # no staging directory left behind
 
 
@@ -172,6 +172,10 @@ def test_barrier_without_cables_is_verified_at_every_level(tmp_path):
     ver = ctx.record["verification"]
     assert ver["verdict"] in ("PASS", "FAIL") and len(ver["prototype"]["levels"]) == 23
     assert ver["not_converged"] == {"prototype": {}, "model": {}}
+    # the bottom row lies on the bed: no empty "bottom cable elongation" panel (issue 23)
+    panels = [t for f in ctx.report.figures if f.name == "verification" for t, _ in f.labels]
+    assert "mid-height deflection / width" in panels
+    assert not any("bottom cable" in t for t in panels)
 
 
 def test_time_limit_stops_the_run_in_its_step(tmp_path, monkeypatch):

@@ -10,7 +10,7 @@ import textwrap
 
 import pytest
 
-from printgen import outputs
+from printgen.outputs import folder as outputs
 from printgen.errors import InputError
 from printgen.outputs import OutputError, check_folder, staged_dir
 
@@ -107,7 +107,7 @@ def test_foreign_folder_needs_force(tmp_path):
     out = tmp_path / "thesis"
     out.mkdir()
     (out / "chapter1.tex").write_text("precious")
-    with pytest.raises(OutputError, match=r"printgen did not write \(no manifest.json\).*--force"):
+    with pytest.raises(OutputError, match=r"not a printgen output folder: it holds chapter1.tex \(the folder has no manifest.json\).*--force"):
         run_into(out, {"a.txt": "1"})
     assert (out / "chapter1.tex").read_text() == "precious"
     run_into(out, {"a.txt": "1"}, force=True)

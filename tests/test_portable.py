@@ -21,21 +21,28 @@ from proto_files import REALISTIC
 
 from printgen import workers
 from printgen.cli import main
+from printgen.outputs import lock
 
 ROOT = Path(__file__).resolve().parents[1]
 LINUX_ONLY = ("fcntl", "termios", "resource", "pty", "tty", "grp", "pwd")  # absent on Windows
 GONE_WITHIN_S = 10.0  # the watchdog ends an orphaned worker at once; slack for a loaded CI
 START_WITHIN_S = 120.0  # spawned workers import numpy and printgen: slow on a loaded machine
 
-# Run first in a child interpreter: the Linux-only modules cannot be imported, os has no fork
-# and signal no SIGHUP or SIGKILL, as on Windows.
+# Run first in a child interpreter: the Linux-only modules are absent (every finder says it
+# has none, so `importlib.util.find_spec` gives None and `import` raises ModuleNotFoundError),
+# os has no fork and signal no SIGHUP or SIGKILL, as on Windows.
 SIMULATE = textwrap.dedent(f"""
-    import importlib.abc, os, signal, sys
-    class Block(importlib.abc.MetaPathFinder):
+    import os, signal, sys
+    class Hide:
+        def __init__(self, inner):
+            self.inner = inner
         def find_spec(self, name, path=None, target=None):
             if name.split(".")[0] in {LINUX_ONLY!r}:
-                raise ImportError(f"{{name}}: not on this platform (simulated)")
-    sys.meta_path.insert(0, Block())
+                return None
+            return self.inner.find_spec(name, path, target)
+        def __getattr__(self, attr):
+            return getattr(self.inner, attr)
+    sys.meta_path[:] = [Hide(f) for f in sys.meta_path]
     for mod in {LINUX_ONLY!r}:
         sys.modules.pop(mod, None)
     for obj, name in ((os, "fork"), (os, "forkpty"), (os, "register_at_fork"),
@@ -68,19 +75,33 @@ def test_import_help_and_version_need_nothing_linux_only():
     loaded = simulated(f"""
         import sys
         from printgen.cli import build_parser
+        from printgen.outputs import lock
         build_parser([])
-        print(sorted(m for m in {LINUX_ONLY!r} if m in sys.modules))
+        print(sorted(m for m in {LINUX_ONLY!r} if m in sys.modules), lock.BACKEND)
     """)
-    assert loaded.returncode == 0 and loaded.stdout.strip() == "[]", loaded.stderr
+    assert loaded.returncode == 0 and loaded.stdout.split() == ["[]", "exclusive"], loaded.stderr
 
 
-def simulate_windows(monkeypatch) -> None:
-    """In this process: no fork (spawn only), no prctl (workers.SYSTEM), no SIGHUP."""
+def simulate_windows(monkeypatch) -> list[Path]:
+    """In this process: no fork (spawn only), no prctl (workers.SYSTEM), no SIGHUP, no fcntl
+    (the output lock's `exclusive` backend; flock fails the test). The returned list collects
+    the folders locked the exclusive way."""
+    locked: list[Path] = []
+    exclusive = lock._exclusive
+
+    def no_flock(dest: Path, path: Path) -> int:
+        raise AssertionError(f"flock used for {dest} on a platform without fcntl")
+
+    monkeypatch.setattr(lock, "BACKEND", "exclusive")
+    monkeypatch.setattr(lock, "_flock", no_flock)
+    monkeypatch.setattr(lock, "_exclusive",
+                        lambda dest, path: locked.append(dest) or exclusive(dest, path))
     monkeypatch.setattr(workers, "SYSTEM", "win32")
     monkeypatch.setattr(multiprocessing, "get_all_start_methods", lambda: ["spawn"])
     monkeypatch.delattr(os, "fork")
     monkeypatch.delattr(signal, "SIGHUP")
     monkeypatch.delenv("PRINTGEN_SERIAL", raising=False)
+    return locked
 
 
 def what_a_worker_sees() -> tuple:
@@ -148,7 +169,7 @@ def test_the_watchdog_ends_workers_whose_parent_was_killed(tmp_path):
 
 @pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="workers need 2 cores")
 def test_make_end_to_end_on_a_platform_without_fork_prctl_sighup_fcntl(tmp_path, monkeypatch):
-    simulate_windows(monkeypatch)
+    locked = simulate_windows(monkeypatch)
     asked: list[str] = []
     get_context = multiprocessing.get_context
     monkeypatch.setattr(multiprocessing, "get_context",
@@ -156,4 +177,5 @@ def test_make_end_to_end_on_a_platform_without_fork_prctl_sighup_fcntl(tmp_path,
     out = tmp_path / "o"
     assert main(["make", str(REALISTIC), "-s", "40", "--out", str(out)]) == 0
     assert asked and set(asked) == {"spawn"}  # the verification's helper process and its pool
+    assert locked == [out] and not lock.lock_path(out).exists()  # lock file created, removed
     assert main(["check", str(out)]) == 0

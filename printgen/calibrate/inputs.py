@@ -13,6 +13,7 @@ from pathlib import Path
 
 from printgen.calibrate.reader import TEXT_SUFFIXES
 from printgen.errors import CalibrationError
+from printgen.outputs.files import kind_of
 
 log = logging.getLogger(__name__)
 
@@ -47,6 +48,9 @@ def expand(paths: Sequence[str | Path], *, exclude: Iterable[str | Path] = ()
                 notes.append(f"{p.name}: a sidecar (.toml), not read as data")
                 continue
             out.append((p, False))
+        elif p.exists():
+            raise CalibrationError(f"{p}: is {kind_of(p.stat().st_mode)}, not a regular file; "
+                                   "give an export saved on disk")
         else:
             raise CalibrationError(f"{p}: file not found; check the path")
     kept = [(f, d) for f, d in out if f.resolve() not in skip]

@@ -39,6 +39,7 @@ from printgen.calibrate.specimen import (
     resolve,
 )
 from printgen.errors import CalibrationError
+from printgen.inputs.profiles import profile_name
 
 log = logging.getLogger(__name__)
 
@@ -115,6 +116,7 @@ def calibrate(paths: Sequence[str | Path], *, material: str, options: FitOptions
     """
     if not paths:
         raise CalibrationError("no tensile-test exports given")
+    material = profile_name(material, "--material")  # it names <material>.toml and .png
     opt = options or FitOptions()
     kind = (specimen or {}).get("kind")
     if kind is not None and kind not in KINDS:

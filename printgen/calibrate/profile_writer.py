@@ -23,6 +23,7 @@ from printgen import outputs
 from printgen.calibrate.pipeline import Calibration
 from printgen.errors import CalibrationError, PrintgenError
 from printgen.inputs.materials import Material, load_material
+from printgen.inputs.profiles import profile_name
 
 SOURCE = "printgen calibrate: tensile tests"
 SIG = 6  # significant digits written for measured values
@@ -65,6 +66,9 @@ def measured_tables(cal: Calibration, *, date: str | None = None) -> dict[str, d
 def write_profile(cal: Calibration, *, name: str, out: str | Path | None = None,
                   inherits: str | None = None, date: str | None = None) -> tuple[Path, Material]:
     """Write (or update) `<dir>/materials/<name>.toml`; return its path and the loaded material."""
+    name = profile_name(name, "--material")
+    if inherits is not None:
+        inherits = profile_name(inherits, "--inherits")
     if cal.groups:
         raise CalibrationError(
             "the files mix specimen orientations ("

@@ -9,6 +9,7 @@ file, the line and what was expected.
 from __future__ import annotations
 
 import csv
+import io
 import logging
 import zipfile
 from collections.abc import Mapping
@@ -28,13 +29,15 @@ from printgen.calibrate.columns import (
 )
 from printgen.calibrate.numbers import decimal_of, parse_number
 from printgen.calibrate.status import StatusColumn, decide
-from printgen.errors import CalibrationError
+from printgen.errors import CalibrationError, InputError
+from printgen.outputs.files import INPUT_LIMIT_BYTES, read_input
 
 log = logging.getLogger(__name__)
 
 DELIMITERS = (";", "\t", ",")  # preferred first: a decimal comma would split a ',' file
 SNIFF_ROWS = 40  # rows from the table's end used to choose the decimal separator
 TEXT_SUFFIXES = (".csv", ".txt", ".tsv", ".dat")
+EXPORT_LIMIT_BYTES = INPUT_LIMIT_BYTES  # one export, or what a zip of one unpacks to
 _BOOLEAN = {"true": 1.0, "false": 0.0}  # flag columns written as words
 
 
@@ -86,16 +89,31 @@ def read_text(path: str | Path) -> tuple[str, str]:
     if p.is_dir():
         raise CalibrationError(f"{p}: is a directory; pass it to `printgen calibrate` (which "
                                "reads every export in it) or name the export file")
-    if not p.is_file():
-        raise CalibrationError(f"{p}: file not found; check the path")
+    try:
+        data = read_input(p, "tensile-test export", limit=EXPORT_LIMIT_BYTES)
+    except InputError as exc:
+        raise CalibrationError(str(exc)) from None
     if p.suffix.lower() == ".zip":
-        with zipfile.ZipFile(p) as z:
+        return _unzip(data, p)
+    return _decode(data, p), str(p)
+
+
+def _unzip(data: bytes, p: Path) -> tuple[str, str]:
+    """The one export inside a zip, its uncompressed size capped like a file's."""
+    try:
+        with zipfile.ZipFile(io.BytesIO(data)) as z:
             names = [n for n in z.namelist()
                      if n.lower().endswith(TEXT_SUFFIXES) and not n.startswith("__MACOSX")]
             if len(names) != 1:
                 raise CalibrationError(f"{p}: expected one CSV inside the zip, found {names}")
-            return _decode(z.read(names[0]), p), f"{p}:{names[0]}"
-    return _decode(p.read_bytes(), p), str(p)
+            with z.open(names[0]) as fh:
+                text = fh.read(EXPORT_LIMIT_BYTES + 1)
+    except (zipfile.BadZipFile, OSError, NotImplementedError) as exc:
+        raise CalibrationError(f"{p}: not a readable zip archive ({exc})") from None
+    if len(text) > EXPORT_LIMIT_BYTES:
+        raise CalibrationError(f"{p}:{names[0]} unpacks to more than {EXPORT_LIMIT_BYTES:,} "
+                               "bytes, over the limit for one export; is it the right file?")
+    return _decode(text, p), f"{p}:{names[0]}"
 
 
 def _decode(data: bytes, p: Path) -> str:

@@ -62,6 +62,9 @@ class Variant:
     slack: float = 0.0
     mounting: str | None = None
     source: str = ""
+    orientation: str | None = None  # panel-test orientation of the net's law (None: profile's)
+    pressure: str = "flow"  # the water's force along the flow or normal to the net (scenes)
+    span: float | None = None  # lateral supports this far apart (m; None: the printed width)
 
 
 def mounting_options() -> tuple[str, ...]:
@@ -75,9 +78,11 @@ def mounting_options() -> tuple[str, ...]:
     return tuple(getattr(scenes, "MOUNTINGS", ()))
 
 
-def model_variants(d: Design, mounting: str | None = None) -> tuple[list[Variant], list[str]]:
+def model_variants(d: Design, mounting: str | None = None, free_section: float | None = None
+                   ) -> tuple[list[Variant], list[str]]:
     """The variants of design `d` to sweep, and one note per uncertainty left out and why;
-    `mounting` is the nominal run's (the other mountings become variants)."""
+    `mounting` is the nominal run's (the other mountings become variants); `free_section` m:
+    the flume's free section, when narrower than the net (a mounting-span variant)."""
     out, notes = [], []
     net = load_material(d.net.material)
     panel = net.panel_law
@@ -98,6 +103,7 @@ def model_variants(d: Design, mounting: str | None = None) -> tuple[list[Variant
         out += _cable_variants(d, notes)
     if panel is not None and panel.has_geometry:
         out += _panel_geometry_variant(d, notes)
+        out += _orientation_variants(d)
     opts = mounting_options() if d.cables else ()  # no border cables: bed and banks only
     nominal = mounting or (opts[0] if opts else None)
     out += [Variant(f"mounting: {m}", mounting=m, source="flume mounting option "
@@ -105,8 +111,29 @@ def model_variants(d: Design, mounting: str | None = None) -> tuple[list[Variant
     if not opts:
         notes.append("mounting: the model scene has one mounting only; no mounting variant")
     out.append(Variant(f"initial slack {SLACK_MAX:.0%}", slack=SLACK_MAX,
-                       source="printed net hung with 0 to 1 % slack (issue 10)"))
+                       source="printed net hung with 0 to 1 % slack (printgen; README: Uncertainty band)"))
+    out += _model_form_variants(d, free_section, notes)
     return out, notes
+
+
+def _model_form_variants(d: Design, free_section: float | None, notes: list[str]
+                         ) -> list[Variant]:
+    """Issue 25: the water's force normal to the deformed net, and the net mounted in a free
+    section narrower than its printed width (printgen.check.mount)."""
+    out = [Variant("pressure normal to the deformed net", pressure="normal",
+                   source="the folded film presses normal to the net (nominal: along the "
+                          "flow, reference section 3)")]
+    width = d.net.width_mm * MM
+    if d.cables and free_section is not None and free_section < width * (1 - SAME):
+        out.append(Variant(f"mounted in the {free_section * 1e3:g} mm free section",
+                           span=free_section, source=(
+                               f"net printed {width * 1e3:.4g} mm wide, side sheets "
+                               f"{free_section * 1e3:g} mm apart; how the excess is held is "
+                               "not stated (reference section 4)")))
+    else:
+        notes.append("mounting span: no free section narrower than the net given "
+                     "([flume] free_section_m); no span variant")
+    return out
 
 
 def _cable_variants(d: Design, notes: list[str]) -> list[Variant]:
@@ -138,6 +165,23 @@ def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
                     source=f"{mat.name} profile [measured.panel_law] conditions")]
 
 
+def _orientation_variants(d: Design) -> list[Variant]:
+    """The panel law read along each mesh diagonal its profile does not record (issue 25:
+    the paper does not say which diagonal its printed panels were loaded along)."""
+    from printgen.check.scenes import ORIENTATIONS
+
+    law = load_material(d.net.material).panel_law
+    recorded = "short" if law.mesh_along_load <= law.mesh_across_load else "long"
+    return [Variant(f"panel test along the {o} diagonal", orientation=o,
+                    source=f"panel-test orientation not stated (profile: {recorded})")
+            for o in ORIENTATIONS if o != recorded]
+
+
+def free_section(p: Prototype) -> float | None:
+    """The flume's free section (m) of the prototype file's [flume] table, or None."""
+    return p.flume.free_section if p.flume is not None else None
+
+
 def model_load_kw(p: Prototype, d: Design, drag: bool) -> dict[str, float] | None:
     """The model's load keywords for `sweep`: drag at the Froude-scaled velocity, as `verify`
     loads the model with drag; None for the hydrostatic test."""
@@ -154,13 +198,19 @@ def variant_scene(d: Design, v: Variant, coarsen: int = 1) -> BarrierScene:
         n = d.net
         d = dataclasses.replace(d, net=dataclasses.replace(
             n, mesh_x_mm=n.mesh_x_mm * coarsen, mesh_y_mm=n.mesh_y_mm * coarsen))
-    s = model_scene(d, **({"mounting": v.mounting} if v.mounting else {}))
+    s = model_scene(d, **({"mounting": v.mounting} if v.mounting else {}),
+                    orientation=v.orientation)
     laws = list(s.laws)
     laws[0] = _scaled(laws[0], v.net_factor * coarsen)
     if len(laws) > 1:  # the printed border frame, of the net's material
         laws[1] = _scaled(laws[1], v.frame_factor)
     cables = {k: (nodes, _scaled(law, v.cable_factor)) for k, (nodes, law) in s.cables.items()}
-    return dataclasses.replace(s, laws=laws, cables=cables)
+    s = dataclasses.replace(s, laws=laws, cables=cables, pressure=v.pressure)
+    if v.span is not None:  # issue 25: the printed net mounted in the flume's free section
+        from printgen.check.mount import in_free_section
+
+        s = in_free_section(s, v.span)
+    return s
 
 
 def _scaled(law: tuple, factor: float) -> tuple:
@@ -258,7 +308,8 @@ def _largest_change(c: dict[str, np.ndarray], ref: dict[str, np.ndarray]) -> flo
 
 
 def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
-               variants: list[Variant] | None = None, notes: list[str] | None = None) -> Band:
+               variants: list[Variant] | None = None, notes: list[str] | None = None,
+               free_section: float | None = None) -> Band:
     """Sweep every variant of design `d` and collect them around the `nominal` run (the
     model's sweep on the design's own net, as `verify` ran it), at the same levels.
 
@@ -269,7 +320,7 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
     lv = nominal.deformation.levels
     mounting = getattr(nominal.scene, "mounting", None)
     if variants is None:
-        variants, auto_notes = model_variants(d, mounting)
+        variants, auto_notes = model_variants(d, mounting, free_section)
         notes = [*(notes or []), *auto_notes]
     variants = [v if v.mounting else dataclasses.replace(v, mounting=mounting)
                 for v in variants]

@@ -1,16 +1,23 @@
 """A lab's loading test brought back to the pre-print check: read its CSV, compare it with the
-predicted curves, and fit the one factor of the printed net that best explains it (issue 10).
+predicted curves, and fit the one factor of the printed net that best explains it.
 
 The CSV (`,` or `;` separated; with `;`, decimal commas are accepted; lines starting with `#`
-are comments) has a column `h_over_hb` and any of the columns in `COLUMNS`. Elongations are
+are comments) has a column `h_over_hb` and any of the columns in `COLUMNS`; given the printed
+model's lengths, also the raw readings in mm (`water_depth_mm` for the level, the sensors'
+wire change, deflection and top lowering: printgen.check.readings.RAW_COLUMNS). Columns
+named `expected_*` (the model's readings on printgen's measurement sheet) are skipped, and so
+are columns left empty when others hold values. Elongations are
 read as what the extension sensors record: counted from h / h_B = 0 (sensors zeroed before
 the water arrives), so they are compared with the predicted curves counted from there too.
-An empty cell is a reading that was not taken.
+An empty cell is a reading that was not taken. A cell `<x` is an upper bound (a source that
+says only "below x", e.g. "negligible, all below 0.5 %"): it counts in the mismatch only by how
+far a prediction exceeds it, and is never used as a value.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -19,8 +26,11 @@ from pathlib import Path
 import numpy as np
 
 from printgen.check.bands import Band, Variant, curves, run_variant
+from printgen.check.readings import DEPTH_COLUMN, RAW_COLUMNS, FlumeUnits
 from printgen.design.record import Design
 from printgen.errors import InputError
+from printgen.inputs.profiles import profile_name
+from printgen.outputs.files import read_input_text
 
 LEVEL_COLUMN = "h_over_hb"
 # CSV column -> (METRICS key of printgen.check.compare, factor from the CSV unit to the key's)
@@ -29,13 +39,19 @@ COLUMNS = {
     "top_cable_elongation_pct": ("strain_top", 0.01),
     "mid_height_elongation_pct": ("strain_mid", 0.01),
     "deflection_over_width": ("deflection", 1.0),
+    "lowering_over_height": ("lowering", 1.0),
 }
+MEASURED_LIMIT_BYTES = 4 << 20  # a loading test is tens of lines; 4 MiB is surely not one
 MAX_LEVEL = 1.1  # the sweep's last relative loading (overflow): no prediction beyond it
+IGNORED_PREFIX = "expected_"  # columns of the measurement sheet that hold the model's readings
+LEVEL_AGREE = 0.01  # h_over_hb and water_depth_mm / h_B may differ by this much (h / h_B)
+RAW_LIMIT_MM = 1000.0  # a raw reading beyond +-1 m is not a flume model's: check the unit
 LIMITS = {  # plausible range of each column (CSV units): beyond it the unit is wrong
     "bottom_cable_elongation_pct": (-100.0, 100.0),
     "top_cable_elongation_pct": (-100.0, 100.0),
     "mid_height_elongation_pct": (-100.0, 100.0),
     "deflection_over_width": (-2.0, 2.0),
+    "lowering_over_height": (-2.0, 2.0),
 }
 
 
@@ -52,15 +68,24 @@ class Measurement:
     levels: np.ndarray
     values: dict[str, np.ndarray]
     columns: dict[str, str]  # METRICS key -> CSV column
+    bounds: dict[str, np.ndarray] | None = None  # METRICS key -> (k,) upper bounds, NaN: none
+
+    def bound(self, key: str) -> np.ndarray:
+        """(k,) upper bounds of column `key` (NaN where the cell is a value or empty)."""
+        if self.bounds is None or key not in self.bounds:
+            return np.full(len(self.levels), np.nan)
+        return self.bounds[key]
 
 
-def read_measured(path: str | Path) -> Measurement:
-    """Read and check a measured loading test (see the module docstring for the format)."""
+def read_measured(path: str | Path, units: FlumeUnits | None = None) -> Measurement:
+    """Read and check a measured loading test (see the module docstring for the format).
+
+    With `units` (the printed model's lengths, printgen.check.readings) the raw columns in mm
+    (RAW_COLUMNS, and DEPTH_COLUMN for the level) are read too; `expected_*` columns (the
+    model's readings on the measurement sheet) are skipped.
+    """
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise MeasurementError(f"{p}: cannot read the measured data: {exc}") from exc
+    text = read_input_text(p, "measured data", limit=MEASURED_LIMIT_BYTES, encoding="utf-8-sig")
     lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines())
              if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
@@ -68,20 +93,77 @@ def read_measured(path: str | Path) -> Measurement:
                                f"any of {', '.join(COLUMNS)}, then one line per level")
     sep = ";" if ";" in lines[0][1] else ","
     header = [h.strip().lower() for h in lines[0][1].split(sep)]
-    _check_header(p, header)
+    cols = _columns(units)
+    _check_header(p, header, cols, units)
     rows = lines[1:]
     if not rows:
         raise MeasurementError(f"{p}: a header but no data lines; give one line per level")
-    table = np.array([_row(p, n, ln, sep, header) for n, ln in rows])
-    data = dict(zip(header, table.T, strict=True))
-    _check_ranges(p, data, [n for n, _ in rows])
-    keys = {COLUMNS[c][0]: c for c in header if c != LEVEL_COLUMN}
-    values = {COLUMNS[c][0]: data[c] * COLUMNS[c][1] for c in header if c != LEVEL_COLUMN}
-    return Measurement(str(p), data[LEVEL_COLUMN], values, keys)
+    parsed = [_row(p, n, ln, sep, header) for n, ln in rows]
+    table = np.array([[v for v, _ in r] for r in parsed])
+    upper = np.array([[b for _, b in r] for r in parsed])
+    data = {h: c for h, c in zip(header, table.T, strict=True)
+            if not h.startswith(IGNORED_PREFIX)}
+    bounds = {h: c for h, c in zip(header, upper.T, strict=True)
+              if not h.startswith(IGNORED_PREFIX)}
+    if units is not None and DEPTH_COLUMN in data:
+        data = _level_from_depth(p, data, units)
+    read = [c for c in data if c in cols]
+    if len(read) > 1:  # a sheet's unfilled columns are dropped; a lone empty one is an error
+        read = [c for c in read
+                if not (np.all(np.isnan(data[c])) and np.all(np.isnan(bounds[c])))] or read
+    _check_ranges(p, {LEVEL_COLUMN: data[LEVEL_COLUMN],
+                      **{c: np.where(np.isnan(bounds[c]), data[c], bounds[c]) for c in read}},
+                  [n for n, _ in rows])
+    keys = {cols[c][0]: c for c in read}
+    if len(keys) < len(read):
+        raise MeasurementError(f"{p}: two columns measure the same quantity ({', '.join(read)});"
+                               " keep one of each")
+    values = {cols[c][0]: data[c] * cols[c][1] for c in read}
+    limits = {cols[c][0]: bounds[c] * cols[c][1] for c in read}
+    if values and all(np.all(np.isnan(v)) for v in values.values()) \
+            and not all(np.all(np.isnan(b)) for b in limits.values()):
+        raise MeasurementError(f"{p}: only bounds ('<x'), no measured value; give at least "
+                               "one reading")
+    return Measurement(str(p), data[LEVEL_COLUMN], values, keys, limits)
 
 
-def _check_header(p: Path, header: list[str]) -> None:
-    allowed = [LEVEL_COLUMN, *COLUMNS]
+def _columns(units: FlumeUnits | None) -> dict[str, tuple[str, float]]:
+    """Readable columns -> (METRICS key, factor to its unit): COLUMNS, and with `units` the
+    raw columns in mm."""
+    if units is None:
+        return dict(COLUMNS)
+    return {**COLUMNS, **{c: (k, 1.0 / units.length_mm(k)) for c, k in RAW_COLUMNS.items()}}
+
+
+def _level_from_depth(p: Path, data: dict[str, np.ndarray], units: FlumeUnits
+                      ) -> dict[str, np.ndarray]:
+    """h_over_hb from the water depth in mm (h_B = the net's height), checked against an
+    h_over_hb column when both are given."""
+    level = data.pop(DEPTH_COLUMN) / units.height_mm
+    given = data.get(LEVEL_COLUMN)
+    if given is not None:
+        ok = ~np.isnan(level)
+        if np.any(np.abs(level[ok] - given[ok]) > LEVEL_AGREE):
+            i = int(np.flatnonzero(ok & (np.abs(np.nan_to_num(level) - given) > LEVEL_AGREE))[0])
+            raise MeasurementError(
+                f"{p}: {DEPTH_COLUMN} {level[i] * units.height_mm:g} mm is h/h_B = {level[i]:.3f}"
+                f" (h_B = {units.height_mm:g} mm) but {LEVEL_COLUMN} says {given[i]:g}; fix "
+                "one or leave the depth cell empty")
+        return data
+    if np.any(np.isnan(level)):
+        raise MeasurementError(f"{p}: an empty {DEPTH_COLUMN} cell; give the depth of every "
+                               "reading (or an h_over_hb column)")
+    return {LEVEL_COLUMN: level, **data}
+
+
+def _check_header(p: Path, header: list[str], cols: dict[str, tuple[str, float]],
+                  units: FlumeUnits | None) -> None:
+    header = [h for h in header if not h.startswith(IGNORED_PREFIX)]
+    if units is not None and DEPTH_COLUMN in header and LEVEL_COLUMN not in header:
+        header = [LEVEL_COLUMN if h == DEPTH_COLUMN else h for h in header]
+    elif units is not None:
+        header = [h for h in header if h != DEPTH_COLUMN]
+    allowed = [LEVEL_COLUMN, *cols]
     for h in header:
         if h not in allowed:
             raise MeasurementError(f"{p}: unknown column {h!r}; allowed: {', '.join(allowed)}")
@@ -92,10 +174,12 @@ def _check_header(p: Path, header: list[str]) -> None:
         raise MeasurementError(f"{p}: missing column {LEVEL_COLUMN!r} (relative loading "
                                f"h / h_B); columns found: {', '.join(header)}")
     if len(header) < 2:
-        raise MeasurementError(f"{p}: no measured column; add any of {', '.join(COLUMNS)}")
+        raise MeasurementError(f"{p}: no measured column; add any of {', '.join(cols)}")
 
 
-def _row(p: Path, n: int, line: str, sep: str, header: list[str]) -> list[float]:
+def _row(p: Path, n: int, line: str, sep: str, header: list[str]
+         ) -> list[tuple[float, float]]:
+    """(value, upper bound) per cell: (x, NaN) for a reading, (NaN, x) for `<x`."""
     cells = [c.strip() for c in line.split(sep)]
     if len(cells) != len(header):
         raise MeasurementError(f"{p}, line {n}: {len(cells)} cells for {len(header)} columns "
@@ -103,17 +187,19 @@ def _row(p: Path, n: int, line: str, sep: str, header: list[str]) -> list[float]
     out = []
     for col, cell in zip(header, cells, strict=True):
         if cell == "" and col != LEVEL_COLUMN:
-            out.append(math.nan)  # a reading that was not taken
+            out.append((math.nan, math.nan))  # a reading that was not taken
             continue
-        text = cell.replace(",", ".") if sep == ";" else cell
+        bound = cell.startswith("<") and col != LEVEL_COLUMN
+        text = cell[1:].strip() if bound else cell
+        text = text.replace(",", ".") if sep == ";" else text
         try:
             v = float(text)
         except ValueError:
             v = math.nan
         if not math.isfinite(v):
             raise MeasurementError(f"{p}, line {n}, column {col!r}: {cell!r} is not a finite "
-                                   "number")
-        out.append(v)
+                                   "number (or '<number' for an upper bound)")
+        out.append((math.nan, v) if bound else (v, math.nan))
     return out
 
 
@@ -124,7 +210,8 @@ def _check_ranges(p: Path, data: dict[str, np.ndarray], line_numbers: list[int])
         i = int(bad[0])
         raise MeasurementError(f"{p}, line {line_numbers[i]}: {LEVEL_COLUMN} = {lv[i]:g} outside "
                                f"0 to {MAX_LEVEL:g} (the predicted range; h / h_B, not mm)")
-    for col, (lo, hi) in LIMITS.items():
+    limits = {**LIMITS, **{c: (-RAW_LIMIT_MM, RAW_LIMIT_MM) for c in RAW_COLUMNS}}
+    for col, (lo, hi) in limits.items():
         if col not in data:
             continue
         v = data[col]
@@ -135,6 +222,7 @@ def _check_ranges(p: Path, data: dict[str, np.ndarray], line_numbers: list[int])
                                    f"outside {lo:g} to {hi:g}; check the unit of the column")
         if np.all(np.isnan(v)):
             raise MeasurementError(f"{p}: column {col!r} holds no value; fill or remove it")
+
 
 
 @dataclass(frozen=True)
@@ -157,17 +245,19 @@ def mismatch(m: Measurement, predicted: dict[str, np.ndarray],
     measured levels), and how many points fall inside the band [lo, hi] when one is given."""
     out = []
     for key, col in m.columns.items():
-        meas, pred = m.values[key], predicted[key]
+        meas, pred, cap = m.values[key], predicted[key], m.bound(key)
         ok = ~np.isnan(meas) & ~np.isnan(pred)
-        diff = meas[ok] - pred[ok]
-        rms = float(np.sqrt(np.mean(diff**2))) if ok.any() else math.nan
-        peak = float(np.abs(meas[ok]).max()) if ok.any() else 0.0
+        capped = ~np.isnan(cap) & ~np.isnan(pred)  # a bound counts by its excess only
+        diff = np.concatenate([meas[ok] - pred[ok], np.maximum(pred[capped] - cap[capped], 0)])
+        rms = float(np.sqrt(np.mean(diff**2))) if diff.size else math.nan
+        peak = float(np.abs(meas[ok]).max()) if ok.any() else (
+            float(np.abs(cap[capped]).max()) if capped.any() else 0.0)  # bounds only: their scale
         inside = 0
         if lo is not None and hi is not None:
             inside = int(np.sum((meas[ok] >= lo[key][ok] - 1e-12)
                                 & (meas[ok] <= hi[key][ok] + 1e-12)))
-        out.append(Mismatch(key, col, rms, rms / peak if peak > 0 else math.nan, int(ok.sum()),
-                            inside))
+        out.append(Mismatch(key, col, rms, rms / peak if peak > 0 else math.nan,
+                            int(ok.sum() + capped.sum()), inside))
     return out
 
 
@@ -178,7 +268,7 @@ def objective(m: Measurement, predicted: dict[str, np.ndarray]) -> float:
 
 
 Predictor = Callable[[float], dict[str, np.ndarray]]
-FIT_KINDS = ("stiffness", "slack")
+FIT_KINDS = ("stiffness", "slack", "multi")  # multi: printgen.check.fit (issue 25)
 STIFFNESS_RANGE = (0.2, 5.0)  # net stiffness factors searched: a printed net 5x off is a misprint
 SLACK_RANGE = (0.0, 0.03)  # initial slack searched: 3 % sags visibly, a lab would see it
 XTOL_LOG = 0.005  # stiffness factor known to 0.5 % (bounded Brent on log factor)
@@ -211,7 +301,7 @@ def fit_factor(m: Measurement, predict: Predictor, kind: str = "stiffness") -> F
     `predict(value)` returns the predicted curves at the measured levels (from h / h_B = 0)."""
     from scipy.optimize import minimize_scalar
 
-    if kind not in FIT_KINDS:
+    if kind not in FIT_KINDS[:2]:
         raise InputError(f"fit {kind!r} unknown; choose one of {', '.join(FIT_KINDS)}")
     cache: dict[float, dict[str, np.ndarray]] = {}
 
@@ -236,20 +326,23 @@ def fit_factor(m: Measurement, predict: Predictor, kind: str = "stiffness") -> F
 def fitted_profile(material: str, kind: str, value: float, *, panel_kappas: tuple | None,
                    modulus_gpa: float | None, source: str) -> str:
     """TOML text of a material profile that feeds a fitted stiffness factor back: it inherits
-    `material` and scales its panel law (or its measured modulus). None for a slack fit."""
+    `material` (a profile name) and scales its panel law (or its measured modulus). "" for a
+    slack fit."""
+    material = profile_name(material, "fitted profile: inherits")
     if kind != "stiffness":
         return ""
-    lines = [f'# The printed net of {source}, fitted by printgen verify --measured:',
+    shown = json.dumps(source)  # a quoted TOML string: a file name cannot break the syntax
+    lines = [f"# The printed net of {shown}, fitted by printgen verify --measured:",
              f"# effective stiffness {value:.3f} x the '{material}' profile.",
              f'inherits = "{material}"', ""]
-    cond = f"effective law of the printed net fitted to the loading test {source}"
+    cond = json.dumps(f"effective law of the printed net fitted to the loading test {source}")
+    origin = json.dumps(f"printgen verify --measured {source}")
     if panel_kappas:
         kappas = ", ".join(f"{k * value / 1e3:.4g}" for k in panel_kappas)
-        lines += ["[measured.panel_law]", f"kappa_kn_per_m_per_m = [{kappas}]",
-                  f'source = "printgen verify --measured {source}"', f'conditions = "{cond}"']
+        lines += ["[measured.panel_law]", f"kappa_kn_per_m_per_m = [{kappas}]"]
     else:
-        lines += ["[measured.tensile_modulus]", f"value_gpa = {modulus_gpa * value:.4g}",
-                  f'source = "printgen verify --measured {source}"', f'conditions = "{cond}"']
+        lines += ["[measured.tensile_modulus]", f"value_gpa = {modulus_gpa * value:.4g}"]
+    lines += [f"source = {origin}", f"conditions = {cond}"]
     return "\n".join(lines) + "\n"
 
 

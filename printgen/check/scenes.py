@@ -40,6 +40,15 @@ SENSOR_FORCE_N = 1.0  # wire tension of each string potentiometer (reference, se
 SENSOR_EXIT = 0.1  # the potentiometer stands this fraction of the width beyond the right edge
 FLOW = np.array([0.0, 1.0, 0.0])  # flow direction: the water pushes along it
 MOUNTINGS = LATERAL  # lateral mounting in the flume ([flume] lateral), the default first
+# Panel-test orientation (issue 25): the diagonal of the mesh its panel test loaded, the one
+# a panel law is read along. The prototype's 1.33 m panel was loaded along the water-drop's
+# long axis; the printed nets' orientation is not stated, and their profile (TPE) records the
+# short diagonal, whose strand modulus matches the datasheet (see `panel_strand_law`).
+ORIENTATIONS = ("short", "long")
+# Direction of the water's force on a node: along the flow (the reference's section 3), or
+# normal to the deformed net (the film lies on the net: `printgen.check.pressure`).
+PRESSURES = ("flow", "normal")
+PROTOTYPE_ORIENTATION = "long"
 # Stiffness holding each free node where it is when its strands carry no load (N/m), as a
 # fraction of rho g A* (the rate at which a node's hydrostatic load grows per metre of head):
 # it scales like every stiffness (lambda^-2), so prototype and model get the same share.
@@ -89,6 +98,8 @@ class BarrierScene:
     mounting: str = MOUNTINGS[0]
     hold: float = 0.0
     assumptions: tuple[Assumption, ...] = ()
+    pressure: str = "flow"  # one of PRESSURES: the water's force along the flow or normal
+    rest_nodes: np.ndarray | None = None  # (n, 3) m printed geometry when mounted otherwise
 
 
 def strand_law_from_membrane(knees: tuple[float, ...], slopes: tuple[float, ...],
@@ -102,6 +113,16 @@ def strand_law_from_membrane(knees: tuple[float, ...], slopes: tuple[float, ...]
     sin = diamond_sin(mesh_along, mesh_across)
     f = 1.0 / (diamond_factor(mesh_along, mesh_across))
     return tuple(k * sin * sin for k in knees), tuple(s * f for s in slopes)
+
+
+def panel_axes(mesh_a: float, mesh_b: float, orientation: str) -> tuple[float, float]:
+    """(along, across) the load of a panel test on a mesh with diagonals a and b, loaded along
+    its `orientation` ("short" or "long") diagonal."""
+    if orientation not in ORIENTATIONS:
+        raise GeometryError(f"panel-test orientation {orientation!r} is not one of "
+                            f"{', '.join(ORIENTATIONS)}")
+    lo, hi = sorted((mesh_a, mesh_b))
+    return (lo, hi) if orientation == "short" else (hi, lo)
 
 
 def _net_arrays(g: NetGraph, to_m: float) -> tuple[np.ndarray, dict[str, np.ndarray], int, int]:
@@ -187,10 +208,11 @@ def lateral_mounting(p: Prototype) -> str:
     return p.flume.lateral if p.flume is not None else MOUNTINGS[0]
 
 
-def prototype_scene(p: Prototype, *, mounting: str | None = None) -> BarrierScene:
-    """The prototype: net with its panel law (or linear strands), sliding border cables,
-    mounted like the model (`mounting`, default the file's [flume] lateral); its sensor
-    wires only read (a field barrier carries no sensors)."""
+def prototype_scene(p: Prototype, *, mounting: str | None = None,
+                    orientation: str = PROTOTYPE_ORIENTATION) -> BarrierScene:
+    """The prototype: net with its panel law (read along the mesh diagonal `orientation`) or
+    linear strands, sliding border cables, mounted like the model (`mounting`, default the
+    file's [flume] lateral); its sensor wires only read (a field barrier carries no sensors)."""
     mounting = mounting or lateral_mounting(p)
     if p.net.pattern == "square":
         g = square_graph(p.width / MM, p.height / MM, p.net.mesh_x / MM)
@@ -198,11 +220,13 @@ def prototype_scene(p: Prototype, *, mounting: str | None = None) -> BarrierScen
         g = diamond_net(p.width / MM, p.height / MM, p.net.mesh_x / MM, p.net.mesh_y / MM)
     if p.net.panel_law is not None:
         knees, kappas, length = p.net.panel_law
+        along, across = panel_axes(p.net.mesh_x, p.net.mesh_y, orientation)
         net_law = strand_law_from_membrane(knees, tuple(k * length for k in kappas),
-                                           p.net.mesh_y, p.net.mesh_x)
+                                           along, across)
         law_text = ("panel law " + ", ".join(f"{k / 1e3:g}" for k in kappas) + " kN/m/m"
                     + (" (knees " + ", ".join(f"{k:.0%}" for k in knees) + ")" if knees else "")
-                    + " turned into a strand law")
+                    + f" of a panel loaded along the {along / MM:g} mm ({orientation}) "
+                    "diagonal, transverse displacement blocked, turned into a strand law")
     else:
         net_law = ((), (p.net.strand_modulus * math.pi / 4 * p.net.strand_diameter**2,))
         law_text = (f"linear strands E = {p.net.strand_modulus / 1e9:g} GPa, "
@@ -221,15 +245,16 @@ def prototype_scene(p: Prototype, *, mounting: str | None = None) -> BarrierScen
     return _finish(s, rows, sensors=False)
 
 
-def model_scene(d: Design, *, mounting: str = MOUNTINGS[0]) -> BarrierScene:
+def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
+                orientation: str | None = None) -> BarrierScene:
     """The printed model: diamond net with the material's (measured) law, printed border frame,
     cables of the measured modulus, mounted by `mounting`, and the three sensor wires pulling
-    SENSOR_FORCE_N along themselves."""
+    SENSOR_FORCE_N along themselves. `orientation` ("short", "long"): the mesh diagonal the
+    material's panel test loaded (None: the one its profile records)."""
     n = d.net
     g = diamond_net(n.width_mm, n.height_mm, n.mesh_x_mm, n.mesh_y_mm)
     mat = load_material(n.material)
-    knees, slopes, how = net_membrane_law(mat, n.strand, n.mesh_y_mm * MM, n.mesh_x_mm * MM)
-    net_law = strand_law_from_membrane(knees, slopes, n.mesh_y_mm * MM, n.mesh_x_mm * MM)
+    net_law, how = model_net_law(mat, n, orientation)
     e, e_src = mat.modulus()
     border_ea = e * n.border_width_mm * n.strand.thickness_mm * MM * MM
     cable_law, rows = None, []
@@ -252,6 +277,23 @@ def model_scene(d: Design, *, mounting: str = MOUNTINGS[0]) -> BarrierScene:
     return _finish(s, rows, sensors=True)
 
 
+def model_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
+    """The printed net's strand law and how it was found: a panel law with its tested net is
+    read along the tested net's `orientation` diagonal (a strand law of the tested strands,
+    rescaled to the design's strand section); otherwise the membrane law of the design."""
+    law = mat.panel_law
+    if law is None or not law.has_geometry or orientation is None:
+        knees, slopes, how = net_membrane_law(mat, n.strand, n.mesh_y_mm * MM, n.mesh_x_mm * MM)
+        return strand_law_from_membrane(knees, slopes, n.mesh_y_mm * MM, n.mesh_x_mm * MM), how
+    along, across = panel_axes(law.mesh_along_load, law.mesh_across_load, orientation)
+    knees, slopes = strand_law_from_membrane(
+        law.knee_strains, tuple(k * law.panel_length for k in law.kappas), along, across)
+    ratio = area_m2(n.strand) / (law.strand_width * law.strand_thickness)
+    return (knees, tuple(s * ratio for s in slopes)), (
+        f"measured panel law read along the tested net's {along / MM:g} mm ({orientation}) "
+        "diagonal")
+
+
 def _finish(s: BarrierScene, rows: list[Assumption], *, sensors: bool) -> BarrierScene:
     """The scene with its sensor wires pulling (model) or only reading (prototype), and the
     assumptions shared by every scene after the scene's own."""
@@ -262,28 +304,34 @@ def _finish(s: BarrierScene, rows: list[Assumption], *, sensors: bool) -> Barrie
 
 
 def _common_assumptions(s: BarrierScene, sensors: bool) -> list[Assumption]:
-    ref = "barrier-physics.md"
+    paper = "Lambert et al. 2023"
     out = []
     if s.cables:
         held = ("lateral edges held by the side sheets along their whole height"
                 if s.mounting == "walls" else "lateral cables held only at their eyelets")
         out.append(("mounting", (f"{s.mounting}: {held}; top and bottom cables on the four "
-                     "corner anchors"), f"[flume] lateral (default walls: {ref} section 4)"))
+                     "corner anchors"),
+                    (f"[flume] lateral (default walls: {paper}, the 1:40 model fixed to the "
+                     "flume's side sheets; README: Pre-print verification, Mounting)")))
     else:
         out.append(("mounting", "anchored on the bed and the banks, top free",
-                    f"scene simple-free-top ({ref} section 7)"))
+                    ("printgen's scene simple-free-top (README: Pre-print verification, barriers "
+                     "without border cables)")))
     wire = (f"{SENSOR_FORCE_N:g} N along each wire" if sensors
             else "read only (no sensors on a field barrier)")
     out += [("sensor wires", (f"bottom, top and mid-height rows, {wire}; anchored at the left "
              f"edge node, over the row's nodes, to the potentiometer {SENSOR_EXIT:.0%} of the "
-             "width beyond the right edge; reading = change of wire length"), f"{ref} section 4"),
+             "width beyond the right edge; reading = change of wire length"),
+             (f"{paper}: three 1 N extension sensors (Fig. 6a); routing: README, The flume "
+             "test as it is run")),
             ("loading", ("hydrostatic rho g (h - z) A* at the current node height, h/h_B = 0 "
-             "to 1.1; the folded film adds no stiffness"), f"{ref} sections 3 and 4"),
+             "to 1.1; the folded film adds no stiffness"),
+             f"{paper}: nodal hydrostatic loads, loading test behind a folded film (Fig. 6a)"),
             ("initial state", "flat, no pretension, no slack; gravity on the net neglected",
-             f"{ref} section 4")]
+             f"{paper}: no pretension in the main cables at installation")]
     if s.hold > 0:
         out.append(("unloaded strands", (f"stay where they are: each free node held at rest by "
                     f"{s.hold:.3g} N/m ({HOLD_FRACTION:g} x rho g A*), a regularisation of the "
                     "dry, slack net above the water (a mechanism otherwise)"),
-                    "printgen (issue 10); its force share is reported"))
+                    "printgen (README: barriers without border cables); its force share is reported"))
     return out

@@ -66,10 +66,13 @@ def build(s: BarrierScene, *, slack: float = 0.0) -> tuple[solver.Net, Extras]:
     """The solver net of scene `s` with relative initial `slack` of strands and cables."""
     nodes, fixed = [s.nodes], [s.fixed]
     elements, law_index = [s.elements], [s.element_law]
-    lengths = np.linalg.norm(s.nodes[s.elements[:, 1]] - s.nodes[s.elements[:, 0]], axis=1)
+    printed = s.nodes if s.rest_nodes is None else s.rest_nodes  # strands' unstressed shape
+    lengths = np.linalg.norm(printed[s.elements[:, 1]] - printed[s.elements[:, 0]], axis=1)
     rest = [lengths * (1.0 + slack)]
     laws = [solver.piecewise(k, sl) for k, sl in s.laws]
-    cables = [solver.SlidingCable(c, solver.piecewise(*law)) for c, law in s.cables.values()]
+    cables = [solver.SlidingCable(c, solver.piecewise(*law), None if s.rest_nodes is None else
+                                  _polyline(printed[c]) * (1.0 + slack))
+              for c, law in s.cables.values()]
     n, first = len(s.nodes), len(s.elements)
     for w in s.wires.values():
         if w.force <= 0:
@@ -104,6 +107,10 @@ def build(s: BarrierScene, *, slack: float = 0.0) -> tuple[solver.Net, Extras]:
                      element_law=np.concatenate(law_index), rest_length=np.concatenate(rest),
                      slack=slack, cables=cables)
     return net, Extras(len(s.nodes), len(s.elements), len(s.cables), ties, wire_elements)
+
+
+def _polyline(p: np.ndarray) -> float:
+    return float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
 
 
 def wire_slack(strains: np.ndarray, ex: Extras) -> int:

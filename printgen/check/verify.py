@@ -10,7 +10,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -43,6 +43,9 @@ from printgen.workers import (  # worker lifecycle: ground floor
 )
 from solver.loads import total_forces
 
+if TYPE_CHECKING:
+    from printgen.check.pressure import NormalPressure
+
 LEVEL_STEP = 0.05  # relative loading step of the sweep (issue: at most 0.05)
 OVERFLOW = 1.1  # last relative loading h / h_B
 PATH_CUTS = 2  # halvings tried before a load level is reported as not converged
@@ -74,10 +77,18 @@ def loads_function(s: BarrierScene, *, velocity: float | None = None,
     free = np.flatnonzero(~s.fixed)
     strand_per_node = _strand_length(s) / len(s.nodes)
     row_gap = float(np.diff(np.unique(np.round(s.nodes[:, 2], 12))).min())  # node rows apart
+    normal = None
+    if s.pressure == "normal":  # issue 25: the film presses normal to the deformed net
+        from printgen.check.pressure import normal_pressure
+
+        normal = normal_pressure(s.nodes, s.elements[s.element_law == 0], free,
+                                 s.area_per_node, 0.0)
 
     def loads_at(r: float) -> list:
-        out: list[solver.Hydrostatic | solver.Drag] = [solver.Hydrostatic(free, s.area_per_node, r * s.height, tuple(FLOW),
-                                  rho=RHO_WATER, g=G)]
+        out: list[solver.Hydrostatic | solver.Drag | NormalPressure] = [
+            solver.Hydrostatic(free, s.area_per_node, r * s.height, tuple(FLOW),
+                               rho=RHO_WATER, g=G) if normal is None
+            else dataclasses.replace(normal, level=r * s.height)]
         if velocity:
             out.append(solver.Drag(free, strand_per_node, strand_diameter, velocity,
                                    r * s.height, tuple(FLOW), rho=RHO_WATER, ramp=row_gap))

@@ -26,6 +26,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("bench", help="run a benchmark (speed against error) into a folder")
     p.add_argument("name", choices=BENCHES)
     p.add_argument("--out", type=Path, default=Path("benchmarks/results"))
+    p.add_argument("--json", action="store_true",
+                   help="print the report as JSON (the files in --out hold it all)")
     p.set_defaults(func=run)
 
 
@@ -36,4 +38,5 @@ def run(args: argparse.Namespace) -> int:
     if str(ROOT) not in sys.path:
         sys.path.insert(0, str(ROOT))
     module = importlib.import_module(f"benchmarks.bench_{args.name}")
-    return int(module.main(["--out", str(args.out)]) or 0)
+    extra = ["--json"] if args.json else []
+    return int(module.main(["--out", str(args.out), *extra]) or 0)

@@ -29,6 +29,7 @@ from printgen.calibrate.sample import DEFAULT_SECANTS, PRELOAD_STEPS, FitOptions
 from printgen.calibrate.specimen import KINDS
 from printgen.commands.common import add_json_arg, console, emit_json, fmt, table
 from printgen.errors import CalibrationError
+from printgen.inputs.profiles import profile_name
 
 WIDEST = 10_000  # characters: a results table's width is measured up to this
 PRELOAD_COL = "ΔE % at P∓10%"  # modulus change (%) at 0.9 and 1.1 x the preload
@@ -124,6 +125,9 @@ def options_from(args: argparse.Namespace) -> FitOptions:
 
 
 def run(args: argparse.Namespace) -> int:
+    material = profile_name(args.material, "--material")  # names <material>.toml and .png
+    if args.inherits is not None:
+        profile_name(args.inherits, "--inherits")
     spec = {name: getattr(args, opt) * f for opt, name, f in DIMENSION_OPTIONS
             if getattr(args, opt) is not None}
     if args.kind:
@@ -149,7 +153,7 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         from printgen.calibrate.plot import plot_calibration
 
-        written["plot"] = str(plot_calibration(cal, Path(args.plot) / f"{args.material}.png"))
+        written["plot"] = str(plot_calibration(cal, Path(args.plot) / f"{material}.png"))
     if args.json:
         emit_json({**calibration_record(cal), "written": written})
         return 0

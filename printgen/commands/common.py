@@ -9,6 +9,7 @@ from typing import Any
 from rich.console import Console
 from rich.table import Table
 
+from printgen.inputs.profiles import profile_name
 from printgen.report.jsonout import dumps
 
 
@@ -16,6 +17,16 @@ def add_prototype_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("prototype", help="prototype barrier TOML (see examples/)")
     p.add_argument("--scale", "-s", type=float, required=True, metavar="LAMBDA",
                    help="geometric scale lambda = prototype / model, >= 1 (1:40 -> 40)")
+
+
+def check_profile_args(args: argparse.Namespace, *options: str) -> None:
+    """ProfileError now, before any work, when --printer, --materials, ... is not a plain
+    profile name (a path, a glob, a hidden file)."""
+    for opt in options:
+        value = getattr(args, opt, None)
+        for name in value if isinstance(value, (list, tuple)) else [value]:
+            if name is not None:
+                profile_name(name, f"--{opt}")
 
 
 def add_json_arg(p: argparse.ArgumentParser) -> None:

@@ -8,11 +8,12 @@ import argparse
 import sys
 from pathlib import Path
 
-from printgen.commands.common import add_json_arg, console, emit_json, table
+from printgen.commands.common import add_json_arg, check_profile_args, console, emit_json, table
 from printgen.design.search import OBJECTIVES, VERIFY_NETS
 from printgen.design.search_choice import short
+from printgen.design.sweep import check_address
 from printgen.errors import InputError
-from printgen.run.design import DesignRun, SearchOptions, design_searches, write_outputs
+from printgen.run.design import DesignRun, SearchOptions, check_out, design_searches, write_outputs
 
 SHOW = 10  # Pareto members shown per scale in the table (all are in report.json)
 
@@ -52,6 +53,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_profile_args(args, "printer", "materials")
+    if args.scheduler:
+        check_address(args.scheduler)
     scales = _scales(args)
     if len(scales) > 1 and (args.mesh_x_mm or args.mesh_y_mm):
         raise InputError("--mesh-x-mm/--mesh-y-mm are millimetres at one scale; with --scales "
@@ -63,9 +67,10 @@ def run(args: argparse.Namespace) -> int:
         border_beads=_ints(args.border_beads, "--border-beads"), printer=args.printer,
         verify_nets=args.verify_nets, level_step=args.level_step)
     out = args.out or Path("out") / f"{Path(args.prototype).stem}-design"
+    check_out(out, args.prototype)  # before the search
     result = design_searches(args.prototype, scales, options=opts, scheduler=args.scheduler,
                              workers=args.workers, serial=args.serial, progress=not args.json)
-    files = write_outputs(result, out, args.scale if args.scale else scales[0])
+    files = write_outputs(result, out, args.scale if args.scale else scales[0], args.prototype)
     if args.json:
         emit_json(result.record)
         return 0

@@ -10,7 +10,14 @@ from pathlib import Path
 
 from rich.console import Console
 
-from printgen.commands.common import add_json_arg, add_prototype_args, console, emit_json, table
+from printgen.commands.common import (
+    add_json_arg,
+    add_prototype_args,
+    check_profile_args,
+    console,
+    emit_json,
+    table,
+)
 from printgen.run import api
 from printgen.run.budget import DEFAULT_LIMIT_S
 from printgen.run.make import json_output
@@ -37,11 +44,15 @@ def register(sub: argparse._SubParsersAction) -> None:
                         f"cores, and never stop)")
     p.add_argument("--force", action="store_true",
                    help="replace --out even when it holds files printgen did not write")
+    p.add_argument("--pdf", action="store_true",
+                   help="also print report.pdf with headless Chromium (skipped, with one line, "
+                        "when Chromium is not installed)")
     add_json_arg(p)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    check_profile_args(args, "printer")
     out = args.out or Path("out") / f"{Path(args.prototype).stem}-1-{args.scale:g}"
     err = Console(stderr=True, highlight=False)
     t0 = time.perf_counter()
@@ -50,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
                        step=args.step, progress=Progress(status),
                        options={"force": args.force, "command": getattr(args, "argv", None),
                                 "design_file": args.design,
-                                "time_limit_s": args.time_limit})
+                                "time_limit_s": args.time_limit, "pdf": args.pdf})
     seconds = time.perf_counter() - t0
     ver = ctx.record.get("verification") or {}
     code = EXIT_INCOMPLETE if ver.get("complete") is False else 0
@@ -100,5 +111,11 @@ def show_summary(ctx, out: Path, seconds: float) -> None:
         rows.append(["verification", ver["verdict"], ver["summary"]])
     c.print(table(f"printgen make: 1:{ctx.targets.scale:g} in {seconds:.1f} s",
                   ["item", "choice", "stiffness / result"], rows))
+    from printgen.report.summary import summary_lines
+
+    for line in summary_lines(ctx.record.get("summary") or {})[1:]:  # verdict: in the table
+        c.print(line)
+    if ctx.record.get("pdf_skipped"):
+        c.print(ctx.record["pdf_skipped"])
     c.print(f"{len(ctx.record['files'])} files in {out}/ ; open {out / 'report.html'}")
     sys.stdout.flush()

@@ -10,7 +10,14 @@ from printgen.commands.common import add_json_arg, console, emit_json, table
 from printgen.errors import ProfileError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
-from printgen.inputs.profiles import KINDS, list_profiles, profile_path, searched
+from printgen.inputs.profiles import (
+    KINDS,
+    list_profiles,
+    load_raw,
+    profile_name,
+    profile_path,
+    searched,
+)
 from printgen.report.jsonout import jsonable
 
 LOADERS: dict[str, Callable[[str], Any]] = {
@@ -25,7 +32,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     ls.add_argument("--kind", choices=KINDS, help="only this kind")
     add_json_arg(ls)
     ls.set_defaults(func=run_list)
-    show = verbs.add_parser("show", help="show one profile, validated, in SI units")
+    show = verbs.add_parser("show", help="show one profile, validated, in the units of its file")
     show.add_argument("name")
     show.add_argument("--kind", choices=KINDS, help="kind, when a name exists in several")
     add_json_arg(show)
@@ -61,6 +68,7 @@ def _summary(kind: str, name: str) -> str:
 
 
 def run_show(args: argparse.Namespace) -> int:
+    profile_name(args.name, "profiles show")
     kinds = [args.kind] if args.kind else [k for k in KINDS if args.name.lower() in list_profiles(k)]
     if not kinds:
         known = "; ".join(f"{k}: {', '.join(list_profiles(k))}" for k in KINDS)
@@ -68,14 +76,24 @@ def run_show(args: argparse.Namespace) -> int:
     if len(kinds) > 1:
         raise ProfileError(f"{args.name!r} exists as {' and '.join(kinds)}; add --kind")
     kind = kinds[0]
-    data = jsonable(LOADERS[kind](args.name))
+    data = jsonable(LOADERS[kind](args.name))  # validated (an invalid profile fails here)
     if args.json:
         emit_json({"kind": kind, "profile": data})
         return 0
-    rows = [[k, str(v)] for k, v in _flatten(data)]
-    console().print(table(f"{kind[:-1]} {args.name} ({profile_path(kind, args.name)})",
-                          ["key", "value (SI)"], rows))
+    raw, chain = load_raw(kind, args.name)  # as written, inherited keys merged in
+    rows = [[k, _text(v)] for k, v in _flatten(raw) if k != "inherits"]
+    via = f"; inherits {', '.join(p.stem for p in chain[1:])}" if len(chain) > 1 else ""
+    console().print(table(f"{kind[:-1]} {args.name} ({profile_path(kind, args.name)}{via})",
+                          ["key (its unit in the name)", "value (as in the file)"], rows))
     return 0
+
+
+def _text(v: object) -> str:
+    if isinstance(v, float):
+        return f"{v:g}"
+    if isinstance(v, list):
+        return "[" + ", ".join(_text(x) for x in v) + "]"
+    return str(v)
 
 
 def _flatten(d: dict, prefix: str = "") -> list[tuple[str, object]]:

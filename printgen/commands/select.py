@@ -7,6 +7,7 @@ import argparse
 from printgen.commands.common import (
     add_json_arg,
     add_prototype_args,
+    check_profile_args,
     console,
     emit_json,
     fmt,
@@ -17,6 +18,7 @@ from printgen.inputs.prototype import load_prototype
 from printgen.run import api
 
 SHOW = 8  # candidates shown per component in the table (all are in --json)
+STIFFNESS_WARN = 0.25  # |stiffness error| of the choice beyond which select warns
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -31,13 +33,30 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_profile_args(args, "printer", "materials")
     proto = load_prototype(args.prototype)
     s = api.select(proto, args.scale, printer=args.printer, materials=args.materials)
     if args.json:
         emit_json({"prototype": proto.name, "scale": args.scale, **s.to_record()})
         return 0
     show_selection(s, None if args.all else SHOW)
+    show_bed(proto, args.scale, s)
     return 0
+
+
+def show_bed(proto, scale: float, s: Selection) -> None:
+    """Whether the chosen net fits the printer's bed (and which printers or lambda fit)."""
+    from printgen.design.bedfit import bed_fit
+    from printgen.design.plan import make_design
+    from printgen.design.similitude import scale_targets
+    from printgen.errors import DesignError
+
+    try:
+        fit = bed_fit(make_design(proto, scale_targets(proto, scale), s))
+    except DesignError as exc:
+        console().print(f"[bold red]No design:[/] {exc}")
+        return
+    console().print(fit.message() if fit.ok else f"[bold red]{fit.message()}[/]")
 
 
 def show_selection(s: Selection, limit: int | None) -> None:
@@ -51,6 +70,11 @@ def show_selection(s: Selection, limit: int | None) -> None:
                 "error", "Pi3", "SF", "score", "printable"]
         out.print(table(f"{what}: target {cands[0].target:.4g} {unit} "
                         f"({len(cands)} candidates, best first)", cols, rows))
+        best = cands[0]
+        if best.feasible and abs(best.error) > STIFFNESS_WARN:
+            out.print(f"[bold red]Warning:[/] the best {what} candidate is {best.error:+.0%} off "
+                      "its stiffness target: the model will not deform like the prototype; "
+                      "printgen design searches mesh and strand too.")
         out.print(f"[bold]Choice:[/] {why}\n")
 
 

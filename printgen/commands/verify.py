@@ -38,7 +38,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from printgen.run.verify import band_summary, verify_design
+    from printgen.run.verify import band_summary, fitted_name, verify_design
 
     folder = args.design.resolve().parent
     out = args.out or folder.with_name(f"{folder.name}-verify")
@@ -52,15 +52,22 @@ def run(args: argparse.Namespace) -> int:
         emit_json(res.record)
         return 0
     c = console()
+    v = res.record["verification"]
+    c.print(f"[bold]{v['verdict']}[/bold]: {v['summary']}")
     rows = [[line.split(": ", 1)[0], line.split(": ", 1)[1]] for line in band_summary(res)]
     c.print(table(f"printgen verify: 1:{res.design.scale:g} in {time.perf_counter() - t0:.1f} s"
                   " (prototype vs the model's band)", ["quantity", "verdict"], rows))
     if res.fit is not None:
         c.print(res.record["measured"]["fit"]["sentence"])
-        if res.profile_text:
-            name = f"{res.design.net.material}-fitted.toml"
-            c.print(f"Feed it back: copy {out / name} into profiles/materials/ (or a folder in "
-                    "$PRINTGEN_PROFILES) and use it as the net's material.")
+        if res.profile_text and not res.fit.at_bound:
+            from printgen.inputs.profiles import user_folder_hint
+
+            name = fitted_name(res.design)
+            c.print(f"Feed it back: {out / name} is the fitted profile; "
+                    f"{user_folder_hint('materials', name)}, and use it as the net's material.")
+        elif res.fit.at_bound:
+            c.print("No profile to feed back: look for the cause in the test (sensor zero, "
+                    "mounting, slack) before changing the material.")
     c.print(f"{len(res.files)} files in {out}/ ; open {out / 'report.html'}")
     sys.stdout.flush()
     return 0

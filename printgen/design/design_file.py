@@ -14,6 +14,10 @@ from typing import Any
 
 from printgen.design.record import CableDesign, Design, NetDesign, Section
 from printgen.errors import InputError
+from printgen.inputs.profiles import profile_name
+from printgen.outputs.files import read_input_text
+
+DESIGN_LIMIT_BYTES = 16 << 20  # a design.json is ~2 kB, a report.json holding one < 1 MB
 
 
 def _fields(cls: type, data: Any, where: str) -> dict[str, Any]:
@@ -55,16 +59,21 @@ def design_from_dict(data: Any, where: str = "design") -> Design:
     for key in ("width_mm", "height_mm", "mesh_x_mm", "mesh_y_mm", "border_width_mm"):
         net[key] = _positive(net[key], f"{where}.net.{key}")
     net["strand"] = _section(net["strand"], f"{where}.net.strand")
+    for key in ("material", "print_style"):
+        net[key] = profile_name(net[key], f"{where}.net.{key}")
     if not isinstance(kw["cables"], list):
         raise InputError(f"{where}.cables must be a list of cables")
     cables = []
     for i, c in enumerate(kw["cables"]):
         ckw = _fields(CableDesign, c, f"{where}.cables[{i}]")
         ckw["section"] = _section(ckw["section"], f"{where}.cables[{i}].section")
+        for key in ("material", "print_style"):
+            ckw[key] = profile_name(ckw[key], f"{where}.cables[{i}].{key}")
+        ckw["name"] = profile_name(ckw["name"], f"{where}.cables[{i}].name", what="cable")
         for key in ("length_mm", "eyelet_inner_mm", "eyelet_outer_mm"):
             ckw[key] = _positive(ckw[key], f"{where}.cables[{i}].{key}")
         cables.append(CableDesign(**ckw))
-    return Design(scale=_positive(kw["scale"], f"{where}.scale"), printer=str(kw["printer"]),
+    return Design(scale=_positive(kw["scale"], f"{where}.scale"), printer=profile_name(kw["printer"], f"{where}.printer"),
                   net=NetDesign(**net), cables=tuple(cables))
 
 
@@ -72,11 +81,10 @@ def load_design(path: str | Path, *, scale: float | None = None) -> Design:
     """Read a design.json file (or the report.json holding one); with `scale`, it must be a
     design at that scale."""
     p = Path(path)
+    text = read_input_text(p, "design file", limit=DESIGN_LIMIT_BYTES)
     try:
-        data = json.loads(p.read_text("utf-8"))
-    except FileNotFoundError as exc:
-        raise InputError(f"design file {p} not found; write one with printgen design") from exc
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        data = json.loads(text)
+    except (json.JSONDecodeError, RecursionError) as exc:
         raise InputError(f"design file {p} cannot be read as JSON: {exc}") from exc
     if isinstance(data, dict) and "design" in data and "net" not in data:
         data = data["design"]  # a report.json holds the design under "design"

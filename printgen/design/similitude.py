@@ -93,11 +93,12 @@ def check_scale(scale: float) -> float:
 def prototype_quantities(p: Prototype) -> list[tuple[str, str, str, float, float]]:
     """(key, label, unit, exponent, prototype value) of every scaled quantity."""
     rho = p.density
+    mesh = "mesh side" if p.net.pattern == "square" else "mesh diagonal"  # what mesh_x_m is
     q = [
         ("width", "barrier width w_B", "m", -1, p.width),
         ("height", "barrier height h_B", "m", -1, p.height),
-        ("mesh_x", "mesh diagonal across a_x", "m", -1, p.net.mesh_x),
-        ("mesh_y", "mesh diagonal up a_y", "m", -1, p.net.mesh_y),
+        ("mesh_x", f"{mesh} across a_x", "m", -1, p.net.mesh_x),
+        ("mesh_y", f"{mesh} up a_y", "m", -1, p.net.mesh_y),
         ("strand_d", "net strand diameter d", "m", -1, p.net.strand_diameter),
         ("strand_area", "net strand section A", "m^2", -2, math.pi / 4 * p.net.strand_diameter**2),
         ("depth", "flow depth h", "m", -1, p.depth),

@@ -14,8 +14,10 @@ daemonic, so they never outlive this process. No home-made pool: everything para
 
 from __future__ import annotations
 
+import ipaddress
 import logging
 import os
+import re
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
@@ -26,6 +28,8 @@ from printgen.errors import InputError
 log = logging.getLogger(__name__)
 
 INSTALL_HINT = "pip install 'printgen[sweep]' (dask[distributed])"
+ADDRESS = re.compile(r"tcp://(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9](?:[A-Za-z0-9.-]*[A-Za-z0-9])?)"
+                     r":(?P<port>[0-9]{1,5})")
 CONNECT_TIMEOUT_S = 20  # a scheduler that does not answer within this is reported, not awaited
 
 
@@ -103,6 +107,8 @@ def open_runner(*, scheduler: str | None = None, workers: int | None = None,
         return
     if workers is not None and workers < 1:
         raise InputError(f"--workers {workers} must be >= 1")
+    if scheduler:
+        check_address(scheduler)  # before the (slow) import of distributed
     distributed = _distributed()
     with ExitStack() as stack:
         quiet = logging.getLogger("distributed")
@@ -126,6 +132,23 @@ def open_runner(*, scheduler: str | None = None, workers: int | None = None,
             where = f"local Dask cluster ({n} worker processes)"
         log.info("sweep on %s", where)
         yield Runner(client, where, progress)
+
+
+def check_address(address: str) -> str:
+    """`address` when it is tcp://HOST:PORT (a host name, an IPv4 address or [IPv6]), else
+    InputError: other schemes (file://, inproc://, tls://, ucx://) are not connected to."""
+    m = ADDRESS.fullmatch(address)
+    ok = m is not None and 1 <= int(m["port"]) <= 65535
+    if ok and m["host"].startswith("["):
+        try:
+            ipaddress.IPv6Address(m["host"][1:-1])
+        except ValueError:
+            ok = False
+    if not ok:
+        raise InputError(f"--scheduler {address[:100]!r} is not a Dask scheduler address: give "
+                         "tcp://HOST:PORT, e.g. tcp://10.0.0.5:8786 (the address `dask "
+                         "scheduler` prints), or leave out --scheduler for a local cluster")
+    return address
 
 
 def batches(items: Sequence[Any], workers: int, *, per_worker: int = 4,

@@ -7,12 +7,19 @@ the child winning. Lookup order (`search_dirs`): directories in $PRINTGEN_PROFIL
 of an installed printgen, the top-level `profiles/` of a source checkout, which is their source
 of truth; setup.py copies it into the wheel). Validation is done by the module that owns the
 data (materials.py, printers.py, ...); this module only finds, reads and merges.
+
+A profile name is a name, never a path: ASCII letters, digits, '-', '_' and '.', not starting
+with '.', at most 64 characters (`profile_name`). Every place a profile is named (a
+prototype's [model], `inherits`, design.json, --printer, --materials, `profiles show`,
+`calibrate --material`) goes through it, so no name can reach a file outside the profile
+folders, and no name can make a path when printgen writes `<name>.toml` or `<name>.png`.
 """
 
 from __future__ import annotations
 
 import importlib.resources
 import os
+import re
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -46,6 +53,23 @@ def user_dir() -> Path:
     return user_config_path("printgen", appauthor=False) / "profiles"
 
 
+NAME_MAX = 64  # characters in a profile name
+NAME = re.compile(rf"[A-Za-z0-9][A-Za-z0-9._-]{{0,{NAME_MAX - 1}}}")
+
+
+def profile_name(name: object, where: str = "profile name", *, what: str = "profile") -> str:
+    """`name` when it is a plain name (of a profile, or of a part: it becomes a file name),
+    else ProfileError naming it and the rule."""
+    if isinstance(name, str) and NAME.fullmatch(name):
+        return name
+    shown = repr(name) if isinstance(name, str) else f"{name!r} ({type(name).__name__})"
+    hint = ("a profile is named, never given as a path (put the file in profiles/<kind>/ or a "
+            "$PRINTGEN_PROFILES folder)" if what == "profile" else "it becomes a file name")
+    raise ProfileError(
+        f"{where}: {shown[:80]} is not a {what} name: use ASCII letters, digits, '-', '_' and "
+        f"'.', not starting with '.', at most {NAME_MAX} characters; {hint}")
+
+
 def search_dirs() -> list[Path]:
     """Profile roots, highest priority first."""
     extra = [Path(p) for p in os.environ.get("PRINTGEN_PROFILES", "").split(os.pathsep) if p]
@@ -58,11 +82,20 @@ def searched() -> str:
     return f"looked in {', '.join(map(str, search_dirs()))}{env}"
 
 
+def user_folder_hint(kind: str, file_name: str) -> str:
+    """Where a user puts a profile of their own: the first folder of $PRINTGEN_PROFILES, else
+    the per-user folder (never the installation's bundled profiles/)."""
+    extra = [p for p in os.environ.get("PRINTGEN_PROFILES", "").split(os.pathsep) if p]
+    if extra:
+        return f"copy it to {Path(extra[0]) / kind / file_name} ($PRINTGEN_PROFILES)"
+    return f"copy it to {user_dir() / kind / file_name} (your per-user profile folder)"
+
+
 def profile_path(kind: str, name: str) -> Path:
     """Path of profile `name` of `kind` (case-insensitive file stem), first match wins."""
     if kind not in KINDS:
         raise ProfileError(f"unknown profile kind {kind!r}; kinds: {', '.join(KINDS)}")
-    stem = name.lower()
+    stem = profile_name(name, f"{kind[:-1]} profile").lower()
     for root in search_dirs():
         p = root / kind / f"{stem}.toml"
         if p.is_file():
@@ -75,9 +108,10 @@ def profile_path(kind: str, name: str) -> Path:
 
 
 def list_profiles(kind: str) -> list[str]:
-    """Names (file stems) of every profile of `kind`, deduplicated, sorted."""
+    """Names (file stems) of every profile of `kind`, deduplicated, sorted; a file whose stem
+    is not a profile name (`profile_name`) is left out."""
     names = {p.stem for root in search_dirs() for p in (root / kind).glob("*.toml")}
-    return sorted(names)
+    return sorted(n for n in names if NAME.fullmatch(n))
 
 
 def load_raw(kind: str, name: str) -> tuple[dict[str, Any], list[Path]]:
@@ -95,8 +129,8 @@ def load_raw(kind: str, name: str) -> tuple[dict[str, Any], list[Path]]:
         chain.append(path)
         layer = load_toml(path)
         parent = layer.pop("inherits", None)
-        if parent is not None and not isinstance(parent, str):
-            raise ProfileError(f"{path}: inherits = {parent!r} must be a profile name string")
+        if parent is not None:
+            parent = profile_name(parent, f"{path}: inherits")
         data = merge(layer, data)
         current = parent
     return data, chain

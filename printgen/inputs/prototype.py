@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from printgen.errors import InputError
+from printgen.inputs.profiles import profile_name
 from printgen.inputs.schema import Field, load_toml, positive, read_table
 
 DEPTH_OVER_HEIGHT_MAX = 2.0  # flow depth / barrier height: beyond it the barrier is drowned
@@ -44,7 +45,10 @@ FLUME = [positive("width_m", 10.0), positive("max_discharge_l_per_s", 1e5),
          positive("froude_min", 10.0, si=False), positive("froude_max", 10.0, si=False),
          Field("lateral", str, choices=LATERAL, required=False, default=LATERAL[0],
                help="walls: side sheets hold the lateral edges; eyelets: only the cables' ends")]
-MODEL = [positive("mesh_x_mm", 1000.0, si=False), positive("mesh_y_mm", 1000.0, si=False),
+MODEL = [positive("mesh_x_mm", 1000.0, si=False, required=False,
+                  help="printed mesh across (default: the prototype's mesh_x_m scaled)"),
+         positive("mesh_y_mm", 1000.0, si=False, required=False,
+                  help="printed mesh up (default: the prototype's mesh_y_m scaled)"),
          Field("printer", str, required=False), Field("net_print", str, required=False),
          Field("cable_print", str, required=False),
          Field("materials", list, required=False, default=[])]
@@ -116,7 +120,7 @@ def load_prototype(path: str | Path) -> Prototype:
     """Read and validate a prototype TOML file."""
     p = Path(path)
     where = str(p)
-    top = read_table(load_toml(p), TOP, where=where)
+    top = read_table(load_toml(p, "prototype file"), TOP, where=where)
     bar = read_table(top["barrier"], BARRIER, where=f"{where} [barrier]")
     net = read_table(top["net"], NET, where=f"{where} [net]")
     flow = read_table(top["flow"], FLOW, where=f"{where} [flow]")
@@ -128,6 +132,10 @@ def load_prototype(path: str | Path) -> Prototype:
                                                        where=f"{where} [border]"))
     flume = top["flume"] and FlumeSpec(**read_table(top["flume"], FLUME, where=f"{where} [flume]"))
     model = read_table(top["model"], MODEL, where=f"{where} [model]") if top["model"] else {}
+    if (model.get("mesh_x_mm") is None) != (model.get("mesh_y_mm") is None):
+        raise InputError(f"{where} [model]: give both mesh_x_mm and mesh_y_mm, or neither (then "
+                         "the prototype's mesh is scaled)")
+    _check_profile_names(model, f"{where} [model]")
     depth = flow["depth"] if flow["depth"] is not None else bar["height"]
     if flume and flume.lateral == "eyelets" and not border:
         raise InputError(f"{where} [flume]: lateral = \"eyelets\" anchors the lateral border "
@@ -156,6 +164,15 @@ def load_prototype(path: str | Path) -> Prototype:
     )
 
 
+def _check_profile_names(model: dict, where: str) -> None:
+    """[model] printer, net_print, cable_print and materials name profiles: names, not paths."""
+    for key in ("printer", "net_print", "cable_print"):
+        if model.get(key) is not None:
+            profile_name(model[key], f"{where}: {key}")
+    for i, name in enumerate(model.get("materials") or ()):
+        profile_name(name, f"{where}: materials[{i}]")
+
+
 def _panel_law(raw: dict | None, where: str):
     if raw is None:
         return None
@@ -172,6 +189,7 @@ def _panel_law(raw: dict | None, where: str):
     return (tuple(k / 100 for k in knees), tuple(k * 1e3 for k in kappas), t["panel_length"])
 
 
+OPTIONAL_TABLES = ("[net.panel_law]", "[border]", "[flume]", "[model]")  # may be left out
 SCHEMA_TABLES = (("", TOP), ("[barrier]", BARRIER), ("[net]", NET),
                  ("[net.panel_law]", PANEL_LAW), ("[border]", BORDER), ("[flow]", FLOW),
                  ("[flume]", FLUME), ("[model]", MODEL))
@@ -181,6 +199,7 @@ CROSS_CHECKS = (
     "[net.panel_law]: increasing knees, one kappa per segment (knees + 1), all > 0 and < 1e9",
     "[net]: strand_modulus_gpa or a [net.panel_law] is required",
     "[flume] lateral = \"eyelets\" needs a [border] table (the eyelets are the cables' ends)",
+    "[model] mesh_x_mm and mesh_y_mm: both or neither (neither: the prototype's mesh scaled)",
 )
 
 
@@ -192,8 +211,10 @@ def ranges_markdown() -> str:
         for f in fields:
             if f.kind is dict:
                 continue
+            need = ("no" if not f.required else
+                    "when the table is given" if table in OPTIONAL_TABLES else "yes")
             rows.append(f"| {table or '(top)'} | `{f.key}` | {f.kind.__name__} | {_range(f)} | "
-                        f"{'yes' if f.required else 'no'} |")
+                        f"{need} |")
     rows += ["", "Checks across keys:", ""] + [f"- {c}" for c in CROSS_CHECKS]
     return "\n".join(rows) + "\n"
 

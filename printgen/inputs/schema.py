@@ -15,7 +15,10 @@ from pathlib import Path
 from typing import Any
 
 from printgen.errors import InputError
+from printgen.outputs.files import read_input_text
 from printgen.units import split_unit_key
+
+TOML_LIMIT_BYTES = 1 << 20  # a prototype or profile is a few kB; 1 MiB is surely not one
 
 
 @dataclass(frozen=True)
@@ -52,21 +55,19 @@ def positive(key: str, hi: float | None = None, **kw: Any) -> Field:
     return Field(key, float, lo=0.0, hi=hi, lo_open=True, **kw)
 
 
-def load_toml(path: str | Path) -> dict[str, Any]:
-    """Read a TOML file; missing files and syntax errors become `InputError`."""
+def load_toml(path: str | Path, what: str = "TOML file") -> dict[str, Any]:
+    """Read a TOML file; missing, non-regular or oversized files and syntax errors become
+    `InputError` (outputs.read_input: a FIFO or /dev/zero is refused, not read)."""
     p = Path(path)
     if p.is_dir():
         some = sorted(p.glob("*.toml"))[:3]
         hint = f" such as {', '.join(str(x) for x in some)}" if some else ""
         raise InputError(f"{p} is a folder, not a TOML file; give the file itself{hint}")
-    if not p.is_file():
-        raise InputError(f"file not found: {p}; check the path (relative to {Path.cwd()})")
+    text = read_input_text(p, what, limit=TOML_LIMIT_BYTES)
     try:
-        return tomllib.loads(p.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
         raise InputError(f"{p}: not valid TOML: {exc}; fix the file's syntax") from exc
-    except OSError as exc:
-        raise InputError(f"cannot read {p}: {exc.strerror}; check its permissions") from exc
 
 
 def read_table(data: Any, fields: Sequence[Field], *, where: str) -> dict[str, Any]:

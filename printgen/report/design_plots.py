@@ -17,15 +17,15 @@ def pareto_figure(res: SearchResult) -> bytes:
     sc = res.screened
     if res.objective == "deformation":
         idx = sorted(res.verified)
-        label, sel_y = ("deformation mismatch (RMS, solver)",
+        label, sel_y = ("deformation mismatch, RMS of the solver (-)",
                         None if res.select_score is None else res.select_score.mismatch)
     else:
         idx = [s.point.index for s in sc if s.feasible]
-        label, sel_y = "membrane-law error (RMS log, 1-40 %)", res.select_screened.error_rms_log
+        label, sel_y = "membrane-law error, RMS log over 1-40 % strain (-)", res.select_screened.error_rms_log
     idx = idx[::max(1, len(idx) // MAX_CLOUD)]
     y = np.array([res.objective_value(i) for i in idx])
-    cols = [("|dPi2| (mesh / h_B)", lambda s: abs(s.d_pi2)),
-            ("|dPi3| (strand d / h_B)", lambda s: abs(s.d_pi3)),
+    cols = [("|dPi2| = |mesh / h_B deviation| (-)", lambda s: abs(s.d_pi2)),
+            ("|dPi3| = |strand d / h_B deviation| (-)", lambda s: abs(s.d_pi3)),
             ("net print time (min)", lambda s: s.print_time_s / 60)]
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.2), constrained_layout=True, sharey=True)
     for ax, (xlabel, f) in zip(axes, cols, strict=True):
@@ -42,8 +42,8 @@ def pareto_figure(res: SearchResult) -> bytes:
             ax.scatter([f(res.select_screened)], [sel_y], s=50, marker="s", c="k",
                        label="select's pick")
         ax.set_xlabel(xlabel)
+        ax.set_ylabel(label)
         ax.grid(alpha=0.3)
-    axes[0].set_ylabel(label)
     axes[0].legend(fontsize=8)
     fig.suptitle(f"{res.prototype}: design search at 1:{res.scale:g} "
                  f"({len(sc)} candidates, objective: {res.objective})")

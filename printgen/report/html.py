@@ -20,15 +20,31 @@ th { background: #eef5f0; } td.t { text-align: left; } td:first-child, th:first-
 .note { color: #555; font-size: .9em; }
 figure { margin: 1em 0; } figcaption { color: #555; font-size: .9em; }
 img { max-width: 100%; }
+.summary { border: 2px solid #2a6; border-radius: .4em; padding: .2em 1em; background: #f6fbf7; }
+.summary h2 { margin-top: .4em; } .verdict { font-size: 1.15em; }
 """
+
+
+@dataclass(frozen=True)
+class FigureFile:
+    """A figure of the report as its own files: `name` (no suffix), PNG and SVG bytes."""
+
+    name: str
+    caption: str
+    png: bytes
+    svg: bytes
+    labels: tuple[tuple[str, tuple[str, ...]], ...] = ()  # (axis title, its axis labels)
 
 
 @dataclass
 class Report:
-    """Blocks of HTML in order; `add_*` append, `html()` renders."""
+    """Blocks of HTML in order; `add_*` append, `html()` renders. `lead` (the summary box)
+    comes first, right under the title; `figures` are the figures added, for their files."""
 
     title: str
     blocks: list[str] = field(default_factory=list)
+    lead: str = ""
+    figures: list[FigureFile] = field(default_factory=list)
 
     def heading(self, text: str) -> None:
         self.blocks.append(f"<h2>{html.escape(text)}</h2>")
@@ -46,7 +62,14 @@ class Report:
         body = "".join("<tr>" + "".join(_cell(v) for v in r) + "</tr>" for r in rows)
         self.blocks.append(f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
 
-    def figure(self, png: bytes, caption: str) -> None:
+    def figure(self, png: bytes, caption: str, name: str = "") -> None:
+        """Embed `png`; when it carries its SVG (printgen.report.plots), keep both as the
+        figure `name` (default: from the caption) for the files beside the report."""
+        svg = getattr(png, "svg", None)
+        if svg is not None:
+            labels = tuple((t, tuple(names)) for t, names in getattr(png, "labels", ()))
+            self.figures.append(FigureFile(name or slug(caption), caption, bytes(png), svg,
+                                           labels))
         data = base64.b64encode(png).decode("ascii")
         self.blocks.append(f'<figure><img alt="{html.escape(caption)}" '
                            f'src="data:image/png;base64,{data}"><figcaption>'
@@ -56,7 +79,7 @@ class Report:
         body = "\n".join(self.blocks)
         return (f"<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
                 f"<title>{html.escape(self.title)}</title><style>{CSS}</style></head>\n"
-                f"<body><h1>{html.escape(self.title)}</h1>\n{body}\n</body></html>\n")
+                f"<body><h1>{html.escape(self.title)}</h1>\n{self.lead}\n{body}\n</body></html>\n")
 
 
 def _cell(v: object) -> str:
@@ -69,3 +92,9 @@ def _cell(v: object) -> str:
     except ValueError:
         cls = ' class="t"'
     return f"<td{cls}>{html.escape(text)}</td>"
+
+
+def slug(text: str, words: int = 5) -> str:
+    """A file name from the first `words` words of `text`: lower case, a-z0-9 and '-'."""
+    kept = "".join(ch if ch.isalnum() else " " for ch in text.lower()).split()[:words]
+    return "-".join(kept) or "figure"

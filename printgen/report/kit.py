@@ -85,7 +85,8 @@ def _polygon(ax, poly, face: str, edge: str) -> None:
         xy = np.asarray(ring.coords)
         verts.append(xy)
         codes += [Path.MOVETO] + [Path.LINETO] * (len(xy) - 2) + [Path.CLOSEPOLY]
-    ax.add_patch(PathPatch(Path(np.vstack(verts), codes), fc=face, ec=edge, lw=0.3, zorder=1))
+    ax.add_patch(PathPatch(Path(np.vstack(verts), codes), fc=face, ec=edge, lw=0.3, zorder=1,
+                           rasterized=True))  # thousands of holes: a raster in the SVG
 
 
 def toolpath_preview(tp: Toolpath, title: str, *, window_mm: tuple[float, float] | None = None
@@ -113,7 +114,8 @@ def toolpath_preview(tp: Toolpath, title: str, *, window_mm: tuple[float, float]
     for k, ax in enumerate(axes[0]):
         on = tp.layer[ext] == k
         ax.add_collection(PolyCollection(quads[on], facecolors=colours[on],
-                                         edgecolors=colours[on], linewidths=0.3))
+                                         edgecolors=colours[on], linewidths=0.3,
+                                         rasterized=True))  # every bead: a raster in the SVG
         if window_mm is None:
             hi = quads.reshape(-1, 2).max(axis=0)
             ax.set_xlim(lo[0] - 1, hi[0] + 1)
@@ -125,7 +127,7 @@ def toolpath_preview(tp: Toolpath, title: str, *, window_mm: tuple[float, float]
         ax.set_title(f"pass {k + 1}: z = {tp.layer_z_mm[k]:.2f} mm, "
                      f"{len(np.unique(path_id[on]))} paths", fontsize=9)
         ax.set_xlabel("bed x (mm)")
-    axes[0][0].set_ylabel("bed y (mm)")
+        ax.set_ylabel("bed y (mm)")
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     return _png(fig)

@@ -42,19 +42,36 @@ def design_sections(rep: Report, proto: Prototype, t: ScaledTargets, sel: Select
             continue
         rep.heading(f"Selection: {what.lower()}")
         rep.paragraph(why)
-        rep.table(["#", "material", "E source", "section (mm)", "passes", "stiffness",
-                   "target", "error", "Pi3", "safety factor"],
+        unit = "E*A, N" if what == "Border cables" else "initial membrane, N/m"
+        rep.table(["#", "material", "E source", "section (mm)", "passes", f"stiffness ({unit})",
+                   f"target ({unit})", "stiffness error", "Pi3 deviation", "safety factor (-)"],
                   [_row(i + 1, c) for i, c in enumerate(cands[:SHOW])])
+        same = _same_stiffness(cands[:SHOW])
+        if same:
+            rep.paragraph(f"Equivalent rows (#{same.replace('; ', ' and #')}): the same material "
+                          "and bead area laid out differently (beads across x layers), so the "
+                          "same stiffness; the ranking between them is the shape's.", "note")
     rep.heading("Printed parts")
     n = design.net
     rows = [["net", n.material.upper(), f"{n.width_mm:g} x {n.height_mm:g}",
-             (f"mesh {n.mesh_x_mm:g} x {n.mesh_y_mm:g}, strand {n.strand.width_mm:g} x "
+             (f"diamond mesh {n.mesh_x_mm:g} x {n.mesh_y_mm:g}, strand {n.strand.width_mm:g} x "
              f"{n.strand.thickness_mm:g} mm, {n.strand.passes} passes")]]
     rows += [[f"cable {c.name}", c.material.upper(), f"{c.length_mm:g} long",
               (f"{c.section.width_mm:g} x {c.section.thickness_mm:g} mm, {c.section.passes} "
               f"passes, eyelets {c.eyelet_inner_mm:g}/{c.eyelet_outer_mm:g} mm")]
              for c in design.cables]
     rep.table(["part", "material", "size (mm)", "section"], rows)
+
+
+def _same_stiffness(cands: tuple[Candidate, ...] | list[Candidate]) -> str:
+    """'1-3, 4-5': runs of ranked rows with the same material and section area."""
+    groups, out = {}, []
+    for i, c in enumerate(cands, 1):
+        groups.setdefault((c.material, round(c.section.area_mm2, 9)), []).append(i)
+    for rows in groups.values():
+        if len(rows) > 1:
+            out.append(", ".join(map(str, rows)))
+    return "; ".join(out)
 
 
 def _row(rank: int, c: Candidate) -> list[str]:
@@ -112,8 +129,9 @@ def _sweep_sections(rep: Report, v: Verification, scale: float, band: Band | Non
     idx = [int(np.argmin(np.abs(p.levels - x))) for x in (0.5, 1.0, 1.1)]
     rows = []
     for mm in v.mismatches:
-        rows.append([METRICS[mm.metric]]
-                    + [f"{p.values[mm.metric][i]:.4f} / {m.values[mm.metric][i]:.4f}" for i in idx]
+        rows.append([f"{METRICS[mm.metric]} ({unit_of(mm.metric)})"]
+                    + [f"{fmt_value(mm.metric, p.values[mm.metric][i])} / "
+                       f"{fmt_value(mm.metric, m.values[mm.metric][i])}" for i in idx]
                     + [f"{mm.max_rel:.0%}", f"{mm.rms_rel:.0%}", f"{mm.ratio_high:.2f}",
                        "ok" if mm.ok else "FAIL"])
     rep.table(["quantity (prototype / model)", "h/h_B = 0.5", "1.0", "1.1", "max mismatch",
@@ -135,11 +153,22 @@ def _sweep_sections(rep: Report, v: Verification, scale: float, band: Band | Non
     rep.figure(verification_figure(p, m, scale, "Normalised deformation against relative "
                                    "loading", band=band),
                "Prototype (black) and printed model (orange"
-               + ("; shaded: the model's uncertainty band)." if band is not None else ")."))
+               + ("; shaded: the model's uncertainty band)." if band is not None else ")."),
+               "verification")
     _deformed_section(rep, v)
     rep.paragraph(f"Solver: {sum(v.prototype.iterations)} + {sum(v.model.iterations)} Newton "
                   f"iterations over {len(p.levels)} load levels (times in timings.json).",
                   "note")
+
+
+def unit_of(metric: str) -> str:
+    """The unit a METRICS quantity is shown in: strains in %, the rest normalised (-)."""
+    return "%" if metric.startswith("strain") else "-"
+
+
+def fmt_value(metric: str, x: float) -> str:
+    """A METRICS value as shown: strains in % (2 decimals), the rest to 4 decimals."""
+    return f"{x * 100:.2f}" if metric.startswith("strain") else f"{x:.4f}"
 
 
 def _deformed_section(rep: Report, v: Verification) -> None:
@@ -152,7 +181,7 @@ def _deformed_section(rep: Report, v: Verification) -> None:
         rep.figure(deformed_figure(shapes, SHOWN_LEVEL), "Both nets deformed at h/h_B = "
                    f"{SHOWN_LEVEL:g}, normalised by their own width (x, deflection) and height "
                    "(z); black: border cables. Model node positions at 0.5, 1.0 and 1.1 are in "
-                   "report.json (verification.deformed_shape).")
+                   "report.json (verification.deformed_shape).", "deformed-nets")
     for who, run in (("prototype", v.prototype), ("model", v.model)):
         if run.scene.hold > 0:
             rep.paragraph(f"{who}: unloaded strands stay where they are (held by "

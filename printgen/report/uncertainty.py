@@ -1,5 +1,5 @@
 """Report sections and JSON records of the model's uncertainty band and of a lab's measured
-loading test (issue 10): what varied, the band at h/h_B = 0.5, 1.0, 1.1, the band verdicts,
+loading test: what varied, the band at h/h_B = 0.5, 1.0, 1.1, the band verdicts,
 and the measured points against the band with the fitted factor of the printed net."""
 
 from __future__ import annotations
@@ -10,10 +10,11 @@ from typing import Any
 import numpy as np
 
 from printgen.check.bands import Band, BandVerdict, band_verdicts
-from printgen.check.compare import METRICS
+from printgen.check.compare import METRICS, Deformation
 from printgen.check.measured import Fit, Measurement, mismatch
 from printgen.check.verify import Verification
 from printgen.report.html import Report
+from printgen.report.report import fmt_value, unit_of
 
 SHOW_LEVELS = (0.5, 1.0, 1.1)  # relative loadings shown in the tables and summaries
 
@@ -48,11 +49,20 @@ def band_sections(rep: Report, v: Verification, band: Band) -> None:
     idx = [_at(band.levels, x) for x in SHOW_LEVELS]
     rows = []
     for key in METRICS:
-        cells = [("-" if i is None else f"{p[key][i]:.4f} / {lo[key][i]:.4f}-{hi[key][i]:.4f}")
+        cells = [("-" if i is None else f"{fmt_value(key, p[key][i])} (band "
+                  f"{fmt_value(key, lo[key][i])} to {fmt_value(key, hi[key][i])})")
                  for i in idx]
-        rows.append([METRICS[key], *cells, verdicts[key].text, start[key].text])
-    rep.table(["quantity (prototype / model band)", *(f"h/h_B = {x:g}" for x in SHOW_LEVELS),
-               "verdict", "counted from h/h_B = 0"], rows)
+        rows.append([f"{METRICS[key]} ({unit_of(key)})", *cells, verdicts[key].text,
+                     start[key].text])
+    rep.table(["quantity: prototype (model band min to max)",
+               *(f"h/h_B = {x:g}" for x in SHOW_LEVELS), "verdict", "counted from h/h_B = 0"],
+              rows)
+    negative = [METRICS[k].split(" (")[0] for k in METRICS
+                if k.startswith("strain") and np.nanmin(lo[k]) < 0]
+    if negative:
+        rep.paragraph(f"Band below zero ({', '.join(negative)}): in some variant the sensor "
+                      "wire is shorter there than at rest; a sensor zeroed at h/h_B = 0 reads "
+                      "that as a negative elongation (a computed reading, not an error).", "note")
 
 
 def band_record(v: Verification, band: Band) -> dict[str, Any]:
@@ -91,7 +101,7 @@ def predicted_at(m: Measurement, band: Band) -> tuple[dict, dict, dict]:
 
 
 def measured_sections(rep: Report, m: Measurement, band: Band, fit: Fit | None,
-                      profile: str) -> None:
+                      profile: str, *, prototype: Deformation | None = None) -> None:
     """Measured points against the band, their mismatch, the fitted factor and its profile."""
     from printgen.report.plots import measured_figure
 
@@ -110,11 +120,18 @@ def measured_sections(rep: Report, m: Measurement, band: Band, fit: Fit | None,
     rep.table(cols, rows)
     if fit:
         rep.paragraph(_fit_sentence(fit))
-    rep.figure(measured_figure(m, band, fit), "Measured points (black) on the predicted band "
-               "(orange: nominal line, shaded: band), counted from h/h_B = 0; dashed: fitted.")
-    if profile:
-        rep.paragraph("To feed it back, save this as profiles/materials/<name>.toml (or a folder "
-                      "in $PRINTGEN_PROFILES) and name it as the net's material:")
+        if fit.kind == "multi":
+            from printgen.report.fitreport import multi_fit_sections
+
+            multi_fit_sections(rep, fit)
+    rep.figure(measured_figure(m, band, fit, prototype), "Measured points (black dots; open "
+               "triangles: 'below' bounds) on the predicted band (orange: model nominal, shaded: "
+               "band; thin lines: each variant), with the prototype (black line), all counted "
+               "from h/h_B = 0; dashed: fitted.", "measured")
+    if profile and not (fit and fit.at_bound):
+        rep.paragraph("To feed it back, save this in a profile folder of your own as "
+                      "materials/<name>.toml, add the folder to $PRINTGEN_PROFILES, and name "
+                      "it as the net's material:")
         rep.blocks.append(f"<pre>{html.escape(profile)}</pre>")
 
 
@@ -124,6 +141,8 @@ def _fmt(mm) -> str:
 
 
 def _fit_sentence(fit: Fit) -> str:
+    if fit.kind == "multi":
+        return fit.sentence()
     what = (f"net stiffness {fit.value:.3f} x its profile" if fit.kind == "stiffness"
             else f"initial slack {fit.value:.2%} of the net")
     edge = (" The best value is at the end of the searched range: the measurement is outside "
@@ -140,7 +159,9 @@ def measured_record(m: Measurement, band: Band, fit: Fit | None, profile: str
                            "columns": m.columns, "predicted_nominal": nom,
                            "band_min": lo, "band_max": hi,
                            "mismatch": mismatch(m, nom, lo, hi), "fit": None}
-    if fit:
+    if fit and fit.kind == "multi":
+        rec["fit"] = {**fit.to_record(), "profile": profile}
+    elif fit:
         rec["fit"] = {"kind": fit.kind, "value": fit.value, "at_bound": fit.at_bound,
                       "evaluations": fit.evaluations, "mismatch_nominal": fit.before,
                       "mismatch_fitted": fit.after, "predicted": fit.predicted,

@@ -35,8 +35,9 @@ from printgen.design.search_record import candidates_json, result_record
 from printgen.design.search_space import SearchSpace, default_space
 from printgen.design.similitude import scale_targets
 from printgen.design.sweep import open_runner
+from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
-from printgen.outputs import staged_dir
+from printgen.outputs import check_destination, staged_dir
 from printgen.report.jsonout import dumps
 
 
@@ -142,7 +143,19 @@ def series_row(r: SearchResult) -> dict:
             "print_time_s": s.print_time_s, "binding_constraints": list(r.binding)}
 
 
-def write_outputs(run: DesignRun, out: str | Path, main_scale: float | None) -> list[str]:
+def design_inputs(prototype: str | Path | Prototype) -> list:
+    """The files and folders a design run reads (none may lie inside its --out)."""
+    path = prototype.path if isinstance(prototype, Prototype) else prototype
+    return [path, *search_dirs()]
+
+
+def check_out(out: str | Path, prototype: str | Path | Prototype) -> None:
+    """OutputError now, before the search, when `out` cannot take the run's folder."""
+    check_destination(Path(out), force=False, inputs=design_inputs(prototype))
+
+
+def write_outputs(run: DesignRun, out: str | Path, main_scale: float | None,
+                  prototype: str | Path | Prototype | None = None) -> list[str]:
     """Write the folder (whole, atomically); returns the file names."""
     from printgen.report.design_plots import pareto_figure
 
@@ -155,7 +168,8 @@ def write_outputs(run: DesignRun, out: str | Path, main_scale: float | None) -> 
             if main_scale is not None and r.scale == main_scale:
                 files["design.json"] = text
         files[f"pareto-1-{r.scale:g}.png"] = pareto_figure(r)
-    with staged_dir(out) as stage:
+    inputs = design_inputs(prototype) if prototype is not None else []
+    with staged_dir(out, inputs=inputs) as stage:
         for name, data in files.items():
             path = stage / name
             if isinstance(data, bytes):

@@ -26,8 +26,10 @@ from printgen.design.record import Design
 from printgen.design.selection import Selection, select
 from printgen.design.similitude import ScaledTargets, scale_targets
 from printgen.errors import TimeLimitError
+from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import MANIFEST, check_destination, staged_dir
+from printgen.report.extras import report_files
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
 from printgen.report.report import design_record, design_sections
@@ -111,7 +113,9 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     version, command line) and timings.json (the only file that differs between runs).
     """
     t0 = time.perf_counter()
-    check_destination(Path(out), force=bool((options or {}).get("force")))  # fail fast
+    inputs = [prototype_path, (options or {}).get("design_file"), *search_dirs()]
+    check_destination(Path(out), force=bool((options or {}).get("force")),
+                      inputs=inputs)  # fail fast
     ctx = plan(prototype_path, scale, printer=printer, options=options)
     est = size_check(ctx, steps is None or any(s is verify_step for _, s in steps))
     if progress and est.seconds > LONG_RUN_S:
@@ -123,7 +127,7 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     bound = run_bound(ctx.options)
     with deadline(None if bound is None else time.time() + bound - (time.perf_counter() - t0)), \
             staged_dir(out, force=bool(ctx.options.get("force")), meta=meta,
-                       volatile=(TIMINGS,)) as stage, level_bars(long_run), \
+                       volatile=(TIMINGS,), inputs=inputs) as stage, level_bars(long_run), \
             verification_ahead(ctx, steps, long_run is None):
         for label, step in steps:
             if progress:
@@ -137,16 +141,37 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
             ctx.record.setdefault("timings_s", {})[label] = time.perf_counter() - t
         meta.update(provenance(ctx))
         provenance_section(ctx.report, meta)
+        for name, data in report_files(ctx.record, ctx.report).items():
+            (stage / name).parent.mkdir(exist_ok=True)
+            (stage / name).write_bytes(data)
+            ctx.files.append(name)
+        (stage / "report.html").write_text(ctx.report.html())
+        if ctx.options.get("pdf"):
+            report_pdf(ctx, stage, progress)
         ctx.record["files"] = sorted([*ctx.files, "report.html", "report.json", "design.json",
                                       MANIFEST, TIMINGS])
         ctx.record.setdefault("timings_s", {})["total"] = time.perf_counter() - t0
         stable, timings = split_timings(ctx.record)
         (stage / "design.json").write_text(dumps(ctx.design.to_dict()))
         (stage / "report.json").write_text(dumps(stable))
-        (stage / "report.html").write_text(ctx.report.html())
         (stage / TIMINGS).write_text(dumps(timings))
     log.info("make finished in %.2f s", time.perf_counter() - t0)
     return ctx
+
+
+def report_pdf(ctx: MakeContext, stage: Path, progress: Callable[[str], None] | None) -> None:
+    """report.pdf from the written report.html (headless Chromium); without Chromium the
+    one-line reason goes to ctx.record["pdf_skipped"] and the run goes on."""
+    from printgen.report.pdf import print_pdf
+
+    if progress:
+        progress("report.pdf (headless Chromium)")
+    skipped = print_pdf(stage / "report.html", stage / "report.pdf")
+    if skipped:
+        log.warning("%s", skipped)
+        ctx.record["pdf_skipped"] = skipped
+    else:
+        ctx.files.append("report.pdf")
 
 
 @contextlib.contextmanager

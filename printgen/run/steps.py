@@ -32,6 +32,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from printgen.inputs.printers import Printer
     from printgen.inputs.prototype import Prototype
     from printgen.parts.gcode.toolpath import Toolpath
+    from printgen.report.html import FigureFile
     from printgen.run.make import MakeContext
 
 
@@ -62,8 +63,10 @@ def part_toolpath(ctx: MakeContext, name: str, part: Any, printer: Printer) -> T
 
 def gcode_step(ctx: MakeContext, stage: Path) -> None:
     """Direct G-code for the net and each cable, checked by read-back against the design."""
+    from printgen.parts.gcode.estimate import print_estimate
     from printgen.parts.gcode.readback import read_gcode_text
     from printgen.parts.gcode.writer import gcode_text
+    from printgen.report.summary import print_rows
 
     d = ctx.design
     printer = load_printer(d.printer)
@@ -86,7 +89,8 @@ def gcode_step(ctx: MakeContext, stage: Path) -> None:
         rec[name] = {"file": path.name, "layers": len(back.layer_z_mm),
                      "volume_mm3": tp.volume_mm3, "readback_volume_mm3": back.volume_mm3,
                      "readback_error": err, "readback_vs_stl": vs_stl,
-                     "retractions": retractions, "seconds": seconds}
+                     "retractions": retractions, "seconds": seconds,
+                     "print": print_estimate(tp, printer, mat).to_record()}
         rows.append([name, path.name, str(len(back.layer_z_mm)), f"{tp.volume_mm3:.1f}",
                      f"{err:+.2%}", "-" if vs_stl is None else f"{vs_stl:+.2%}",
                      str(retractions)])  # times go to timings.json: the report is reproducible
@@ -95,8 +99,9 @@ def gcode_step(ctx: MakeContext, stage: Path) -> None:
     ctx.report.paragraph("Every net strand is one straight extrusion through the crossings, the "
                          "strand families alternate per pass; the G-code is read back and its "
                          "extruded volume compared with the toolpath's.")
-    ctx.report.table(["part", "file", "layers", "volume mm^3", "read-back error",
+    ctx.report.table(["part", "file", "layers", "volume (mm^3)", "read-back error",
                       "read back vs STL", "retractions"], rows)
+    ctx.report.table(*print_rows(rec))
 
 
 def kit_step(ctx: MakeContext, stage: Path) -> None:
@@ -129,7 +134,7 @@ def kit_step(ctx: MakeContext, stage: Path) -> None:
         ctx.files.append(name)
         if name == "preview-net.png":
             ctx.report.heading("Toolpath previews")
-        ctx.report.figure(png, caption)
+        ctx.report.figure(png, caption, name.removesuffix(".png"))
         if name == "assembly.png":
             ctx.report.paragraph("Check after printing:")
             for k, line in enumerate(a.checklist(), 1):
@@ -268,13 +273,14 @@ def verify_step(ctx: MakeContext, stage: Path) -> None:
     sweeps_done(ctx)
     pending = ctx.background.pop("verification report", None)
     if pending is not None:
-        (blocks, record), seconds = _collect(pending)
+        (blocks, figures, record), seconds = _collect(pending)
         ctx.record.setdefault("timings_s", {})[HELPER_REPORT] = seconds
     else:
         v, band = verification_sweeps(ctx.prototype, ctx.design,
                                       drag=bool(ctx.options.get("drag")))
-        blocks, record = verification_report(v, band, ctx.targets.scale)
+        blocks, figures, record = verification_report(v, band, ctx.targets.scale)
     ctx.report.blocks.extend(blocks)
+    ctx.report.figures.extend(figures)
     ctx.record["verification"] = record
 
 
@@ -314,20 +320,23 @@ def verification_sweeps(prototype: Prototype, design: Design, *, drag: bool = Fa
     """Both barriers' load sweeps compared, and the model's uncertainty band.
 
     The sweep is the scene realistic-1:40 with border cables, simple-free-top without them
-    (barrier-physics.md, section 7); every load level is solved on both. Needs nothing from
+    (README: Pre-print verification); every load level is solved on both. Needs nothing from
     the other steps, so it can run in a worker process while they run.
     """
-    from printgen.check.bands import model_band, model_load_kw
+    from printgen.check.bands import free_section, model_band, model_load_kw
     from printgen.check.verify import verify
 
     v = verify(prototype, design, drag=drag, counterexample=True)
-    return v, model_band(design, v.model, load_kw=model_load_kw(prototype, design, drag))
+    return v, model_band(design, v.model, load_kw=model_load_kw(prototype, design, drag),
+                         free_section=free_section(prototype))
 
 
 def verification_report(v: Verification, band: Band, scale: float
-                        ) -> tuple[list[str], dict[str, Any]]:
-    """The verification's report blocks (figures included) and its record."""
+                        ) -> tuple[list[str], list[FigureFile], dict[str, Any]]:
+    """The verification's report blocks (figures included), its figures' files and its
+    record (with the lab's curves and expected readings, printgen.report.labfiles)."""
     from printgen.report.html import Report
+    from printgen.report.labfiles import lab_record
     from printgen.report.report import verification_sections
     from printgen.report.uncertainty import band_record, band_sections
 
@@ -336,4 +345,5 @@ def verification_report(v: Verification, band: Band, scale: float
     band_sections(rep, v, band)
     record = v.to_record()
     record["bands"] = band_record(v, band)
-    return rep.blocks, record
+    record["lab"] = lab_record(v, band, scale)
+    return rep.blocks, rep.figures, record

@@ -1,8 +1,9 @@
 """`printgen verify`: the pre-print check of an existing design (the design.json `make`
 wrote), with its uncertainty band, and optionally a lab's measured loading test compared with
 it and one factor of the printed net fitted to it. Output folder (written whole,
-`outputs.staged_dir`): report.html, report.json, timings.json, and with a stiffness fit
-`<material>-fitted.toml`, the profile that feeds the fit back.
+`outputs.staged_dir`): report.html, report.json, timings.json, the lab's CSV files
+(printgen.report.labfiles), and with a stiffness fit `<material>-fitted.toml`, the profile
+that feeds the fit back.
 """
 
 from __future__ import annotations
@@ -13,7 +14,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from printgen.check.bands import Band, band_verdicts, model_band, model_load_kw
+from printgen.check.bands import (
+    Band,
+    band_verdicts,
+    free_section,
+    model_band,
+    model_load_kw,
+)
+from printgen.check.fit import MultiFit, fit_levels, fit_measured
 from printgen.check.measured import (
     Fit,
     Measurement,
@@ -22,15 +30,19 @@ from printgen.check.measured import (
     model_predictor,
     read_measured,
 )
+from printgen.check.readings import design_units
 from printgen.check.verify import Verification, verify
 from printgen.design.design_file import load_design
 from printgen.design.record import Design
 from printgen.inputs.materials import load_material
+from printgen.inputs.profiles import profile_name, search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
-from printgen.outputs import staged_dir
+from printgen.outputs import check_destination, staged_dir
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
+from printgen.report.labfiles import lab_files, lab_record
 from printgen.report.report import verification_sections
+from printgen.report.summary import summary_html, summary_record
 from printgen.report.uncertainty import (
     band_record,
     band_sections,
@@ -66,30 +78,54 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     """
     say = progress or (lambda _label: None)
     t0 = time.perf_counter()
+    inputs = [prototype, design_path, measured, *search_dirs()]
+    check_destination(Path(out), force=force, inputs=inputs)  # before any work
     p = load_prototype(prototype)
     d = load_design(design_path, scale=scale)
-    m = read_measured(measured) if measured is not None else None
+    m = read_measured(measured, design_units(d)) if measured is not None else None
     load_kw = model_load_kw(p, d, drag)
     say("verification (prototype and model load sweeps)")
     v = verify(p, d, drag=drag)
     say("uncertainty band (model variants)")
-    band = model_band(d, v.model, load_kw=load_kw)
+    band = model_band(d, v.model, load_kw=load_kw, free_section=free_section(p))
     result, text = None, ""
-    if m is not None:
+    if m is not None and fit == "multi":
+        say(f"multi-parameter fit of the printed net to {Path(measured).name}")
+        result = fit_measured(d, m, fit_levels(m), load_kw=load_kw, free_section=free_section(p))
+        text = _multi_profile_text(d, result, Path(measured).name) if result.explains else ""
+    elif m is not None:
         say(f"fit of the net's {fit} to {Path(measured).name}")
         result = fit_factor(m, model_predictor(d, band, m, fit, load_kw=load_kw), fit)
-        text = _profile_text(d, result, Path(measured).name)
+        # a factor at the end of its range explains nothing: no profile to feed back
+        text = "" if result.at_bound else _profile_text(d, result, Path(measured).name)
     rep = Report(f"printgen verify: {p.name} at 1:{d.scale:g}")
     verification_sections(rep, v, None, d.scale, band=band)
     band_sections(rep, v, band)
     record = {"design": d.to_dict(), "verification": v.to_record(),
-              "bands": band_record(v, band)}
+              "bands": band_record(v, band), "lab": lab_record(v, band, d.scale)}
     if m is not None:
-        measured_sections(rep, m, band, result, text)
+        measured_sections(rep, m, band, result, text, prototype=v.prototype.deformation)
         record["measured"] = measured_record(m, band, result, text)
+    record["summary"] = summary_record(record, record["measured"]["fit"]["sentence"]
+                                       if m is not None and result else "")
+    rep.lead = summary_html(record["summary"])
     record["timings_s"] = {"total": time.perf_counter() - t0, "band": band.seconds}
-    files = _write(out, rep, record, d, text, force)
+    files = _write(out, rep, record, d, text, force, inputs)
     return VerifyRun(p, d, v, band, m, result, text, record, files)
+
+
+def _multi_profile_text(d: Design, fit: MultiFit, source: str) -> str:
+    """The profile of an explained multi-parameter fit: its net law factor (slack and the
+    mounting choices belong to the test's installation, stated as comments)."""
+    p = fit.params
+    mat = load_material(d.net.material)
+    law = mat.panel_law
+    kappas = law.kappas if law is not None and law.has_geometry else None
+    text = fitted_profile(d.net.material, "stiffness", p.net_factor, panel_kappas=kappas,
+                          modulus_gpa=mat.modulus()[0] / 1e9, source=source)
+    return (f"# installation fitted with it (not material): net slack {p.net_slack:.2%}, "
+            f"cable slack {p.cable_slack:.2%}, mounting {p.mounting}, orientation "
+            f"{p.orientation or 'as profiled'}\n" + text)
 
 
 def _profile_text(d: Design, fit: Fit, source: str) -> str:
@@ -100,15 +136,22 @@ def _profile_text(d: Design, fit: Fit, source: str) -> str:
                           modulus_gpa=mat.modulus()[0] / 1e9, source=source)
 
 
+def fitted_name(d: Design) -> str:
+    """File name of the fitted profile, inside the output folder (the material is a profile
+    name, checked when the design was read, so this is one plain file name)."""
+    return f"{profile_name(d.net.material, 'design net.material')}-fitted.toml"
+
+
 def _write(out: str | Path, rep: Report, record: dict[str, Any], d: Design, profile: str,
-           force: bool) -> list[str]:
+           force: bool, inputs: list) -> list[str]:
     timings = record.pop("timings_s")
     files = {"report.html": rep.html(), "report.json": dumps(record),
              TIMINGS: dumps({"timings_s": timings})}
+    files.update(lab_files(record["lab"]))  # curves, expected readings, measurement sheet
     if profile:
-        files[f"{d.net.material}-fitted.toml"] = profile
+        files[fitted_name(d)] = profile
     record["timings_s"] = timings
-    with staged_dir(out, force=force, volatile=(TIMINGS,)) as stage:
+    with staged_dir(out, force=force, volatile=(TIMINGS,), inputs=inputs) as stage:
         for name, text in files.items():
             (stage / name).write_text(text)
     return sorted(files)

@@ -85,7 +85,8 @@ def fit_angle(mesh, printer: Printer, name: str) -> float:
             f"{name}: part {size[0]:.1f} x {size[1]:.1f} mm does not fit {where}, not even "
             f"turned diagonally (best: {degrees[best]:g} deg, "
             f"{ext[best, 0]:.1f} x {ext[best, 1]:.1f} mm); choose a printer with a larger bed "
-            "(--printer), split the part, or build at a smaller scale")
+            "(--printer) or a larger lambda (a smaller model): printgen select says which "
+            "printers and which lambda fit")
     return float(degrees[int(np.argmax(fits))])
 
 

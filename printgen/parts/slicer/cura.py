@@ -34,8 +34,8 @@ def cura_settings(part_kind: str, design_part: NetDesign | CableDesign, printer:
     """CuraEngine settings (key -> value text) for a cable: one wall loop per 2 beads."""
     if part_kind != "cable":
         raise PrintabilityError(
-            "CuraEngine 4.13 cannot slice the diamond net into one bead per strand (no Arachne; "
-            "slicers.md section 3): use the PrusaSlicer profile or printgen's direct G-code")
+            "CuraEngine 4.13 cannot slice the diamond net into one bead per strand (it has no "
+            "Arachne wall generator): use the PrusaSlicer profile or printgen's direct G-code")
     check_part(part_kind, design_part, printer, style)
     sec = part_section(part_kind, design_part)
     heights = sec.layer_heights_mm

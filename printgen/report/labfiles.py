@@ -1,0 +1,128 @@
+"""Files a lab takes to the flume, beside the report: the curves (curves.csv), the expected
+readings in flume units (expected-readings.csv) and a blank measurement sheet in the columns
+`printgen verify --measured` reads, with the model's expected readings beside them
+(measurement-sheet.csv). Column names carry their unit (`_pct`, `_mm`, `_n`, `_kn`; no
+suffix: normalised, dimensionless). The numbers are the record's (`lab_record`, in
+report.json under "lab"), so the files and the JSON say the same.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from printgen.check.bands import Band
+from printgen.check.compare import METRICS
+from printgen.check.measured import COLUMNS, LEVEL_COLUMN
+from printgen.check.readings import DEPTH_COLUMN, RAW_COLUMNS, flume_units
+from printgen.check.verify import Verification
+
+DIGITS = 8  # significant digits of every number in the CSV files
+NOISE = 1e-6  # |value| below this (in the column's unit: %, mm, N, kN or -) is written as 0
+CURVES, READINGS, SHEET = "curves.csv", "expected-readings.csv", "measurement-sheet.csv"
+# METRICS key -> (CSV stem with its unit, factor from the record's unit)
+CURVE_COLUMNS = {key: (col, 100.0 if col.endswith("_pct") else 1.0)
+                 for col, (key, _) in COLUMNS.items()}
+
+
+def _levels_of(levels: np.ndarray, keep: np.ndarray) -> np.ndarray:
+    """Indices into `levels` of each value of `keep` (the band's levels are the sweep's)."""
+    return np.array([int(np.argmin(np.abs(levels - x))) for x in keep], dtype=int)
+
+
+def lab_record(v: Verification, band: Band, scale: float) -> dict[str, Any]:
+    """Curves (prototype, model nominal, band min/max) and the model's expected readings in
+    flume units at the band's levels; the record of report.json's "lab"."""
+    units = flume_units(v.model.scene)
+    lv = band.levels
+    ip = _levels_of(v.prototype.deformation.levels, lv)
+    im = _levels_of(v.model.deformation.levels, lv)
+    p, m = v.prototype.deformation, v.model.deformation
+    lo, hi = band.envelope()
+    lo0, hi0 = band.envelope(from_start=True)
+    curves = {"levels": lv}
+    for key in METRICS:
+        curves[key] = {"prototype": p.values[key][ip], "model": m.values[key][im],
+                       "band_min": lo[key], "band_max": hi[key]}
+    curves["tension"] = {
+        "prototype_strand_kn": p.max_strand_tension[ip] / 1e3,
+        "prototype_cable_kn": p.max_cable_tension[ip] / 1e3,
+        "model_strand_n": m.max_strand_tension[im], "model_cable_n": m.max_cable_tension[im],
+        "model_strand_scaled_kn": m.max_strand_tension[im] * scale**3 / 1e3,
+        "model_cable_scaled_kn": m.max_cable_tension[im] * scale**3 / 1e3}
+    readings: dict[str, Any] = {"levels": lv, "water_depth_mm": lv * units.height_mm}
+    for col, key in RAW_COLUMNS.items():
+        nominal = band.nominal[key] - (band.nominal[key][0] if key.startswith("strain") else 0)
+        low, high = (lo0, hi0) if key.startswith("strain") else (lo, hi)
+        f = units.length_mm(key)
+        readings[col] = {"nominal": nominal * f, "min": low[key] * f, "max": high[key] * f}
+    readings["max_strand_tension_n"] = m.max_strand_tension[im]
+    readings["max_cable_tension_n"] = m.max_cable_tension[im]
+    return {"units": units.to_record(), "curves": curves, "readings": readings,
+            "files": [CURVES, READINGS, SHEET]}
+
+
+def lab_files(lab: dict[str, Any]) -> dict[str, str]:
+    """The three CSV texts of `lab_record`'s output, by file name."""
+    return {CURVES: curves_csv(lab), READINGS: readings_csv(lab), SHEET: sheet_csv(lab)}
+
+
+def curves_csv(lab: dict[str, Any]) -> str:
+    c = lab["curves"]
+    header, cols = [LEVEL_COLUMN], [c["levels"]]
+    for key, (stem, f) in CURVE_COLUMNS.items():
+        for who in ("prototype", "model", "band_min", "band_max"):
+            header.append(f"{stem.removesuffix('_pct')}_{who}" + ("_pct" if f != 1 else ""))
+            cols.append(np.asarray(c[key][who]) * f)
+    for name, values in c["tension"].items():
+        header.append(f"max_{name}")
+        cols.append(values)
+    return _csv(header, cols)
+
+
+def readings_csv(lab: dict[str, Any]) -> str:
+    r = lab["readings"]
+    header, cols = [LEVEL_COLUMN, DEPTH_COLUMN], [r["levels"], r["water_depth_mm"]]
+    for col in RAW_COLUMNS:
+        stem = col.removesuffix("_mm")
+        for what in ("nominal", "min", "max"):
+            header.append(f"{stem}_{what}_mm")
+            cols.append(r[col][what])
+    header += ["max_strand_tension_n", "max_cable_tension_n"]
+    cols += [r["max_strand_tension_n"], r["max_cable_tension_n"]]
+    return _csv(header, cols)
+
+
+def sheet_csv(lab: dict[str, Any]) -> str:
+    """The blank sheet: the level and depth filled in, an empty cell for each reading, and
+    each reading's expected model value (nominal, band min and max) beside it."""
+    r = lab["readings"]
+    header, cols = [LEVEL_COLUMN, DEPTH_COLUMN], [r["levels"], r["water_depth_mm"]]
+    blank = np.full(len(r["levels"]), np.nan)
+    for col in RAW_COLUMNS:
+        header.append(col)
+        cols.append(blank)
+        for what in ("nominal", "min", "max"):
+            header.append(f"expected_{col.removesuffix('_mm')}_{what}_mm")
+            cols.append(r[col][what])
+    note = ("# printgen measurement sheet: fill the empty columns with the readings in mm "
+            "(sensors zeroed at h/h_B = 0; deflection and top lowering from rest); leave a "
+            "column empty if not measured. expected_* columns: the printed model's prediction "
+            "(nominal, band min, band max), skipped when read back. Read with: printgen "
+            "verify PROTOTYPE --scale S --design design.json --measured this-file.csv\n")
+    return note + _csv(header, cols)
+
+
+def _csv(header: list[str], cols: list[Any]) -> str:
+    lines = [",".join(header)]
+    for row in zip(*(np.asarray(c, dtype=float) for c in cols), strict=True):
+        lines.append(",".join(_num(x) for x in row))
+    return "\n".join(lines) + "\n"
+
+
+def _num(x: float) -> str:
+    if not math.isfinite(x):
+        return ""
+    return "0" if abs(x) < NOISE else f"{x:.{DIGITS}g}"  # solver round-off, "-0" included

@@ -1,0 +1,151 @@
+"""The report's summary box, first on the page: the verdict and its reason, the band verdict,
+the chosen materials and sections with their stiffness error, print time and mass, and what
+to do next. Built from the run's record (the numbers report.json holds), so the box, the
+JSON and the terminal say the same."""
+
+from __future__ import annotations
+
+import html
+from typing import Any
+
+from printgen.check.compare import METRICS
+
+NEXT_PASS = ("Print the parts (the .gcode files, or slice the .3mf files), assemble them as the "
+             "Assembly section below shows, and run the flume test with measurement-sheet.csv; "
+             "bring the readings back with printgen verify --measured.")
+NEXT_STIFF = ("Change the net before printing: the model is too stiff. Try a softer material, "
+              "fewer passes or a thinner strand (printgen select lists them), or let printgen "
+              "design search the net (--objective deformation), then make again.")
+NEXT_SOFT = ("Change the net before printing: the model is too soft. Try a stiffer material or "
+             "more passes (printgen select), or printgen design, then make again.")
+NEXT_NONE = "Run make with the verification step to get the verdict before printing."
+
+
+def print_rows(gcode: dict[str, Any]) -> tuple[list[str], list[list[str]]]:
+    """(columns, rows) of the print-time table: each part and the total."""
+    from printgen.parts.gcode.estimate import NOT_COUNTED, duration
+
+    rows, tot = [], {"print_time_s": 0.0, "filament_mm": 0.0, "mass_g": 0.0}
+    for name, rec in gcode.items():
+        p = rec["print"]
+        rows.append([name, duration(p["print_time_s"]), f"{p['filament_mm'] / 1e3:.3f}",
+                     f"{p['mass_g']:.2f}"])
+        for k in tot:
+            tot[k] += p[k]
+    rows.append(["total", duration(tot["print_time_s"]), f"{tot['filament_mm'] / 1e3:.3f}",
+                 f"{tot['mass_g']:.2f}"])
+    return ([f"part (print time: {NOT_COUNTED})", "print time", "filament (m)", "mass (g)"],
+            rows)
+
+
+def print_totals(gcode: dict[str, Any]) -> dict[str, float]:
+    """Total print time (s), filament (mm) and mass (g) over every part's G-code."""
+    keys = ("print_time_s", "filament_mm", "mass_g")
+    return {k: float(sum(r["print"][k] for r in gcode.values())) for k in keys}
+
+
+def summary_record(record: dict[str, Any], next_step: str = "") -> dict[str, Any]:
+    """The summary's numbers: verdict, reason, band verdicts, chosen parts, print totals,
+    next step (report.json "summary"; `next_step` replaces the one chosen from the verdict).
+    The band is record["verification"]["bands"] (make) or record["bands"] (verify)."""
+    v = record.get("verification") or {}
+    verdicts = (v.get("bands") or record.get("bands") or {}).get("verdicts", [])
+    ratios = [m.ratio_high for m in v.get("mismatches", []) if not m.ok]
+    if not v:
+        nxt = NEXT_NONE
+    elif v.get("ok"):
+        nxt = NEXT_PASS
+    else:
+        nxt = NEXT_STIFF if ratios and min(ratios) < 1 else NEXT_SOFT
+    out: dict[str, Any] = {
+        "verdict": v.get("verdict", "not run"), "reason": v.get("summary", ""),
+        "band": {b["metric"]: b["text"] for b in verdicts},
+        "parts": chosen_parts(record), "next": next_step or nxt}
+    if record.get("gcode"):
+        out["print"] = print_totals(record["gcode"])
+    return out
+
+
+def chosen_parts(record: dict[str, Any]) -> list[dict[str, Any]]:
+    """The net and the border cables as chosen: material, section, passes, stiffness error."""
+    sel, design = record.get("selection"), record["design"]
+    out = []
+    net = design["net"]
+    pick = sel and _same_section(sel["net"]["ranked"], net["material"], net["strand"])
+    out.append({"part": "net", "material": net["material"].upper(),
+                "section": (f"strand {_mm(net['strand'])}, mesh {net['mesh_x_mm']:g} x "
+                            f"{net['mesh_y_mm']:g} mm"),
+                "stiffness_error": None if pick is None else pick["error"]})
+    if design["cables"]:
+        c = design["cables"][0]
+        pick = sel and _same_section(sel["cable"]["ranked"], c["material"], c["section"])
+        out.append({"part": f"border cables ({len(design['cables'])})",
+                    "material": c["material"].upper(), "section": _mm(c["section"]),
+                    "stiffness_error": None if pick is None else pick["error"]})
+    return out
+
+
+def _mm(s: dict[str, Any]) -> str:
+    w, t, n = _dims(s)
+    return f"{w:g} x {t:g} mm, {n} passes"
+
+
+def _dims(s: dict[str, Any]) -> tuple[float, float, int]:
+    """(width mm, thickness mm, passes) of a Section record (design.json's form)."""
+    layers = s["layer_heights_mm"]
+    return (round(s["bead_width_mm"] * s["beads_across"], 6), round(float(sum(layers)), 6),
+            s["beads_across"] * len(layers))
+
+
+def _same_section(ranked: list[dict], material: str, s: dict) -> dict | None:
+    w, t, n = _dims(s)
+    for c in ranked:
+        cs = c["section"]
+        if (c["material"] == material and cs["passes"] == n
+                and abs(cs["width_mm"] - w) < 1e-9 and abs(cs["thickness_mm"] - t) < 1e-9):
+            return c
+    return None
+
+
+def summary_html(s: dict[str, Any]) -> str:
+    """The summary box (HTML) of `summary_record`'s output."""
+    from printgen.parts.gcode.estimate import duration
+
+    e = html.escape
+    ok = s["verdict"] == "PASS"
+    tag = ("pass" if ok else "fail") if s["verdict"] != "not run" else "note"
+    lines = [(f'<p class="verdict"><span class="{tag}">{e(s["verdict"])}</span> '
+             f'{e(s["reason"] or "the verification was not run")}</p>')]
+    if s["band"]:
+        lines.append("<p><b>Uncertainty band</b> (where the prototype lies against the "
+                     "model's band):</p><ul>" + "".join(
+                         f"<li>{e(METRICS[k].split(' (')[0])}: {e(t)}</li>"
+                         for k, t in s["band"].items()) + "</ul>")
+    parts = "; ".join(
+        f"{e(p['part'])}: {e(p['material'])}, {e(p['section'])}"
+        + ("" if p["stiffness_error"] is None else
+           f", stiffness {p['stiffness_error']:+.0%} off target") for p in s["parts"])
+    lines.append(f"<p><b>Chosen:</b> {parts}</p>")
+    if "print" in s:
+        t = s["print"]
+        lines.append(f"<p><b>Printing:</b> {e(duration(t['print_time_s']))}, "
+                     f"{t['filament_mm'] / 1e3:.2f} m of filament, {t['mass_g']:.1f} g "
+                     "(all parts; per part in Direct G-code)</p>")
+    lines.append(f"<p><b>Next:</b> {e(s['next'])}</p>")
+    return '<section class="summary" id="summary"><h2>Summary</h2>' + "".join(lines) \
+        + "</section>"
+
+
+def summary_lines(s: dict[str, Any]) -> list[str]:
+    """The summary as plain lines for the terminal."""
+    from printgen.parts.gcode.estimate import duration
+
+    if not s:
+        return []
+    out = [f"{s['verdict']}: {s['reason']}" if s["reason"] else s["verdict"]]
+    if "print" in s:
+        t = s["print"]
+        out.append(f"printing: {duration(t['print_time_s'])}, {t['filament_mm'] / 1e3:.2f} m "
+                   f"of filament, {t['mass_g']:.1f} g")
+    out.append(f"next: {s['next']}")
+    return out

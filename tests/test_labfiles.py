@@ -1,0 +1,130 @@
+"""What a lab takes to the flume, without a `make` (issue 23): print time, filament and mass
+from a toolpath against hand arithmetic; the printed model's lengths in mm; the measurement
+sheet's raw mm readings read back as the normalised quantities; reproducible SVG figures."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from conftest import reference_design_1_40
+
+from printgen.check.measured import MeasurementError, read_measured
+from printgen.check.readings import RAW_COLUMNS, FlumeUnits, design_units
+from printgen.inputs.materials import load_material
+from printgen.inputs.printers import load_printer
+from printgen.parts.gcode.estimate import duration, print_estimate
+from printgen.parts.gcode.toolpath import BORDER, TRAVEL, Toolpath
+
+EXACT = 1e-12  # sums of a few floats
+READ_TOL = 1e-9  # numbers written with 10 significant digits and read back
+
+
+def line_toolpath(length_mm: float, speed: float, travel_mm: float) -> Toolpath:
+    """A travel of `travel_mm` then one 0.4 x 0.2 mm bead of `length_mm` at `speed`."""
+    xyz = np.array([[0.0, 0.0, 0.2], [travel_mm, 0.0, 0.2], [travel_mm + length_mm, 0.0, 0.2]])
+    return Toolpath(xyz, np.array([0.0, 0.0, 0.4]), np.array([0.0, 0.0, 0.2]),
+                    np.array([100.0, 100.0, speed]), np.array([0.0, 0.0, 1.0]),
+                    np.zeros(3, dtype=int), np.array([TRAVEL, TRAVEL, BORDER]), np.array([0.2]))
+
+
+def test_print_estimate_is_the_hand_arithmetic():
+    printer, mat = load_printer("prusa-mk4"), load_material("petg")
+    tp = line_toolpath(50.0, 25.0, 1.0)  # travel under 2 mm: not retracted
+    est = print_estimate(tp, printer, mat)
+    assert est.seconds == pytest.approx(1.0 / 100.0 + 50.0 / 25.0, rel=EXACT)
+    volume = 0.4 * 0.2 * 50.0
+    assert est.volume_mm3 == pytest.approx(volume, rel=EXACT)
+    assert est.filament_mm == pytest.approx(
+        volume / (math.pi * printer.filament_diameter_mm**2 / 4), rel=EXACT)
+    assert est.mass_g == pytest.approx(volume * 1e-3 * 1.27, rel=EXACT)  # PETG 1.27 g/cm^3
+    long = print_estimate(line_toolpath(50.0, 25.0, 10.0), printer, mat)  # retracted travel
+    p = mat.print
+    assert long.seconds == pytest.approx(10.0 / 100.0 + 2.0 + 2 * p.retract_length_mm
+                                         / p.retract_speed_mm_per_s, rel=EXACT)
+    assert duration(3723.4) == "1h 02m 03s" and duration(65) == "1m 05s"
+    assert "; filament used [g] = " in "\n".join(est.header_lines())
+
+
+def test_model_lengths_are_the_design_in_mm():
+    d = reference_design_1_40()
+    u = design_units(d)
+    # the solver net spans a whole number of meshes: within one mesh of the printed size
+    assert abs(u.width_mm - d.net.width_mm) < d.net.mesh_x_mm
+    assert abs(u.height_mm - d.net.height_mm) < d.net.mesh_y_mm
+    # each wire runs along its row, about the net's width (a row zig-zags a little)
+    for row, length in u.row_mm.items():
+        assert d.net.width_mm * 0.9 < length < d.net.width_mm * 1.5, row
+
+
+UNITS = FlumeUnits(330.0, 100.0, {"bottom": 330.0, "top": 331.0, "mid": 335.0})
+
+
+def test_raw_mm_readings_and_water_depth_read_as_normalised(tmp_path):
+    p = tmp_path / "sheet.csv"
+    p.write_text("# a sheet\nwater_depth_mm,mid_sensor_mm,deflection_mm,top_lowering_mm,"
+                 "expected_mid_sensor_nominal_mm,bottom_sensor_mm\n"
+                 "50,3.35,10,,1.0,\n100,33.5,33,5,2.0,\n")
+    m = read_measured(p, UNITS)
+    np.testing.assert_allclose(m.levels, [0.5, 1.0], rtol=READ_TOL)
+    np.testing.assert_allclose(m.values["strain_mid"], [0.01, 0.1], rtol=READ_TOL)
+    np.testing.assert_allclose(m.values["deflection"], [10 / 330, 0.1], rtol=READ_TOL)
+    assert np.isnan(m.values["lowering"][0]) and m.values["lowering"][1] == pytest.approx(0.05)
+    assert "strain_bottom" not in m.values  # the empty column of the sheet is left out
+    assert m.columns["strain_mid"] == "mid_sensor_mm"
+
+
+BAD = {
+    "depth disagrees": ("h_over_hb,water_depth_mm,mid_sensor_mm\n0.5,70,1\n", "water_depth_mm"),
+    "same quantity twice": ("h_over_hb,deflection_mm,deflection_over_width\n0.5,3,0.01\n",
+                            "same quantity"),
+    "mm beyond a metre": ("h_over_hb,deflection_mm\n0.5,3000\n", "deflection_mm"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD))
+def test_bad_raw_sheets_are_refused_naming_the_column(tmp_path, case):
+    text, named = BAD[case]
+    p = tmp_path / "bad.csv"
+    p.write_text(text)
+    with pytest.raises(MeasurementError, match=named):
+        read_measured(p, UNITS)
+
+
+def test_raw_columns_need_the_model_lengths(tmp_path):
+    p = tmp_path / "raw.csv"
+    p.write_text("h_over_hb,mid_sensor_mm\n0.5,1\n")
+    with pytest.raises(MeasurementError, match="mid_sensor_mm"):
+        read_measured(p)  # without the design there is no length to divide by
+    assert set(RAW_COLUMNS) >= {"mid_sensor_mm", "deflection_mm", "top_lowering_mm"}
+
+
+def test_figures_give_the_same_png_and_svg_twice():
+    from printgen.report.plots import _png, _pyplot
+
+    def draw():
+        fig, ax = _pyplot().subplots()
+        ax.plot([0, 1], [0, 2])
+        ax.set_xlabel("relative loading h / h_B (-)")
+        return _png(fig)
+
+    a, b = draw(), draw()
+    assert bytes(a) == bytes(b) and a.svg == b.svg and a.svg.startswith(b"<?xml")
+    assert a.labels == [("", ["relative loading h / h_B (-)", ""])]
+
+
+def test_summary_of_a_verify_record_without_selection():
+    """`verify` has the design but no selection: the box names the parts without an error."""
+    from printgen.report.summary import summary_html, summary_record
+
+    d = reference_design_1_40()
+    rec = {"verification": {"verdict": "FAIL", "summary": "model too stiff", "ok": False,
+                            "mismatches": []},
+           "bands": {"verdicts": [{"metric": "deflection", "text": "model stiffer by 20%"}]},
+           "design": d.to_dict()}
+    s = summary_record(rec, "fitted: stiffness 0.8 x")
+    assert s["verdict"] == "FAIL" and s["next"] == "fitted: stiffness 0.8 x"
+    assert [p["stiffness_error"] for p in s["parts"]] == [None, None]
+    box = summary_html(s)
+    assert 'id="summary"' in box and "model stiffer by 20%" in box and "TPE" in box

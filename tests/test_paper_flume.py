@@ -1,0 +1,58 @@
+"""The paper's flume test as bundled data (issue 25): the printed design, the measured points
+with "negligible" as a bound, and the panel-test orientation option of the scenes."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from printgen.check.measured import MeasurementError, mismatch, read_measured
+from printgen.check.scenes import model_scene, panel_axes
+from printgen.design.design_file import load_design
+from printgen.errors import GeometryError
+
+HERE = Path(__file__).resolve().parents[1] / "examples" / "paper_1_40"
+EXACT = 1e-12  # values read from the CSV: only round-off
+MM = 1e-3
+
+
+def test_bundled_measurement_holds_only_the_stated_values():
+    m = read_measured(HERE / "measured.csv")
+    np.testing.assert_allclose(m.levels, [0.5, 0.8, 1.0])
+    mid = m.values["strain_mid"]
+    assert np.isnan(mid[0]) and mid[1:] == pytest.approx([0.05, 0.105], abs=EXACT)
+    assert np.isnan(m.values["strain_bottom"]).all()  # the paper gives no bottom value
+    for key in ("strain_bottom", "strain_top", "strain_mid"):
+        assert m.bound(key)[0] == pytest.approx(0.005, abs=EXACT)
+
+
+def test_a_bound_counts_only_by_its_excess():
+    m = read_measured(HERE / "measured.csv")
+    under = {k: np.array([0.004, 0.05, 0.105]) for k in m.values}
+    over = {k: np.array([0.015, 0.05, 0.105]) for k in m.values}
+    mid_under = next(x for x in mismatch(m, under) if x.metric == "strain_mid")
+    mid_over = next(x for x in mismatch(m, over) if x.metric == "strain_mid")
+    assert mid_under.rms == pytest.approx(0.0, abs=EXACT)
+    assert mid_over.rms == pytest.approx(np.sqrt(0.01**2 / 3), rel=1e-9)
+
+
+def test_bounds_only_is_refused(tmp_path):
+    f = tmp_path / "m.csv"
+    f.write_text("h_over_hb,mid_height_elongation_pct\n0.5,<0.5\n")
+    with pytest.raises(MeasurementError, match="no measured value"):
+        read_measured(f)
+
+
+def test_orientation_reads_the_panel_law_along_the_chosen_diagonal():
+    d = load_design(HERE / "design.json", scale=40)
+    short, long_ = (model_scene(d, orientation=o).laws[0] for o in ("short", "long"))
+    assert model_scene(d).laws[0] == short  # the TPE profile records the short diagonal
+    sin_s, sin_l = 4.7 / np.hypot(4.7, 10.3), 10.3 / np.hypot(4.7, 10.3)
+    # strand EA = kappa L a_across / (2 sin^3): the two readings differ by this ratio
+    ratio = (9.4 / sin_l**3) / (20.6 / sin_s**3)
+    assert long_[1][0] / short[1][0] == pytest.approx(ratio, rel=1e-9)
+    assert panel_axes(20.6 * MM, 9.4 * MM, "long") == (20.6 * MM, 9.4 * MM)
+    with pytest.raises(GeometryError, match="orientation"):
+        panel_axes(1.0, 2.0, "diagonal")
