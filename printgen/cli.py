@@ -15,6 +15,7 @@ import sys
 from concurrent.futures.process import BrokenProcessPool
 from typing import NoReturn
 
+import printgen
 from printgen.errors import PrintgenError, TimeLimitError
 from printgen.outputs import describe_os_error, os_error_exit_code, tracking_swaps
 from printgen.workers import Interrupted, signals_raise
@@ -31,6 +32,7 @@ COMMAND_MODULES = (
     "printgen.commands.panel",
     "printgen.commands.bench",
     "printgen.commands.calibrate",
+    "printgen.commands.example",
     "printgen.commands.init",
 )
 
@@ -56,10 +58,13 @@ def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
         description="Stiffness-scaled, printable flexible-barrier models for flume experiments.",
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
+    parser.add_argument("--version", action="version", version=f"printgen {printgen.__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     words = [a for a in argv or [] if not a.startswith("-") or a in ("-h", "--help")]
     only = [m for m in COMMAND_MODULES if words and m.rsplit(".", 1)[-1] == words[0]]
+    if not words and "--version" in (argv or []):
+        return parser  # argparse prints the version and exits: no command is needed
     for name in only or COMMAND_MODULES:
         importlib.import_module(name).register(sub)
     return parser

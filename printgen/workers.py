@@ -1,33 +1,83 @@
 """Worker processes and signals: workers die with their parent, signals end a run cleanly.
 
-`run_jobs` runs independent jobs in a process pool whose workers (Linux) ask the kernel to
-kill them when their parent dies (`prctl(PR_SET_PDEATHSIG, SIGKILL)` in the initializer), so
-a `make` killed by SIGKILL leaves no orphan. The workers ignore SIGINT, SIGTERM and SIGHUP:
-the parent handles those (`signals_raise`: they become an `Interrupted` exception), stops the
-workers, lets every `finally` remove its stage folder, and the command line prints one line and
-exits with 128 + the signal number (130 for Ctrl-C, 143 for SIGTERM). Other pools (the design
-search's Dask workers) use `init_worker` as their initializer too.
+`run_jobs` runs independent jobs in a process pool whose workers die with their parent, so a
+`make` killed by SIGKILL leaves no orphan: on Linux the kernel kills them
+(`prctl(PR_SET_PDEATHSIG, SIGKILL)` in the initializer), elsewhere a watchdog thread in each
+worker waits on multiprocessing's parent sentinel and exits when it fires. Workers start by
+`fork` where it exists and is safe (Linux, a parent running no other Python thread), else by
+`forkserver` (POSIX) or `spawn` (Windows, macOS): see `start_method`. The workers ignore SIGINT,
+SIGTERM and SIGHUP (where the platform defines it): the parent handles those (`signals_raise`:
+they become an `Interrupted` exception), stops the workers, lets every `finally` remove its
+stage folder, and the command line prints one line and exits with 128 + the signal number (130
+for Ctrl-C, 143 for SIGTERM). What the platform offers is found once in the first process
+(`platform`) and handed to every worker it starts, so workers of workers use the same.
 """
 
 from __future__ import annotations
 
 import contextlib
-import ctypes
 import multiprocessing
 import os
 import signal
+import sys
 import threading
 import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures import TimeoutError as FutureTimeout
+from dataclasses import dataclass
 from typing import Any
 
 from printgen.errors import TimeLimitError
 
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
-HANDLED = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+SIGNAL_NAMES = ("SIGINT", "SIGTERM", "SIGHUP")  # the stop signals; SIGHUP is POSIX only
+SYSTEM = sys.platform  # "linux", "darwin", "win32", ...
 READER_JOIN_S = 5.0  # the progress reader has only the queued reports left to pass on
+
+
+@dataclass(frozen=True)
+class Platform:
+    """What the platform offers worker processes: its name (`sys.platform`), multiprocessing's
+    start methods, and the stop signals it defines (numbers)."""
+
+    system: str
+    start_methods: tuple[str, ...]
+    signals: tuple[int, ...]
+
+    @property
+    def pdeathsig(self) -> bool:
+        """The kernel can kill a worker whose parent dies (Linux prctl)."""
+        return self.system.startswith("linux")
+
+
+_inherited: Platform | None = None  # in a worker: the first process's Platform (`init_worker`)
+
+
+def handled_signals() -> tuple[int, ...]:
+    """SIGINT, SIGTERM and SIGHUP, those the platform defines."""
+    return tuple(int(getattr(signal, n)) for n in SIGNAL_NAMES if hasattr(signal, n))
+
+
+def platform() -> Platform:
+    """This platform's offer (in a worker: the one its first ancestor found)."""
+    if _inherited is not None:
+        return _inherited
+    return Platform(SYSTEM, tuple(multiprocessing.get_all_start_methods()), handled_signals())
+
+
+def start_method(plat: Platform | None = None) -> str:
+    """`fork` on Linux while this process runs no other Python thread (forking a threaded
+    process can deadlock the child on a lock another thread held, and Python 3.12+ warns: a
+    notebook kernel, a Dask client); else `forkserver` where it exists, except on macOS, whose
+    system libraries are unsafe after fork; else `spawn` (Windows)."""
+    plat = plat or platform()
+    linux = plat.system.startswith("linux")
+    if "fork" in plat.start_methods and linux and threading.active_count() == 1:
+        return "fork"
+    if "forkserver" in plat.start_methods and plat.system != "darwin":
+        return "forkserver"
+    return "spawn"
 
 
 class Interrupted(BaseException):
@@ -62,12 +112,12 @@ def _raise(signum: int, _frame: Any) -> None:
 
 @contextlib.contextmanager
 def signals_raise() -> Iterator[None]:
-    """Within the block SIGINT, SIGTERM and SIGHUP raise `Interrupted` (main thread only);
+    """Within the block SIGINT, SIGTERM and SIGHUP (`handled_signals`) raise `Interrupted` (main thread only);
     the previous handlers come back afterwards."""
     if multiprocessing.parent_process() is not None or not _main_thread():
         yield
         return
-    previous = {s: signal.signal(s, _raise) for s in HANDLED}
+    previous = {s: signal.signal(s, _raise) for s in handled_signals()}
     try:
         yield
     finally:
@@ -85,7 +135,7 @@ def signals_deferred() -> Iterator[None]:
         return
     held: list[int] = []
     previous = {s: signal.signal(s, lambda signum, _frame: held.append(signum))
-                for s in HANDLED}
+                for s in handled_signals()}
     try:
         yield
     finally:
@@ -99,15 +149,42 @@ def _main_thread() -> bool:
     return threading.current_thread() is threading.main_thread()
 
 
-def init_worker(parent_pid: int) -> None:
-    """Pool initializer: die with the parent, leave signals to the parent."""
-    for s in HANDLED:
+def init_worker(plat: Platform, sink: Any = None, at: float | None = None) -> None:
+    """Pool initializer: die with the parent, leave signals to the parent, report progress to
+    `sink` (the parent's queue, or None), keep the parent's deadline `at` (`deadline`)."""
+    global _inherited, _sink, _deadline
+    _inherited, _sink, _deadline = plat, sink, at
+    for s in plat.signals:
         signal.signal(s, signal.SIG_IGN)
+    if plat.pdeathsig:
+        _die_with_parent_linux()
+    else:
+        _watch_parent()
+    parent = multiprocessing.parent_process()
+    if parent is not None and not parent.is_alive():  # it died before the guard took effect
+        os._exit(1)
+
+
+def _die_with_parent_linux() -> None:
+    import ctypes
+
     with contextlib.suppress(OSError, AttributeError):
         libc = ctypes.CDLL(None, use_errno=True)
         libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
-    if os.getppid() != parent_pid:  # the parent died before prctl took effect
+
+
+def _watch_parent() -> None:
+    """Where no parent-death signal exists: a daemon thread waits on the parent's sentinel
+    (closed by the OS when the parent dies, however it dies) and ends this worker."""
+    parent = multiprocessing.parent_process()
+    if parent is None:
+        return
+
+    def watch() -> None:
+        parent.join()
         os._exit(1)
+
+    threading.Thread(target=watch, name="printgen-parent-watch", daemon=True).start()
 
 
 _listener: Callable[[str, float, float], None] | None = None  # set by `reporting`
@@ -127,14 +204,14 @@ def reporting(listener: Callable[[str, float, float], None]) -> Iterator[None]:
         _listener = previous
 
 
-_deadline: float | None = None  # time.time() past which `check_deadline` raises (inherited by
-# forked workers: set before they start)
+_deadline: float | None = None  # time.time() past which `check_deadline` raises (handed to
+# workers by `init_worker`: set before their pool is made)
 
 
 @contextlib.contextmanager
 def deadline(at: float | None) -> Iterator[None]:
     """Within the block, `check_deadline` raises TimeLimitError once time.time() passes `at`
-    (None: no limit), in this process and in workers forked inside the block."""
+    (None: no limit), in this process and in workers whose pool is made inside the block."""
     global _deadline
     previous, _deadline = _deadline, at
     try:
@@ -190,27 +267,25 @@ def run_jobs(jobs: list[tuple]) -> list:
     global _sink
     workers = min(len(jobs), cores())
     if workers < 2 or os.environ.get("PRINTGEN_SERIAL"):
-        _sink = _listener
+        previous, _sink = _sink, _listener or _sink  # in a worker: its parent's queue
         try:
             return [fn(*args, **kw) for fn, args, kw in jobs]
         finally:
-            _sink = None
-    ctx = multiprocessing.get_context("fork")
+            _sink = previous
+    plat = platform()
+    ctx = multiprocessing.get_context(start_method(plat))
     queue = ctx.SimpleQueue() if _listener else None
-    if queue is not None:
-        _sink = queue  # the forked workers inherit it
-        reader = threading.Thread(target=_drain, args=(queue, _listener), daemon=True)
-        reader.start()
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=init_worker,
-                               initargs=(os.getpid(),))
+                               initargs=(plat, queue, _deadline))
     try:
         futures = [pool.submit(fn, *args, **kw) for fn, args, kw in jobs]
+        if queue is not None:  # started once the workers are: fork only a one-thread process
+            reader = threading.Thread(target=_drain, args=(queue, _listener), daemon=True)
+            reader.start()
         results = [_result(f) for f in futures]
     except BaseException:
         stop(pool)
         raise
-    finally:
-        _sink = None
     pool.shutdown(wait=True)
     if queue is not None:
         queue.put(None)  # the workers are done: end the helper thread after the last report
@@ -222,8 +297,10 @@ class Helper:
     """One worker process that runs the jobs submitted to it in order (see `helper`)."""
 
     def __init__(self) -> None:
-        self.pool = ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context(
-            "fork"), initializer=init_worker, initargs=(os.getpid(),))
+        plat = platform()
+        self.pool = ProcessPoolExecutor(
+            max_workers=1, mp_context=multiprocessing.get_context(start_method(plat)),
+            initializer=init_worker, initargs=(plat, None, _deadline))
         self.futures: list[Future] = []
 
     def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> Future:

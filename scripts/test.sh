@@ -8,6 +8,8 @@ if ! .venv/bin/python -c "import cadquery" 2>/dev/null; then
   .venv/bin/python -m pip install -q -e ".[all,cad]" >.venv/setup-cad.log 2>&1 \
     || { cat .venv/setup-cad.log >&2; echo "test: installing the cad extra failed" >&2; exit 1; }
 fi
+# The wheel, installed outside the clone and used from an empty folder (issue 21; ~30 s).
+bash scripts/test_wheel.sh
 export PRINTGEN_REQUIRE_SLICERS=1   # slicer tests fail, not skip, when a slicer is missing
 # ../shared tests (G-code checker, tensile exports) fail, not skip, when ../shared sits beside the
 # clone or PRINTGEN_REQUIRE_SHARED=1 is given (.ci/run); a clone with nothing beside it skips them.

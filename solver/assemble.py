@@ -96,7 +96,9 @@ def internal(bars: Bars, cables: list[Cable], u: np.ndarray, n_nodes: int, *,
              with_tangent: bool = True):
     """Resisting forces g (n, 3) and, when asked, the tangent K (3n x 3n, CSR)."""
     g = np.zeros((n_nodes, 3))
-    rows, cols, vals = [], [], []
+    rows: list[np.ndarray] = []
+    cols: list[np.ndarray] = []
+    vals: list[np.ndarray] = []
     _, force, tangent, d, l = bar_state(bars, u)
     taut = force > 0
     n = d / l[:, None]
@@ -111,7 +113,9 @@ def internal(bars: Bars, cables: list[Cable], u: np.ndarray, n_nodes: int, *,
         i, j = bars.i[taut], bars.j[taut]
         for a, b, s in ((i, i, 1), (j, j, 1), (i, j, -1), (j, i, -1)):
             r, c, v = _block_entries(a, b, s * k)
-            rows.append(r), cols.append(c), vals.append(v)
+            rows.append(r)
+            cols.append(c)
+            vals.append(v)
     for cab in cables:
         _, t, kt, nvec, ls = cable_state(cab, u)
         if t <= 0:
@@ -127,11 +131,14 @@ def internal(bars: Bars, cables: list[Cable], u: np.ndarray, n_nodes: int, *,
         a, b = cab.nodes[:-1], cab.nodes[1:]
         for p, q, s in ((a, a, 1), (b, b, 1), (a, b, -1), (b, a, -1)):
             r, c, v = _block_entries(p, q, s * k)
-            rows.append(r), cols.append(c), vals.append(v)
+            rows.append(r)
+            cols.append(c)
+            vals.append(v)
         # all nodes of a cable share its tension: rank-one coupling kt/L0 grad grad^T
         dof = (3 * cab.nodes[:, None] + np.arange(3)).ravel()
         gv = grad.ravel()
-        rows.append(np.repeat(dof, len(dof))), cols.append(np.tile(dof, len(dof)))
+        rows.append(np.repeat(dof, len(dof)))
+        cols.append(np.tile(dof, len(dof)))
         vals.append((kt / cab.rest) * np.outer(gv, gv).ravel())
     if not with_tangent:
         return g, None

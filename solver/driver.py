@@ -43,18 +43,18 @@ class FastSolver:
             st = membrane_start(ns, evaluate(ns, np.zeros_like(ns.x0)), self.stepper)
         st, iters, ok, reason = iterate(ns, st, tol, max_iter, self.stepper)
         return _result(ns, st, iters, ok, reason, time.perf_counter() - t0, level,
-                       self.stepper.factorizations - f0)
+                       self.stepper.factorizations - f0, self.stepper.backend)
 
 
 def _result(ns: NetSystem, st: State, iters: int, ok: bool, reason: str, seconds: float,
-            level: float | None, factorizations: int) -> Result:
+            level: float | None, factorizations: int, backend: str) -> Result:
     eps, force = st.bar[0], st.bar[1]  # the strand pass `evaluate` made at st.u
     cab = [cable_state(c, st.u) for c in ns.cables]
     disp = st.u * ns.L
     return Result(ns.x0 + disp, disp, eps, force * ns.S, force <= 0,
                   np.array([c[0] for c in cab]), np.array([c[1] * ns.S for c in cab]),
                   st.r_norm * ns.S, st.f_norm * ns.S, iters, ok, reason, seconds, level,
-                  factorizations)
+                  factorizations, backend)
 
 
 def _check(method: str) -> None:
@@ -92,7 +92,8 @@ def _starts(history: list[tuple[float, np.ndarray]], target: float) -> list[np.n
     return [u2, u2 + (u2 - u1) * ((target - l2) / (l2 - l1))]
 
 
-def solve_path(net: Net, loads_at: Callable[[float], Sequence], levels: Sequence[float], *,
+def solve_path(net: Net, loads_at: Callable[[float], Sequence],
+               levels: Sequence[float] | np.ndarray, *,
                tol: float = TOL_FORCE, max_iter: int = MAX_ITER, strict: bool = False,
                max_cuts: int = MAX_CUTS, skip_failed: bool = False,
                method: str = "fast") -> list[Result]:

@@ -96,7 +96,8 @@ def iterate(ns: NetSystem, st: State, tol: float, max_iter: int, stepper: Steppe
     At the round-off level (max |R| <= ROUND_OFF but above tol x the force scale) one more
     Newton step is still taken while it lowers max |R|: the answer then does not depend on
     how close to round-off the path happened to land."""
-    it, chord, recent = 0, None, []
+    it, chord = 0, None
+    recent: list[float] = []
     while True:
         if st.r_norm <= tol * st.f_norm:
             return st, it, True, "converged"

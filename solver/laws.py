@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -25,16 +26,28 @@ class Law:
             raise ValueError(f"knees must be positive and increasing, got {self.knees}")
         if any(not np.isfinite(s) or s <= 0 for s in self.slopes):
             raise ValueError(f"slopes must be positive and finite, got {self.slopes}")
-        lo = np.array([0.0, *self.knees])
-        width = np.append(np.diff(lo), np.inf)
-        slopes = np.asarray(self.slopes, dtype=float)
-        # arrays reused by every evaluation (the dataclass is frozen: set them once here)
-        object.__setattr__(self, "_lo", lo)
-        object.__setattr__(self, "_width", width)
-        object.__setattr__(self, "_slopes", slopes)
-        object.__setattr__(self, "_knees", np.asarray(self.knees, dtype=float))
-        object.__setattr__(self, "_before", np.concatenate(
-            [[0.0], np.cumsum(slopes[:-1] * width[:-1])]))
+
+    # arrays reused by every evaluation, computed once per law (cached_property: not fields,
+    # so equality, hashing and records see only knees and slopes)
+    @cached_property
+    def _lo(self) -> np.ndarray:
+        return np.array([0.0, *self.knees])
+
+    @cached_property
+    def _width(self) -> np.ndarray:
+        return np.append(np.diff(self._lo), np.inf)
+
+    @cached_property
+    def _slopes(self) -> np.ndarray:
+        return np.asarray(self.slopes, dtype=float)
+
+    @cached_property
+    def _knees(self) -> np.ndarray:
+        return np.asarray(self.knees, dtype=float)
+
+    @cached_property
+    def _before(self) -> np.ndarray:
+        return np.concatenate([[0.0], np.cumsum(self._slopes[:-1] * self._width[:-1])])
 
     def force_and_tangent(self, eps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(force N, tangent dF/deps N) at each strain; both zero when eps <= 0."""

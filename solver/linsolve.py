@@ -20,7 +20,7 @@ SuperLU on A is the last resort. The answer is always that of A.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import scipy.sparse.linalg as spla
@@ -112,7 +112,10 @@ class Factorization:
 
     def __init__(self, pattern: Pattern, data: np.ndarray, backend: str, handle=None) -> None:
         self.pattern, self.A, self.backend = pattern, pattern.csr(data), backend
-        self.handle, self.direct, self.symmetric, self.lu = None, None, False, None
+        self.handle: Any = None  # the backend's object (qdldl.Solver, Pardiso)
+        self.direct: Callable[[np.ndarray], np.ndarray] | None = None  # its solve
+        self.symmetric = False
+        self.lu: Any = None  # scipy's SuperLU, when it is needed
         self.ok = True
         try:
             if backend == "ldl":
@@ -160,7 +163,7 @@ class Factorization:
 
     def symmetric_solve(self, b: np.ndarray) -> np.ndarray | None:
         """S^-1 b alone (a direction on the symmetric model), or None without an LDL^T."""
-        if not self.symmetric:
+        if not self.symmetric or self.direct is None:
             return None
         with np.errstate(all="ignore"):
             x = self.direct(b)
@@ -181,15 +184,18 @@ class Factorization:
             return float(np.abs(res).max()) <= LINEAR_RTOL * (a_norm * float(np.abs(x).max())
                                                               + b_norm)
 
+        direct = self.direct
+        if direct is None:
+            return None
         try:
             with np.errstate(all="ignore"):
-                x = self.direct(b)
+                x = direct(b)
                 if good(x):
                     return x
                 if not np.all(np.isfinite(x)):
                     return None
                 target = max(forcing * b_norm, GMRES_RTOL * float(np.linalg.norm(b)))
-                x = gmres(self.A, self.direct, b, x, target, GMRES_RESTART)
+                x = gmres(self.A, direct, b, x, target, GMRES_RESTART)
         except Exception:  # noqa: BLE001 - a failing backend: SuperLU decides
             return None
         return x if good(x) else None
@@ -210,7 +216,7 @@ def gmres(A: sp.csr_matrix, precondition: Callable[[np.ndarray], np.ndarray], b:
     V[0] = r0 / beta
     e1 = np.zeros(m + 1)
     e1[0] = beta
-    y = np.zeros(0)
+    y: np.ndarray = np.zeros(0)
     for k in range(m):
         Z[k] = precondition(V[k])
         w = A @ Z[k]

@@ -43,18 +43,21 @@ class Pattern:
 
     def __init__(self, n_nodes: int, free: np.ndarray, bar_i: np.ndarray, bar_j: np.ndarray,
                  cable_nodes: list[np.ndarray]) -> None:
-        rows, cols = [], []
-        r, c = pair_rows_cols(bar_i, bar_j)
-        rows.append(r.ravel()), cols.append(c.ravel())
+        row_parts: list[np.ndarray] = []
+        col_parts: list[np.ndarray] = []
+
+        def add(r: np.ndarray, c: np.ndarray) -> None:
+            row_parts.append(r.ravel())
+            col_parts.append(c.ravel())
+
+        add(*pair_rows_cols(bar_i, bar_j))
         for nodes in cable_nodes:
-            r, c = pair_rows_cols(nodes[:-1], nodes[1:])
-            rows.append(r.ravel()), cols.append(c.ravel())
+            add(*pair_rows_cols(nodes[:-1], nodes[1:]))
             dof = (3 * nodes[:, None] + np.arange(3)).ravel()
-            rows.append(np.repeat(dof, len(dof))), cols.append(np.tile(dof, len(dof)))
+            add(np.repeat(dof, len(dof)), np.tile(dof, len(dof)))
         every = np.arange(n_nodes)
-        r, c = block_rows_cols(every, every)
-        rows.append(r.ravel()), cols.append(c.ravel())
-        rows, cols = np.concatenate(rows), np.concatenate(cols)
+        add(*block_rows_cols(every, every))
+        rows, cols = np.concatenate(row_parts), np.concatenate(col_parts)
         index = np.full(3 * n_nodes, -1)
         index[free] = np.arange(int(free.sum()))
         fr, fc = index[rows], index[cols]

@@ -17,7 +17,9 @@ class Result:
     slack : (m,) bool, strands carrying no force; cable_strains, cable_tensions : (c,) of the
     sliding cables; residual : max out-of-balance force on a free node (N); load_norm : max
     applied force (N); converged with `reason`; iterations (Newton and chord steps);
-    seconds; level of a load path; factorizations of the tangent (the main cost)."""
+    seconds; level of a load path; factorizations of the tangent (the main cost); backend: the
+    linear solver of the tangent ("ldl" qdldl, "pardiso" MKL PARDISO, "lu" SuperLU: see
+    solver.linsolve)."""
 
     positions: np.ndarray
     displacements: np.ndarray
@@ -34,3 +36,4 @@ class Result:
     seconds: float
     level: float | None = None
     factorizations: int = 0
+    backend: str = "lu"

@@ -64,8 +64,8 @@ def simple_scene(*, scale: float = 1.0, modulus: float | None = None, pinned_top
     v = s["velocity"] / math.sqrt(lam)
     z0 = None if current_z else nodes[free, 2]
 
-    def loads_at(r: float):
-        out = [Hydrostatic(free, a * a, r * h, initial_z=z0)]
+    def loads_at(r: float) -> list[Hydrostatic | Drag]:
+        out: list[Hydrostatic | Drag] = [Hydrostatic(free, a * a, r * h, initial_z=z0)]
         if drag:
             out.append(Drag(free, 2 * a, d / refine, v, r * h))
         return out

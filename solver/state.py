@@ -65,7 +65,7 @@ class NetSystem:
         full = np.zeros(3 * n)
         full[self.free] = b
         rhs, out = full.reshape(n, 3), np.zeros((n, 3))
-        masks = {fixed[:, k].tobytes(): [] for k in range(3)}
+        masks: dict[bytes, list[int]] = {fixed[:, k].tobytes(): [] for k in range(3)}
         for k in range(3):
             masks[fixed[:, k].tobytes()].append(k)
         for dirs in masks.values():  # one factorization per distinct set of free nodes
@@ -75,7 +75,8 @@ class NetSystem:
             try:
                 with np.errstate(all="ignore"):
                     lu = spla.splu(lap[nodes][:, nodes].tocsc())
-                    out[np.ix_(nodes, dirs)] = lu.solve(rhs[np.ix_(nodes, dirs)])
+                    at = np.ix_(nodes, np.asarray(dirs))
+                    out[at] = lu.solve(rhs[at])
             except RuntimeError:  # singular: some nodes reach no anchor through D
                 return None
         v = out.ravel()[self.free]

@@ -327,7 +327,7 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
                 for v in variants]
     nom = curves(nominal)
     k, change = refinement_test(d, nom, lv, load_kw, Variant(mounting=mounting))
-    jobs = [(run_variant, (d, v, lv, k, load_kw), {}) for v in variants]
+    jobs: list[tuple] = [(run_variant, (d, v, lv, k, load_kw), {}) for v in variants]
     if k > 1:
         jobs.append((run_variant, (d, Variant(mounting=mounting), lv, k, load_kw), {}))
     runs = run_jobs(jobs)

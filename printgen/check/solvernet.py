@@ -77,13 +77,15 @@ def build(s: BarrierScene, *, slack: float = 0.0) -> tuple[solver.Net, Extras]:
     for w in s.wires.values():
         if w.force <= 0:
             continue
-        nodes.append(w.exit[None, :]), fixed.append(np.array([True]))
+        nodes.append(w.exit[None, :])
+        fixed.append(np.array([True]))
         seg = np.column_stack([w.nodes, np.append(w.nodes[1:], n)])
         span = np.linalg.norm(np.diff(np.vstack([s.nodes[w.nodes], w.exit]), axis=0), axis=1)
         law = wire_law(w.force)
         if law not in laws:
             laws.append(law)
-        elements.append(seg), law_index.append(np.full(len(seg), laws.index(law)))
+        elements.append(seg)
+        law_index.append(np.full(len(seg), laws.index(law)))
         rest.append(span / (1.0 + WIRE_STRAIN))
         n += 1
     wire_elements = np.arange(first, first + sum(len(e) for e in elements[1:]))
@@ -95,8 +97,10 @@ def build(s: BarrierScene, *, slack: float = 0.0) -> tuple[solver.Net, Extras]:
         anchors = np.vstack([s.nodes[free] - [0, arm, 0], s.nodes[free] + [0, arm, 0]])
         idx = n + np.arange(2 * len(free))
         ties = np.column_stack([np.tile(free, 2), idx])
-        nodes.append(anchors), fixed.append(np.ones(len(anchors), bool))
-        elements.append(ties), law_index.append(np.full(len(ties), len(laws)))
+        nodes.append(anchors)
+        fixed.append(np.ones(len(anchors), bool))
+        elements.append(ties)
+        law_index.append(np.full(len(ties), len(laws)))
         rest.append(np.full(len(ties), arm / 2))
         laws.append(solver.linear(tension))  # EA = T: strain 1 at rest
     net = solver.Net(np.vstack(nodes), np.concatenate(fixed), np.vstack(elements), laws,

@@ -102,7 +102,8 @@ def load_keywords(p: Prototype, d: Design, load: str | LoadCase | None = None
 class Run:
     """One barrier's sweep: its deformation and solver statistics; `shapes`: node positions
     (n, 3) m at the SHAPE_LEVELS it reached; `hold_share`: the largest force of the hold of
-    unloaded nodes over the applied load (0 without a hold)."""
+    unloaded nodes over the applied load (0 without a hold); `backend`: the solver's linear
+    backend(s) ("ldl", "pardiso", "lu"; comma-separated if several)."""
 
     scene: BarrierScene
     deformation: Deformation
@@ -111,6 +112,7 @@ class Run:
     failed: dict[float, str]  # load levels that did not converge -> the solver's reason
     shapes: dict[float, np.ndarray] = field(default_factory=dict)
     hold_share: float = 0.0
+    backend: str = ""
 
     def shape_record(self) -> dict[str, Any]:
         """The node positions (m, rounded to SHAPE_DECIMALS) at rest and at each kept level."""
@@ -155,7 +157,7 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw: Any
     shapes = {float(r.level): r.positions[:n] for r in results
               if r.converged and np.any(np.isclose(r.level, SHAPE_LEVELS))}
     return Run(s, d, [r.iterations for r in results], time.perf_counter() - t0, failed, shapes,
-               share)
+               share, ",".join(sorted({r.backend for r in results})))
 
 
 @dataclass(frozen=True)
@@ -205,6 +207,7 @@ class Verification:
             "mismatches_from_start": self.from_start,
             "prototype": dump(self.prototype.deformation), "model": dump(self.model.deformation),
             "iterations": {who: run.iterations for who, run in runs},
+            "solver_backend": {who: run.backend for who, run in runs},
             "not_converged": {who: run.failed for who, run in runs},
             "levels_asked": self.asked, "levels_compared": self.compared,
             "complete": self.complete,
@@ -229,7 +232,7 @@ def verify(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
     case = kw_m["load"]
     ps = prototype_scene(p, mounting=mounting, load=case)
     ms = model_scene(d, mounting=mounting, load=case)
-    jobs = [(sweep, (ms, lv), kw_m), (sweep, (ps, lv), kw_p)]  # the longest first
+    jobs: list[tuple] = [(sweep, (ms, lv), kw_m), (sweep, (ps, lv), kw_p)]  # longest first
     if counterexample:
         jobs.append((steel_counterexample, (d.scale,), {}))
     model, proto, *ce = run_jobs(jobs)

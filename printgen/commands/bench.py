@@ -1,5 +1,6 @@
 """`printgen bench solver|gcode|parts|design|make --out DIR`: run a benchmark of benchmarks/ (a source
-checkout) and write its JSON/PNG into DIR."""
+checkout) and write its JSON/PNG into DIR. An installed wheel has no benchmarks/: there the
+command is not offered (argparse lists the commands that are)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,14 @@ ROOT = Path(__file__).resolve().parents[2]
 BENCHES = ("solver", "gcode", "parts", "design", "make")
 
 
+def available() -> bool:
+    """True when printgen runs from a source checkout that holds the benchmarks."""
+    return (ROOT / "pyproject.toml").is_file() and (ROOT / "benchmarks").is_dir()
+
+
 def register(sub: argparse._SubParsersAction) -> None:
+    if not available():
+        return
     p = sub.add_parser("bench", help="run a benchmark (speed against error) into a folder")
     p.add_argument("name", choices=BENCHES)
     p.add_argument("--out", type=Path, default=Path("benchmarks/results"))

@@ -3,15 +3,25 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Callable
+from typing import Any
 
 from printgen.commands.common import add_json_arg, console, emit_json, table
 from printgen.errors import ProfileError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
-from printgen.inputs.profiles import KINDS, list_profiles, load_raw, profile_name, profile_path
+from printgen.inputs.profiles import (
+    KINDS,
+    list_profiles,
+    load_raw,
+    profile_name,
+    profile_path,
+    searched,
+)
 from printgen.report.jsonout import jsonable
 
-LOADERS = {"materials": load_material, "printers": load_printer, "prints": load_print_style}
+LOADERS: dict[str, Callable[[str], Any]] = {
+    "materials": load_material, "printers": load_printer, "prints": load_print_style}
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -32,6 +42,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run_list(args: argparse.Namespace) -> int:
     kinds = [args.kind] if args.kind else list(KINDS)
     found = {k: list_profiles(k) for k in kinds}
+    if missing := [k for k, names in found.items() if not names]:
+        raise ProfileError(f"no {', '.join(missing)} profiles found; {searched()}; reinstall "
+                           "printgen, or set PRINTGEN_PROFILES to a folder holding "
+                           f"{missing[0]}/NAME.toml")
     if args.json:
         emit_json({k: [{"name": n, "path": profile_path(k, n)} for n in names]
                    for k, names in found.items()})

@@ -43,7 +43,7 @@ def binding_constraints(screened: list[Screened], space: SearchSpace
 
 def _kinds(cands: list[Screened], what: str) -> list[str]:
     counts = Counter(k for s in cands for k in {k for k, _ in s.violations})
-    example = {}
+    example: dict[str, str] = {}
     for s in cands:
         for k, reason in s.violations:
             example.setdefault(k, reason)

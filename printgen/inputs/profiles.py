@@ -1,8 +1,11 @@
 """Profile files: TOML under `profiles/<kind>/<name>.toml`, with `inherits`.
 
 A profile may name a parent of the same kind with `inherits = "name"`; tables merge key by key,
-the child winning. Lookup order: directories in $PRINTGEN_PROFILES (os.pathsep-separated),
-then the bundled `profiles/` of this checkout. Validation is done by the module that owns the
+the child winning. Lookup order (`search_dirs`): directories in $PRINTGEN_PROFILES
+(os.pathsep-separated), then the per-user folder (`user_dir`: platformdirs' config folder, e.g.
+~/.config/printgen/profiles on Linux), then the bundled profiles (`bundled_dir`: package data
+of an installed printgen, the top-level `profiles/` of a source checkout, which is their source
+of truth; setup.py copies it into the wheel). Validation is done by the module that owns the
 data (materials.py, printers.py, ...); this module only finds, reads and merges.
 
 A profile name is a name, never a path: ASCII letters, digits, '-', '_' and '.', not starting
@@ -14,6 +17,7 @@ folders, and no name can make a path when printgen writes `<name>.toml` or `<nam
 
 from __future__ import annotations
 
+import importlib.resources
 import os
 import re
 from collections.abc import Mapping
@@ -24,8 +28,31 @@ from printgen.errors import ProfileError
 from printgen.inputs.schema import load_toml
 
 KINDS = ("materials", "printers", "prints")
-BUNDLED = Path(__file__).resolve().parents[2] / "profiles"
 MAX_INHERIT_DEPTH = 8  # a longer chain is almost surely a cycle or a mistake
+CHECKOUT = Path(__file__).resolve().parents[2]  # the clone's root, when printgen runs from one
+
+
+def bundled_dir(folder: str = "profiles") -> Path:
+    """The data printgen ships (`profiles`, or `examples`): `printgen/<folder>` inside an
+    installed wheel (package data), else `<folder>/` at the root of a source checkout (an
+    editable install or PYTHONPATH), where it is kept."""
+    packaged = importlib.resources.files("printgen") / folder
+    if isinstance(packaged, Path) and packaged.is_dir():
+        return packaged
+    return CHECKOUT / folder
+
+
+BUNDLED = bundled_dir()
+
+
+def user_dir() -> Path:
+    """The per-user profile folder (same layout as `profiles/`), searched after
+    $PRINTGEN_PROFILES and before the bundled profiles."""
+    from platformdirs import user_config_path
+
+    return user_config_path("printgen", appauthor=False) / "profiles"
+
+
 NAME_MAX = 64  # characters in a profile name
 NAME = re.compile(rf"[A-Za-z0-9][A-Za-z0-9._-]{{0,{NAME_MAX - 1}}}")
 
@@ -46,17 +73,22 @@ def profile_name(name: object, where: str = "profile name", *, what: str = "prof
 def search_dirs() -> list[Path]:
     """Profile roots, highest priority first."""
     extra = [Path(p) for p in os.environ.get("PRINTGEN_PROFILES", "").split(os.pathsep) if p]
-    return [*extra, BUNDLED]
+    return [*extra, user_dir(), BUNDLED]
+
+
+def searched() -> str:
+    """Where profiles are looked for, for error messages."""
+    env = "" if os.environ.get("PRINTGEN_PROFILES") else " ($PRINTGEN_PROFILES is not set)"
+    return f"looked in {', '.join(map(str, search_dirs()))}{env}"
 
 
 def user_folder_hint(kind: str, file_name: str) -> str:
-    """Where a user puts a profile of their own: the first folder of $PRINTGEN_PROFILES, or
-    one to create and name there (never the installation's bundled profiles/)."""
+    """Where a user puts a profile of their own: the first folder of $PRINTGEN_PROFILES, else
+    the per-user folder (never the installation's bundled profiles/)."""
     extra = [p for p in os.environ.get("PRINTGEN_PROFILES", "").split(os.pathsep) if p]
     if extra:
         return f"copy it to {Path(extra[0]) / kind / file_name} ($PRINTGEN_PROFILES)"
-    return (f"copy it to a profile folder of your own, e.g. ~/printgen-profiles/{kind}/"
-            f"{file_name}, and set PRINTGEN_PROFILES=~/printgen-profiles")
+    return f"copy it to {user_dir() / kind / file_name} (your per-user profile folder)"
 
 
 def profile_path(kind: str, name: str) -> Path:
@@ -68,7 +100,7 @@ def profile_path(kind: str, name: str) -> Path:
         p = root / kind / f"{stem}.toml"
         if p.is_file():
             return p
-    known = ", ".join(list_profiles(kind)) or "none"
+    known = ", ".join(list_profiles(kind)) or f"none ({searched()})"
     raise ProfileError(
         f"no {kind[:-1]} profile named {name!r}; known: {known}; "
         f"add profiles/{kind}/{stem}.toml or set PRINTGEN_PROFILES to a folder holding {kind}/"

@@ -75,3 +75,11 @@ def provenance_section(rep: Report, meta: dict[str, Any]) -> None:
                   "verifies them.")
     rep.table(["input", "file", "sha256"],
               [[k, v["path"], v["sha256"]] for k, v in meta["inputs"].items()])
+    env = meta["environment"]
+    backend = env["solver_backend"] or {}
+    rep.paragraph(f"Made with Python {env['python']}; solver backend (linear solves of the "
+                  f"tangent): {', '.join(f'{k} {v}' for k, v in backend.items()) or 'none'}. "
+                  "Other versions of these packages may change the last digits of the "
+                  "results (the outputs are byte-identical for the same versions):")
+    rep.table(["package", "version"], [[k, v or "not installed"]
+                                       for k, v in env["packages"].items()])

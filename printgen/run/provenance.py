@@ -1,13 +1,16 @@
 """What a `make` folder says about itself: the provenance (version, command line, sha256 of
-every input) that goes into manifest.json and the report, and the split of the run's record
-into its reproducible part (report.json) and its wall-clock times (timings.json, the one
+every input, the versions of Python and of the packages the numbers and bytes depend on, the
+solver's linear backend) that goes into manifest.json and the report, and the split of the
+run's record into its reproducible part (report.json) and its wall-clock times (timings.json, the one
 volatile file, and `make --json`'s "timings" key)."""
 
 from __future__ import annotations
 
+import platform
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import printgen
 from printgen.outputs import file_digest
 
 if TYPE_CHECKING:
@@ -15,6 +18,10 @@ if TYPE_CHECKING:
 
 TIMINGS = "timings.json"  # the one volatile file: every wall-clock time of the run
 TIME_KEYS = ("timings_s", "seconds", "time_s")  # record keys that hold wall-clock times
+# The packages whose versions can move the outputs' numbers or bytes (meshes, solver, figures);
+# the same inputs with other versions may differ in the last digits (values within ~1e-4).
+PACKAGES = ("numpy", "scipy", "manifold3d", "trimesh", "shapely", "matplotlib", "qdldl",
+            "pypardiso")
 
 
 def split_timings(record: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
@@ -49,9 +56,8 @@ def json_output(record: dict[str, Any]) -> dict[str, Any]:
 
 
 def provenance(ctx: MakeContext) -> dict[str, Any]:
-    """Version, command line and the sha256 of every input (prototype, each profile used)."""
-    from importlib.metadata import version
-
+    """Version, command line, the sha256 of every input (prototype, each profile used) and the
+    software environment (`environment`)."""
     from printgen.inputs.profiles import BUNDLED, load_raw
 
     d = ctx.design
@@ -67,8 +73,24 @@ def provenance(ctx: MakeContext) -> dict[str, Any]:
             shown = (Path("profiles") / path.relative_to(BUNDLED)
                      if path.is_relative_to(BUNDLED) else path)
             inputs[f"{kind}/{path.stem}"] = _digest(path, shown)
-    return {"printgen_version": version("printgen"), "command": ctx.options.command,
-            "inputs": inputs}
+    return {"printgen_version": printgen.__version__, "command": ctx.options.command,
+            "inputs": inputs, "environment": environment(ctx.record)}
+
+
+def environment(record: dict[str, Any]) -> dict[str, Any]:
+    """Python's version, each of PACKAGES' (None: not installed) and the solver backend the
+    verification's sweeps used (from the run's record; None when it did not verify)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    def installed(name: str) -> str | None:
+        try:
+            return version(name)
+        except PackageNotFoundError:
+            return None
+
+    return {"python": platform.python_version(),
+            "packages": {name: installed(name) for name in PACKAGES},
+            "solver_backend": record.get("verification", {}).get("solver_backend")}
 
 
 def _digest(path: Path, shown: Path | None = None) -> dict[str, Any]:
