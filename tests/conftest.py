@@ -88,3 +88,12 @@ def made_1_40(tmp_path_factory):
 
     out = tmp_path_factory.mktemp("make-1-40") / "out"
     return make_mod.make(REALISTIC, 40, out), out
+
+
+def alive(pid: int) -> bool:
+    """True while process `pid` runs (Linux /proc: a zombie counts as ended)."""
+    try:
+        text = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return False
+    return text[text.rindex(")") + 2] != "Z"

@@ -13,6 +13,7 @@ import time
 from pathlib import Path
 
 import pytest
+from conftest import alive
 from proto_files import SIMPLE, write_variant
 
 import printgen.run.make as make_mod
@@ -50,14 +51,6 @@ def _sleep(pid_file: str) -> None:
     time.sleep(SLEEP_S)
 
 
-def _alive(pid: int) -> bool:
-    try:
-        text = Path(f"/proc/{pid}/stat").read_text()
-    except OSError:
-        return False
-    return text[text.rindex(")") + 2] != "Z"
-
-
 @two_cores
 def test_helper_runs_jobs_that_have_workers_of_their_own(monkeypatch):
     monkeypatch.delenv("PRINTGEN_SERIAL", raising=False)
@@ -83,7 +76,7 @@ def test_a_failure_in_the_block_kills_the_worker_and_its_workers(tmp_path, monke
         raise RuntimeError("parent failed")
     pids = [int(f.read_text()) for f in files]
     deadline = time.monotonic() + GONE_WITHIN_S
-    while any(_alive(p) for p in pids):
+    while any(alive(p) for p in pids):
         assert time.monotonic() < deadline, "workers still running"
         time.sleep(0.1)
 

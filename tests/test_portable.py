@@ -17,6 +17,7 @@ import time
 from pathlib import Path
 
 import pytest
+from conftest import alive
 from proto_files import REALISTIC
 
 from printgen import workers
@@ -137,14 +138,6 @@ def sleeper(pid_file: str) -> None:
     time.sleep(START_WITHIN_S * 2)
 
 
-def _alive(pid: int) -> bool:
-    try:
-        text = Path(f"/proc/{pid}/stat").read_text()
-    except OSError:
-        return False
-    return text[text.rindex(")") + 2] != "Z"
-
-
 @pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="workers need 2 cores")
 def test_the_watchdog_ends_workers_whose_parent_was_killed(tmp_path):
     """Without PR_SET_PDEATHSIG a worker ends itself when its parent dies (SIGKILL)."""
@@ -162,7 +155,7 @@ def test_the_watchdog_ends_workers_whose_parent_was_killed(tmp_path):
         parent.wait()
     pids = [int(Path(f).read_text()) for f in files]
     deadline = time.monotonic() + GONE_WITHIN_S
-    while any(_alive(p) for p in pids):
+    while any(alive(p) for p in pids):
         assert time.monotonic() < deadline, f"orphaned workers {pids} still running"
         time.sleep(0.1)
 
