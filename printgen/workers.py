@@ -2,8 +2,10 @@
 
 `run_jobs` runs independent jobs in a process pool whose workers die with their parent, so a
 `make` killed by SIGKILL leaves no orphan: on Linux the kernel kills them
-(`prctl(PR_SET_PDEATHSIG, SIGKILL)` in the initializer), elsewhere a watchdog thread in each
-worker waits on multiprocessing's parent sentinel and exits when it fires. Workers start by
+(`prctl(PR_SET_PDEATHSIG, SIGKILL)` in the initializer) when the parent forked the worker
+itself; elsewhere, and under `forkserver` (whose workers are the fork server's children), a
+watchdog thread in each worker waits on multiprocessing's parent sentinel and exits when it
+fires. Workers start by
 `fork` where it exists and is safe (Linux, a parent running no other Python thread), else by
 `forkserver` (POSIX) or `spawn` (Windows, macOS): see `start_method`. The workers ignore SIGINT,
 SIGTERM and SIGHUP (where the platform defines it): the parent handles those (`signals_raise`:
@@ -156,11 +158,13 @@ def init_worker(plat: Platform, sink: Any = None, at: float | None = None) -> No
     _inherited, _sink, _deadline = plat, sink, at
     for s in plat.signals:
         signal.signal(s, signal.SIG_IGN)
+    parent = multiprocessing.parent_process()
     if plat.pdeathsig:
         _die_with_parent_linux()
-    else:
+    if not plat.pdeathsig or (parent is not None and os.getppid() != parent.pid):
+        # the kernel's signal follows the process that forked this one: under `forkserver`
+        # that is the fork server, which outlives a SIGKILLed parent while workers hold it
         _watch_parent()
-    parent = multiprocessing.parent_process()
     if parent is not None and not parent.is_alive():  # it died before the guard took effect
         os._exit(1)
 
