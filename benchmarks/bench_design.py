@@ -29,10 +29,10 @@ LEVEL_STEP = 0.1  # coarser than the verification's 0.05: a benchmark, not a ver
 
 def _setup():
     from printgen.design.plan import make_design
-    from printgen.design.search_space import default_space, grid, search_context
     from printgen.design.selection import select
     from printgen.design.similitude import scale_targets
     from printgen.inputs.prototype import load_prototype
+    from printgen.search.space import default_space, grid, search_context
 
     p = load_prototype(Path(__file__).resolve().parents[1] / "examples/realistic_barrier.toml")
     t = scale_targets(p, 40)
@@ -46,8 +46,8 @@ def _setup():
 
 
 def _stage_times(runner, p, ctx, points, designs, repeat: int) -> dict:
-    from printgen.design.search import VerifyShared, VerifyTask, screen_all
-    from printgen.run.design import verify_task
+    from printgen.run.search import verify_task
+    from printgen.search.nets import VerifyShared, VerifyTask, screen_all
 
     best_screen = min(_timed(lambda: screen_all(runner, ctx, points)) for _ in range(repeat))
     tasks = [VerifyTask(str(i), d) for i, d in enumerate(designs)]
@@ -66,9 +66,9 @@ def _timed(fn) -> float:
 
 
 def run(out_dir: Path, repeat: int = 2) -> dict:
-    from printgen.design.sweep import open_runner
     from printgen.outputs import write_bytes, write_text
     from printgen.report.jsonout import dumps
+    from printgen.search.sweep import open_runner
 
     p, ctx, points, designs = _setup()
     cores = os.cpu_count() or 1

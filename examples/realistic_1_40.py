@@ -12,11 +12,11 @@ from pathlib import Path
 
 import numpy as np
 
-from printgen.check.verify import Verification, verify
 from printgen.design.plan import make_design
 from printgen.design.selection import select
 from printgen.design.similitude import scale_targets
 from printgen.inputs.prototype import load_prototype
+from printgen.verification.verify import Verification, verify
 
 HERE = Path(__file__).resolve().parent
 

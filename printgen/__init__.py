@@ -12,7 +12,7 @@ The public verbs (`printgen.run.api`), imported on first use so `import printgen
 - ``verify(prototype, scale, design=None)`` -> `Verification`
 - ``verify_design(prototype, scale, design_file, out)`` -> `VerifyRun` (printgen verify's folder)
 - ``calibrate(paths, material=...)`` -> `Calibration`
-- ``design_search(prototype, scales)`` -> `DesignRun` (the inverse design, on Dask)
+- ``search_nets(prototype, scales)`` -> `DesignRun` (the inverse design, on Dask)
 """
 
 from __future__ import annotations
@@ -22,16 +22,25 @@ from typing import TYPE_CHECKING, Any
 __version__ = "0.1.0"
 
 VERBS = ("targets", "select", "plan", "make", "verify", "verify_design", "calibrate",
-         "design_search")
-__all__ = ["__version__", "calibrate", "design_search", "make", "plan", "select", "targets",
-           "verify", "verify_design"]
+         "search_nets")
+__all__ = [
+    "__version__",
+    "calibrate",
+    "make",
+    "plan",
+    "search_nets",
+    "select",
+    "targets",
+    "verify",
+    "verify_design",
+]
 
 if TYPE_CHECKING:
     from printgen.run.api import (
         calibrate,
-        design_search,
         make,
         plan,
+        search_nets,
         select,
         targets,
         verify,

@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 from conftest import reference_design_1_40
 
-from printgen.check import bands
-from printgen.check.bands import (
+from printgen.design.record import Section
+from printgen.verification import bands
+from printgen.verification.bands import (
     Variant,
     band_verdict,
     model_band,
@@ -19,8 +20,7 @@ from printgen.check.bands import (
     run_variant,
     variant_scene,
 )
-from printgen.check.compare import METRICS
-from printgen.design.record import Section
+from printgen.verification.compare import METRICS
 
 COARSE = 3  # the 1:40 net with a 3x coarser mesh (50 nodes): fast sweeps
 LEVELS = np.round(np.arange(0.0, 1.11, 0.1), 10)  # 0.1 steps keep the sweeps short

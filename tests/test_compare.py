@@ -7,7 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from printgen.check.compare import METRICS, Deformation, compare, explain, headline, row_strain
+from printgen.verification.compare import (
+    METRICS,
+    Deformation,
+    compare,
+    explain,
+    headline,
+    row_strain,
+)
 
 EXACT = 1e-12  # closed-form geometry, round-off only
 

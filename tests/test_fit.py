@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from conftest import reference_design_1_40
 
-from printgen.check.fit import Params, fit_measured, predict, slackened
-from printgen.check.measured import Measurement
+from printgen.verification.fit import Params, fit_measured, predict, slackened
+from printgen.verification.measured import Measurement
 
 COARSE = 2  # the 1:40 net with a 2x coarser mesh (distinct top and mid rows): fast sweeps
 LEVELS = np.array([0.0, 0.5, 0.8, 1.0])  # the load path of every evaluation

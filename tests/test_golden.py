@@ -13,7 +13,7 @@ from conftest import ROOT
 
 GOLDEN = ROOT / "tests" / "golden" / "realistic_1_40.json"
 LEVELS = (0.5, 1.0, 1.1)  # relative loadings h / h_B kept
-# The solver stops at an out-of-balance force of 1e-7 of the load (check/verify.SOLVER_TOL);
+# The solver stops at an out-of-balance force of 1e-7 of the load (verification/verify.SOLVER_TOL);
 # curves from the same inputs agree far closer, across BLAS builds to about 1e-9 relative.
 CURVE_RTOL = 1e-6
 CURVE_ATOL = 1e-9  # a curve that is 0 at a level (the strains at rest)

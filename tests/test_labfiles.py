@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 from conftest import reference_design_1_40
 
-from printgen.check.measured import MeasurementError, read_measured
-from printgen.check.readings import RAW_COLUMNS, FlumeUnits, design_units
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_printer
 from printgen.parts.gcode.estimate import duration, print_estimate
 from printgen.parts.gcode.toolpath import BORDER, TRAVEL, Toolpath
+from printgen.verification.measured import MeasurementError, read_measured
+from printgen.verification.readings import RAW_COLUMNS, FlumeUnits, design_units
 
 EXACT = 1e-12  # sums of a few floats
 READ_TOL = 1e-9  # numbers written with 10 significant digits and read back

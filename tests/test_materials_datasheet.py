@@ -9,15 +9,15 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
-from printgen.design.per_material import first_on_target, per_material, reachable, target_sentence
-from printgen.design.screen import screen_batch
-from printgen.design.search_choice import SMALL_STRAIN_TOLERANCE
-from printgen.design.search_space import default_space, grid, search_context
 from printgen.design.selection import CALIBRATE_FIRST, MIN_SAFETY_FACTOR
 from printgen.design.similitude import scale_targets
 from printgen.errors import InputError
 from printgen.inputs import materials as mats
 from printgen.inputs.prototype import load_prototype
+from printgen.search.choice import SMALL_STRAIN_TOLERANCE
+from printgen.search.per_material import first_on_target, per_material, reachable, target_sentence
+from printgen.search.screen import screen_batch
+from printgen.search.space import default_space, grid, search_context
 
 DATASHEET_PROFILES = ("tpu-85a",)
 SECANT_TO_100_PERCENT_PA = 6e6  # CR-3D TPU 85A TDS: stress at 100 % strain 6 MPa / strain 1.0
@@ -96,7 +96,7 @@ def test_strand_section_coupon_export_calibrates_back_to_its_modulus(tmp_path, s
     generated with the datasheet modulus (linear to 2 % strain, then softening), and its
     sidecar: `calibrate` gives that modulus back."""
     from printgen.calibrate.pipeline import calibrate
-    from printgen.design.screen import strand_section
+    from printgen.search.screen import strand_section
 
     hit = first_on_target(screened_1_40)
     p = load_prototype(ROOT / "examples" / "realistic_barrier.toml")

@@ -10,8 +10,10 @@ import numpy as np
 import pytest
 from conftest import EXAMPLES, reference_design_1_40
 
-from printgen.check.bands import Band
-from printgen.check.measured import (
+from printgen.cli import main
+from printgen.design.record import Design
+from printgen.verification.bands import Band
+from printgen.verification.measured import (
     COLUMNS,
     Measurement,
     MeasurementError,
@@ -21,8 +23,6 @@ from printgen.check.measured import (
     model_predictor,
     read_measured,
 )
-from printgen.cli import main
-from printgen.design.record import Design
 
 FIT_TOL = 0.05  # issue 10: the fit recovers a known stiffness factor to 5 %
 KNOWN_FACTOR = 1.6  # the "printed net" of the synthetic test: 60 % stiffer than its profile

@@ -10,21 +10,21 @@ import pytest
 from proto_files import REALISTIC
 
 import solver
-from printgen.check.compare import wire_elongation
-from printgen.check.scenes import (
+from printgen.design.plan import make_design
+from printgen.design.selection import select
+from printgen.design.similitude import scale_targets
+from printgen.errors import InputError
+from printgen.inputs.prototype import load_prototype
+from printgen.verification.compare import wire_elongation
+from printgen.verification.scenes import (
     SENSOR_FORCE_N,
     BarrierScene,
     Wire,
     model_scene,
     prototype_scene,
 )
-from printgen.check.solvernet import WIRE_RATE, WIRE_STRAIN, build, wire_law
-from printgen.check.verify import sweep
-from printgen.design.plan import make_design
-from printgen.design.selection import select
-from printgen.design.similitude import scale_targets
-from printgen.errors import InputError
-from printgen.inputs.prototype import load_prototype
+from printgen.verification.solvernet import WIRE_RATE, WIRE_STRAIN, build, wire_law
+from printgen.verification.verify import sweep
 from solver.assemble import internal, make_bars, make_cable
 
 EXACT = 1e-12  # closed-form geometry: round-off only

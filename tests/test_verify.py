@@ -10,14 +10,14 @@ import numpy as np
 import pytest
 from proto_files import REALISTIC, SIMPLE, write_variant
 
-from printgen.check.scenes import model_scene, prototype_scene
-from printgen.check.verify import SHAPE_LEVELS, sweep, verify
 from printgen.design.plan import make_design
 from printgen.design.selection import select
 from printgen.design.similitude import scale_targets
 from printgen.inputs.prototype import load_prototype
 from printgen.report.jsonout import dumps
 from printgen.report.plots import deformed_figure
+from printgen.verification.scenes import model_scene, prototype_scene
+from printgen.verification.verify import SHAPE_LEVELS, sweep, verify
 
 HOLD_SHARE_MAX = 0.01  # the hold may carry at most 1 % of the applied load (a regularisation)
 HOLD_EFFECT = 0.01  # ... and move no normalised deformation by more than 1 % of its peak
@@ -95,9 +95,9 @@ def _reference_curves(s, lv: np.ndarray) -> dict[str, np.ndarray]:
     constant tension (not per-segment elements), solved to TIGHT_TOL: an independent
     formulation of the same physics."""
     import solver
-    from printgen.check.compare import deformation
-    from printgen.check.solvernet import WIRE_STRAIN, build, path_length, wire_law
-    from printgen.check.verify import loads_function
+    from printgen.verification.compare import deformation
+    from printgen.verification.solvernet import WIRE_STRAIN, build, path_length, wire_law
+    from printgen.verification.verify import loads_function
 
     net, ex = build(s)
     keep = np.setdiff1d(np.arange(len(net.elements)), ex.wire_elements)

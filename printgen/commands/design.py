@@ -1,6 +1,6 @@
 """`printgen design PROTOTYPE --scale 40 [--objective deformation|stiffness] [--out DIR]
 [--scheduler ADDRESS | --workers N | --serial] [--scales 20,30,40,60] [bounds] [--json]`:
-search the printable net that deforms most like the prototype (see printgen.design.search)."""
+search the printable net that deforms most like the prototype (see printgen.search.nets)."""
 
 from __future__ import annotations
 
@@ -9,12 +9,12 @@ import sys
 from pathlib import Path
 
 from printgen.commands.common import add_json_arg, check_profile_args, console, emit_json, table
-from printgen.design.search import OBJECTIVES, VERIFY_NETS
-from printgen.design.search_choice import short
-from printgen.design.sweep import check_address
 from printgen.errors import InputError
 from printgen.run import api
-from printgen.run.design import DesignRun, SearchOptions, check_out, write_outputs
+from printgen.run.search import DesignRun, SearchOptions, check_out, write_outputs
+from printgen.search.choice import short
+from printgen.search.nets import OBJECTIVES, VERIFY_NETS
+from printgen.search.sweep import check_address
 
 SHOW = 10  # Pareto members shown per scale in the table (all are in report.json)
 
@@ -69,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
         verify_nets=args.verify_nets, level_step=args.level_step)
     out = args.out or Path("out") / f"{Path(args.prototype).stem}-design"
     check_out(out, args.prototype)  # before the search
-    result = api.design_search(args.prototype, scales, options=opts, scheduler=args.scheduler,
+    result = api.search_nets(args.prototype, scales, options=opts, scheduler=args.scheduler,
                                workers=args.workers, serial=args.serial,
                                progress=not args.json)
     files = write_outputs(result, out, args.scale if args.scale else scales[0], args.prototype)

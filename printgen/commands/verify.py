@@ -11,7 +11,6 @@ from pathlib import Path
 
 from rich.console import Console
 
-from printgen.check.measured import COLUMNS, FIT_KINDS, LEVEL_COLUMN
 from printgen.commands.common import (
     add_json_arg,
     add_load_args,
@@ -21,6 +20,7 @@ from printgen.commands.common import (
     emit_json,
     table,
 )
+from printgen.verification.measured import COLUMNS, FIT_KINDS, LEVEL_COLUMN
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from printgen.design.search import SearchResult
 from printgen.report.plots import _png, _pyplot
+from printgen.search.nets import SearchResult
 
 MAX_CLOUD = 4000  # candidates drawn in the background cloud (every k-th beyond this)
 

@@ -3,8 +3,8 @@ against their bounds, the best of each discrete choice, and what the data determ
 
 from __future__ import annotations
 
-from printgen.check.fit import BOUNDS, MultiFit
 from printgen.report.html import Report
+from printgen.verification.fit import BOUNDS, MultiFit
 
 
 def _value(key: str, v: float) -> str:

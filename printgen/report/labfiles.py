@@ -13,11 +13,11 @@ from typing import Any
 
 import numpy as np
 
-from printgen.check.bands import Band
-from printgen.check.compare import METRICS
-from printgen.check.measured import COLUMNS, LEVEL_COLUMN
-from printgen.check.readings import DEPTH_COLUMN, RAW_COLUMNS, flume_units
-from printgen.check.verify import Verification
+from printgen.verification.bands import Band
+from printgen.verification.compare import METRICS
+from printgen.verification.measured import COLUMNS, LEVEL_COLUMN
+from printgen.verification.readings import DEPTH_COLUMN, RAW_COLUMNS, flume_units
+from printgen.verification.verify import Verification
 
 DIGITS = 8  # significant digits of every number in the CSV files
 NOISE = 1e-6  # |value| below this (in the column's unit: %, mm, N, kN or -) is written as 0

@@ -6,12 +6,12 @@ import io
 
 import numpy as np
 
-from printgen.check.bands import Band
-from printgen.check.compare import METRICS, Deformation
-from printgen.check.measured import Fit, Measurement
-from printgen.check.scenes import BarrierScene
 from printgen.design.similitude import FORCE_EXPONENT, to_prototype
 from printgen.errors import PrintgenError
+from printgen.verification.bands import Band
+from printgen.verification.compare import METRICS, Deformation
+from printgen.verification.measured import Fit, Measurement
+from printgen.verification.scenes import BarrierScene
 
 DPI = 110
 SVG_SALT = "printgen"  # matplotlib's svg.hashsalt: the same figure gives the same SVG ids

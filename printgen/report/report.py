@@ -7,13 +7,13 @@ from typing import Any
 
 import numpy as np
 
-from printgen.check.bands import Band
-from printgen.check.verify import CounterExample, Verification
 from printgen.design.record import Design
 from printgen.design.selection import Candidate, Selection
 from printgen.design.similitude import FORCE_EXPONENT, ScaledTargets, to_prototype
 from printgen.inputs.prototype import Prototype
 from printgen.report.html import Report
+from printgen.verification.bands import Band
+from printgen.verification.verify import CounterExample, Verification
 
 SHOW = 6  # candidates per component in the report's tables (all are in report.json)
 SHOWN_LEVEL = 1.0  # relative loading of the 3D picture of both deformed nets
@@ -107,8 +107,8 @@ def verification_sections(rep: Report, v: Verification | None, ce: CounterExampl
 
 def _sweep_sections(rep: Report, v: Verification, scale: float, band: Band | None = None
                     ) -> None:
-    from printgen.check.compare import METRICS, TOLERANCE
     from printgen.report.plots import verification_figure
+    from printgen.verification.compare import METRICS, TOLERANCE
 
     rep.paragraph(
         f"Both barriers are solved as tension-only cable nets (solver/) under the same relative "

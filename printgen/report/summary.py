@@ -8,7 +8,7 @@ from __future__ import annotations
 import html
 from typing import Any
 
-from printgen.check.compare import METRICS
+from printgen.verification.compare import METRICS
 
 NEXT_PASS = ("Print the parts (the .gcode files, or slice the .3mf files), assemble them as the "
              "Assembly section below shows, and run the flume test with measurement-sheet.csv; "

@@ -9,12 +9,12 @@ from typing import Any
 
 import numpy as np
 
-from printgen.check.bands import Band, BandVerdict, band_verdicts
-from printgen.check.compare import METRICS, Deformation
-from printgen.check.measured import Fit, Measurement, mismatch
-from printgen.check.verify import Verification
 from printgen.report.html import Report
 from printgen.report.report import fmt_value, unit_of
+from printgen.verification.bands import Band, BandVerdict, band_verdicts
+from printgen.verification.compare import METRICS, Deformation
+from printgen.verification.measured import Fit, Measurement, mismatch
+from printgen.verification.verify import Verification
 
 SHOW_LEVELS = (0.5, 1.0, 1.1)  # relative loadings shown in the tables and summaries
 

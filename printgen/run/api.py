@@ -26,10 +26,10 @@ from printgen.inputs.prototype import Prototype, load_prototype
 if TYPE_CHECKING:
     from printgen.calibrate.pipeline import Calibration
     from printgen.calibrate.sample import FitOptions
-    from printgen.check.verify import Verification
-    from printgen.run.design import DesignRun, SearchOptions
     from printgen.run.make import MakeContext, MakeOptions
+    from printgen.run.search import DesignRun, SearchOptions
     from printgen.run.verify import VerifyRun
+    from printgen.verification.verify import Verification
 
 PrototypeLike = str | Path | Prototype
 
@@ -99,8 +99,8 @@ def verify(prototype: PrototypeLike, scale: float, design_: Design | str | Path 
     loading, h/h_B = 0 to 1.1, and compared by their normalised deformations. `design_` is a
     `Design` or the design.json that `make` wrote; without it, the design `make` would print
     is checked."""
-    from printgen.check.verify import verify as _verify
     from printgen.design.design_file import load_design
+    from printgen.verification.verify import verify as _verify
 
     p = prototype_of(prototype)
     if design_ is None:
@@ -126,17 +126,17 @@ def verify_design(prototype: str | Path, scale: float, design_file: str | Path,
                           time_limit_s=time_limit_s)
 
 
-def design_search(prototype: PrototypeLike, scales: float | Sequence[float], *,
+def search_nets(prototype: PrototypeLike, scales: float | Sequence[float], *,
                   options: SearchOptions | None = None, scheduler: str | None = None,
                   serial: bool = False, workers: int | None = None,
                   progress: bool = False) -> DesignRun:
     """The inverse design: the printable net that deforms most like the prototype at each
     scale (screened by the membrane law, the best verified with the solver), on a local Dask
     cluster, the cluster at `scheduler`, or serially."""
-    from printgen.run.design import SearchOptions, design_searches
+    from printgen.run.search import SearchOptions, search_at_scales
 
     lams = [float(scales)] if isinstance(scales, int | float) else [float(s) for s in scales]
-    return design_searches(prototype, lams, options=options or SearchOptions(),
+    return search_at_scales(prototype, lams, options=options or SearchOptions(),
                            scheduler=scheduler, serial=serial, workers=workers,
                            progress=progress)
 

@@ -31,7 +31,7 @@ DEFAULT_LIMIT_S = 60.0
 SWEEP_S_AT_REFERENCE = 0.45  # one net over the 23 load levels of the sweep, one core
 REFERENCE_NODES = 500  # node count at which SWEEP_S_AT_REFERENCE was measured
 SWEEP_EXPONENT = 1.45  # sweep time grows as nodes^1.45 (518 -> 1998 -> 7776 nodes)
-# Uncertainty bands (check/bands.py): refinement test and model variants on coarsened nets
+# Uncertainty bands (verification/bands.py): refinement test and model variants on coarsened nets
 # after the nominal sweeps: 2.7 s on the 1:40 example, ~1.4 x the model's sweep on the simple.
 BANDS_FACTOR = 1.5
 BANDS_MIN_S = 2.5

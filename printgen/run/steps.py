@@ -28,14 +28,14 @@ HELPER_REPORT = "helper: verification figures and tables"
 WAIT_SWEEPS = "waiting for the verification sweeps"  # in this process, within a step
 
 if TYPE_CHECKING:  # pragma: no cover
-    from printgen.check.bands import Band
-    from printgen.check.verify import Verification
     from printgen.design.record import Design
     from printgen.inputs.printers import Printer
     from printgen.inputs.prototype import Prototype
     from printgen.parts.gcode.toolpath import Toolpath
     from printgen.report.html import FigureFile
     from printgen.run.make import MakeContext
+    from printgen.verification.bands import Band
+    from printgen.verification.verify import Verification
 
 
 def preload_parts() -> None:
@@ -241,7 +241,7 @@ def part_thickness(kind: str, part) -> float:
 
 def verify_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     """Prototype vs model over the loading sweep, the model's uncertainty band
-    (printgen.check.bands), and the steel counter-example: the sections and record of
+    (printgen.verification.bands), and the steel counter-example: the sections and record of
     `verification_report`, collected from the helper process `make` started the sweeps in,
     or computed here."""
     sweeps_done(ctx)
@@ -296,8 +296,8 @@ def verification_sweeps(prototype: Prototype, design: Design, *, load: str | Non
     (README: Pre-print verification); every load level is solved on both. Needs nothing from
     the other steps, so it can run in a worker process while they run.
     """
-    from printgen.check.bands import free_section, model_band, model_load_kw
-    from printgen.check.verify import verify
+    from printgen.verification.bands import free_section, model_band, model_load_kw
+    from printgen.verification.verify import verify
 
     v = verify(prototype, design, load=load, counterexample=True)
     return v, model_band(design, v.model, load_kw=model_load_kw(prototype, design, load),

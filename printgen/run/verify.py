@@ -14,24 +14,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from printgen.check.bands import (
-    Band,
-    band_verdicts,
-    free_section,
-    model_band,
-    model_load_kw,
-)
-from printgen.check.fit import MultiFit, fit_levels, fit_measured
-from printgen.check.measured import (
-    Fit,
-    Measurement,
-    fit_factor,
-    fitted_profile,
-    model_predictor,
-    read_measured,
-)
-from printgen.check.readings import design_units
-from printgen.check.verify import Verification, verify
 from printgen.design.design_file import load_design
 from printgen.design.record import Design
 from printgen.inputs.materials import load_material
@@ -51,6 +33,24 @@ from printgen.report.uncertainty import (
 )
 from printgen.run.budget import DEFAULT_LIMIT_S, Work, check_budget, sweep_cores
 from printgen.run.provenance import TIMINGS
+from printgen.verification.bands import (
+    Band,
+    band_verdicts,
+    free_section,
+    model_band,
+    model_load_kw,
+)
+from printgen.verification.fit import MultiFit, fit_levels, fit_measured
+from printgen.verification.measured import (
+    Fit,
+    Measurement,
+    fit_factor,
+    fitted_profile,
+    model_predictor,
+    read_measured,
+)
+from printgen.verification.readings import design_units
+from printgen.verification.verify import Verification, verify
 
 
 @dataclass
@@ -165,7 +165,7 @@ def _write(out: str | Path, rep: Report, record: dict[str, Any], d: Design, prof
 
 def band_summary(run: VerifyRun) -> list[str]:
     """One line per metric: the band verdict (for the command line's summary)."""
-    from printgen.check.compare import METRICS
+    from printgen.verification.compare import METRICS
 
     keep = run.band.levels
     proto = run.verification.prototype.deformation

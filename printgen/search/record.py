@@ -10,11 +10,11 @@ import json
 from collections import Counter
 from typing import Any
 
-from printgen.design.per_material import per_material
-from printgen.design.screen import Screened
-from printgen.design.search import SearchResult, VerifyScore
-from printgen.design.search_choice import SMALL_STRAIN_TOLERANCE
-from printgen.design.search_space import space_record
+from printgen.search.choice import SMALL_STRAIN_TOLERANCE
+from printgen.search.nets import SearchResult, VerifyScore
+from printgen.search.per_material import per_material
+from printgen.search.screen import Screened
+from printgen.search.space import space_record
 
 # Columns of the candidate table (candidates.json), in order.
 COLUMNS = ("index", "material", "beads_across", "layers", "mesh_x_mm", "mesh_y_mm",

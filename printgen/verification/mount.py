@@ -16,8 +16,8 @@ import dataclasses
 
 import numpy as np
 
-from printgen.check.scenes import BarrierScene
 from printgen.errors import GeometryError
+from printgen.verification.scenes import BarrierScene
 
 SPANS = ("printed", "free-section")
 

@@ -11,12 +11,12 @@ from __future__ import annotations
 from collections import Counter
 from typing import TYPE_CHECKING
 
-from printgen.design.screen import Screened
-from printgen.design.search_space import SearchSpace, half_cell_counts
 from printgen.design.selection import CALIBRATE_FIRST, MIN_SAFETY_FACTOR, NET_ON_TARGET
+from printgen.search.screen import Screened
+from printgen.search.space import SearchSpace, half_cell_counts
 
 if TYPE_CHECKING:
-    from printgen.design.search import SearchResult
+    from printgen.search.nets import SearchResult
 
 SMALL_STRAIN_TOLERANCE = NET_ON_TARGET  # on target: small-strain membrane stiffness within +-30 %
 LABELS = {"strength": f"strength (safety factor < {MIN_SAFETY_FACTOR} at the overflow force)",

@@ -33,15 +33,15 @@ import numpy as np
 from printgen.barrier.loads import LoadCase
 from printgen.barrier.patterns import get_pattern
 from printgen.barrier.patterns.diamond import diamond_factor
-from printgen.check.compare import METRICS
-from printgen.check.scenes import BarrierScene, model_scene
-from printgen.check.verify import Run, load_keywords, run_jobs, sweep
 from printgen.design.record import Design
 from printgen.design.section import area_m2
 from printgen.errors import GeometryError
 from printgen.inputs.materials import load_material
 from printgen.inputs.prototype import Prototype
 from printgen.units import MM
+from printgen.verification.compare import METRICS
+from printgen.verification.scenes import BarrierScene, model_scene
+from printgen.verification.verify import Run, load_keywords, run_jobs, sweep
 
 SLACK_MAX = 0.01  # initial slack of the printed net, upper end of the range (issue 10: 0-1 %)
 COARSENINGS = (2, 3)  # mesh multipliers tried in turn for the variant sweeps
@@ -76,7 +76,7 @@ def mounting_options() -> tuple[str, ...]:
     param = inspect.signature(model_scene).parameters.get("mounting")
     if param is None:
         return ()
-    from printgen.check import scenes
+    from printgen.verification import scenes
 
     return tuple(getattr(scenes, "MOUNTINGS", ()))
 
@@ -122,7 +122,7 @@ def model_variants(d: Design, mounting: str | None = None, free_section: float |
 def _model_form_variants(d: Design, free_section: float | None, notes: list[str]
                          ) -> list[Variant]:
     """Issue 25: the water's force normal to the deformed net, and the net mounted in a free
-    section narrower than its printed width (printgen.check.mount)."""
+    section narrower than its printed width (printgen.verification.mount)."""
     out = [Variant("pressure normal to the deformed net", pressure="normal",
                    source="the folded film presses normal to the net (nominal: along the "
                           "flow, reference section 3)")]
@@ -172,7 +172,7 @@ def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
 def _orientation_variants(d: Design) -> list[Variant]:
     """The panel law read along each mesh diagonal its profile does not record (issue 25:
     the paper does not say which diagonal its printed panels were loaded along)."""
-    from printgen.check.scenes import ORIENTATIONS
+    from printgen.verification.scenes import ORIENTATIONS
 
     law = load_material(d.net.material).panel_law
     recorded = "short" if law.mesh_along_load <= law.mesh_across_load else "long"
@@ -208,7 +208,7 @@ def variant_scene(d: Design, v: Variant, coarsen: int = 1) -> BarrierScene:
     cables = {k: (nodes, _scaled(law, v.cable_factor)) for k, (nodes, law) in s.cables.items()}
     s = dataclasses.replace(s, laws=laws, cables=cables, pressure=v.pressure)
     if v.span is not None:  # issue 25: the printed net mounted in the flume's free section
-        from printgen.check.mount import in_free_section
+        from printgen.verification.mount import in_free_section
 
         s = in_free_section(s, v.span)
     return s

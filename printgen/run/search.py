@@ -1,8 +1,8 @@
 """`printgen design`: the design search at one scale or a series of scales, with the solver
 stage wired in, and its output folder.
 
-The search (`printgen.design.search`) screens the candidates by the analytic membrane law and
-verifies the best few with the pre-print verification (`printgen.check.verify`); the solver
+The search (`printgen.search.nets`) screens the candidates by the analytic membrane law and
+verifies the best few with the pre-print verification (`printgen.verification.verify`); the solver
 task lives here because the check stage sits above the design stage. Output folder (written
 whole, `outputs.staged_dir`):
 
@@ -23,22 +23,22 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from printgen.design.per_material import reachable
-from printgen.design.search import (
+from printgen.design.similitude import scale_targets
+from printgen.inputs.profiles import search_dirs
+from printgen.inputs.prototype import Prototype, load_prototype
+from printgen.outputs import check_destination, staged_dir
+from printgen.report.jsonout import dumps
+from printgen.search.nets import (
     SearchResult,
     VerifyScore,
     VerifyShared,
     VerifyTask,
     search,
 )
-from printgen.design.search_record import candidates_json, result_record
-from printgen.design.search_space import SearchSpace, default_space
-from printgen.design.similitude import scale_targets
-from printgen.design.sweep import open_runner
-from printgen.inputs.profiles import search_dirs
-from printgen.inputs.prototype import Prototype, load_prototype
-from printgen.outputs import check_destination, staged_dir
-from printgen.report.jsonout import dumps
+from printgen.search.per_material import reachable
+from printgen.search.record import candidates_json, result_record
+from printgen.search.space import SearchSpace, default_space
+from printgen.search.sweep import open_runner
 
 
 def verify_task(shared: VerifyShared, task: VerifyTask) -> VerifyScore:
@@ -46,7 +46,7 @@ def verify_task(shared: VerifyShared, task: VerifyTask) -> VerifyScore:
     same task gives the same score in any process (the sweep worker runs it serially)."""
     from threadpoolctl import threadpool_limits
 
-    from printgen.check.verify import levels, verify
+    from printgen.verification.verify import levels, verify
 
     lv = None if shared.level_step is None else levels(step=shared.level_step)
     with _serial(), threadpool_limits(limits=1):  # one BLAS thread: the same sums everywhere
@@ -103,7 +103,7 @@ def space_for(p: Prototype, scale: float, o: SearchOptions) -> SearchSpace:
     return default_space(p, scale_targets(p, scale), **kw)
 
 
-def design_searches(prototype: str | Path | Prototype, scales: list[float], *,
+def search_at_scales(prototype: str | Path | Prototype, scales: list[float], *,
                     options: SearchOptions = SearchOptions(), scheduler: str | None = None,
                     workers: int | None = None, serial: bool = False,
                     progress: bool = False) -> DesignRun:

@@ -11,7 +11,7 @@ Two stages over the space of `search_space` (material x strand section x diamond
 
 Both stages run on a `sweep.Runner` (Dask, or serial): each task is a pure function of a small
 frozen record, so the result does not depend on where it ran. The solver stage is passed in
-(`verifier`) because the check stage sits above the design stage (`printgen.run.design` wires
+(`verifier`) because the check stage sits above the design stage (`printgen.run.search` wires
 it); with the `stiffness` objective the search stops after stage 1.
 """
 
@@ -23,13 +23,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from printgen.design.pareto import pareto_mask
-from printgen.design.per_material import target_sentence
 from printgen.design.plan import make_design
 from printgen.design.record import Design, NetDesign
-from printgen.design.screen import Screened, screen_batch, strand_section
-from printgen.design.search_choice import binding_constraints, choice_reasons
-from printgen.design.search_space import (
+from printgen.design.selection import select
+from printgen.design.similitude import scale_targets
+from printgen.errors import InputError
+from printgen.inputs.materials import load_material
+from printgen.inputs.prototype import Prototype
+from printgen.search.choice import binding_constraints, choice_reasons
+from printgen.search.pareto import pareto_mask
+from printgen.search.per_material import target_sentence
+from printgen.search.screen import Screened, screen_batch, strand_section
+from printgen.search.space import (
     NetPoint,
     SearchContext,
     SearchSpace,
@@ -37,12 +42,7 @@ from printgen.design.search_space import (
     grid,
     search_context,
 )
-from printgen.design.selection import select
-from printgen.design.similitude import scale_targets
-from printgen.design.sweep import Runner, batches
-from printgen.errors import InputError
-from printgen.inputs.materials import load_material
-from printgen.inputs.prototype import Prototype
+from printgen.search.sweep import Runner, batches
 
 OBJECTIVES = ("deformation", "stiffness")
 VERIFY_NETS = 3  # nets verified by the solver (each with every border width)

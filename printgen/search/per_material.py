@@ -11,9 +11,9 @@ must be measured on the test pieces before the barrier is printed.
 
 from __future__ import annotations
 
-from printgen.design.screen import Screened
-from printgen.design.search_choice import SMALL_STRAIN_TOLERANCE, short
 from printgen.design.selection import CALIBRATE_FIRST, MIN_SAFETY_FACTOR
+from printgen.search.choice import SMALL_STRAIN_TOLERANCE, short
+from printgen.search.screen import Screened
 
 
 def on_target(s: Screened) -> bool:

@@ -5,7 +5,7 @@ water depth (mm) for each relative loading, and the tensions (N).
 The pre-print check works in normalised quantities (strain of a sensor row, deflection /
 width, lowering / height, h / h_B); a reading in mm is the normalised value times the printed
 model's own length: the sensor row's rest length (the wire from its anchor over the row's
-nodes, printgen.check.compare.wire_elongation), the net's width or height, the barrier height
+nodes, printgen.verification.compare.wire_elongation), the net's width or height, the barrier height
 h_B (the net's height: the water depth at h / h_B = 1).
 """
 
@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from printgen.check.scenes import BarrierScene
-from printgen.check.solvernet import path_length
+from printgen.verification.scenes import BarrierScene
+from printgen.verification.solvernet import path_length
 
 MM = 1e3  # mm per m
 SENSORS = {"strain_bottom": "bottom", "strain_top": "top", "strain_mid": "mid"}
@@ -58,6 +58,6 @@ def flume_units(scene: BarrierScene) -> FlumeUnits:
 
 def design_units(design) -> FlumeUnits:
     """`flume_units` of the printed model of `design` (printgen.design.record.Design)."""
-    from printgen.check.scenes import model_scene
+    from printgen.verification.scenes import model_scene
 
     return flume_units(model_scene(design))

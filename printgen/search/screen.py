@@ -19,7 +19,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from printgen.design.record import Section
-from printgen.design.search_space import NetPoint, SearchContext
 from printgen.design.section import area_m2, equal_area_diameter, net_membrane_law
 from printgen.design.selection import (
     DATASHEET_PENALTY,
@@ -30,6 +29,7 @@ from printgen.design.selection import (
     target_net_law,
 )
 from printgen.inputs.laws import piecewise_linear
+from printgen.search.space import NetPoint, SearchContext
 from printgen.units import MM
 
 MIN_OPENING_MM = 2.0  # clear mesh opening: narrower holes fuse when printed and pass no water

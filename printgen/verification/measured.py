@@ -4,7 +4,7 @@ predicted curves, and fit the one factor of the printed net that best explains i
 The CSV (`,` or `;` separated; with `;`, decimal commas are accepted; lines starting with `#`
 are comments) has a column `h_over_hb` and any of the columns in `COLUMNS`; given the printed
 model's lengths, also the raw readings in mm (`water_depth_mm` for the level, the sensors'
-wire change, deflection and top lowering: printgen.check.readings.RAW_COLUMNS). Columns
+wire change, deflection and top lowering: printgen.verification.readings.RAW_COLUMNS). Columns
 named `expected_*` (the model's readings on printgen's measurement sheet) are skipped, and so
 are columns left empty when others hold values. Elongations are
 read as what the extension sensors record: counted from h / h_B = 0 (sensors zeroed before
@@ -24,15 +24,15 @@ from pathlib import Path
 
 import numpy as np
 
-from printgen.check.bands import Band, Variant, curves, run_variant
-from printgen.check.readings import DEPTH_COLUMN, RAW_COLUMNS, FlumeUnits
 from printgen.design.record import Design
 from printgen.errors import InputError
 from printgen.inputs.profiles import profile_name
 from printgen.outputs.files import read_input_text
+from printgen.verification.bands import Band, Variant, curves, run_variant
+from printgen.verification.readings import DEPTH_COLUMN, RAW_COLUMNS, FlumeUnits
 
 LEVEL_COLUMN = "h_over_hb"
-# CSV column -> (METRICS key of printgen.check.compare, factor from the CSV unit to the key's)
+# CSV column -> (METRICS key of printgen.verification.compare, factor from the CSV unit to the key's)
 COLUMNS = {
     "bottom_cable_elongation_pct": ("strain_bottom", 0.01),
     "top_cable_elongation_pct": ("strain_top", 0.01),
@@ -79,7 +79,7 @@ class Measurement:
 def read_measured(path: str | Path, units: FlumeUnits | None = None) -> Measurement:
     """Read and check a measured loading test (see the module docstring for the format).
 
-    With `units` (the printed model's lengths, printgen.check.readings) the raw columns in mm
+    With `units` (the printed model's lengths, printgen.verification.readings) the raw columns in mm
     (RAW_COLUMNS, and DEPTH_COLUMN for the level) are read too; `expected_*` columns (the
     model's readings on the measurement sheet) are skipped.
     """
@@ -273,7 +273,7 @@ def objective(m: Measurement, predicted: dict[str, np.ndarray]) -> float:
 
 
 Predictor = Callable[[float], dict[str, np.ndarray]]
-FIT_KINDS = ("stiffness", "slack", "multi")  # multi: printgen.check.fit (issue 25)
+FIT_KINDS = ("stiffness", "slack", "multi")  # multi: printgen.verification.fit (issue 25)
 STIFFNESS_RANGE = (0.2, 5.0)  # net stiffness factors searched: a printed net 5x off is a misprint
 SLACK_RANGE = (0.0, 0.03)  # initial slack searched: 3 % sags visibly, a lab would see it
 XTOL_LOG = 0.005  # stiffness factor known to 0.5 % (bounded Brent on log factor)

@@ -6,7 +6,7 @@ Parameters, each bounded by what a lab would see or measure (`BOUNDS`):
 - net_slack: initial slack of the net's strands (a zero-force strain before they pull);
 - cable_slack: initial slack of the border cables (the same, on the cables);
 and, as discrete choices tried in turn, the flume mounting and the panel-test orientation
-(`printgen.check.scenes`). Slack is a law with a first, (nearly) flat segment (`slackened`):
+(`printgen.verification.scenes`). Slack is a law with a first, (nearly) flat segment (`slackened`):
 the same to first order as a rest length (1 + slack) times longer.
 
 For every discrete choice the continuous parameters are searched (scipy's bounded
@@ -30,11 +30,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from printgen.check.bands import Variant, curves, variant_scene
-from printgen.check.measured import Measurement, mismatch, objective
-from printgen.check.scenes import MOUNTINGS, ORIENTATIONS, BarrierScene
-from printgen.check.verify import sweep
 from printgen.design.record import Design
+from printgen.verification.bands import Variant, curves, variant_scene
+from printgen.verification.measured import Measurement, mismatch, objective
+from printgen.verification.scenes import MOUNTINGS, ORIENTATIONS, BarrierScene
+from printgen.verification.verify import sweep
 
 # (low, high, nominal) of each continuous parameter
 BOUNDS = {

@@ -13,10 +13,10 @@ import pytest
 from conftest import EXAMPLES
 
 from printgen.design.design_file import design_from_dict, load_design
-from printgen.design.pareto import dominates, pareto_mask
 from printgen.errors import InputError
 from printgen.report.jsonout import dumps
-from printgen.run.design import SearchOptions, design_searches
+from printgen.run.search import SearchOptions, search_at_scales
+from printgen.search.pareto import dominates, pareto_mask
 
 REALISTIC = EXAMPLES / "realistic_barrier.toml"
 SCALE = 40.0
@@ -30,7 +30,7 @@ pytest.importorskip("distributed")
 
 @pytest.fixture(scope="module")
 def serial_run():
-    return design_searches(REALISTIC, [SCALE], options=SMALL, serial=True)
+    return search_at_scales(REALISTIC, [SCALE], options=SMALL, serial=True)
 
 
 def _objectives(rec: dict, rows: list[dict]) -> np.ndarray:
@@ -61,7 +61,7 @@ def test_pareto_set_has_no_dominated_member(serial_run):
 
 
 def test_stiffness_objective_pareto_over_every_printable_candidate():
-    run = design_searches(REALISTIC, [SCALE], options=SearchOptions(
+    run = search_at_scales(REALISTIC, [SCALE], options=SearchOptions(
         objective="stiffness", materials=("tpe", "tpu"), mesh_x_mm=(18.0, 22.0),
         mesh_y_mm=(8.0, 10.0)), serial=True)
     res = run.results[0]
@@ -78,10 +78,10 @@ def test_stiffness_objective_pareto_over_every_printable_candidate():
 def test_same_json_serial_local_cluster_and_remote_scheduler(serial_run):
     from distributed import LocalCluster
 
-    local = design_searches(REALISTIC, [SCALE], options=SMALL, workers=2)
+    local = search_at_scales(REALISTIC, [SCALE], options=SMALL, workers=2)
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                       dashboard_address=None) as cluster:
-        remote = design_searches(REALISTIC, [SCALE], options=SMALL,
+        remote = search_at_scales(REALISTIC, [SCALE], options=SMALL,
                                  scheduler=cluster.scheduler_address)
     assert "local Dask cluster" in local.where and "scheduler" in remote.where
     ref = dumps(serial_run.record)
@@ -91,7 +91,7 @@ def test_same_json_serial_local_cluster_and_remote_scheduler(serial_run):
 
 
 def test_report_names_choice_select_pick_and_design_round_trips(serial_run, tmp_path):
-    from printgen.run.design import write_outputs
+    from printgen.run.search import write_outputs
 
     rec = serial_run.record["scales"][f"{SCALE:g}"]
     assert rec["chosen"]["feasible"] and rec["chosen"]["safety_factor"] >= 1.5
@@ -108,10 +108,10 @@ def test_report_names_choice_select_pick_and_design_round_trips(serial_run, tmp_
 
 def test_bad_input_is_named():
     with pytest.raises(InputError, match="mesh x bounds"):
-        design_searches(REALISTIC, [SCALE], options=SearchOptions(mesh_x_mm=(20.0, 10.0)),
+        search_at_scales(REALISTIC, [SCALE], options=SearchOptions(mesh_x_mm=(20.0, 10.0)),
                         serial=True)
     with pytest.raises(InputError, match="objective"):
-        design_searches(REALISTIC, [SCALE], options=SearchOptions(objective="speed"),
+        search_at_scales(REALISTIC, [SCALE], options=SearchOptions(objective="speed"),
                         serial=True)
     with pytest.raises(InputError, match="unknown keys"):
         design_from_dict({"scale": 40, "printer": "generic-350", "net": {}, "cables": [],
