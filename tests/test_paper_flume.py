@@ -56,3 +56,22 @@ def test_orientation_reads_the_panel_law_along_the_chosen_diagonal():
     assert panel_axes(20.6 * MM, 9.4 * MM, "long") == (20.6 * MM, 9.4 * MM)
     with pytest.raises(GeometryError, match="orientation"):
         panel_axes(1.0, 2.0, "diagonal")
+
+
+def test_make_with_the_paper_design_shows_its_own_net_error():
+    """`make --design` reports the design file's own net, not select's pick: the paper's net is
+    the panel law's tested net, so its small-strain membrane stiffness is the measured
+    kappa_0 x panel length with no geometric rescaling."""
+    from printgen.inputs.materials import load_material
+    from printgen.report.summary import chosen_parts
+    from printgen.run.make import MakeOptions, plan
+
+    realistic = HERE.parent / "realistic_barrier.toml"
+    ctx = plan(realistic, 40, options=MakeOptions(design_file=HERE / "design.json"))
+    own = ctx.record["design_net"]
+    law = load_material(ctx.design.net.material).panel_law
+    assert own["stiffness"] == pytest.approx(law.kappas[0] * law.panel_length, rel=EXACT)
+    assert own["error"] == pytest.approx(own["stiffness"] / own["target"] - 1, rel=EXACT)
+    assert abs(own["error"] - ctx.selection.net[0].error) > 0.5  # not select's pick
+    assert chosen_parts(ctx.record)[0]["stiffness_error"] == own["error"]
+    assert f"({own['error']:+.0%})" in ctx.report.html()

@@ -60,11 +60,24 @@ def test_pareto_set_has_no_dominated_member(serial_run):
         assert (i in members) == (not beaten), f"candidate {i}: member {i in members}"
 
 
-def test_stiffness_objective_pareto_over_every_printable_candidate():
-    run = search_at_scales(REALISTIC, [SCALE], options=SearchOptions(
+def test_stiffness_objective_pareto_over_every_printable_candidate(tmp_path, monkeypatch):
+    import printgen.run.search as run_search
+    from printgen.commands.design import SHOW, shown_rows
+    from printgen.run import api
+
+    writes = []
+    staged = run_search.staged_dir
+    monkeypatch.setattr(run_search, "staged_dir", lambda *a, **k: writes.append(a) or
+                        staged(*a, **k))
+    run = api.search_nets(REALISTIC, [SCALE], options=SearchOptions(
         objective="stiffness", materials=("tpe", "tpu"), mesh_x_mm=(18.0, 22.0),
-        mesh_y_mm=(8.0, 10.0)), serial=True)
+        mesh_y_mm=(8.0, 10.0)), serial=True, out=tmp_path / "o")
+    assert len(writes) == 1 and "design.json" in run.files  # one folder, written once
     res = run.results[0]
+    rows = shown_rows(res)  # the table's rows: the chosen net first, marked "* "
+    assert rows[0] == res.chosen and len(rows) == min(SHOW, len(set(res.pareto) | {rows[0]}))
+    strength = [r for s in res.screened for k, r in s.violations if k == "strength"]
+    assert strength and all(", mesh " in r for r in strength)  # the net named unambiguously
     assert not res.verified and res.select_score is None  # no solver with this objective
     feasible = [s for s in res.screened if s.feasible]
     vals = np.array([[s.error_rms_log, abs(s.d_pi2), abs(s.d_pi3), s.print_time_s]

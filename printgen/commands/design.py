@@ -11,9 +11,9 @@ from pathlib import Path
 from printgen.commands.common import add_json_arg, check_profile_args, console, emit_json, table
 from printgen.errors import InputError
 from printgen.run import api
-from printgen.run.search import DesignRun, SearchOptions, check_out, write_outputs
+from printgen.run.search import DesignRun, SearchOptions
 from printgen.search.choice import short
-from printgen.search.nets import OBJECTIVES, VERIFY_NETS
+from printgen.search.nets import OBJECTIVES, VERIFY_NETS, SearchResult
 from printgen.search.sweep import check_address
 
 SHOW = 10  # Pareto members shown per scale in the table (all are in report.json)
@@ -68,15 +68,13 @@ def run(args: argparse.Namespace) -> int:
         border_beads=_ints(args.border_beads, "--border-beads"), printer=args.printer,
         verify_nets=args.verify_nets, level_step=args.level_step)
     out = args.out or Path("out") / f"{Path(args.prototype).stem}-design"
-    check_out(out, args.prototype)  # before the search
     result = api.search_nets(args.prototype, scales, options=opts, scheduler=args.scheduler,
-                               workers=args.workers, serial=args.serial,
-                               progress=not args.json)
-    files = write_outputs(result, out, args.scale if args.scale else scales[0], args.prototype)
+                             workers=args.workers, serial=args.serial, progress=not args.json,
+                             out=out, main_scale=args.scale)
     if args.json:
         emit_json(result.record)
         return 0
-    show(result, out, files)
+    show(result, out, result.files)
     return 0
 
 
@@ -121,17 +119,20 @@ def show(result: DesignRun, out: Path, files: list[str]) -> None:
     c = console()
     for r in result.results:
         sc = r.screened
+        shown = shown_rows(r)
         rows = []
-        for i in r.pareto[:SHOW]:
+        for i in shown:
             s = sc[i]
-            rows.append([str(i), ("* " if i == r.chosen else "") + short(s),
+            mark = "* " if i == r.chosen else ""
+            rows.append([str(i) + ("" if i in r.pareto else " (off front)"), mark + short(s),
                          f"{r.objective_value(i):.3f}", f"{s.error_small:+.0%}",
                          f"{s.d_pi2:+.0%}", f"{s.d_pi3:+.0%}", f"{s.print_time_s / 60:.0f}",
                          f"{s.safety_factor:.2f}"])
         obj = "mismatch" if r.objective == "deformation" else "law error"
-        c.print(table(f"1:{r.scale:g}: Pareto set ({len(r.pareto)} of {len(sc)} candidates; "
-                      f"* chosen)", ["#", "net (material beads x layers, mesh, border)", obj, "k small strain", "dPi2", "dPi3",
-                                     "print min", "SF"], rows))
+        c.print(table(f"1:{r.scale:g}: Pareto set ({len(r.pareto)} of {len(sc)} candidates, "
+                      f"the {len(shown)} lowest {obj} shown; * chosen)",
+                      ["#", "net (material beads x layers, mesh, border)", obj,
+                       "k small strain", "dPi2", "dPi3", "print min", "SF"], rows))
         c.print(table(f"1:{r.scale:g}: per material (on target: +-30 % at SF >= 1.5)",
                       ["material", "printable", "on target", "best net", "k", "SF",
                        "first on target", "k", "SF"],
@@ -154,6 +155,16 @@ def show(result: DesignRun, out: Path, files: list[str]) -> None:
     sys.stdout.flush()
 
 
+def shown_rows(r: SearchResult) -> list[int]:
+    """The candidates of the Pareto table: the chosen net first (also when the datasheet
+    penalty of its ranking keeps it off the front), then the front's lowest objective values,
+    `SHOW` in all."""
+    front = sorted((i for i in r.pareto if i != r.chosen),
+                   key=lambda i: (r.objective_value(i), i))
+    first = [] if r.chosen is None else [r.chosen]
+    return (first + front)[:SHOW]
+
+
 def _material_row(row: dict) -> list[str]:
     def net(c: dict | None) -> list[str]:
         if c is None:
@@ -169,7 +180,7 @@ def _material_row(row: dict) -> list[str]:
 def _series_row(row: dict) -> list[str]:
     if row["chosen"] is None:
         return [f"1:{row['scale']:g}", "none", "-", "-", "-", "-", "-",
-                "; ".join(row["binding_constraints"])[:60]]
+                "; ".join(row["binding_constraints"])]
     ch = row["chosen"]
 
     def f(v: float | None) -> str:
@@ -180,4 +191,4 @@ def _series_row(row: dict) -> list[str]:
                                     f"{ch['mesh_y_mm']:.3g} mm"),
             f"{row['error_small_strain']:+.0%}", f(row["mismatch_rms"]),
             f(row["select_mismatch_rms"]), f"{row['d_pi2']:+.0%}", f"{row['d_pi3']:+.0%}",
-            "; ".join(row["binding_constraints"])[:60] or "-"]
+            "; ".join(row["binding_constraints"]) or "-"]

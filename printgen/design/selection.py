@@ -16,7 +16,7 @@ import numpy as np
 
 from printgen.barrier.loads import OVERFLOW  # peak relative loading of the loading test
 from printgen.barrier.patterns import get_pattern
-from printgen.design.record import Section
+from printgen.design.record import NetDesign, Section
 from printgen.design.section import area_m2, equal_area_diameter, net_membrane_law
 from printgen.design.similitude import ScaledTargets
 from printgen.errors import InputError, PrintabilityError
@@ -201,11 +201,13 @@ def model_mesh(p: Prototype, t: ScaledTargets) -> tuple[float, float]:
 
 
 def net_candidate(p: Prototype, t: ScaledTargets, m: Material, sec: Section,
-                  printer: Printer) -> Candidate:
+                  printer: Printer, *, mesh: tuple[float, float] | None = None,
+                  pattern: str = PRINTED_PATTERN) -> Candidate:
     """Score one net candidate: its membrane law (the printed pattern's geometry) against the
-    target law."""
-    mesh_x, mesh_y = model_mesh(p, t)
-    knees, slopes, source = net_membrane_law(m, sec, mesh_y, mesh_x, PRINTED_PATTERN)
+    target law; `mesh` (mesh_x, mesh_y in m, default `model_mesh`) and `pattern` of a given
+    design's net."""
+    mesh_x, mesh_y = mesh or model_mesh(p, t)
+    knees, slopes, source = net_membrane_law(m, sec, mesh_y, mesh_x, pattern)
     t_knees, t_slopes = target_net_law(p, t)
     got = piecewise_linear(NET_STRAINS, knees, slopes)
     want = piecewise_linear(NET_STRAINS, t_knees, t_slopes)
@@ -225,6 +227,13 @@ def net_candidate(p: Prototype, t: ScaledTargets, m: Material, sec: Section,
                      float(got[0] / want[0] - 1), low, high, rms,
                      equal_area_diameter(sec) / t["strand_d"] - 1, force, sf, speed,
                      tuple(reasons), score)
+
+
+def design_net(p: Prototype, t: ScaledTargets, net: NetDesign, printer: str) -> Candidate:
+    """A given design's own net (the design.json of `printgen design`) scored like select's
+    candidates: its material, strand, mesh and pattern against the same target law."""
+    return net_candidate(p, t, load_material(net.material), net.strand, load_printer(printer),
+                         mesh=(net.mesh_x_mm * MM, net.mesh_y_mm * MM), pattern=net.pattern)
 
 
 def select(p: Prototype, t: ScaledTargets, *, printer: str | None = None,

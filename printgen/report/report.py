@@ -20,9 +20,11 @@ SHOWN_LEVEL = 1.0  # relative loading of the 3D picture of both deformed nets
 
 
 def design_sections(rep: Report, proto: Prototype, t: ScaledTargets, sel: Selection,
-                    design: Design, *, design_file: str | None = None) -> None:
+                    design: Design, *, design_file: str | None = None,
+                    own_net: Candidate | None = None) -> None:
     """Targets, flow checks, the ranked selection and the chosen design (that of
-    `design_file`, printgen design's, when given)."""
+    `design_file`, printgen design's, when given, with `own_net`: its net scored like the
+    selection's candidates)."""
     rep.paragraph(f"Prototype: {proto.name} ({proto.description}). Model scale 1:{t.scale:g}. "
                   "Similitude of Lambert et al. (2023), J. Hydraul. Eng. 149(3), "
                   "doi:10.1061/JHEND8.HYENG-13070: Froude scaling with stiffness scaled too.")
@@ -63,8 +65,12 @@ def design_sections(rep: Report, proto: Prototype, t: ScaledTargets, sel: Select
              for c in design.cables]
     rep.table(["part", "material", "size (mm)", "section"], rows)
     if design_file:
+        own = "" if own_net is None else (
+            f" Its net's initial membrane stiffness: {own_net.stiffness:.4g} N/m against the "
+            f"target {own_net.target:.4g} N/m ({own_net.error:+.0%}), safety factor "
+            f"{own_net.safety_factor:.2f}.")
         rep.paragraph(f"The printed parts are the design of {design_file} "
-                      "(printgen design), not the selection's choice above.")
+                      f"(printgen design), not the selection's choice above.{own}")
 
 
 def _same_stiffness(cands: tuple[Candidate, ...] | list[Candidate]) -> str:

@@ -71,7 +71,8 @@ def chosen_parts(record: dict[str, Any]) -> list[dict[str, Any]]:
     sel, design = record.get("selection"), record["design"]
     out = []
     net = design["net"]
-    pick = sel and _same_section(sel["net"]["ranked"], net["material"], net["strand"])
+    pick = record.get("design_net") or (  # a design.json's net: its own error, not select's
+        sel and _same_section(sel["net"]["ranked"], net["material"], net["strand"]))
     out.append({"part": "net", "material": net["material"].upper(),
                 "section": (f"strand {_mm(net['strand'])}, mesh {net['mesh_x_mm']:g} x "
                             f"{net['mesh_y_mm']:g} mm"),

@@ -127,18 +127,27 @@ def verify_design(prototype: str | Path, scale: float, design_file: str | Path,
 
 
 def search_nets(prototype: PrototypeLike, scales: float | Sequence[float], *,
-                  options: SearchOptions | None = None, scheduler: str | None = None,
-                  serial: bool = False, workers: int | None = None,
-                  progress: bool = False) -> DesignRun:
+                options: SearchOptions | None = None, scheduler: str | None = None,
+                serial: bool = False, workers: int | None = None,
+                progress: bool = False, out: str | Path | None = None,
+                main_scale: float | None = None) -> DesignRun:
     """The inverse design: the printable net that deforms most like the prototype at each
     scale (screened by the membrane law, the best verified with the solver), on a local Dask
-    cluster, the cluster at `scheduler`, or serially."""
-    from printgen.run.search import SearchOptions, search_at_scales
+    cluster, the cluster at `scheduler`, or serially. With `out`, the run's folder is checked
+    before the search and written once, whole, after it (`DesignRun.files`); its design.json
+    is the net at `main_scale` (default: the first scale)."""
+    from printgen.run.search import SearchOptions, check_out, search_at_scales, write_outputs
 
     lams = [float(scales)] if isinstance(scales, int | float) else [float(s) for s in scales]
-    return search_at_scales(prototype, lams, options=options or SearchOptions(),
+    if out is not None:
+        check_out(out, prototype)  # before the search: a refused folder costs nothing
+    run = search_at_scales(prototype, lams, options=options or SearchOptions(),
                            scheduler=scheduler, serial=serial, workers=workers,
                            progress=progress)
+    if out is not None:
+        write_outputs(run, out, lams[0] if main_scale is None else float(main_scale),
+                      prototype)
+    return run
 
 
 def calibrate(paths: Sequence[str | Path], *, material: str,

@@ -24,7 +24,7 @@ from printgen.barrier.loads import DEFAULT as DEFAULT_LOAD
 from printgen.design.design_file import load_design
 from printgen.design.plan import make_design
 from printgen.design.record import Design
-from printgen.design.selection import Selection, select
+from printgen.design.selection import Selection, design_net, select
 from printgen.design.similitude import ScaledTargets, scale_targets
 from printgen.errors import TimeLimitError
 from printgen.inputs.profiles import search_dirs
@@ -114,16 +114,18 @@ def plan(prototype_path: str | Path, scale: float, *, printer: str | None = None
     t = scale_targets(proto, scale)
     sel = select(proto, t, printer=printer)
     design = make_design(proto, t, sel)
-    design_file = options.design_file
+    design_file, own = options.design_file, None
     if design_file:  # the net of `printgen design` (its design.json) instead of select's
         design = load_design(design_file, scale=t.scale)
+        own = design_net(proto, t, design.net, design.printer)
     rep = Report(f"printgen: {proto.name} at 1:{t.scale:g}")
     shown = Path(design_file).name if design_file else None
-    design_sections(rep, proto, t, sel, design, design_file=shown)
+    design_sections(rep, proto, t, sel, design, design_file=shown, own_net=own)
     ctx = MakeContext(proto, t, sel, design, rep, options)
     ctx.record.update(design_record(proto, t, sel, design))
     if shown:
         ctx.record["design_file"] = shown
+        ctx.record["design_net"] = own.to_record()  # its own stiffness error, not select's
     return ctx
 
 

@@ -159,7 +159,8 @@ def screen_point(ctx: SearchContext, point: NetPoint,
     force = peak_strand_force(t, ax, ay)
     sf = m.failure_stress()[0] * area_m2(sec) / force
     if sf < MIN_SAFETY_FACTOR:
-        violations.append(("strength", (f"{where}: safety factor {sf:.2f} below "
+        violations.append(("strength", (f"{where}, mesh {point.mesh_x_mm:.4g} x "
+                                       f"{point.mesh_y_mm:.4g} mm: safety factor {sf:.2f} below "
                                        f"{MIN_SAFETY_FACTOR} at {force:.3g} N (overflow)")))
     bed = bed_violation(ctx, point, sec.bead_width_mm)
     if bed:
