@@ -13,7 +13,7 @@ from printgen.design.similitude import FORCE_EXPONENT, ScaledTargets, to_prototy
 from printgen.inputs.prototype import Prototype
 from printgen.report.html import Report
 from printgen.verification.bands import Band
-from printgen.verification.verify import CounterExample, Verification
+from printgen.verification.verify import SHAPE_LEVELS, CounterExample, Verification
 
 SHOW = 6  # candidates per component in the report's tables (all are in report.json)
 SHOWN_LEVEL = 1.0  # relative loading of the 3D picture of both deformed nets
@@ -136,7 +136,7 @@ def _sweep_sections(rep: Report, v: Verification, scale: float, band: Band | Non
         rep.paragraph(f"The verdict rests on {v.compared} of {v.asked} load levels: the others "
                       "did not converge on one barrier or both (above); `make` exits 3.")
     p, m = v.prototype.deformation, v.model.deformation
-    idx = [int(np.argmin(np.abs(p.levels - x))) for x in (0.5, 1.0, 1.1)]
+    idx = [int(np.argmin(np.abs(p.levels - x))) for x in SHAPE_LEVELS]
     rows = []
     for mm in v.mismatches:
         rows.append([f"{METRICS[mm.metric]} ({unit_of(mm.metric)})"]

@@ -14,9 +14,9 @@ from printgen.report.report import fmt_value, unit_of
 from printgen.verification.bands import Band, BandVerdict, band_verdicts
 from printgen.verification.compare import METRICS, Deformation
 from printgen.verification.measured import Fit, Measurement, mismatch
-from printgen.verification.verify import Verification
+from printgen.verification.verify import SHAPE_LEVELS, Verification
 
-SHOW_LEVELS = (0.5, 1.0, 1.1)  # relative loadings shown in the tables and summaries
+SHOW_LEVELS = SHAPE_LEVELS  # relative loadings shown in the tables and summaries
 
 
 def _at(levels: np.ndarray, x: float) -> int | None:

@@ -29,7 +29,7 @@ from printgen.design.similitude import ScaledTargets, scale_targets
 from printgen.errors import TimeLimitError
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
-from printgen.outputs import MANIFEST, check_destination, staged_dir
+from printgen.outputs import MANIFEST, TIMINGS, check_destination, staged_dir
 from printgen.report.extras import report_files
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
@@ -44,7 +44,6 @@ from printgen.run.budget import (
 )
 from printgen.run.provenance import (  # noqa: F401 (json_output, TIME_KEYS: used via make)
     TIME_KEYS,
-    TIMINGS,
     json_output,
     provenance,
     split_timings,

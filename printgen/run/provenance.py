@@ -16,7 +16,6 @@ from printgen.outputs import file_digest
 if TYPE_CHECKING:
     from printgen.run.make import MakeContext
 
-TIMINGS = "timings.json"  # the one volatile file: every wall-clock time of the run
 TIME_KEYS = ("timings_s", "seconds", "time_s")  # record keys that hold wall-clock times
 # The packages whose versions can move the outputs' numbers or bytes (meshes, solver, figures);
 # the same inputs with other versions may differ in the last digits (values within ~1e-4).

@@ -3,7 +3,7 @@ stage wired in, and its output folder.
 
 The search (`printgen.search.nets`) screens the candidates by the analytic membrane law and
 verifies the best few with the pre-print verification (`printgen.verification.verify`); the solver
-task lives here because the check stage sits above the design stage. Output folder (written
+task lives here because the verification stage sits above the search stage. Output folder (written
 whole, `outputs.staged_dir`):
 
 - report.json: per scale the chosen net and the reasons, the Pareto set, the verified nets,

@@ -19,7 +19,7 @@ from printgen.design.record import Design
 from printgen.inputs.materials import load_material
 from printgen.inputs.profiles import profile_name, search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
-from printgen.outputs import check_destination, staged_dir
+from printgen.outputs import TIMINGS, check_destination, staged_dir
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
 from printgen.report.labfiles import lab_files, lab_record
@@ -32,7 +32,6 @@ from printgen.report.uncertainty import (
     measured_sections,
 )
 from printgen.run.budget import DEFAULT_LIMIT_S, Work, check_budget, sweep_cores
-from printgen.run.provenance import TIMINGS
 from printgen.verification.bands import (
     Band,
     band_verdicts,

@@ -11,7 +11,7 @@ Two stages over the space of `search_space` (material x strand section x diamond
 
 Both stages run on a `sweep.Runner` (Dask, or serial): each task is a pure function of a small
 frozen record, so the result does not depend on where it ran. The solver stage is passed in
-(`verifier`) because the check stage sits above the design stage (`printgen.run.search` wires
+(`verifier`) because the verification stage sits above the search stage (`printgen.run.search` wires
 it); with the `stiffness` objective the search stops after stage 1.
 """
 

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from printgen.barrier.loads import OVERFLOW
 from printgen.design.record import Design
 from printgen.errors import InputError
 from printgen.inputs.profiles import profile_name
@@ -41,7 +42,7 @@ COLUMNS = {
     "lowering_over_height": ("lowering", 1.0),
 }
 MEASURED_LIMIT_BYTES = 4 << 20  # a loading test is tens of lines; 4 MiB is surely not one
-MAX_LEVEL = 1.1  # the sweep's last relative loading (overflow): no prediction beyond it
+MAX_LEVEL = OVERFLOW  # the sweep's last relative loading: no prediction beyond it
 IGNORED_PREFIX = "expected_"  # columns of the measurement sheet that hold the model's readings
 LEVEL_AGREE = 0.01  # h_over_hb and water_depth_mm / h_B may differ by this much (h / h_B)
 RAW_LIMIT_MM = 1000.0  # a raw reading beyond +-1 m is not a flume model's: check the unit

@@ -15,10 +15,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from printgen.units import MM
 from printgen.verification.scenes import BarrierScene
 from printgen.verification.solvernet import path_length
 
-MM = 1e3  # mm per m
 SENSORS = {"strain_bottom": "bottom", "strain_top": "top", "strain_mid": "mid"}
 # raw CSV column (mm) -> METRICS key; the water depth column stands for h_over_hb
 RAW_COLUMNS = {"bottom_sensor_mm": "strain_bottom", "top_sensor_mm": "strain_top",
@@ -52,8 +52,8 @@ def flume_units(scene: BarrierScene) -> FlumeUnits:
     rows = {}
     for row, w in scene.wires.items():
         rest = path_length(x0, w.nodes, w.exit)
-        rows[row] = (rest - float(np.linalg.norm(w.exit - x0[w.nodes[-1]]))) * MM
-    return FlumeUnits(scene.width * MM, scene.height * MM, rows)
+        rows[row] = (rest - float(np.linalg.norm(w.exit - x0[w.nodes[-1]]))) / MM
+    return FlumeUnits(scene.width / MM, scene.height / MM, rows)
 
 
 def design_units(design) -> FlumeUnits:

@@ -47,7 +47,7 @@ from solver.loads import total_forces
 LEVEL_STEP = 0.05  # relative loading step of the sweep (issue: at most 0.05)
 PATH_CUTS = 2  # halvings tried before a load level is reported as not converged
 MIN_COMPARED = 2  # levels both barriers must reach (h = 0 and one loaded) for a verdict
-SHAPE_LEVELS = (0.5, 1.0, 1.1)  # relative loadings whose deformed shapes are kept
+SHAPE_LEVELS = (0.5, 1.0, OVERFLOW)  # relative loadings whose deformed shapes are kept
 SHAPE_DECIMALS = 6  # node positions in report.json rounded to 1 um: reproducible bytes
 SOLVER_TOL = 1e-7  # out-of-balance force / load: far below what a flume measures (~1e-2)
 
