@@ -247,6 +247,16 @@ def test_csv_files_hold_the_numbers_of_report_json(made):
     np.testing.assert_allclose(reads["max_strand_tension_n"],
                                np.array(ver["model"]["max_strand_tension_n"])[at], rtol=CSV_TOL,
                                atol=CSV_ZERO)
+    with open(out / "sensor-layout.csv", newline="") as fh:
+        placed = {r["item"]: r for r in csv.DictReader(fh)}
+    for sensor in lab["layout"]["sensors"]:
+        r = placed[f"{sensor['row']} wire"]
+        np.testing.assert_allclose([float(r[k]) for k in ("x_mm", "z_mm", "x_to_mm", "z_to_mm")],
+                                   [*sensor["anchor_mm"], *sensor["potentiometer_mm"]],
+                                   rtol=CSV_TOL, atol=CSV_ZERO)
+    for i, pin in enumerate(lab["layout"]["anchor_pins_mm"], 1):
+        r = placed[f"anchor pin {i}"]
+        np.testing.assert_allclose([float(r["x_mm"]), float(r["z_mm"])], pin, rtol=CSV_TOL)
 
 
 def test_the_filled_measurement_sheet_reads_back(made, tmp_path):

@@ -128,3 +128,44 @@ def test_summary_of_a_verify_record_without_selection():
     assert [p["stiffness_error"] for p in s["parts"]] == [None, None]
     box = summary_html(s)
     assert 'id="summary"' in box and "model stiffer by 20%" in box and "TPE" in box
+
+
+def test_sensor_and_anchor_layout_is_the_scene_in_mm():
+    """The layout drawing's positions: the pins on the net's corners, each wire anchored at the
+    left end of its row with its potentiometer SENSOR_EXIT x width beyond the right edge in line
+    with the row, the row lengths those the readings divide by; its CSV holds the record."""
+    import csv
+    import io
+
+    from printgen.report.layout import layout_csv, layout_figure, layout_rows
+    from printgen.report.plots import _png, axis_labels
+    from printgen.verification.layout import flume_layout
+    from printgen.verification.readings import flume_units
+    from printgen.verification.scenes import SENSOR_EXIT, model_scene
+
+    s = model_scene(reference_design_1_40())
+    lay = flume_layout(s)
+    w, h = lay.width_mm, lay.height_mm
+    assert w == pytest.approx(s.width * 1e3, rel=EXACT) and h == pytest.approx(s.height * 1e3,
+                                                                              rel=EXACT)
+    assert sorted(map(tuple, lay.pins_mm.round(9))) == [(0, 0), (0, h), (w, 0), (w, h)]
+    assert set(lay.held_mm) == {"left", "right"}  # walls: the side sheets hold the sides
+    units = flume_units(s)
+    for sensor in lay.sensors:
+        z = sensor.anchor_mm[1]
+        assert sensor.anchor_mm[0] == pytest.approx(0.0, abs=EXACT)
+        assert sensor.potentiometer_mm == pytest.approx((w * (1 + SENSOR_EXIT), z), rel=EXACT)
+        assert sensor.along_row_mm == pytest.approx(units.row_mm[sensor.row], rel=EXACT)
+        assert np.allclose(sensor.route_mm[:, 1], z)  # the row is level at rest
+    rec = lay.to_record()
+    rows = list(csv.DictReader(io.StringIO(layout_csv(rec))))
+    wires = {r["item"]: r for r in rows if r["item"].endswith(" wire")}
+    for sensor in rec["sensors"]:
+        r = wires[f"{sensor['row']} wire"]
+        assert [float(r[k]) for k in ("x_mm", "z_mm", "x_to_mm", "z_to_mm")] == pytest.approx(
+            [*sensor["anchor_mm"], *sensor["potentiometer_mm"]], rel=READ_TOL)
+    assert len(layout_rows(rec)) == 4 + 2 + 2 * 3  # pins, held edges, wire ends
+    fig = layout_figure(rec, lay.strands_mm)
+    labels = axis_labels(fig)
+    _png(fig)
+    assert all(name.endswith("(mm)") for _, names in labels for name in names)

@@ -1,7 +1,8 @@
 """Files a lab takes to the flume, beside the report: the curves (curves.csv), the expected
 readings in flume units (expected-readings.csv) and a blank measurement sheet in the columns
 `printgen verify --measured` reads, with the model's expected readings beside them
-(measurement-sheet.csv). Column names carry their unit (`_pct`, `_mm`, `_n`, `_kn`; no
+(measurement-sheet.csv), and where the sensors and anchors go (sensor-layout.csv,
+printgen.report.layout). Column names carry their unit (`_pct`, `_mm`, `_n`, `_kn`; no
 suffix: normalised, dimensionless). The numbers are the record's (`lab_record`, in
 report.json under "lab"), so the files and the JSON say the same.
 """
@@ -13,8 +14,10 @@ from typing import Any
 
 import numpy as np
 
+from printgen.report.layout import LAYOUT_CSV, layout_csv
 from printgen.verification.bands import Band
 from printgen.verification.compare import METRICS
+from printgen.verification.layout import flume_layout
 from printgen.verification.measured import COLUMNS, LEVEL_COLUMN
 from printgen.verification.readings import DEPTH_COLUMN, RAW_COLUMNS, flume_units
 from printgen.verification.verify import Verification
@@ -61,12 +64,14 @@ def lab_record(v: Verification, band: Band, scale: float) -> dict[str, Any]:
     readings["max_strand_tension_n"] = m.max_strand_tension[im]
     readings["max_cable_tension_n"] = m.max_cable_tension[im]
     return {"units": units.to_record(), "curves": curves, "readings": readings,
-            "files": [CURVES, READINGS, SHEET]}
+            "layout": flume_layout(v.model.scene).to_record(),
+            "files": [CURVES, READINGS, SHEET, LAYOUT_CSV]}
 
 
 def lab_files(lab: dict[str, Any]) -> dict[str, str]:
-    """The three CSV texts of `lab_record`'s output, by file name."""
-    return {CURVES: curves_csv(lab), READINGS: readings_csv(lab), SHEET: sheet_csv(lab)}
+    """The CSV texts of `lab_record`'s output, by file name."""
+    return {CURVES: curves_csv(lab), READINGS: readings_csv(lab), SHEET: sheet_csv(lab),
+            LAYOUT_CSV: layout_csv(lab["layout"])}
 
 
 def curves_csv(lab: dict[str, Any]) -> str:

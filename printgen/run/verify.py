@@ -23,6 +23,7 @@ from printgen.outputs import TIMINGS, check_destination, staged_dir
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
 from printgen.report.labfiles import lab_files, lab_record
+from printgen.report.layout import layout_section
 from printgen.report.report import verification_sections
 from printgen.report.summary import summary_html, summary_record
 from printgen.report.uncertainty import (
@@ -40,6 +41,7 @@ from printgen.verification.bands import (
     model_load_kw,
 )
 from printgen.verification.fit import MultiFit, fit_levels, fit_measured
+from printgen.verification.layout import flume_layout
 from printgen.verification.measured import (
     Fit,
     Measurement,
@@ -106,6 +108,7 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     rep = Report(f"printgen verify: {p.name} at 1:{d.scale:g}")
     verification_sections(rep, v, None, d.scale, band=band)
     band_sections(rep, v, band)
+    layout_section(rep, flume_layout(v.model.scene))
     record = {"design": d.to_dict(), "verification": v.to_record(),
               "bands": band_record(v, band), "lab": lab_record(v, band, d.scale)}
     if m is not None:
