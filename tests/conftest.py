@@ -90,6 +90,32 @@ def made_1_40(tmp_path_factory):
     return make_mod.make(REALISTIC, 40, out), out
 
 
+COARSE_SIMPLE = {("net", "mesh_x_m"): 0.4, ("net", "mesh_y_m"): 0.4,
+                 ("model", "mesh_x_mm"): 10.0, ("model", "mesh_y_mm"): 10.0}
+
+
+@pytest.fixture(scope="session")
+def made_simple_drag(tmp_path_factory):
+    """One `make` of the simple barrier (no border cables) on a coarse mesh (COARSE_SIMPLE),
+    its verification step only, under the drag load case, run inline (PRINTGEN_SERIAL=1: no
+    helper process) per session: (its MakeContext, its output folder, its prototype file),
+    for the tests that read the verification step's record and report."""
+    from proto_files import SIMPLE, write_variant
+
+    import printgen.run.make as make_mod
+    from printgen.run import api
+
+    tmp = tmp_path_factory.mktemp("make-simple-drag")
+    path = write_variant(tmp, COARSE_SIMPLE, base=SIMPLE)
+    verify_only = [s for s in make_mod.default_steps() if s[1] is make_mod.verify_step]
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("PRINTGEN_SERIAL", "1")
+        mp.setattr(make_mod, "helper", None)  # inline: a helper would fail here
+        mp.setattr(make_mod, "default_steps", lambda: verify_only)
+        ctx = api.make(path, 40, tmp / "out", drag=True)
+    return ctx, tmp / "out", path
+
+
 def alive(pid: int) -> bool:
     """True while process `pid` runs (Linux /proc: a zombie counts as ended)."""
     try:

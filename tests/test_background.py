@@ -14,7 +14,6 @@ from pathlib import Path
 
 import pytest
 from conftest import alive
-from proto_files import SIMPLE, write_variant
 
 import printgen.run.make as make_mod
 from printgen import workers
@@ -108,20 +107,18 @@ def _deferred_in_thread() -> bool:
 
 
 @two_cores
-def test_verification_in_the_helper_equals_the_verification_step(tmp_path, monkeypatch):
-    """Same report blocks and record (times aside) from the helper as from the step itself."""
+def test_verification_in_the_helper_equals_the_verification_step(made_simple_drag, tmp_path,
+                                                                  monkeypatch):
+    """Same report blocks and record (times aside) from the helper as from the step itself
+    (the shared run, made inline with PRINTGEN_SERIAL=1 and no helper)."""
     monkeypatch.delenv("PRINTGEN_SERIAL", raising=False)
-    path = write_variant(tmp_path, {("net", "mesh_x_m"): 0.4, ("net", "mesh_y_m"): 0.4,
-                                    ("model", "mesh_x_mm"): 10.0, ("model", "mesh_y_mm"): 10.0},
-                         base=SIMPLE)
+    inline, _, path = made_simple_drag
     steps = [s for s in make_mod.default_steps() if s[1] is make_mod.verify_step]
     started = []
     monkeypatch.setattr(make_mod, "helper", _spy(make_mod.helper, started))
-    ahead = make_mod.make(path, 40, tmp_path / "ahead", steps=steps)
+    ahead = make_mod.make(path, 40, tmp_path / "ahead", steps=steps,
+                          options=make_mod.MakeOptions(load="drag"))
     assert started == ["verification_sweeps", "verification_report"]
-    monkeypatch.setenv("PRINTGEN_SERIAL", "1")
-    inline = make_mod.make(path, 40, tmp_path / "inline", steps=steps)
-    assert len(started) == 2  # the serial run computed both in its step
     assert ahead.report.blocks == inline.report.blocks
     assert (dumps(split_timings(ahead.record["verification"])[0])
             == dumps(split_timings(inline.record["verification"])[0]))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 import time
 
 import pytest
@@ -15,6 +16,7 @@ from printgen.errors import PrintgenError, TimeLimitError
 from printgen.outputs import check_folder, folder_files
 from printgen.report.jsonout import dumps
 
+SLICER_ONLY = [s for s in make_mod.default_steps() if s[1] is make_mod.slicer_step]
 REFUSE_WITHIN_S = 15.0  # issue 16: a run too big to do is refused within 15 s
 SLOW_STEP_S = 2.0  # a step that outlasts a time limit of half of it
 
@@ -75,14 +77,15 @@ def times_outside_timings(obj, path=""):
     return []
 
 
-def test_simple_after_realistic_leaves_only_the_simple_run(tmp_path):
+def test_simple_after_realistic_leaves_only_the_simple_run(made, tmp_path):
+    """A run of another barrier into the 1:40 example's folder (a copy of the shared run's)
+    replaces it whole: no cable file of the first run is left."""
     from proto_files import SIMPLE
 
     out = tmp_path / "out"
-    fast = [s for s in make_mod.default_steps() if s[1] is not make_mod.verify_step]
-    make_mod.make(REALISTIC, 40, out, steps=fast)
+    shutil.copytree(made[1], out)
     assert (out / "cable-left.gcode").exists()
-    ctx = make_mod.make(SIMPLE, 40, out, steps=fast)
+    ctx = make_mod.make(SIMPLE, 40, out, steps=SLICER_ONLY)
     assert folder_files(out) == ctx.record["files"]
     assert not any(p.name.startswith("cable") for p in out.iterdir())
     assert check_folder(out) == [] and [p.name for p in tmp_path.iterdir()] == ["out"]
@@ -112,19 +115,17 @@ def test_estimate_counts_the_nodes_the_solver_gets(made):
     assert size["nets"]["prototype"]["unknowns"] == 3 * prototype_nodes(ctx.prototype)
 
 
-def test_failed_step_leaves_previous_outputs_intact(made, tmp_path, monkeypatch):
+def test_failed_step_leaves_previous_outputs_intact(made, tmp_path):
     out = tmp_path / "out"
-    fast = [s for s in make_mod.default_steps() if not s[0].startswith("verification")]
-    make_mod.make(REALISTIC, 40, out, steps=fast)
+    shutil.copytree(made[1], out)  # the shared 1:40 run's folder
     before = {name: (out / name).read_bytes() for name in folder_files(out)}
 
     def broken(ctx, stage):
         (stage / "half-written.gcode").write_text("G1 X1")
         raise PrintgenError("forced failure")
 
-    steps = [*fast, ("broken", broken)]
     with pytest.raises(PrintgenError, match="forced failure"):
-        make_mod.make(REALISTIC, 40, out, steps=steps)
+        make_mod.make(REALISTIC, 40, out, steps=[*SLICER_ONLY, ("broken", broken)])
     assert {name: (out / name).read_bytes() for name in folder_files(out)} == before
     assert [p.name for p in tmp_path.iterdir()] == ["out"]  # no staging directory left behind
 
@@ -135,19 +136,27 @@ def test_failed_first_run_writes_nothing(tmp_path):
     assert not (tmp_path / "out").exists()
 
 
-def test_cli_make_json_and_exit_codes(tmp_path, capsys, monkeypatch):
-    """--json and --drag through the command line; the verification alone, on the coarse
-    simple barrier (the full run of the 1:40 example is `made`)."""
-    from proto_files import SIMPLE
+def test_cli_make_json_and_exit_codes(made_simple_drag, tmp_path, capsys, monkeypatch):
+    """--json and --drag through the command line: the command passes the load case to
+    `api.make` (a spy returns the shared drag run of the coarse simple barrier, made through
+    `api.make(..., drag=True)`) and prints that run's record."""
+    from printgen.run import api
 
-    path = write_variant(tmp_path, {("net", "mesh_x_m"): 0.4, ("net", "mesh_y_m"): 0.4,
-                                    ("model", "mesh_x_mm"): 10.0, ("model", "mesh_y_mm"): 10.0},
-                         base=SIMPLE)
-    verify_only = [s for s in make_mod.default_steps() if s[1] is make_mod.verify_step]
-    monkeypatch.setattr(make_mod, "default_steps", lambda: verify_only)
+    ctx, _, path = made_simple_drag
+    real, calls = api.make, []
+
+    def spy(prototype, *args, **kwargs):
+        if str(prototype) != str(path):
+            return real(prototype, *args, **kwargs)
+        calls.append(kwargs)
+        return ctx
+
+    monkeypatch.setattr(api, "make", spy)
     assert main(["make", str(path), "-s", "40", "--out", str(tmp_path / "o"), "--json",
                  "--drag"]) == 0
+    assert [c["load"] for c in calls] == ["drag"]
     rec = json.loads(capsys.readouterr().out)
+    assert dumps(rec) == dumps(make_mod.json_output(ctx.record))
     assert rec["targets"]["scale"] == 40
     assert rec["timings"]["timings_s"]["total"] > 0
     assert times_outside_timings({k: v for k, v in rec.items() if k != "timings"}) == []
@@ -167,16 +176,11 @@ def test_report_html_has_the_verification_and_its_figures(made):
                                                           in html)
 
 
-def test_barrier_without_cables_is_verified_at_every_level(tmp_path):
+def test_barrier_without_cables_is_verified_at_every_level(made_simple_drag):
     """A net anchored on its bed and banks with a free top (examples/simple_barrier.toml, on a
-    coarser mesh for the test's time) gets the whole sweep: no level left out."""
-    from proto_files import SIMPLE, write_variant
-
-    path = write_variant(tmp_path, {("net", "mesh_x_m"): 0.4, ("net", "mesh_y_m"): 0.4,
-                                    ("model", "mesh_x_mm"): 10.0, ("model", "mesh_y_mm"): 10.0},
-                         base=SIMPLE)
-    steps = [s for s in make_mod.default_steps() if s[0].startswith("verification")]
-    ctx = make_mod.make(path, 40, tmp_path / "simple", steps=steps)
+    coarser mesh for the test's time, under the drag load case of the shared run) gets the
+    whole sweep: no level left out."""
+    ctx = made_simple_drag[0]
     ver = ctx.record["verification"]
     assert ver["verdict"] in ("PASS", "FAIL") and len(ver["prototype"]["levels"]) == 23
     assert ver["not_converged"] == {"prototype": {}, "model": {}}
