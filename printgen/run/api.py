@@ -76,7 +76,8 @@ def make(prototype: str | Path, scale: float, out: str | Path, *,
     from printgen.run.make import make as _make
 
     opts = options or MakeOptions()
-    opts = dataclasses.replace(opts, load=load_name(load or opts.load, drag),
+    given = load if load is not None else (None if drag else opts.load)  # drag=True: "drag"
+    opts = dataclasses.replace(opts, load=load_name(given, drag),
                                step=step or opts.step)
     return _make(prototype, scale, out, printer=printer, options=opts, progress=progress)
 
