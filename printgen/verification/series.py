@@ -62,6 +62,7 @@ class Row:
     key: str
     label: str
     kind: str
+    short: str
     modulus: float | None = None
     source: str = ""
 
@@ -141,12 +142,13 @@ def rows_for(p: Prototype, materials: list[str] | tuple[str, ...]) -> list[Row]:
     (ProfileError for an unknown one, before any solve)."""
     own = (f"{p.net.strand_modulus / 1e9:g} GPa" if p.net.strand_modulus is not None
            else "its panel law")
-    rows = [Row("unscaled", f"prototype material unscaled ({own}, Froude only)", "unscaled"),
-            Row("similitude", "E / lambda (similitude)", "similitude")]
+    rows = [Row("unscaled", f"prototype material unscaled ({own}, Froude only)", "unscaled",
+                "The prototype's material"),
+            Row("similitude", "E / lambda (similitude)", "similitude", "E / lambda")]
     for name in dict.fromkeys(materials):
         m = load_material(profile_name(name, "--materials"))
         e, how = m.modulus()
-        rows.append(Row(name, f"{m.name} {e / 1e9:.3g} GPa ({how})", "material", e,
+        rows.append(Row(name, f"{m.name} {e / 1e9:.3g} GPa ({how})", "material", m.name, e,
                         f"profile materials/{name}: {how} tensile modulus"))
     return rows
 
@@ -236,5 +238,7 @@ def solve_case(shared: SeriesShared, case: tuple[str, float]) -> CaseResult:
 
 
 def cases(shared: SeriesShared, scales: tuple[float, ...]) -> list[tuple[str, float]]:
-    """Every (row key, lambda) of the series, row by row."""
-    return [(r.key, lam) for r in shared.rows for lam in scales]
+    """Every (row key, lambda) of the series, row by row, with the prototype itself
+    ("unscaled" at lambda = 1, the reference of every ratio) first when the series lacks it."""
+    own = [] if 1.0 in scales else [("unscaled", 1.0)]
+    return own + [(r.key, lam) for r in shared.rows for lam in scales]
