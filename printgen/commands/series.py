@@ -79,12 +79,13 @@ def show(res, out: Path) -> None:
     from printgen.report.series import table_rows
 
     s = res.series
+    short = {r.label: r.short for r in s.rows}
     c = console()
     c.print(table(f"Scale series of {s.prototype} ({s.scene}, {res.record['load_case']}, "
                   f"h/h_B = {res.record['level']:g}; ratio = value / prototype)",
                   ["row", "lambda", "deflection", "lowering", "elong. mid", "defl. ratio",
-                   "low. ratio", "elong. ratio", "Pi = F/EA", "law dep. defl", "law dep. low"],
-                  table_rows(s)))
+                   "low. ratio", "elong. ratio", "Pi = F/EA", "law dep. defl", "law dep. elong"],
+                  [[short[r[0]], *r[1:]] for r in table_rows(s)]))
     for text in s.sentences.values():
         c.print(f"- {text}")
     c.print(f"ran on {res.where}; {len(res.files)} files in {out}/ ; open "
