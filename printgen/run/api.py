@@ -29,8 +29,8 @@ if TYPE_CHECKING:
     from printgen.run.make import MakeContext, MakeOptions
     from printgen.run.search import DesignRun, SearchOptions
     from printgen.run.series import SeriesRun
-    from printgen.verification.series import NetOptions
     from printgen.run.verify import VerifyRun
+    from printgen.verification.series import NetOptions
     from printgen.verification.verify import Verification
 
 PrototypeLike = str | Path | Prototype

@@ -102,27 +102,27 @@ def scaling_assumptions(shared: SeriesShared) -> list[tuple[str, str, str]]:
     paper = "Lambert et al. 2023 (Fig. 2: the scale series)"
     p = shared.prototype
     mats = [r for r in shared.rows if r.kind == "material"]
-    out = [("scaling", "every length / lambda (nodes, mesh, strand and cable diameters), so "
-            "sections / lambda^2; loads by Froude: A* / lambda^2, velocity / sqrt(lambda)", paper),
-           ("row: prototype material unscaled", "the prototype's laws with E A / lambda^2 "
-            "(same E, the Froude-only practice)", paper),
-           ("row: E / lambda", "every law's force slope / lambda^3 (similitude: E A like every "
-            "force)", paper)]
+    out = [("scaling", ("every length / lambda (nodes, mesh, strand and cable diameters), so "
+            "sections / lambda^2; loads by Froude: A* / lambda^2, velocity / sqrt(lambda)"), paper),
+           ("row: prototype material unscaled", ("the prototype's laws with E A / lambda^2 "
+            "(same E, the Froude-only practice)"), paper),
+           ("row: E / lambda", ("every law's force slope / lambda^3 (similitude: E A like every "
+            "force)"), paper)]
     if mats:
         sec = f"net d = {p.net.strand_diameter * 1e3:g} mm / lambda"
         if p.border is not None:
             sec += f", cables d = {p.border.diameter * 1e3:g} mm / lambda"
         law = "" if p.net.panel_law is None else "; the prototype's panel law is replaced"
-        out.append(("rows: materials", f"E of the profile on the prototype's sections scaled "
+        out.append(("rows: materials", (f"E of the profile on the prototype's sections scaled "
                     f"({sec}), linear, tension-only{law} (not select's section: the series "
-                    "isolates the material)", "; ".join(r.source for r in mats)))
-    out.append(("reading", f"at h / h_B = {shared.level:g}, reached in steps of "
-                f"{shared.level_step:g} (warm-started)", paper))
+                    "isolates the material)"), "; ".join(r.source for r in mats)))
+    out.append(("reading", (f"at h / h_B = {shared.level:g}, reached in steps of "
+                f"{shared.level_step:g} (warm-started)"), paper))
     sensors = ("three 1 N wires pulling on every model (lambda > 1): a force that does not "
                "scale" if shared.net.sensors else "wires read only (they pull nothing)")
     out.append(("sensors", sensors, "--solver-net sensors=on|off"))
-    out.append(("prototype reference", "the prototype row at lambda = 1 (its own material); "
-                "ratio = value / reference", "printgen"))
+    out.append(("prototype reference", ("the prototype row at lambda = 1 (its own material); "
+                "ratio = value / reference"), "printgen"))
     return out
 
 

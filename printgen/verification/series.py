@@ -134,7 +134,7 @@ def check_scales(scales: list[float] | tuple[float, ...]) -> tuple[float, ...]:
         if not (math.isfinite(s) and 0 < s <= SCALE_MAX):
             raise InputError(f"scale {s:g} must be > 0 and <= {SCALE_MAX:g} (lambda = "
                              "prototype / model; 1 is the prototype), e.g. --scales 1,10,30")
-    return tuple(sorted(set(float(s) for s in scales)))
+    return tuple(sorted({float(s) for s in scales}))
 
 
 def rows_for(p: Prototype, materials: list[str] | tuple[str, ...]) -> list[Row]:

@@ -15,6 +15,7 @@ reported and expected between the two.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -159,7 +160,7 @@ def sentence(s: Series, row: Row, pi0: float, pure: bool) -> str:
 def local_exponents(pts: list[Point], key: str) -> list[float]:
     """d ln(value) / d ln(Pi) between neighbouring scales of one row."""
     return [math.log(b.values[key] / a.values[key]) / math.log(b.pi / a.pi)
-            for a, b in zip(pts, pts[1:], strict=False)
+            for a, b in itertools.pairwise(pts)
             if b.pi != a.pi and a.values[key] > 0 and b.values[key] > 0]
 
 
@@ -173,10 +174,10 @@ def law_check(s: Series, row: Row, slack: float, pure: bool) -> dict[str, Any]:
     worst = max(pts, key=lambda p: abs(p.departure["deflection"]))
     size = max(abs(worst.values["deflection"]), abs(worst.values["lowering"]),
                abs(s.reference["deflection"]), abs(s.reference["lowering"]))
-    why = [f"largest deflection departure {worst.departure['deflection']:+.1%} at lambda = "
+    why = [(f"largest deflection departure {worst.departure['deflection']:+.1%} at lambda = "
            f"{worst.scale:g}, where the net deflects {worst.values['deflection']:.3f} x width "
            f"and its top lowers {worst.values['lowering']:.3f} x height (prototype: "
-           f"{s.reference['deflection']:.3f} / {s.reference['lowering']:.3f})"]
+           f"{s.reference['deflection']:.3f} / {s.reference['lowering']:.3f})")]
     if not pure:
         why.append("not a pure elastic net (border cables sliding, a non-linear panel law or "
                    "sensor wires pulling a force that does not scale): the law is only a guide")
