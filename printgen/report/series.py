@@ -8,7 +8,7 @@ import csv
 import io
 
 from printgen.report.html import Report
-from printgen.report.plots import _png, _pyplot
+from printgen.report.plots import _png, _pyplot, lambda_axis
 from printgen.verification.series import OUTPUTS
 from printgen.verification.series_table import TOLERANCE, Series
 
@@ -30,12 +30,7 @@ def series_figure(s: Series) -> bytes:
             ys = [s.point(row.key, lam).values[key] for lam in lams]
             style = "--" if row.kind == "similitude" else "-o"
             ax.plot(lams, ys, style, color=f"C{i}", label=row.label)
-        if len(lams) > 1:
-            ax.set_xscale("log")
-        ax.set_xlabel("scale lambda (-)")
-        ax.set_ylabel(f"{what} (-)")
-        ax.set_title(what, fontsize=10)
-        ax.grid(alpha=0.3, which="both")
+        lambda_axis(ax, what)
     axes[0].legend(fontsize=7)
     fig.suptitle(f"{s.prototype}: scale series ({s.scene})")
     return _png(fig)

@@ -18,7 +18,7 @@ from pathlib import Path
 from printgen.barrier.loads import get_load
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
-from printgen.outputs import check_destination, staged_dir
+from printgen.outputs import check_destination, write_folder
 from printgen.report.jsonout import dumps
 from printgen.report.series import series_csv, series_figure, series_report
 from printgen.run.provenance import TIMINGS
@@ -136,12 +136,4 @@ def write_series(run: SeriesRun, out: Path, force: bool, inputs: list,
                                      TIMINGS: dumps({"timings_s": timings})}
     for f in rep.figures:
         files[f"figures/01-{f.name}.png"], files[f"figures/01-{f.name}.svg"] = f.png, f.svg
-    with staged_dir(out, force=force, volatile=(TIMINGS,), inputs=inputs) as stage:
-        (stage / "figures").mkdir()
-        for name, data in files.items():
-            path = stage / name
-            if isinstance(data, bytes):
-                path.write_bytes(data)
-            else:
-                path.write_text(data)
-    return sorted(files)
+    return write_folder(out, files, force=force, volatile=(TIMINGS,), inputs=inputs)
