@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from printgen.barrier.loads import get_load
+from printgen.errors import InputError
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import check_destination, write_folder
@@ -66,6 +67,9 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
     say = progress or (lambda _text: None)
     t0 = time.perf_counter()
     lams = check_scales(scales)
+    if serial and (workers is not None or scheduler):
+        raise InputError("--serial runs in this process: leave out --workers/--scheduler, or "
+                         "--serial")
     p = prototype if isinstance(prototype, Prototype) else load_prototype(prototype)
     inputs = [p.path, *search_dirs()] if p.path else list(search_dirs())
     if out is not None:
