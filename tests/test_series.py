@@ -145,3 +145,11 @@ def test_check_scales():
     for bad in ([], [math.nan], [math.inf], [0.5e4]):
         with pytest.raises(InputError):
             check_scales(bad)
+
+
+def test_sensor_row_says_the_models_pull(tiny_realistic):
+    on = run_series(tiny_realistic, [1, 40], serial=True, net=net_options("sensors=on"))
+    rows = {a[0]: a[1] for a in on.series.assumptions}
+    assert "1 N along each wire on the models" in rows["sensor wires"]
+    assert "read only (no sensors" not in rows["sensor wires"]
+    assert rows["sensors"].startswith("three 1 N wires pulling")

@@ -24,6 +24,7 @@ from printgen.report.jsonout import dumps
 from printgen.report.series import series_csv, series_figure, series_report
 from printgen.run.provenance import TIMINGS
 from printgen.search.sweep import open_runner
+from printgen.verification.scenes import SENSOR_FORCE_N
 from printgen.verification.series import (
     LEVEL,
     LEVEL_STEP,
@@ -88,7 +89,7 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
         where = runner.where
     scene = "simple-free-top" if not base.cables else f"border cables, {base.mounting}"
     s = summarise(shared, lams, results, scene)
-    s.assumptions = [*base.assumptions, *scaling_assumptions(shared)]
+    s.assumptions = [*scene_assumptions(base, shared.net), *scaling_assumptions(shared)]
     record = {**s.to_record(), "load_case": shared.load, "ran_on": where, "level": level,
               "level_step": level_step, "solver_net": shared.net.to_record(),
               "curves": [{"row": r.row, "scale": r.scale, "levels": r.levels,
@@ -99,6 +100,18 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
         run.files = write_series(run, Path(out), force, inputs,
                                  {"total": time.perf_counter() - t0})
     return run
+
+
+def scene_assumptions(base, net: NetOptions) -> list[tuple[str, str, str]]:
+    """The prototype scene's rows, its sensor row saying that the models' wires pull when
+    they do (the prototype's scene only reads them)."""
+    rows = list(base.assumptions)
+    if net.sensors:
+        rows = [(w, v.replace("read only (no sensors on a field barrier)",
+                              f"{SENSOR_FORCE_N:g} N along each wire on the models (lambda > 1), "
+                              "read only on the prototype (lambda = 1)"), src)
+                if w == "sensor wires" else (w, v, src) for w, v, src in rows]
+    return rows
 
 
 def scaling_assumptions(shared: SeriesShared) -> list[tuple[str, str, str]]:
