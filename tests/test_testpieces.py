@@ -160,3 +160,18 @@ def test_bad_orientation_and_non_diamond_net_write_nothing(tmp_path):
     with pytest.raises(Exception, match="diamond"):
         write_pieces(path, tmp_path / "b")
     assert not (tmp_path / "b").exists()
+
+
+def test_cli_writes_the_folder_and_refuses_bad_input_with_exit_2(pieces, tmp_path, capsys):
+    from printgen.cli import main
+
+    d, _, _ = pieces
+    path = tmp_path / "design.json"
+    path.write_text(dumps(d.to_dict()))
+    assert main(["testpieces", str(path), "--out", str(tmp_path / "ok"), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["coupon"]["geometry"]["gauge_length_mm"] > 0
+    assert main(["testpieces", str(tmp_path / "missing.json"), "--out", str(tmp_path / "x")]) == 2
+    assert main(["testpieces", str(path), "--orientation", "diagonal",
+                 "--out", str(tmp_path / "y")]) == 2
+    assert not (tmp_path / "x").exists() and not (tmp_path / "y").exists()
+    assert "error" in capsys.readouterr().err
