@@ -38,13 +38,13 @@ def run(args: argparse.Namespace) -> int:
         c.print(f"[bold yellow]{rec['material']} rests on datasheet values[/]: print the test "
                 "pieces below and calibrate before printing the barrier")
     cg, pg = rec["coupon"]["geometry"], rec["panel"]["geometry"]
-    rows = [["coupon", (f"{cg['width_mm']:g} x {cg['thickness_mm']:g} mm strip, gauge "
-             f"{cg['gauge_length_mm']:g} mm, eyelet tabs {cg['eyelet_outer_mm']:g} mm on "
-             f"{cg['pin_hole_mm']:g} mm pins {cg['pin_distance_mm']:g} mm apart (print "
+    rows = [["coupon", (f"{cg['width_mm']:.4g} x {cg['thickness_mm']:.4g} mm strip, gauge "
+             f"{cg['gauge_length_mm']:.4g} mm, eyelet tabs {cg['eyelet_outer_mm']:.4g} mm on "
+             f"{cg['pin_hole_mm']:.4g} mm pins {cg['pin_distance_mm']:.4g} mm apart (print "
              f"{cg['count']})"), f"{rec['coupon']['readback_vs_stl']:+.1%}"],
-            ["panel", (f"{pg['printed_mm'][0]:g} x {pg['printed_mm'][1]:g} mm, clamps "
-             f"{pg['width_mm']:g} mm wide, {pg['length_mm']:g} mm apart, "
-             f"{pg['clamp_depth_mm']:g} mm held each end"), 
+            ["panel", (f"{pg['printed_mm'][0]:.4g} x {pg['printed_mm'][1]:.4g} mm, clamps "
+             f"{pg['width_mm']:.4g} mm wide, {pg['length_mm']:.4g} mm apart, "
+             f"{pg['clamp_depth_mm']:.4g} mm held each end"), 
              f"{rec['panel']['readback_vs_stl']:+.1%}"]]
     c.print(table(f"test pieces in {out}", ["piece", "geometry", "G-code vs STL"], rows))
     for line in rec["loop"]:

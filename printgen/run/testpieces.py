@@ -59,7 +59,7 @@ def testpieces(design_path: str | Path, out: str | Path, *, orientation: str = "
     meta: dict[str, Any] = {"command": command, "design_file": Path(design_path).name}
     with staged_dir(out, force=force, meta=meta, inputs=inputs) as stage:
         rec = {"design_file": Path(design_path).name, "material": d.net.material,
-               "material_source": load_material(d.net.material).modulus()[1],
+               "material_source": material_source(load_material(d.net.material)),
                "coupon": _coupon_files(stage, coupon, printer),
                "panel": _panel_files(stage, piece, printer),
                "loop": [s.format(n=COUPON_COUNT, mat=d.net.material) for s in LOOP]}
@@ -69,6 +69,14 @@ def testpieces(design_path: str | Path, out: str | Path, *, orientation: str = "
         (stage / "README.md").write_text(readme_text(rec, dp.test.describe()))
         (stage / RECORD).write_text(dumps(rec))
     return rec
+
+
+def material_source(mat) -> str:
+    """What the net's law rests on: 'measured panel law', 'measured' (a printed modulus) or
+    'datasheet' (as the selection and the design search flag it)."""
+    if mat.panel_law is not None:
+        return "measured panel law"
+    return mat.modulus()[1]
 
 
 def _panel(d: Design, orientation: str):
@@ -191,18 +199,18 @@ def readme_text(rec: dict[str, Any], panel_test: str) -> str:
                   "test pieces below and calibrate before printing the barrier."), ""]
     lines += [
         f"## Tensile coupon (print {c['count']})",
-        (f"Strip {c['width_mm']:g} x {c['thickness_mm']:g} mm ({c['beads_across']} bead(s) "
+        (f"Strip {c['width_mm']:.4g} x {c['thickness_mm']:.4g} mm ({c['beads_across']} bead(s) "
         f"across, layers {c['layer_heights_mm']} mm: the net strand's passes), gauge length "
-        f"{c['gauge_length_mm']:g} mm (the free strip between the eyelet rings). Grip tabs: "
-        f"eyelet rings, pin hole {c['pin_hole_mm']:g} mm, outer {c['eyelet_outer_mm']:g} mm "
-        f"({c['ring_width_each_side_mm']:g} mm each side = {c['ring_factor']} strand widths), "
-        f"pin centres {c['pin_distance_mm']:g} mm apart: load it on two pins."), "",
+        f"{c['gauge_length_mm']:.4g} mm (the free strip between the eyelet rings). Grip tabs: "
+        f"eyelet rings, pin hole {c['pin_hole_mm']:.4g} mm, outer {c['eyelet_outer_mm']:.4g} mm "
+        f"({c['ring_width_each_side_mm']:.4g} mm each side = {c['ring_factor']} strand widths), "
+        f"pin centres {c['pin_distance_mm']:.4g} mm apart: load it on two pins."), "",
         "## Net test panel (print 1 or more)",
-        (f"Loaded along the {p['orientation']} diagonal (mesh {p['mesh_along_load_mm']:g} mm "
-        f"along x {p['mesh_across_load_mm']:g} mm across). Printed {p['printed_mm'][0]:g} x "
-        f"{p['printed_mm'][1]:g} mm with a border frame. Clamps {p['width_mm']:g} mm wide, "
-        f"their edges on the node rows {p['length_mm']:g} mm apart, each holding "
-        f"{p['clamp_depth_mm']:g} mm of net and the frame bar beyond. Cut the two side bars of "
+        (f"Loaded along the {p['orientation']} diagonal (mesh {p['mesh_along_load_mm']:.4g} mm "
+        f"along x {p['mesh_across_load_mm']:.4g} mm across). Printed {p['printed_mm'][0]:.4g} x "
+        f"{p['printed_mm'][1]:.4g} mm with a border frame. Clamps {p['width_mm']:.4g} mm wide, "
+        f"their edges on the node rows {p['length_mm']:.4g} mm apart, each holding "
+        f"{p['clamp_depth_mm']:.4g} mm of net and the frame bar beyond. Cut the two side bars of "
         "the frame after clamping, before the test (free sides, as simulated)."),
         (f"Expected curve (panel-expected.csv): the virtual panel test, {panel_test}; "
         "columns free (sides free, as tested) and blocked (every strand stretched alike, the "
