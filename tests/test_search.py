@@ -66,9 +66,9 @@ def test_stiffness_objective_pareto_over_every_printable_candidate(tmp_path, mon
     from printgen.run import api
 
     writes = []
-    staged = run_search.staged_dir
-    monkeypatch.setattr(run_search, "staged_dir", lambda *a, **k: writes.append(a) or
-                        staged(*a, **k))
+    write = run_search.write_folder
+    monkeypatch.setattr(run_search, "write_folder", lambda *a, **k: writes.append(a) or
+                        write(*a, **k))
     run = api.search_nets(REALISTIC, [SCALE], options=SearchOptions(
         objective="stiffness", materials=("tpe", "tpu"), mesh_x_mm=(18.0, 22.0),
         mesh_y_mm=(8.0, 10.0)), serial=True, out=tmp_path / "o")
