@@ -31,7 +31,7 @@ def binding_constraints(screened: list[Screened], space: SearchSpace
     constraints that keep the search from the target; empty when that candidate is on it)."""
     feasible = [s for s in screened if s.feasible]
     if not feasible:
-        return None, tuple(_kinds(screened, "every candidate fails"))
+        return None, tuple(_kinds(screened, f"of the {len(screened)} candidates"))
     best = min(feasible, key=lambda s: (abs(s.error_small), s.point.index))
     if abs(best.error_small) <= SMALL_STRAIN_TOLERANCE:
         return best.point.index, ()
