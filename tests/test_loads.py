@@ -108,7 +108,7 @@ def test_uniform_jam_head_on_a_pinned_cable_gives_the_parabola():
     site = Site(velocity=1.0, strand_diameter=1e-4)
     spec = "jam:porosity=0.6,thickness_m=0.5,log_diameter_m=0.3,tailwater_froude=0.5"
     r = 3.0
-    q, hm, _ = seepage(r, net_factor(s) * site.strand_diameter, 0.6, 0.5, 0.3, 0.5)
+    _, hm, _ = seepage(r, net_factor(s) * site.strand_diameter, 0.6, 0.5, 0.3, 0.5)
     assert hm > length + 1.0 / (n - 1)  # precondition: every node wet behind the jam
     loads = get_load(spec).loads_for(s, site)(r)
     f = total_forces(loads, s.nodes)[0] @ FLOW
