@@ -198,6 +198,28 @@ def _assumption_tables(rep: Report, v: Verification) -> None:
         rep.table([f"{who}: what", "value", "source"], [list(a) for a in run.scene.assumptions])
 
 
+def load_case_sections(rep: Report, v: Verification) -> None:
+    """`make --loads`: each load case's assumptions and the printed model's expected readings
+    at its own levels (nominal; the files expected-readings-<case>.csv)."""
+    if not v.by_load:
+        return
+    rep.heading("What the campaign will see: expected readings by load case")
+    rep.paragraph("The nominal printed model (and prototype) under each case of --loads, at "
+                  "the case's own levels (the jam: the flume's discharge steps); no band. "
+                  "Files: expected-readings-<case>.csv.")
+    for name, c in v.by_load.items():
+        rows = [list(a) for a in c.model.scene.assumptions if a[0].startswith("loading")]
+        rep.table([f"{c.spec}: what", "value", "source"], rows)
+        d, used = c.model.deformation, c.load.get("model", {})
+        q = used.get("discharge_l_per_s", used.get("velocity_m_per_s"))
+        head = "discharge (L/s)" if "discharge_l_per_s" in used else "velocity (m/s)"
+        table = [[f"{lv:.3f}", "" if q is None else f"{q[i]:.3g}",
+                  f"{100 * d.values['strain_mid'][i]:.2f}", f"{d.values['deflection'][i]:.4f}",
+                  f"{d.max_cable_tension[i]:.3g}"] for i, lv in enumerate(d.levels)]
+        rep.table([f"{name}: h/h_B", head, "mid-height strain (%)", "deflection / width",
+                   "max cable tension (N)"], table)
+
+
 def _counterexample_section(rep: Report, ce: CounterExample) -> None:
     rep.heading("Why stiffness is scaled: steel at every scale")
     rep.paragraph(

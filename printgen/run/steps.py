@@ -312,12 +312,13 @@ def verification_report(v: Verification, band: Band, scale: float
     record (with the lab's curves and expected readings, printgen.report.labfiles)."""
     from printgen.report.html import Report
     from printgen.report.labfiles import lab_record
-    from printgen.report.report import verification_sections
+    from printgen.report.report import load_case_sections, verification_sections
     from printgen.report.uncertainty import band_record, band_sections
 
     rep = Report("")
     verification_sections(rep, v, v.counterexample, scale, band=band)
     band_sections(rep, v, band)
+    load_case_sections(rep, v)
     record = v.to_record()
     record["bands"] = band_record(v, band)
     record["lab"] = lab_record(v, band, scale)

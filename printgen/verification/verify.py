@@ -289,6 +289,9 @@ class CaseRuns:
 
     def to_record(self) -> dict[str, Any]:
         return {"spec": self.spec, "load": self.load,
+                "assumptions": [dict(zip(("what", "value", "source"), a, strict=True))
+                                for a in self.model.scene.assumptions
+                                if a[0].startswith("loading")],
                 "model_levels": self.model.deformation.levels,
                 "not_converged": {"prototype": self.prototype.failed,
                                   "model": self.model.failed}}
