@@ -182,7 +182,8 @@ def test_cli_loads_and_load_params_make_specs():
 
 def test_case_readings_are_the_nominal_model_at_the_discharge_steps():
     """`make --loads ...,jam` writes expected-readings-jam.csv from these: the model's sweep
-    at the jam's levels, the discharge beside each reading, sensors zeroed at h/h_B = 0."""
+    at the jam's levels, the discharge beside each reading, sensors zeroed at h/h_B = 0; the
+    report states the case's assumptions and readings."""
     from printgen.inputs.prototype import load_prototype
     from printgen.report.labfiles import _csv, case_file, case_readings
     from printgen.verification.readings import flume_units
@@ -195,3 +196,11 @@ def test_case_readings_are_the_nominal_model_at_the_discharge_steps():
     header = _csv(list(r), list(r.values())).splitlines()[0].split(",")
     assert header[:3] == ["h_over_hb", "water_depth_mm", "discharge_l_per_s"]
     assert case_file("jam") == "expected-readings-jam.csv"
+    from printgen.report.html import Report
+    from printgen.report.report import load_case_sections
+
+    rep = Report("")
+    load_case_sections(rep, SimpleNamespace(by_load={"jam": c}))
+    html = rep.html()
+    assert "What the campaign will see" in html and "discharge (L/s)" in html
+    assert "loading: jam at each level" in html and "Ergun 1952" in html

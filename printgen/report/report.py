@@ -198,6 +198,10 @@ def _assumption_tables(rep: Report, v: Verification) -> None:
         rep.table([f"{who}: what", "value", "source"], [list(a) for a in run.scene.assumptions])
 
 
+def _small(x: float, noise: float = 1e-9) -> str:
+    return "0" if abs(x) < noise else f"{x:.3g}"  # solver round-off at h = 0
+
+
 def load_case_sections(rep: Report, v: Verification) -> None:
     """`make --loads`: each load case's assumptions and the printed model's expected readings
     at its own levels (nominal; the files expected-readings-<case>.csv)."""
@@ -215,7 +219,7 @@ def load_case_sections(rep: Report, v: Verification) -> None:
         head = "discharge (L/s)" if "discharge_l_per_s" in used else "velocity (m/s)"
         table = [[f"{lv:.3f}", "" if q is None else f"{q[i]:.3g}",
                   f"{100 * d.values['strain_mid'][i]:.2f}", f"{d.values['deflection'][i]:.4f}",
-                  f"{d.max_cable_tension[i]:.3g}"] for i, lv in enumerate(d.levels)]
+                  _small(d.max_cable_tension[i])] for i, lv in enumerate(d.levels)]
         rep.table([f"{name}: h/h_B", head, "mid-height strain (%)", "deflection / width",
                    "max cable tension (N)"], table)
 

@@ -270,7 +270,8 @@ def stated(case: LoadCase, runs: tuple[Run, Run], sites: tuple[Site, Site]
         rec[who] = {"levels": run.deformation.levels, **values}
         if text:
             row = (f"loading: {case.name} at each level", text,
-                   "printgen (report.json verification.load)")
+                   ("printgen (report.json: verification.load, or verification.by_load.<case> "
+                    "for make --loads)"))
             run = dataclasses.replace(run, scene=dataclasses.replace(
                 run.scene, assumptions=(*run.scene.assumptions, row)))
         out.append(run)
