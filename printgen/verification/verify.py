@@ -1,7 +1,7 @@
 """Pre-print verification: the prototype and the printed model, each as a tension-only net
 (`printgen.verification.scenes`), loaded hydrostatically from h / h_B = 0 to 1.1 (the reference's loading
 test: water raised behind a folded film), or another load case of `printgen.barrier.loads`
-(drag at the Froude-scaled velocity), and compared by their normalised deformations over the whole range (printgen.verification.compare).
+(flow, drag, jam: a case may bring its own levels and states what it used at each), and compared by their normalised deformations over the whole range (printgen.verification.compare).
 Also the counter-example the report warns about: the simple barrier with steel at every scale.
 """
 
