@@ -68,6 +68,8 @@ class Variant:
     orientation: str | None = None  # panel-test orientation of the net's law (None: profile's)
     pressure: str = "flow"  # the water's force along the flow or normal to the net (scenes)
     span: float | None = None  # lateral supports this far apart (m; None: the printed width)
+    net_law: str = "formula"  # strand law: diamond formula or the virtual panel test's (forms)
+    bed: str = "free"  # the net's bottom row free or held on the flume bed (forms)
 
 
 def mounting_options() -> tuple[str, ...]:
@@ -121,18 +123,30 @@ def model_variants(d: Design, mounting: str | None = None, free_section: float |
 
 def _model_form_variants(d: Design, free_section: float | None, notes: list[str]
                          ) -> list[Variant]:
-    """Issue 25: the water's force normal to the deformed net, and the net mounted in a free
-    section narrower than its printed width (printgen.verification.mount)."""
+    """Issue 25: the water's force normal to the deformed net, the virtual panel test's strand
+    law and the bottom row held on the bed (printgen.verification.forms), and the net mounted
+    in a free section narrower than its printed width (printgen.verification.mount), alone and
+    with its slack bottom cable on the bed."""
     out = [Variant("pressure normal to the deformed net", pressure="normal",
                    source="the folded film presses normal to the net (nominal: along the "
                           "flow, reference section 3)")]
+    law = load_material(d.net.material).panel_law
+    if law is not None and law.has_geometry:
+        out.append(Variant("strand law from the virtual panel test", net_law="derived",
+                           source="printgen panel: the strand law whose simulated panel test "
+                                  "reproduces the profile's (nominal: diamond formula)"))
+    if d.cables:
+        out.append(Variant("bottom row held on the bed", bed="held", source=(
+            "the film's foot seals on the bed under the full head (nominal: the bottom "
+            "cable free between its anchors)")))
     width = d.net.width_mm * MM
     if d.cables and free_section is not None and free_section < width * (1 - SAME):
-        out.append(Variant(f"mounted in the {free_section * 1e3:g} mm free section",
-                           span=free_section, source=(
-                               f"net printed {width * 1e3:.4g} mm wide, side sheets "
-                               f"{free_section * 1e3:g} mm apart; how the excess is held is "
-                               "not stated (reference section 4)")))
+        fs = f"{free_section * 1e3:g} mm free section"
+        src = (f"net printed {width * 1e3:.4g} mm wide, side sheets {free_section * 1e3:g} mm "
+               "apart; how the excess is held is not stated (reference section 4)")
+        out += [Variant(f"mounted in the {fs}", span=free_section, source=src),
+                Variant(f"mounted in the {fs}, bottom on the bed", span=free_section,
+                        bed="held", source=src + "; its slack bottom cable lies on the bed")]
     else:
         notes.append("mounting span: no free section narrower than the net given "
                      "([flume] free_section_m); no span variant")
@@ -202,6 +216,13 @@ def variant_scene(d: Design, v: Variant, coarsen: int = 1) -> BarrierScene:
     s = model_scene(d, **({"mounting": v.mounting} if v.mounting else {}),
                     orientation=v.orientation)
     laws = list(s.laws)
+    if v.net_law == "derived":  # issue 25: the virtual panel test's strand law
+        from printgen.verification.forms import derived_net_law
+
+        laws[0], how = derived_net_law(load_material(d.net.material), d.net, v.orientation)
+        s = dataclasses.replace(s, assumptions=tuple(
+            (w, f"{d.net.material}: {how}" if w == "net strands" else val, src)
+            for w, val, src in s.assumptions))
     laws[0] = _scaled(laws[0], v.net_factor * coarsen)
     if len(laws) > 1:  # the printed border frame, of the net's material
         laws[1] = _scaled(laws[1], v.frame_factor)
@@ -211,6 +232,10 @@ def variant_scene(d: Design, v: Variant, coarsen: int = 1) -> BarrierScene:
         from printgen.verification.mount import in_free_section
 
         s = in_free_section(s, v.span)
+    if v.bed == "held":
+        from printgen.verification.forms import held_on_bed
+
+        s = held_on_bed(s)
     return s
 
 

@@ -1,0 +1,81 @@
+"""Model-form options of the printed model's scene (issue 25), each argued from the material or
+the test, never fitted to the flume curve (Lambert et al. 2023, doi:10.1061/JHEND8.HYENG-13070):
+
+- net law (`NET_LAWS`): "formula" (the nominal) turns the profile's panel law into a strand
+  law by the analytic diamond mapping (every strand of an infinite, blocked panel stretched
+  alike); "derived" uses the strand law whose simulated panel test, as the source ran it,
+  reproduces the panel law (`printgen.verification.panel.derive_law`): free between the clamps,
+  or blocked where a free pin-jointed panel is a mechanism over the law's range (the printed
+  net's rigid junctions, which the solver does not model, stop its meshes closing at no force;
+  blocking is their stiff limit);
+- bed (`BEDS`): "free" (the nominal) lets the bottom cable move between its corner anchors;
+  "held" keeps the net's bottom row where it is: it rests on the flume bed at the foot of the
+  folded film, which must lie on the bed to hold the water back and is pressed onto it by the
+  full head; contact and friction hold the bottom edge (with the net squeezed into the free
+  section, its slack bottom cable can only lie on the bed).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from functools import lru_cache
+
+from printgen.units import MM
+from printgen.verification.scenes import BarrierScene, Law, panel_axes
+
+NET_LAWS = ("formula", "derived")
+BEDS = ("free", "held")
+MECHANISM = 0.5  # a free panel whose solver hold carries over half the clamp force is a mechanism
+
+
+@lru_cache(maxsize=16)
+def _derived(knees: tuple[float, ...], slopes: tuple[float, ...], along: float, across: float,
+             length: float, width: float) -> tuple[Law, str, float]:
+    """(strand law, test mode, derivation error) of a panel law n(eps) = piecewise(knees,
+    slopes N/m) tested on a `length` x `width` panel loaded along the `along` diagonal."""
+    from printgen.verification.panel import PanelTest, derive_law, law_strains, simulate
+    from printgen.verification.scenes import strand_law_from_membrane
+
+    free = PanelTest(along, across, length, width, "free")
+    probe = simulate(strand_law_from_membrane(knees, slopes, along, across), free,
+                     law_strains(knees)[:2])
+    t = free if probe.hold_share <= MECHANISM else dataclasses.replace(free, mode="blocked")
+    d = derive_law(knees, slopes, t)
+    return d.law, t.mode, d.error
+
+
+def derived_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
+    """The design's strand law derived from the virtual panel test of `mat`'s panel law, read
+    along `orientation` (None: the diagonal its profile records), rescaled from the tested
+    strand section to the design's; and how it was found. GeometryError-free: a material
+    without a panel law of recorded geometry keeps the formula (`model_net_law`)."""
+    from printgen.design.section import area_m2
+    from printgen.verification.scenes import model_net_law
+
+    law = mat.panel_law
+    if law is None or not law.has_geometry:
+        return model_net_law(mat, n, orientation)
+    if orientation is None:
+        orientation = "short" if law.mesh_along_load <= law.mesh_across_load else "long"
+    along, across = panel_axes(law.mesh_along_load, law.mesh_across_load, orientation)
+    width = law.panel_width or law.panel_length
+    strand, mode, err = _derived(tuple(law.knee_strains),
+                                 tuple(k * law.panel_length for k in law.kappas),
+                                 along, across, law.panel_length, width)
+    ratio = area_m2(n.strand) / (law.strand_width * law.strand_thickness)
+    how = (f"strand law derived from the virtual panel test ({law.panel_length / MM:g} mm "
+           f"panel, {width / MM:g} mm clamps, {mode}, along the {along / MM:g} mm "
+           f"({orientation}) diagonal; reproduces the panel law within {err:.1%})")
+    return (strand[0], tuple(s * ratio for s in strand[1])), how
+
+
+def held_on_bed(s: BarrierScene) -> BarrierScene:
+    """Scene `s` with its bottom row's nodes held in place by the bed (see the module)."""
+    fixed = s.fixed.copy()
+    fixed[s.rows["bottom"]] = True
+    note = ("bed", ("the net's bottom row rests on the flume bed, held there by contact and "
+                    "friction under the film's foot (the bottom cable cannot move)"),
+            ("printgen, issue 25 (the film seals on the bed; Lambert et al. 2023: folded film "
+             "larger than the barrier)"))
+    return dataclasses.replace(s, fixed=fixed, assumptions=(*s.assumptions, note))
+
