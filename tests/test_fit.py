@@ -59,3 +59,14 @@ def test_an_impossible_curve_is_refused():
     fit = fit_measured(d, m, LEVELS, choices=[("walls", None, None)])
     assert not fit.explains
     assert "NOT explained" in fit.sentence()
+
+
+def test_a_bed_choice_is_fitted_and_recorded():
+    """The bed is a discrete choice (issue 25): a 3-tuple choice means the free bed."""
+    d = coarse_design()
+    m = measurement({"strain_mid": np.array([0.001, 0.004, 0.008])})
+    fit = fit_measured(d, m, LEVELS, choices=[("walls", None, None), ("walls", None, None,
+                                                                       "held")],
+                       free=("net_factor",))
+    assert set(fit.choices) == {("walls", None, None, "free"), ("walls", None, None, "held")}
+    assert {c["bed"] for c in fit.to_record()["choices"]} == {"free", "held"}

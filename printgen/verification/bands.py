@@ -117,40 +117,10 @@ def model_variants(d: Design, mounting: str | None = None, free_section: float |
         notes.append("mounting: the model scene has one mounting only; no mounting variant")
     out.append(Variant(f"initial slack {SLACK_MAX:.0%}", slack=SLACK_MAX,
                        source="printed net hung with 0 to 1 % slack (printgen; README: Uncertainty band)"))
-    out += _model_form_variants(d, free_section, notes)
+    from printgen.verification.forms import model_form_variants
+
+    out += model_form_variants(d, free_section, notes)
     return out, notes
-
-
-def _model_form_variants(d: Design, free_section: float | None, notes: list[str]
-                         ) -> list[Variant]:
-    """Issue 25: the water's force normal to the deformed net, the virtual panel test's strand
-    law and the bottom row held on the bed (printgen.verification.forms), and the net mounted
-    in a free section narrower than its printed width (printgen.verification.mount), alone and
-    with its slack bottom cable on the bed."""
-    out = [Variant("pressure normal to the deformed net", pressure="normal",
-                   source="the folded film presses normal to the net (nominal: along the "
-                          "flow, reference section 3)")]
-    law = load_material(d.net.material).panel_law
-    if law is not None and law.has_geometry:
-        out.append(Variant("strand law from the virtual panel test", net_law="derived",
-                           source="printgen panel: the strand law whose simulated panel test "
-                                  "reproduces the profile's (nominal: diamond formula)"))
-    if d.cables:
-        out.append(Variant("bottom row held on the bed", bed="held", source=(
-            "the film's foot seals on the bed under the full head (nominal: the bottom "
-            "cable free between its anchors)")))
-    width = d.net.width_mm * MM
-    if d.cables and free_section is not None and free_section < width * (1 - SAME):
-        fs = f"{free_section * 1e3:g} mm free section"
-        src = (f"net printed {width * 1e3:.4g} mm wide, side sheets {free_section * 1e3:g} mm "
-               "apart; how the excess is held is not stated (reference section 4)")
-        out += [Variant(f"mounted in the {fs}", span=free_section, source=src),
-                Variant(f"mounted in the {fs}, bottom on the bed", span=free_section,
-                        bed="held", source=src + "; its slack bottom cable lies on the bed")]
-    else:
-        notes.append("mounting span: no free section narrower than the net given "
-                     "([flume] free_section_m); no span variant")
-    return out
 
 
 def _cable_variants(d: Design, notes: list[str]) -> list[Variant]:

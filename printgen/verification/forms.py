@@ -19,9 +19,15 @@ from __future__ import annotations
 
 import dataclasses
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
+from printgen.design.record import Design
+from printgen.inputs.materials import load_material
 from printgen.units import MM
 from printgen.verification.scenes import BarrierScene, Law, panel_axes
+
+if TYPE_CHECKING:
+    from printgen.verification.bands import Variant
 
 NET_LAWS = ("formula", "derived")
 BEDS = ("free", "held")
@@ -79,3 +85,36 @@ def held_on_bed(s: BarrierScene) -> BarrierScene:
              "larger than the barrier)"))
     return dataclasses.replace(s, fixed=fixed, assumptions=(*s.assumptions, note))
 
+
+def model_form_variants(d: Design, free_section: float | None, notes: list[str]
+                         ) -> list[Variant]:
+    """Issue 25: the water's force normal to the deformed net, the virtual panel test's strand
+    law and the bottom row held on the bed (printgen.verification.forms), and the net mounted
+    in a free section narrower than its printed width (printgen.verification.mount), alone and
+    with its slack bottom cable on the bed."""
+    from printgen.verification.bands import SAME, Variant
+
+    out = [Variant("pressure normal to the deformed net", pressure="normal",
+                   source="the folded film presses normal to the net (nominal: along the "
+                          "flow, reference section 3)")]
+    law = load_material(d.net.material).panel_law
+    if law is not None and law.has_geometry:
+        out.append(Variant("strand law from the virtual panel test", net_law="derived",
+                           source="printgen panel: the strand law whose simulated panel test "
+                                  "reproduces the profile's (nominal: diamond formula)"))
+    if d.cables:
+        out.append(Variant("bottom row held on the bed", bed="held", source=(
+            "the film's foot seals on the bed under the full head (nominal: the bottom "
+            "cable free between its anchors)")))
+    width = d.net.width_mm * MM
+    if d.cables and free_section is not None and free_section < width * (1 - SAME):
+        fs = f"{free_section * 1e3:g} mm free section"
+        src = (f"net printed {width * 1e3:.4g} mm wide, side sheets {free_section * 1e3:g} mm "
+               "apart; how the excess is held is not stated (reference section 4)")
+        out += [Variant(f"mounted in the {fs}", span=free_section, source=src),
+                Variant(f"mounted in the {fs}, bottom on the bed", span=free_section,
+                        bed="held", source=src + "; its slack bottom cable lies on the bed")]
+    else:
+        notes.append("mounting span: no free section narrower than the net given "
+                     "([flume] free_section_m); no span variant")
+    return out
