@@ -59,3 +59,16 @@ def test_model_form_variants_of_the_paper_design():
     assert labels["bottom row held on the bed"].bed == "held"
     both = labels["mounted in the 300 mm free section, bottom on the bed"]
     assert both.span == pytest.approx(0.3) and both.bed == "held"
+
+
+def test_sensor_routing_is_a_variant_only_where_the_wire_ends_move():
+    d = load_design(PAPER)
+    walls, notes = model_variants(d, "walls", None)
+    assert not [v for v in walls if v.routing != "in-line"]
+    assert any("sensor routing" in n and "no routing variant" in n for n in notes)
+    eyelets = [v for v in model_variants(d, "eyelets", None)[0] if v.routing == "downstream"]
+    assert len(eyelets) == 1
+    s = variant_scene(d, Variant(mounting="eyelets", routing="downstream"))
+    for w in s.wires.values():
+        step = w.exit - s.nodes[w.nodes[-1]]
+        assert step[1] > 0 and step[0] == 0 and step[2] == 0  # downstream, out of the plane

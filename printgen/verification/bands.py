@@ -70,6 +70,7 @@ class Variant:
     span: float | None = None  # lateral supports this far apart (m; None: the printed width)
     net_law: str = "formula"  # strand law: diamond formula or the virtual panel test's (forms)
     bed: str = "free"  # the net's bottom row free or held on the flume bed (forms)
+    routing: str = "in-line"  # the sensor wires beyond the right edge (forms.ROUTINGS)
 
 
 def mounting_options() -> tuple[str, ...]:
@@ -119,7 +120,7 @@ def model_variants(d: Design, mounting: str | None = None, free_section: float |
                        source="printed net hung with 0 to 1 % slack (printgen; README: Uncertainty band)"))
     from printgen.verification.forms import model_form_variants
 
-    out += model_form_variants(d, free_section, notes)
+    out += model_form_variants(d, free_section, notes, nominal)
     return out, notes
 
 
@@ -202,11 +203,10 @@ def variant_scene(d: Design, v: Variant, coarsen: int = 1) -> BarrierScene:
         from printgen.verification.mount import in_free_section
 
         s = in_free_section(s, v.span)
-    if v.bed == "held":
-        from printgen.verification.forms import held_on_bed
+    from printgen.verification.forms import held_on_bed, routed
 
-        s = held_on_bed(s)
-    return s
+    s = held_on_bed(s) if v.bed == "held" else s
+    return routed(s, v.routing)
 
 
 def _scaled(law: tuple, factor: float) -> tuple:

@@ -12,7 +12,13 @@ the test, never fitted to the flume curve (Lambert et al. 2023, doi:10.1061/JHEN
   "held" keeps the net's bottom row where it is: it rests on the flume bed at the foot of the
   folded film, which must lie on the bed to hold the water back and is pressed onto it by the
   full head; contact and friction hold the bottom edge (with the net squeezed into the free
-  section, its slack bottom cable can only lie on the bed).
+  section, its slack bottom cable can only lie on the bed);
+- sensor routing (`ROUTINGS`): beyond the barrier's right edge node the wire runs "in-line"
+  to its potentiometer (the nominal, README: The flume test as it is run) or turns
+  "downstream" to a potentiometer standing behind the barrier, out of the water (the paper
+  does not say where they stood). Where the rows' end nodes are held (walls mounting) the
+  exit segment is fixed at both ends: the routing changes neither the net nor the reading, and
+  no variant is run.
 """
 
 from __future__ import annotations
@@ -20,6 +26,8 @@ from __future__ import annotations
 import dataclasses
 from functools import lru_cache
 from typing import TYPE_CHECKING
+
+import numpy as np
 
 from printgen.design.record import Design
 from printgen.inputs.materials import load_material
@@ -31,6 +39,7 @@ if TYPE_CHECKING:
 
 NET_LAWS = ("formula", "derived")
 BEDS = ("free", "held")
+ROUTINGS = ("in-line", "downstream")
 MECHANISM = 0.5  # a free panel whose solver hold carries over half the clamp force is a mechanism
 
 
@@ -86,17 +95,44 @@ def held_on_bed(s: BarrierScene) -> BarrierScene:
     return dataclasses.replace(s, fixed=fixed, assumptions=(*s.assumptions, note))
 
 
-def model_form_variants(d: Design, free_section: float | None, notes: list[str]
-                         ) -> list[Variant]:
+def routed(s: BarrierScene, routing: str) -> BarrierScene:
+    """Scene `s` with its sensor wires leaving the right edge node by `routing` (ROUTINGS)."""
+    if routing == ROUTINGS[0]:
+        return s
+    reach = {k: float(np.linalg.norm(w.exit - s.nodes[w.nodes[-1]])) for k, w in s.wires.items()}
+    wires = {k: dataclasses.replace(w, exit=s.nodes[w.nodes[-1]] + np.array([0, reach[k], 0]))
+             for k, w in s.wires.items()}
+    note = ("sensor routing", ("beyond the right edge node each wire turns downstream to a "
+                               "potentiometer behind the barrier"),
+            "printgen, issue 25 (the paper does not state where the potentiometers stood)")
+    return dataclasses.replace(s, wires=wires, assumptions=(*s.assumptions, note))
+
+
+def _routing_variants(d: Design, mounting: str | None, notes: list[str]) -> list[Variant]:
+    from printgen.verification.bands import Variant, variant_scene
+
+    s = variant_scene(d, Variant(mounting=mounting))
+    if all(s.fixed[w.nodes[-1]] for w in s.wires.values()):
+        notes.append(f"sensor routing: the rows' end nodes are held ({s.mounting} mounting), "
+                     "so the wire beyond them changes neither the net nor the reading; no "
+                     "routing variant")
+        return []
+    return [Variant("sensor wires turn downstream at the edge", routing="downstream",
+                    source="potentiometers' position not stated (nominal: in line)")]
+
+
+def model_form_variants(d: Design, free_section: float | None, notes: list[str],
+                        mounting: str | None = None) -> list[Variant]:
     """Issue 25: the water's force normal to the deformed net, the virtual panel test's strand
     law and the bottom row held on the bed (printgen.verification.forms), and the net mounted
     in a free section narrower than its printed width (printgen.verification.mount), alone and
-    with its slack bottom cable on the bed."""
+    with its slack bottom cable on the bed; the sensor routing where it matters."""
     from printgen.verification.bands import SAME, Variant
 
     out = [Variant("pressure normal to the deformed net", pressure="normal",
                    source="the folded film presses normal to the net (nominal: along the "
                           "flow, reference section 3)")]
+    out += _routing_variants(d, mounting, notes) if d.cables else []
     law = load_material(d.net.material).panel_law
     if law is not None and law.has_geometry:
         out.append(Variant("strand law from the virtual panel test", net_law="derived",
