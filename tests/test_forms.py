@@ -10,13 +10,13 @@ from proto_files import EXAMPLES
 from printgen.design.design_file import load_design
 from printgen.inputs.materials import load_material
 from printgen.verification.bands import Variant, curves, model_variants, variant_scene
-from printgen.verification.forms import derived_net_law
+from printgen.verification.forms import DERIVE_POINTS, derived_net_law
 from printgen.verification.panel import PanelTest, law_strains, simulate
 from printgen.verification.verify import sweep
 
 PAPER = EXAMPLES / "paper_1_40" / "design.json"
 MM = 1e-3
-DERIVED_TOL = 0.07  # issue 25 asks 5 % over the law's range; 12 points on a 2-mesh panel: 6.7 %
+DERIVED_TOL = 0.05  # issue 25: a derived law reproduces its panel law within 5 % over its range
 STILL = 1e-12  # relative wire change of a row whose nodes are all held (round-off only)
 LEVELS = np.array([0.0, 0.5])
 
@@ -27,7 +27,8 @@ def test_derived_law_reproduces_the_tpe_panel_law_along_the_long_diagonal():
     law, how = derived_net_law(mat, d.net, "long")
     pl = mat.panel_law
     t = PanelTest(20.6 * MM, 9.4 * MM, pl.panel_length, pl.panel_width, "free")
-    eps = law_strains(pl.knee_strains)
+    fitted = law_strains(pl.knee_strains, DERIVE_POINTS)
+    eps = np.sort(np.concatenate([fitted, (fitted[1:] + fitted[:-1]) / 2]))  # and between
     sim = simulate(law, t, eps).force_per_width  # the design's strands are the tested ones
     target = pl.force_per_width(eps)
     assert np.max(np.abs(sim - target)) / np.max(target) < DERIVED_TOL
