@@ -54,6 +54,7 @@ SCREEN_KEEP = 2  # choices searched on after the screen
 XTOL = 1e-4  # stop once a step moves the scaled parameters by less than this (relative)
 STEP = 0.01  # finite-difference step of the Jacobians, fraction of each range
 DETERMINED = 0.1  # a singular value above 10 % of the largest: that direction is determined
+AT_BOUND = 0.01  # a parameter within 1 % of its range from a bound (not its nominal) is at it
 
 
 @dataclass(frozen=True)
@@ -163,6 +164,7 @@ class MultiFit:
     identifiability: Identifiability
     evaluations: int
     explains: bool
+    at_bounds: tuple[str, ...] = ()  # parameters the best set pushes against a bound
 
     kind = "multi"
     at_bound = False  # the one-factor fit's flag; a multi fit says `explains` instead
@@ -177,7 +179,7 @@ class MultiFit:
         """The fit in report.json: parameters, bounds, choices, identifiability, mismatches."""
         ident = self.identifiability
         return {"kind": self.kind, "explains": self.explains, "sentence": self.sentence(),
-                "params": dataclasses.asdict(self.params),
+                "params": dataclasses.asdict(self.params), "at_bounds": list(self.at_bounds),
                 "bounds": {k: {"low": lo, "high": hi, "nominal": nom}
                            for k, (lo, hi, nom) in BOUNDS.items()},
                 "choices": [{"mounting": k[0], "orientation": k[1], "span_m": k[2],
@@ -198,6 +200,11 @@ class MultiFit:
                 f"{p.orientation or 'as profiled'}, span "
                 f"{'printed width' if p.span is None else f'{p.span * 1e3:g} mm'}, bottom row "
                 f"{p.bed}")
+        if self.at_bounds and worst < EXPLAINS:
+            edge = ", ".join(self.at_bounds)
+            return (f"NOT explained: the best set, {what}, leaves {worst:.0%} of the measured "
+                    f"peak, but only with {edge} at the end of its range (issue 25: "
+                    "parameters inside their bounds); no profile is written")
         if self.explains:
             return (f"explained within the bounds by {what} (worst RMS mismatch {worst:.0%} of "
                     f"the measured peak); determined: {', '.join(self.identifiability.determined()) or 'none'}")
@@ -267,8 +274,21 @@ def fit_measured(d: Design, m: Measurement, lv: np.ndarray, *, coarsen: int = 1,
     pred = run(params)
     after = mismatch(m, pred)
     ident = _identifiability(m, params, pred, run)
-    ok = all(mm.rms_rel < EXPLAINS for mm in after if not math.isnan(mm.rms_rel))
-    return MultiFit(params, mismatch(m, nominal), after, pred, best, ident, len(cache), ok)
+    edge = at_bounds(params)
+    ok = all(mm.rms_rel < EXPLAINS for mm in after if not math.isnan(mm.rms_rel)) and not edge
+    return MultiFit(params, mismatch(m, nominal), after, pred, best, ident, len(cache), ok,
+                    edge)
+
+
+def at_bounds(p: Params) -> tuple[str, ...]:
+    """The continuous parameters of `p` within AT_BOUND of a bound other than their nominal
+    (a fit pushed there wants more than physics allows)."""
+    out = []
+    for k, (lo, hi, nom) in BOUNDS.items():
+        u, n = _to_unit(k, getattr(p, k)), _to_unit(k, nom)
+        if (u < AT_BOUND and n >= AT_BOUND) or (u > 1 - AT_BOUND and n <= 1 - AT_BOUND):
+            out.append(k)
+    return tuple(out)
 
 
 def _identifiability(m: Measurement, p: Params, pred: dict[str, np.ndarray], run
