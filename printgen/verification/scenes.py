@@ -4,7 +4,8 @@ three extension sensors of the loading test (Lambert et al. 2023, doi:10.1061/JH
 
 Plane of the net: x across the barrier, z up (from the flume bed), y the flow direction.
 Net strands are the pattern's graph's strand segments (`printgen.barrier.patterns`: the
-diamond's diagonals); their force-strain law is the panel law turned into a strand law by the
+diamond's diagonals, the square's strands up and across, whose edge rows are strands of the
+prototype and the printed border frame of the model); their force-strain law is the panel law turned into a strand law by the
 pattern (`NetPattern.strand_law`). With border cables, the cables
 slide through the net's edge nodes between the four corner anchors; the lateral edges are
 held by the flume's side sheets along their whole height (`walls`, the default) or only the
@@ -196,6 +197,8 @@ def prototype_scene(p: Prototype, *, mounting: str | None = None,
     mounting = mounting or lateral_mounting(p)
     pattern = get_pattern(p.net.pattern)
     g = pattern.graph(p.width / MM, p.height / MM, p.net.mesh_x / MM, p.net.mesh_y / MM)
+    if pattern.edge_strands:  # the square's edge rows are strands of the prototype's net
+        g = dataclasses.replace(g, family=np.where(g.family == 0, 1, g.family))
     if p.net.panel_law is not None:
         knees, kappas, length = p.net.panel_law
         along, across = panel_axes(p.net.mesh_x, p.net.mesh_y, orientation)
