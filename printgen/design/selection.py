@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from printgen.barrier.loads import OVERFLOW  # peak relative loading of the loading test
-from printgen.barrier.patterns import AS_DRAWN, get_pattern
+from printgen.barrier.patterns import AS_DRAWN, get_pattern, mesh_text
 from printgen.barrier.patterns.square import check_square
 from printgen.design.record import Section
 from printgen.design.section import area_m2, equal_area_diameter, net_membrane_law
@@ -104,6 +104,7 @@ class Selection:
     printer: str
     net_print: str
     cable_print: str
+    net_mesh: str = ""  # the printed net's pattern and mesh (`mesh_text`): what was priced
 
     @property
     def cable(self) -> Candidate | None:
@@ -115,7 +116,8 @@ class Selection:
             "printer": self.printer, "net_print": self.net_print, "cable_print": self.cable_print,
             "cable": {"rationale": self.cable_rationale,
                       "ranked": [c.to_record() for c in self.cables]},
-            "net": {"rationale": self.net_rationale, "ranked": [c.to_record() for c in self.net]},
+            "net": {"mesh": self.net_mesh, "rationale": self.net_rationale,
+                    "ranked": [c.to_record() for c in self.net]},
         }
 
 
@@ -261,9 +263,11 @@ def select(p: Prototype, t: ScaledTargets, *, printer: str | None = None,
     if not any(c.feasible for c in nets):
         raise PrintabilityError(f"no material and pass layout can print the net on "
                                 f"{printer_obj.key}: {nets[0].reasons[0]}")
+    mesh_x, mesh_y = model_mesh(p, t)
     return Selection(tuple(cables), tuple(nets), _rationale(cables, "cable"),
                      _rationale(nets, "net") + _per_material(nets), printer_obj.key,
-                     net_style.key, cable_style.key)
+                     net_style.key, cable_style.key,
+                     mesh_text(printed_pattern(p), mesh_x / MM, mesh_y / MM))
 
 
 def _per_material(ranked: list[Candidate]) -> str:

@@ -45,6 +45,12 @@ class NetPattern:
     edge_strands: bool = False
 
 
+def mesh_text(pattern: str, mesh_x_mm: float, mesh_y_mm: float) -> str:
+    """How a printed net is named in every output: "square mesh 5 x 5 mm" (the square's
+    sides), "diamond mesh 20.6 x 9.4 mm" (the diamond's diagonals), across x up."""
+    return f"{pattern} mesh {mesh_x_mm:g} x {mesh_y_mm:g} mm"
+
+
 def pattern_names() -> tuple[str, ...]:
     """Every pattern's name, then those drawn as another (`AS_DRAWN`), without importing the
     patterns: the prototype file's [net] pattern choices."""
