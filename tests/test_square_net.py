@@ -194,3 +194,35 @@ def test_prusaslicer_slices_the_square_net(reduced, tmp_path):
                        check=False)
     summary = r.stdout.strip().splitlines()[-1] if r.stdout.strip() else r.stderr
     assert r.returncode == 0 and summary.startswith("SLICE-CHECK OK"), summary
+
+
+PANEL_REL = 1e-6  # the solver's panel tolerance is 1e-9 of the strand force: far below this
+# Free mode: the ties that hold each free node (panel.HOLD_RATIO) also resist its travel along
+# the load, which `hold_share` (x only) does not count: 0.4 % of the clamp force here.
+FREE_HOLD_REL = 0.01
+
+
+@pytest.mark.parametrize("mode", ["blocked", "free"])
+def test_virtual_panel_of_the_square_net_reads_its_membrane_law(simple, mode):
+    """The same panel machinery as the diamond (`verification.panel`): the designed square
+    strands, tested as a panel, give the membrane law the design priced (one strand per mesh
+    across, `square.membrane_factor`), times (nx + 1) / nx for the panel's two edge strands
+    on a width of nx meshes; free or blocked alike (a square net has no Poisson effect)."""
+    from printgen.design.section import net_membrane_law
+    from printgen.verification.panel import PanelTest, lattice_size, simulate
+
+    _, d = simple
+    n = d.net
+    a = n.mesh_x_mm * 1e-3
+    law = model_scene(d).laws[0]
+    t = PanelTest(a, a, 10 * a, 8 * a, mode, "square")
+    nx = round(lattice_size(t)[1] / a)
+    strains = np.array([0.01, 0.05, 0.2])
+    curve = simulate(law, t, strains)
+    knees, slopes, _ = net_membrane_law(load_material(n.material), n.strand, a, a, "square")
+    from printgen.inputs.laws import piecewise_linear
+
+    want = piecewise_linear(strains, knees, slopes) * (nx + 1) / nx
+    assert_allclose(curve.force_per_width, want,
+                    rtol=PANEL_REL if mode == "blocked" else FREE_HOLD_REL)
+    assert curve.hold_share < PANEL_REL  # no mechanism: nothing moves across the load
