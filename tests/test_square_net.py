@@ -226,3 +226,27 @@ def test_virtual_panel_of_the_square_net_reads_its_membrane_law(simple, mode):
     assert_allclose(curve.force_per_width, want,
                     rtol=PANEL_REL if mode == "blocked" else FREE_HOLD_REL)
     assert curve.hold_share < PANEL_REL  # no mechanism: nothing moves across the load
+
+
+@pytest.fixture(scope="module")
+def coarse_simple(tmp_path_factory):
+    """The simple barrier on a mesh twice as coarse (the test's budget: 31 x 11 nodes), its
+    printed square net at 10 mm; the same scene as examples/simple_barrier.toml otherwise."""
+    path = write_variant(tmp_path_factory.mktemp("square"),
+                         {("net", "mesh_x_m"): 0.4, ("net", "mesh_y_m"): 0.4,
+                          ("model", "mesh_x_mm"): 10.0, ("model", "mesh_y_mm"): 10.0},
+                         base=SIMPLE)
+    return _design(path)
+
+
+def test_verification_of_the_square_net_converges_at_every_level(coarse_simple):
+    """Prototype and printed square net solved at every level of the sweep (h / h_B = 0 to
+    1.1 by 0.05), the model with its printed edge frame and pulling sensor wires."""
+    from printgen.verification.verify import levels, verify
+
+    p, d = coarse_simple
+    assert d.net.pattern == "square"
+    v = verify(p, d)
+    assert not v.prototype.failed and not v.model.failed
+    assert v.compared == v.asked == len(levels())
+    assert any(row[0] == "printed border frame" for row in v.model.scene.assumptions)
