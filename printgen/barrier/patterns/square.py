@@ -1,6 +1,6 @@
 """The square net: strands across and up the barrier (the simple barrier of the scale series,
 Lambert et al. 2023, doi:10.1061/JHEND8.HYENG-13070). Its mesh is the square's side
-`mesh_x` (both ways; `mesh_y` must equal it). Under a stretch eps along the load the strands
+`mesh_x` (both ways; a printed square net must have mesh_y = mesh_x, `check_square`). Under a stretch eps along the load the strands
 up the barrier strain eps and carry it, one per mesh across: N = E A / a_across * eps; the
 strands across carry nothing (transverse strain blocked).
 
@@ -67,7 +67,6 @@ def square_graph(width_mm: float, height_mm: float, mesh_x_mm: float,
     """A square-mesh net (strands across and up) of side `mesh_x_mm` as a NetGraph."""
     mesh_mm = mesh_x_mm
     check_lengths(width=width_mm, height=height_mm, mesh_x=mesh_mm)
-    check_square(mesh_x_mm, mesh_y_mm)
     nx, ny = round(width_mm / mesh_mm), round(height_mm / mesh_mm)
     if min(nx, ny) < MIN_MESHES:
         raise GeometryError(f"net {width_mm:g} x {height_mm:g} mm holds {nx} x {ny} square "
