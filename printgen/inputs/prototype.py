@@ -232,8 +232,8 @@ CROSS_CHECKS = (
     "[flume] lateral = \"eyelets\" needs a [border] table (the eyelets are the cables' ends)",
     "[flume] froude_min <= froude_max",
     "[model] mesh_x_mm and mesh_y_mm: both or neither (neither: the prototype's mesh scaled)",
-    "a printed square net ([model] pattern, default the prototype's) needs a square mesh "
-    "(mesh_x = mesh_y)",
+    ("a printed square net ([model] pattern, default the prototype's) needs a square mesh "
+     "(mesh_x = mesh_y)"),
 )
 
 

@@ -32,7 +32,7 @@ import numpy as np
 
 from printgen.barrier.graph import NetGraph
 from printgen.barrier.loads import FLOW, LoadCase, get_load
-from printgen.barrier.patterns import AS_DRAWN, get_pattern
+from printgen.barrier.patterns import AS_DRAWN, get_pattern, mesh_text
 from printgen.barrier.patterns.diamond import strand_law as strand_law_from_membrane
 from printgen.design.record import Design
 from printgen.design.section import area_m2, net_membrane_law
@@ -251,12 +251,14 @@ def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
                      f"profile materials/{c.material}"))
     s = _scene(f"printed model 1:{d.scale:g}", d.scale, g, MM, net_law, cable_law,
                ((), (border_ea,)), mounting)
-    rows = [("net", (f"{pattern.name} mesh {n.mesh_x_mm:g} x {n.mesh_y_mm:g} mm, "
+    rows = [("net", (f"{mesh_text(pattern.name, n.mesh_x_mm, n.mesh_y_mm)}, "
              f"{len(s.nodes)} nodes, rigid junctions"), "design"),
             ("net strands", (f"{mat.name}: {how}, strand {n.strand.width_mm:g} x "
              f"{n.strand.thickness_mm:g} mm"), f"profile materials/{n.material}"),
             ("printed border frame", (f"{n.border_width_mm:g} mm wide, E = {e / 1e9:.3g} GPa "
-             f"({e_src})"), f"design; profile materials/{n.material}"), *rows]
+             f"({e_src})" + (", on the edge rows (the prototype's edge strands)"
+                             if pattern.edge_strands else "")),
+             f"design; profile materials/{n.material}"), *rows]
     return _finish(s, rows, sensors=True, load=load)
 
 
