@@ -123,6 +123,12 @@ def lockup_strain(mesh_along: float, mesh_across: float) -> float:
     return math.hypot(mesh_along, mesh_across) / mesh_along - 1.0
 
 
+def panel_lockup(t: PanelTest) -> float:
+    """Panel strain of test `t` at which its strands lie along the load: the diamond's
+    `lockup_strain`; 0 for a square net, whose strands up lie along it from the start."""
+    return 0.0 if t.pattern == "square" else lockup_strain(t.mesh_along, t.mesh_across)
+
+
 def analytic_blocked(law: Law, t: PanelTest, strains: np.ndarray) -> np.ndarray:
     """Membrane force per width (N/m) of the blocked, infinite diamond panel at `strains`:
     every strand stretched alike, 2 / a_across strands per unit width, each pulling along its
@@ -301,6 +307,7 @@ def _segment_shares(law: Law, t: PanelTest, eps: np.ndarray) -> tuple[np.ndarray
 
 
 PRINTED_PANEL = (43 * MM, 23 * MM)  # the paper's printed panels: length, clamp width (m)
+TESTED_PATTERN = "diamond"  # the pattern of the nets the material profiles' panel laws tested
 
 
 @dataclass(frozen=True)
@@ -332,4 +339,7 @@ def design_panel(d, orientation: str, mode: str = "free",
     law = model_net_law(mat, n, orientation if pl is not None and pl.has_geometry else None)[0]
     eps = law_strains(pl.knee_strains if pl else (), points)
     curve = simulate(law, t, eps)
-    return DesignPanel(orientation, t, law, curve, pl.force_per_width(eps) if pl else None)
+    # the profiles' panel laws were measured on diamond nets (`design.section`): another
+    # pattern's panel is not that test, and gets no measured column
+    same_net = pl is not None and n.pattern == TESTED_PATTERN
+    return DesignPanel(orientation, t, law, curve, pl.force_per_width(eps) if same_net else None)
