@@ -250,3 +250,28 @@ def test_verification_of_the_square_net_converges_at_every_level(coarse_simple):
     assert not v.prototype.failed and not v.model.failed
     assert v.compared == v.asked == len(levels())
     assert any(row[0] == "printed border frame" for row in v.model.scene.assumptions)
+
+
+RING_QUADRATURE = 1e-4  # the analytic area's polar-grid integral over each ring (1.3e-5 seen)
+
+
+def test_square_net_with_border_cables_has_loops_and_lays_its_volume(tmp_path):
+    """The simple barrier with border cables: a two-bead frame with a loop on every edge node
+    (the cables thread them), a watertight mesh, and a direct G-code laying the mesh's volume."""
+    pytest.importorskip("manifold3d")
+    from printgen.parts.geometry.attach import attachment_for
+    from printgen.parts.geometry.solid import analytic_net_volume, net_solid
+
+    path = tmp_path / "bordered.toml"
+    path.write_text(SIMPLE.read_text() + "\n[border]\ndiameter_mm = 24.0\nmodulus_gpa = 100.0\n")
+    _, d = _design(path)
+    assert d.net.pattern == "square" and d.net.border_width_mm == 2 * d.net.strand.bead_width_mm
+    n = dataclasses.replace(d.net, width_mm=REDUCED_MM[0], height_mm=REDUCED_MM[1])
+    printer = load_printer(d.printer)
+    att = attachment_for(d, hole_compensation_mm=printer.hole_compensation_mm)
+    mesh = net_solid(n, att)
+    assert mesh.is_watertight
+    assert mesh.volume == pytest.approx(analytic_net_volume(n, att), rel=RING_QUADRATURE)
+    tp = net_toolpath(n, printer, load_print_style(n.print_style), load_material(n.material),
+                      attachment=att)
+    assert abs(tp.volume_mm3 / mesh.volume - 1) < VOLUME_TOL
