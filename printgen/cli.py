@@ -30,6 +30,7 @@ COMMAND_MODULES = (
     "printgen.commands.verify",
     "printgen.commands.check",
     "printgen.commands.panel",
+    "printgen.commands.testpieces",
     "printgen.commands.bench",
     "printgen.commands.calibrate",
     "printgen.commands.example",

@@ -11,6 +11,7 @@ from proto_files import REALISTIC, write_variant
 
 import printgen.run.make as make_mod
 from printgen.cli import main
+from printgen.commands.common import EXIT_INCOMPLETE
 from printgen.errors import PrintgenError, TimeLimitError
 from printgen.outputs import check_folder, folder_files
 from printgen.report.jsonout import dumps
@@ -224,5 +225,19 @@ def test_incomplete_verification_exits_3_with_outputs(tmp_path, monkeypatch, cap
 
     monkeypatch.setattr(make_cmd.api, "make", fake)
     code = main(["make", str(REALISTIC), "-s", "40", "--out", str(tmp_path / "o")])
-    assert code == make_cmd.EXIT_INCOMPLETE and code not in (0, 2)
+    assert code == EXIT_INCOMPLETE and code not in (0, 2)
     assert "rests on 20 of 23 load levels" in capsys.readouterr().err
+
+
+def test_incomplete_verify_exits_3(tmp_path, monkeypatch, capsys):
+    """`verify` exits as `make` does when its verdict rests on fewer levels than asked."""
+    from types import SimpleNamespace
+
+    from printgen.run import api
+
+    record = {"verification": {"complete": False, "levels_compared": 21, "levels_asked": 23}}
+    monkeypatch.setattr(api, "verify_design", lambda *a, **k: SimpleNamespace(record=record))
+    code = main(["verify", str(REALISTIC), "-s", "40", "--design", str(tmp_path / "design.json"),
+                 "--json"])
+    assert code == EXIT_INCOMPLETE
+    assert "printgen verify: the verdict rests on 21 of 23" in capsys.readouterr().err

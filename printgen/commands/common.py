@@ -13,6 +13,21 @@ from rich.table import Table
 from printgen.inputs.profiles import profile_name
 from printgen.report.jsonout import dumps
 
+EXIT_INCOMPLETE = 3  # outputs written, but the verdict rests on fewer load levels than asked
+
+
+def incomplete_code(record: dict[str, Any], command: str) -> int:
+    """EXIT_INCOMPLETE, with one line on stderr, when the run's verdict rests on fewer load
+    levels than asked (the others did not converge); else 0. For `make` and `verify`."""
+    ver = record.get("verification") or {}
+    if ver.get("complete") is not False:
+        return 0
+    Console(stderr=True, highlight=False).print(
+        f"printgen {command}: the verdict rests on {ver['levels_compared']} of "
+        f"{ver['levels_asked']} load levels (the others did not converge: see the report); "
+        f"exit {EXIT_INCOMPLETE}")
+    return EXIT_INCOMPLETE
+
 
 def add_prototype_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("prototype", help="prototype barrier TOML (see examples/)")

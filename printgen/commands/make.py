@@ -17,6 +17,7 @@ from printgen.commands.common import (
     check_profile_args,
     console,
     emit_json,
+    incomplete_code,
     seconds,
     table,
 )
@@ -24,7 +25,6 @@ from printgen.run import api
 from printgen.run.budget import DEFAULT_LIMIT_S
 from printgen.run.make import MakeOptions, json_output
 
-EXIT_INCOMPLETE = 3  # outputs written, but the verdict rests on fewer load levels than asked
 EXIT_TIME_LIMIT = 4  # stopped at --time-limit (printgen.cli maps TimeLimitError to it)
 
 
@@ -65,17 +65,11 @@ def run(args: argparse.Namespace) -> int:
                                            design_file=args.design,
                                            time_limit_s=args.time_limit, pdf=args.pdf))
     seconds = time.perf_counter() - t0
-    ver = ctx.record.get("verification") or {}
-    code = EXIT_INCOMPLETE if ver.get("complete") is False else 0
     if args.json:
         emit_json(json_output(ctx.record))
-        return code
-    show_summary(ctx, out, seconds)
-    if code:
-        err.print(f"printgen make: the verdict rests on {ver['levels_compared']} of "
-                  f"{ver['levels_asked']} load levels (the others did not converge: see the "
-                  f"report); exit {code}")
-    return code
+    else:
+        show_summary(ctx, out, seconds)
+    return incomplete_code(ctx.record, "make")
 
 
 class Progress:

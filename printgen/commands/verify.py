@@ -18,6 +18,7 @@ from printgen.commands.common import (
     add_time_limit_arg,
     console,
     emit_json,
+    incomplete_code,
     table,
 )
 from printgen.verification.measured import COLUMNS, FIT_KINDS, LEVEL_COLUMN
@@ -60,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
                                 time_limit_s=args.time_limit)
     if args.json:
         emit_json(res.record)
-        return 0
+        return incomplete_code(res.record, "verify")
     c = console()
     v = res.record["verification"]
     c.print(f"[bold]{v['verdict']}[/bold]: {v['summary']}")
@@ -80,4 +81,4 @@ def run(args: argparse.Namespace) -> int:
                     "mounting, slack) before changing the material.")
     c.print(f"{len(res.files)} files in {out}/ ; open {out / 'report.html'}")
     sys.stdout.flush()
-    return 0
+    return incomplete_code(res.record, "verify")
