@@ -47,7 +47,7 @@ from printgen.parts.gcode.toolpath import (
     speeds,
 )
 from printgen.parts.geometry.attach import CORNER_EXTRA_RINGS, Attachment, Hole, holes
-from printgen.parts.geometry.lattice import crossing_sin, end_sin
+from printgen.parts.geometry.lattice import crossing_direction, crossing_sin, end_sin
 
 
 def net_toolpath(net: NetDesign, printer: Printer, style: PrintStyle, material: Material, *,
@@ -220,7 +220,7 @@ def _bead_pieces(pts: np.ndarray, u: np.ndarray, off: np.ndarray, sec: Section, 
     spans = []
     if f_cross < 1.0:
         half = _crossing_half_span(sec, g)
-        v = np.array([u[0], -u[1]])  # the other family's direction (mirror about x)
+        v = crossing_direction(g, u)  # the other family's direction (any pattern)
         shift = _cross2(off, v) / _cross2(u, v)  # the offset line meets each crossing here
         spans += [(t - shift - half, t - shift + half, f_cross)
                   for t in (float(np.dot(p - pts[0], u)) for p in pts[1:-1])]

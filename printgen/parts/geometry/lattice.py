@@ -33,6 +33,19 @@ def crossing_sin(g: NetGraph) -> float:
     return float(np.abs(u[:, 0] * u[0, 1] - u[:, 1] * u[0, 0]).max())
 
 
+def crossing_direction(g: NetGraph, u: np.ndarray) -> np.ndarray:
+    """Unit direction of the strands that cross a strand of direction `u` (the diamond's other
+    diagonal, the square's strands across the ones up); `u` itself when none cross it. The
+    patterns list one family's strands, then the other's: the first and last strands stand
+    for the two (constant time: the toolpath asks once per bead)."""
+    if not g.strands:
+        return np.asarray(u)
+    d = np.array([g.nodes_mm[s[-1]] - g.nodes_mm[s[0]] for s in (g.strands[0], g.strands[-1])])
+    d /= np.hypot(d[:, 0], d[:, 1])[:, None]
+    cross = np.abs(d[:, 0] * u[1] - d[:, 1] * u[0])
+    return d[int(np.argmax(cross))] if cross.max() > 0 else np.asarray(u)
+
+
 def parallel_spacing(g: NetGraph) -> float:
     """Smallest distance between the centre lines of two neighbouring parallel strands (mm;
     inf for a net without two parallel strands)."""
