@@ -27,6 +27,7 @@ COMMAND_MODULES = (
     "printgen.commands.profiles",
     "printgen.commands.make",
     "printgen.commands.design",
+    "printgen.commands.series",
     "printgen.commands.verify",
     "printgen.commands.check",
     "printgen.commands.panel",

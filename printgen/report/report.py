@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from printgen.barrier.patterns import mesh_text
 from printgen.design.record import Design
 from printgen.design.selection import Candidate, Selection
 from printgen.design.similitude import FORCE_EXPONENT, ScaledTargets, to_prototype
@@ -55,8 +56,8 @@ def design_sections(rep: Report, proto: Prototype, t: ScaledTargets, sel: Select
     rep.heading("Printed parts")
     n = design.net
     rows = [["net", n.material.upper(), f"{n.width_mm:g} x {n.height_mm:g}",
-             (f"diamond mesh {n.mesh_x_mm:g} x {n.mesh_y_mm:g}, strand {n.strand.width_mm:g} x "
-             f"{n.strand.thickness_mm:g} mm, {n.strand.passes} passes")]]
+             (f"{mesh_text(n.pattern, n.mesh_x_mm, n.mesh_y_mm)}, strand "
+              f"{n.strand.width_mm:g} x {n.strand.thickness_mm:g} mm, {n.strand.passes} passes")]]
     rows += [[f"cable {c.name}", c.material.upper(), f"{c.length_mm:g} long",
               (f"{c.section.width_mm:g} x {c.section.thickness_mm:g} mm, {c.section.passes} "
               f"passes, eyelets {c.eyelet_inner_mm:g}/{c.eyelet_outer_mm:g} mm")]
