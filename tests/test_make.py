@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import re
 import shutil
 import time
@@ -11,6 +12,7 @@ import pytest
 from proto_files import REALISTIC, write_variant
 
 import printgen.run.make as make_mod
+from printgen.barrier.loads import get_load
 from printgen.cli import main
 from printgen.commands.common import EXIT_INCOMPLETE
 from printgen.errors import PrintgenError, TimeLimitError
@@ -161,8 +163,11 @@ def test_cli_make_json_and_exit_codes(made_simple_drag, tmp_path, capsys, monkey
     assert rec["targets"]["scale"] == 40
     assert rec["timings"]["timings_s"]["total"] > 0
     assert times_outside_timings({k: v for k, v in rec.items() if k != "timings"}) == []
-    assert rec["verification"]["load_case"] == "hydrostatic + drag at the Froude-scaled velocity"
+    assert rec["verification"]["load_case"] == get_load("drag").title
     assert "loading: drag" in [a["what"] for a in rec["verification"]["assumptions"]["model"]]
+    load = rec["verification"]["load"]  # the velocity of each level, stated
+    assert load["spec"] == "drag" and len(set(load["model"]["velocity_m_per_s"])) == 1
+    assert load["model"]["velocity_m_per_s"][0] == pytest.approx(6.0 / math.sqrt(40), rel=1e-9)
     assert main(["make", str(REALISTIC), "-s", "40", "--printer", "prusa-mk4",
                  "--out", str(tmp_path / "bad")]) == 2
     assert "exceeds" in capsys.readouterr().err and not (tmp_path / "bad").exists()

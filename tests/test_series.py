@@ -22,6 +22,7 @@ SIMILITUDE_RTOL = 1e-9  # the issue's bar: E / lambda reproduces the prototype t
 # one decade: the pure law's 1/3 and 2/3 within this (measured 0.3334 and about 0.66)
 LAW_EXPONENT_TOL = 0.02
 LAW_DEPARTURE_TOL = 0.02  # steel's deflection within 2 % of the law anchored at the prototype
+JAM_AS_HYDROSTATIC_RTOL = 1e-9  # porosity 0: the same loads as hydrostatic to round-off (test_loads: 1e-12)
 
 
 @pytest.fixture(scope="module")
@@ -153,3 +154,17 @@ def test_sensor_row_says_the_models_pull(tiny_realistic):
     assert "1 N along each wire on the models" in rows["sensor wires"]
     assert "read only (no sensors" not in rows["sensor wires"]
     assert rows["sensors"].startswith("three 1 N wires pulling")
+
+
+def test_jam_of_porosity_zero_runs_as_hydrostatic(tiny):
+    """The series takes a load case's parameters (its spec) and hands each scale its own
+    depth and lambda: a jam of porosity 0 is a wall of logs, the hydrostatic case (issue 26's
+    limiting case), at every scale."""
+    jam = run_series(tiny, [1, 10], load="jam:porosity=0", serial=True)
+    hyd = run_series(tiny, [1, 10], serial=True)
+    assert jam.record["load_case"].startswith("jam:") and "porosity=0" in jam.record["load_case"]
+    for lam in (1, 10):
+        a = jam.series.point("similitude", lam).values
+        b = hyd.series.point("similitude", lam).values
+        for k in b:
+            assert a[k] == pytest.approx(b[k], rel=JAM_AS_HYDROSTATIC_RTOL), k

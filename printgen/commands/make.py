@@ -18,6 +18,7 @@ from printgen.commands.common import (
     console,
     emit_json,
     incomplete_code,
+    load_specs,
     seconds,
     table,
 )
@@ -34,7 +35,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_prototype_args(p)
     p.add_argument("--printer", help="printer profile (default: the prototype's [model] choice)")
     p.add_argument("--out", "-o", type=Path, help="output directory")
-    add_load_args(p, "verify")
+    add_load_args(p, "verify", several=True)
     p.add_argument("--step", action="store_true", help="also write STEP files (needs cadquery)")
     p.add_argument("--design", metavar="FILE", type=Path,
                    help="print this design.json (from printgen design) instead of select's")
@@ -57,10 +58,11 @@ def run(args: argparse.Namespace) -> int:
     out = args.out or Path("out") / f"{Path(args.prototype).stem}-1-{args.scale:g}"
     err = Console(stderr=True, highlight=False)
     t0 = time.perf_counter()
+    load, loads = load_specs(args)
     with err.status("planning") as status:
-        ctx = api.make(args.prototype, args.scale, out, printer=args.printer, load=args.load,
+        ctx = api.make(args.prototype, args.scale, out, printer=args.printer, load=load,
                        step=args.step, progress=Progress(status),
-                       options=MakeOptions(force=args.force,
+                       options=MakeOptions(force=args.force, loads=loads,
                                            command=getattr(args, "argv", None),
                                            design_file=args.design,
                                            time_limit_s=args.time_limit, pdf=args.pdf))

@@ -16,6 +16,7 @@ from printgen.commands.common import (
     check_profile_args,
     console,
     emit_json,
+    load_specs,
     table,
 )
 from printgen.errors import InputError
@@ -65,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
     err = Console(stderr=True, highlight=False)
     with err.status("reading inputs") as status:
         res = api.series(args.prototype, _scales(args.scales), materials=args.materials,
-                         load=args.load, net=args.solver_net, out=out, serial=args.serial,
+                         load=load_specs(args)[0], net=args.solver_net, out=out, serial=args.serial,
                          scheduler=args.scheduler, workers=args.workers, force=args.force,
                          progress=lambda s: status.update(f"{s} ..."), bar=not args.json)
     if args.json:

@@ -19,6 +19,7 @@ from printgen.commands.common import (
     console,
     emit_json,
     incomplete_code,
+    load_specs,
     table,
 )
 from printgen.verification.measured import COLUMNS, FIT_KINDS, LEVEL_COLUMN
@@ -56,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     with err.status("reading inputs") as status:
         res = api.verify_design(args.prototype, args.scale, args.design, out,
-                                measured=args.measured, fit=args.fit, load=args.load,
+                                measured=args.measured, fit=args.fit, load=load_specs(args)[0],
                                 force=args.force, progress=lambda s: status.update(f"{s} ..."),
                                 time_limit_s=args.time_limit)
     if args.json:

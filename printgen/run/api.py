@@ -80,6 +80,7 @@ def make(prototype: str | Path, scale: float, out: str | Path, *,
     opts = options or MakeOptions()
     given = load if load is not None else (None if drag else opts.load)  # drag=True: "drag"
     opts = dataclasses.replace(opts, load=load_name(given, drag),
+                               loads=tuple(load_name(x, False) for x in opts.loads),
                                step=step or opts.step)
     return _make(prototype, scale, out, printer=printer, options=opts, progress=progress)
 
@@ -90,9 +91,9 @@ def load_name(load: str | None, drag: bool) -> str:
     from printgen.barrier.loads import get_load
     from printgen.errors import InputError
 
-    if drag and load not in (None, "drag"):
+    if drag and load not in (None, "drag"):  # a spec with parameters names its case first
         raise InputError(f"--drag is --load drag, not --load {load}: give one of them")
-    return get_load("drag" if drag else load).name
+    return get_load("drag" if drag else load).spec
 
 
 def verify(prototype: PrototypeLike, scale: float, design_: Design | str | Path | None = None,

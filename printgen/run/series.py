@@ -75,7 +75,7 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
     if out is not None:
         check_destination(Path(out), force=force, inputs=inputs)  # before any solve
     rows = tuple(rows_for(p, materials))
-    shared = SeriesShared(p, rows, get_load(load).name, net or NetOptions(), level, level_step)
+    shared = SeriesShared(p, rows, get_load(load).spec, net or NetOptions(), level, level_step)
     base = base_scene(shared)  # geometry errors now, not in a worker
     todo = cases(shared, lams)
     if serial is None:

@@ -225,7 +225,8 @@ def solve_case(shared: SeriesShared, case: tuple[str, float]) -> CaseResult:
     row = next(r for r in shared.rows if r.key == key)
     p = shared.prototype
     s = scaled_scene(base_scene(shared), p, row, lam, shared.net.sensors)
-    site = Site(p.velocity / math.sqrt(lam), p.net.strand_diameter / lam)
+    site = Site(p.velocity / math.sqrt(lam), p.net.strand_diameter / lam, p.depth / lam,
+                None, lam)  # the flow spans the barrier's own width at every scale
     lv = levels(step=shared.level_step, top=shared.level)
     with threadpool_limits(limits=1):
         run = sweep(s, lv, slack=shared.net.slack, load=get_load(shared.load), site=site)

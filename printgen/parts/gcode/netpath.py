@@ -1,6 +1,8 @@
-"""Direct toolpath of the diamond net (mm, mm/s), one layer per pass.
+"""Direct toolpath of the net (mm, mm/s), one layer per pass, for any pattern whose strands
+are straight lines of two families (the diamond's diagonals, the square's strands up and
+across; `printgen.barrier.patterns`).
 
-Each layer: the border first, then every diagonal strand of one family as one straight
+Each layer: the border first, then every strand of one family as one straight
 extrusion from border to border through the crossings, then the other family; the family
 order alternates from layer to layer ("crossed passes"). The strands laid second in a layer
 cross beads already there: over each crossing their flow is `crossing_flow_factor` (1 = full
@@ -45,6 +47,7 @@ from printgen.parts.gcode.toolpath import (
     speeds,
 )
 from printgen.parts.geometry.attach import CORNER_EXTRA_RINGS, Attachment, Hole, holes
+from printgen.parts.geometry.lattice import crossing_direction, crossing_sin, end_sin
 
 
 def net_toolpath(net: NetDesign, printer: Printer, style: PrintStyle, material: Material, *,
@@ -186,8 +189,7 @@ def _crossing_half_span(sec: Section, g: NetGraph) -> float:
 
 
 def _sin_crossing(g: NetGraph) -> float:
-    a, b = g.mesh_mm
-    return 2 * a * b / (a * a + b * b)  # sin of the angle between the two families
+    return crossing_sin(g)  # sin of the angle between the two families, any pattern
 
 
 def _strand_beads(pts: np.ndarray, sec: Section, g: NetGraph, f_cross: float, f_end: float,
@@ -218,7 +220,7 @@ def _bead_pieces(pts: np.ndarray, u: np.ndarray, off: np.ndarray, sec: Section, 
     spans = []
     if f_cross < 1.0:
         half = _crossing_half_span(sec, g)
-        v = np.array([u[0], -u[1]])  # the other family's direction (mirror about x)
+        v = crossing_direction(g, u)  # the other family's direction (any pattern)
         shift = _cross2(off, v) / _cross2(u, v)  # the offset line meets each crossing here
         spans += [(t - shift - half, t - shift + half, f_cross)
                   for t in (float(np.dot(p - pts[0], u)) for p in pts[1:-1])]
@@ -290,13 +292,7 @@ def net_volume_budget(net: NetDesign, style: PrintStyle, *,
     border = 2 * (size[0] + size[1]) * net.border_width_mm
     nominal = (strand_len * w + border) * t
     crossing = n_cross * w * w / _sin_crossing(g) * t
-    a, b = g.mesh_mm
-    diag = np.hypot(a, b)
-    junction = 0.0
-    for s in g.strands:
-        for end in (g.nodes_mm[s[0]], g.nodes_mm[s[-1]]):
-            on_side = np.isclose(end[0], 0) or np.isclose(end[0], size[0])
-            sin_phi = a / diag if on_side else b / diag  # strand vs the border edge it meets
-            junction += net.border_width_mm / 2 / sin_phi * w * t
+    # strand ends inside the frame, each at its angle to the border edge it meets
+    junction = float(np.sum(net.border_width_mm / 2 / end_sin(g))) * w * t
     return VolumeBudget(nominal, crossing, junction, f, n_cross)
 
