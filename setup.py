@@ -1,6 +1,8 @@
 """Build hook (the metadata is in pyproject.toml): the wheel ships the repository's top-level
 `profiles/` (the bundled material, printer and print profiles) and the example prototypes
-`examples/*.toml` inside the package, as `printgen/profiles/` and `printgen/examples/`, where
+`examples/*.toml` with the example folders of data files (`examples/paper_1_40/`: the paper's
+printed design and its measured test) inside the package, as `printgen/profiles/` and
+`printgen/examples/`, where
 `printgen.inputs.profiles.bundled_dir` reads them with importlib.resources. An editable
 install reads them where they are kept, at the root of the checkout."""
 
@@ -9,7 +11,8 @@ from pathlib import Path
 from setuptools import setup
 from setuptools.command.build_py import build_py
 
-SHIPPED = {"profiles": "*/*.toml", "examples": "*.toml"}  # folder -> files copied from it
+SHIPPED = {"profiles": ("*/*.toml",),  # folder -> the files copied from it
+           "examples": ("*.toml", "paper_1_40/*.json", "paper_1_40/*.csv", "calibration/*.toml")}
 
 
 class BuildWithData(build_py):
@@ -19,8 +22,8 @@ class BuildWithData(build_py):
         super().run()
         if self.editable_mode:
             return
-        for folder, pattern in SHIPPED.items():
-            for src in sorted(Path(folder).glob(pattern)):
+        for folder, patterns in SHIPPED.items():
+            for src in sorted(f for pattern in patterns for f in Path(folder).glob(pattern)):
                 dest = Path(self.build_lib, "printgen", src)
                 self.mkpath(str(dest.parent))
                 self.copy_file(str(src), str(dest))

@@ -13,6 +13,7 @@ The public verbs (`printgen.run.api`), imported on first use so `import printgen
 - ``verify_design(prototype, scale, design_file, out)`` -> `VerifyRun` (printgen verify's folder)
 - ``calibrate(paths, material=...)`` -> `Calibration`
 - ``search_nets(prototype, scales)`` -> `DesignRun` (the inverse design, on Dask)
+- ``series(prototype, scales)`` -> `SeriesRun` (the virtual scale series)
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 __version__ = "0.1.0"
 
 VERBS = ("targets", "select", "plan", "make", "verify", "verify_design", "calibrate",
-         "search_nets")
+         "search_nets", "series")
 __all__ = [
     "__version__",
     "calibrate",
@@ -30,6 +31,7 @@ __all__ = [
     "plan",
     "search_nets",
     "select",
+    "series",
     "targets",
     "verify",
     "verify_design",
@@ -42,6 +44,7 @@ if TYPE_CHECKING:
         plan,
         search_nets,
         select,
+        series,
         targets,
         verify,
         verify_design,

@@ -28,7 +28,8 @@ git ls-files -z --cached --others --exclude-standard \
 wheel=$(ls "$tmp"/dist/printgen-*.whl)
 built=$SECONDS
 for f in printgen/profiles/materials/petg.toml printgen/profiles/printers/generic-350.toml \
-         printgen/examples/realistic_barrier.toml printgen/py.typed solver/py.typed; do
+         printgen/examples/realistic_barrier.toml printgen/examples/paper_1_40/measured.csv \
+         printgen/py.typed solver/py.typed; do
   unzip -l "$wheel" "$f" >/dev/null || fail "$f missing from $(basename "$wheel")"
 done
 unzip -l "$wheel" '*.dist-info/licenses/LICENSE' >/dev/null || fail "LICENSE missing from the wheel"
@@ -58,6 +59,8 @@ grep -q petg profiles.txt && grep -q generic-350 profiles.txt \
 if "$pg" bench make --out b >bench.txt 2>&1; then fail "bench is offered by the wheel"; fi
 "$pg" example realistic >proto.toml
 cmp -s proto.toml "$clone/examples/realistic_barrier.toml" || fail "example realistic differs"
+"$pg" example paper_1_40 --out paper >/dev/null || fail "example paper_1_40 --out failed"
+cmp -s paper/design.json "$clone/examples/paper_1_40/design.json" || fail "example paper_1_40 differs"
 "$pg" make proto.toml --scale 40 --out o >make.txt 2>&1 || { cat make.txt; fail "make failed"; }
 "$pg" check o
 grep -q '"solver_backend"' o/manifest.json || fail "manifest.json records no solver backend"

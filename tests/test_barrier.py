@@ -30,14 +30,15 @@ def test_registries_name_each_module_as_its_entry():
     entries' names."""
     assert names(patterns_package) == list(patterns())
     assert names(loads_package) == case_names() == list(load_cases())
-    assert {"diamond", "square"} <= set(patterns()) and {"drag", DEFAULT} <= set(load_cases())
+    assert {"diamond", "square"} <= set(patterns())
+    assert {"drag", "flow", "jam", DEFAULT} <= set(load_cases())
 
 
 def test_unknown_names_are_errors_listing_the_known_ones():
     with pytest.raises(InputError, match="'hexagon' is not one of .*diamond, .*square"):
         get_pattern("hexagon")
-    with pytest.raises(InputError, match="'jam' is not one of .*drag, .*hydrostatic"):
-        get_load("jam")
+    with pytest.raises(InputError, match="'avalanche' is not one of .*drag, .*hydrostatic"):
+        get_load("avalanche")
     assert get_pattern("water-drop").name == "diamond"  # drawn as diamonds (the assumption says)
     assert get_load(None).name == DEFAULT
 
@@ -152,5 +153,5 @@ def test_cli_load_and_its_drag_alias(command):
     assert parse([*base, "--drag"]).load == "drag"
     from printgen.cli import UsageError
 
-    with pytest.raises(UsageError, match="invalid choice: 'jam'"):  # one line, exit 2
-        parse([*base, "--load", "jam"])
+    with pytest.raises(UsageError, match="invalid choice: 'avalanche'"):  # one line, exit 2
+        parse([*base, "--load", "avalanche"])

@@ -156,3 +156,12 @@ def test_fuzzed_tables_read_back(tmp_path_factory, values, variant):
 def test_decimal_vote():
     assert decimal_of(["0,5", "12,25", "1.234,5"]) == ","
     assert decimal_of(["2,554.70532", "0.00319"]) == "."
+
+
+def test_plot_labels_show_control_characters_as_escapes():
+    """A file name may hold control characters (an escape, a tab): the plot's legend shows
+    them escaped, never raw."""
+    from printgen.calibrate.plot import printable
+
+    assert printable("coupon\x1b[31m\t1.csv") == "coupon\\x1b[31m\\x091.csv"
+    assert printable("coupon 1 é.csv") == "coupon 1 é.csv"  # printable text unchanged

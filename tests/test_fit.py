@@ -9,7 +9,14 @@ import numpy as np
 import pytest
 from conftest import reference_design_1_40
 
-from printgen.verification.fit import Params, fit_measured, predict, slackened
+from printgen.verification.fit import (
+    BOUNDS,
+    Params,
+    at_bounds,
+    fit_measured,
+    predict,
+    slackened,
+)
 from printgen.verification.measured import Measurement
 
 COARSE = 2  # the 1:40 net with a 2x coarser mesh (distinct top and mid rows): fast sweeps
@@ -59,3 +66,21 @@ def test_an_impossible_curve_is_refused():
     fit = fit_measured(d, m, LEVELS, choices=[("walls", None, None)])
     assert not fit.explains
     assert "NOT explained" in fit.sentence()
+
+
+def test_a_bed_choice_is_fitted_and_recorded():
+    """The bed is a discrete choice (issue 25): a 3-tuple choice means the free bed."""
+    d = coarse_design()
+    m = measurement({"strain_mid": np.array([0.001, 0.004, 0.008])})
+    fit = fit_measured(d, m, LEVELS, choices=[("walls", None, None), ("walls", None, None,
+                                                                       "held")],
+                       free=("net_factor",))
+    assert set(fit.choices) == {("walls", None, None, "free"), ("walls", None, None, "held")}
+    assert {c["bed"] for c in fit.to_record()["choices"]} == {"free", "held"}
+
+
+def test_a_parameter_at_its_bound_is_reported():
+    """Issue 25: explained means parameters inside their bounds; a slack of 0 is nominal."""
+    assert at_bounds(Params(cable_slack=BOUNDS["cable_slack"][1])) == ("cable_slack",)
+    assert at_bounds(Params(net_factor=BOUNDS["net_factor"][0])) == ("net_factor",)
+    assert at_bounds(Params(net_factor=0.5, net_slack=0.01)) == ()

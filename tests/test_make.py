@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import re
 import time
 
@@ -10,7 +11,9 @@ import pytest
 from proto_files import REALISTIC, write_variant
 
 import printgen.run.make as make_mod
+from printgen.barrier.loads import get_load
 from printgen.cli import main
+from printgen.commands.common import EXIT_INCOMPLETE
 from printgen.errors import PrintgenError, TimeLimitError
 from printgen.outputs import check_folder, folder_files
 from printgen.report.jsonout import dumps
@@ -151,8 +154,11 @@ def test_cli_make_json_and_exit_codes(tmp_path, capsys, monkeypatch):
     assert rec["targets"]["scale"] == 40
     assert rec["timings"]["timings_s"]["total"] > 0
     assert times_outside_timings({k: v for k, v in rec.items() if k != "timings"}) == []
-    assert rec["verification"]["load_case"] == "hydrostatic + drag at the Froude-scaled velocity"
+    assert rec["verification"]["load_case"] == get_load("drag").title
     assert "loading: drag" in [a["what"] for a in rec["verification"]["assumptions"]["model"]]
+    load = rec["verification"]["load"]  # the velocity of each level, stated
+    assert load["spec"] == "drag" and len(set(load["model"]["velocity_m_per_s"])) == 1
+    assert load["model"]["velocity_m_per_s"][0] == pytest.approx(6.0 / math.sqrt(40), rel=1e-9)
     assert main(["make", str(REALISTIC), "-s", "40", "--printer", "prusa-mk4",
                  "--out", str(tmp_path / "bad")]) == 2
     assert "exceeds" in capsys.readouterr().err and not (tmp_path / "bad").exists()
@@ -224,5 +230,19 @@ def test_incomplete_verification_exits_3_with_outputs(tmp_path, monkeypatch, cap
 
     monkeypatch.setattr(make_cmd.api, "make", fake)
     code = main(["make", str(REALISTIC), "-s", "40", "--out", str(tmp_path / "o")])
-    assert code == make_cmd.EXIT_INCOMPLETE and code not in (0, 2)
+    assert code == EXIT_INCOMPLETE and code not in (0, 2)
     assert "rests on 20 of 23 load levels" in capsys.readouterr().err
+
+
+def test_incomplete_verify_exits_3(tmp_path, monkeypatch, capsys):
+    """`verify` exits as `make` does when its verdict rests on fewer levels than asked."""
+    from types import SimpleNamespace
+
+    from printgen.run import api
+
+    record = {"verification": {"complete": False, "levels_compared": 21, "levels_asked": 23}}
+    monkeypatch.setattr(api, "verify_design", lambda *a, **k: SimpleNamespace(record=record))
+    code = main(["verify", str(REALISTIC), "-s", "40", "--design", str(tmp_path / "design.json"),
+                 "--json"])
+    assert code == EXIT_INCOMPLETE
+    assert "printgen verify: the verdict rests on 21 of 23" in capsys.readouterr().err

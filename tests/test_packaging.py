@@ -72,9 +72,21 @@ def test_example_prints_the_bundled_file(capsysbinary):
     assert b"simple\tsimple_barrier.toml" in capsysbinary.readouterr().out
 
 
+def test_example_folder_is_copied_whole(tmp_path, capsys):
+    """The paper's printed design and its measured test are an example folder: `--out` copies
+    its files into a new folder and refuses one that exists."""
+    out = tmp_path / "paper"
+    assert main(["example", "paper_1_40", "--out", str(out)]) == 0
+    for name in ("design.json", "measured.csv"):
+        assert (out / name).read_bytes() == (ROOT / "examples/paper_1_40" / name).read_bytes()
+    assert main(["example", "paper_1_40", "--out", str(out)]) == 2
+    assert "exists; name a new folder" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["paper"]  # no stage left
+
+
 def test_unknown_example_exits_2(capsys):
     assert main(["example", "nope"]) == 2
-    assert "no example named 'nope'; examples: realistic, simple" in capsys.readouterr().err
+    assert "no example named 'nope'; examples: realistic, simple, calibration, paper_1_40" in capsys.readouterr().err
 
 
 def test_version(capsys):

@@ -53,7 +53,7 @@ def test_ini_follows_the_measured_rules(design_1_40):
     assert 0.85 * 0.6 < net.strand.bead_width_mm < bead  # one bead per strand in Arachne
     assert s["perimeter_generator"] == "arachne" and s["perimeters"] == "1"
     assert s["use_relative_e_distances"] == "1" and s["layer_gcode"] == "G92 E0"
-    assert s["max_volumetric_speed"] == s["filament_max_volumetric_speed"] == "1.5"
+    assert s["max_volumetric_speed"] == s["filament_max_volumetric_speed"] == "1.425"  # 0.95 x
     assert (s["first_layer_height"], s["layer_height"]) == ("0.35", "0.3")
     assert (s["first_layer_temperature"], s["bed_temperature"]) == ("230", "50")
     assert "M190 S[first_layer_bed_temperature]" in s["start_gcode"]

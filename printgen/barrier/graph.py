@@ -16,10 +16,13 @@ class NetGraph:
 
     nodes_mm : (n, 2) float, mm; x across, y up; origin at the lower-left corner
     segments : (m, 2) int, node indices of straight pieces between neighbouring nodes
-    family : (m,) int, +1 / -1 strand families (the diamond's diagonals), 0 border
+    family : (m,) int, +1 / -1 strand families (the diamond's diagonals; the square's strands
+      up and across), 0 border
     strands : list of (k,) int arrays, each a straight strand, border to border
     border : (p,) int, closed perimeter loop of node indices (first node not repeated)
-    mesh_mm : (a, b) mesh diagonals; half_cells : (nx, ny) half-diagonals across and up
+    mesh_mm : (a, b) the mesh across and up (the diamond's diagonals, the square's sides);
+    half_cells : (nx, ny) lattice steps across and up (the diamond's half-diagonals, the
+      square's sides)
     """
 
     nodes_mm: np.ndarray

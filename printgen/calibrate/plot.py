@@ -7,6 +7,7 @@ with each regression line drawn over the strains it used. matplotlib is imported
 from __future__ import annotations
 
 import io
+import unicodedata
 from pathlib import Path
 
 import numpy as np
@@ -35,7 +36,7 @@ def plot_calibration(cal: Calibration, path: str | Path) -> Path:
     hi = max(s.linear.hi for s in cal.samples) * ZOOM_MARGIN
     for i, s in enumerate(cal.samples):
         color = f"C{i % 10}"
-        label = Path(s.path.split(":")[-1]).name
+        label = printable(Path(s.path.split(":")[-1]).name)
         ax_all.plot(s.x * 100, s.y * scale, color=color, lw=1, label=label)
         if s.bilinear is not None:
             ax_all.plot(s.x * 100, s.bilinear(s.x) * scale, color=color, lw=1, ls="--")
@@ -62,3 +63,9 @@ def plot_calibration(cal: Calibration, path: str | Path) -> Path:
     fig.savefig(buf, format="png", dpi=110)
     plt.close(fig)
     return outputs.write_bytes(path, buf.getvalue())
+
+
+def printable(name: str) -> str:
+    """A file name as a plot label: control characters (a name may hold any but '/' and NUL)
+    shown as escapes, `\\x1b`, never drawn raw."""
+    return "".join(c if unicodedata.category(c) != "Cc" else f"\\x{ord(c):02x}" for c in name)

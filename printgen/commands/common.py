@@ -13,6 +13,21 @@ from rich.table import Table
 from printgen.inputs.profiles import profile_name
 from printgen.report.jsonout import dumps
 
+EXIT_INCOMPLETE = 3  # outputs written, but the verdict rests on fewer load levels than asked
+
+
+def incomplete_code(record: dict[str, Any], command: str) -> int:
+    """EXIT_INCOMPLETE, with one line on stderr, when the run's verdict rests on fewer load
+    levels than asked (the others did not converge); else 0. For `make` and `verify`."""
+    ver = record.get("verification") or {}
+    if ver.get("complete") is not False:
+        return 0
+    Console(stderr=True, highlight=False).print(
+        f"printgen {command}: the verdict rests on {ver['levels_compared']} of "
+        f"{ver['levels_asked']} load levels (the others did not converge: see the report); "
+        f"exit {EXIT_INCOMPLETE}")
+    return EXIT_INCOMPLETE
+
 
 def add_prototype_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("prototype", help="prototype barrier TOML (see examples/)")
@@ -50,15 +65,62 @@ def check_profile_args(args: argparse.Namespace, *options: str) -> None:
         for name in value if isinstance(value, (list, tuple)) else [value]:
             if name is not None:
                 profile_name(name, f"--{opt}")
-def add_load_args(p: argparse.ArgumentParser, what: str) -> None:
-    """--load NAME (a load case of printgen/barrier/loads) and its alias --drag."""
+def add_load_args(p: argparse.ArgumentParser, what: str, *, several: bool = False) -> None:
+    """--load NAME (a load case of printgen/barrier/loads), its alias --drag, --load-param
+    KEY=VALUE (a parameter of the chosen case, e.g. the jam's porosity) and, with `several`,
+    --loads A,B (each case's expected readings side by side)."""
     from printgen.barrier.loads import DEFAULT, case_names
 
     p.add_argument("--load", choices=case_names(), default=None,
-                   help=f"{what} under this load case (default {DEFAULT}; drag: hydrostatic + "
-                        "drag at the Froude-scaled velocity)")
+                   help=f"{what} under this load case (default {DEFAULT}; flow: hydrostatic + "
+                        "drag at a velocity rising with the depth; drag: at a fixed velocity; "
+                        "jam: seepage through a log jam at the flume's discharge steps)")
     p.add_argument("--drag", action="store_const", dest="load", const="drag",
                    help="the same as --load drag")
+    p.add_argument("--load-param", action="append", default=[], metavar="KEY=VALUE",
+                   help="a parameter of the load case(s), e.g. porosity=0.4 for jam "
+                        "(README: Load cases); repeat for several")
+    if several:
+        p.add_argument("--loads", type=load_list, default=(), metavar="A,B",
+                       help="also write each load case's expected readings "
+                            "(expected-readings-<case>.csv), e.g. hydrostatic,jam; the "
+                            "verification runs under --load, or the first of these")
+
+
+def load_list(text: str) -> tuple[str, ...]:
+    """--loads: comma-separated load case names, each a known one."""
+    from printgen.barrier.loads import case_names
+
+    names = tuple(x.strip() for x in text.split(",") if x.strip())
+    bad = [x for x in names if x not in case_names()]
+    if bad or not names:
+        raise argparse.ArgumentTypeError(f"{text!r}: give load cases from "
+                                         f"{', '.join(case_names())}, comma-separated")
+    return names
+
+
+def load_specs(args: argparse.Namespace) -> tuple[str | None, tuple[str, ...]]:
+    """(the verification's load case, every case of --loads) as specs with --load-param's
+    values; InputError for a parameter no chosen case has or a value out of its range."""
+    from printgen.barrier.loads import get_load, with_params
+    from printgen.errors import InputError
+
+    listed = tuple(getattr(args, "loads", ()) or ())
+    main = args.load or (listed[0] if listed else None)
+    params = list(args.load_param)
+    chosen = [main or get_load(None).name, *listed]
+    keys = {p.name for c in chosen for p in get_load(c).params}
+    for item in params:
+        if item.partition("=")[0].strip() not in keys:
+            raise InputError(f"--load-param {item}: none of the load cases "
+                             f"{', '.join(dict.fromkeys(chosen))} has that parameter; give one "
+                             "of theirs (README: Load cases)")
+
+    def spec(name: str) -> str:
+        own = {p.name for p in get_load(name).params}
+        return with_params(name, [x for x in params if x.partition("=")[0].strip() in own])
+
+    return (spec(main) if main else None), tuple(spec(x) for x in listed)
 
 
 def add_json_arg(p: argparse.ArgumentParser) -> None:

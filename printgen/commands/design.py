@@ -150,7 +150,8 @@ def show(result: DesignRun, out: Path, files: list[str]) -> None:
                       ["scale", "net", "k small strain", "mismatch", "select's", "dPi2", "dPi3",
                        "binding"], [_series_row(row) for row in result.record["series"]]))
     c.print(f"ran on {result.where}; {len(files)} files in {out}/ "
-            f"(design.json -> printgen make --design)")
+            f"(design.json -> printgen make --design; printgen testpieces: coupons and a "
+            "panel to test first)")
     sys.stdout.flush()
 
 

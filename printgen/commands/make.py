@@ -17,6 +17,8 @@ from printgen.commands.common import (
     check_profile_args,
     console,
     emit_json,
+    incomplete_code,
+    load_specs,
     seconds,
     table,
 )
@@ -24,7 +26,6 @@ from printgen.run import api
 from printgen.run.budget import DEFAULT_LIMIT_S
 from printgen.run.make import MakeOptions, json_output
 
-EXIT_INCOMPLETE = 3  # outputs written, but the verdict rests on fewer load levels than asked
 EXIT_TIME_LIMIT = 4  # stopped at --time-limit (printgen.cli maps TimeLimitError to it)
 
 
@@ -34,7 +35,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_prototype_args(p)
     p.add_argument("--printer", help="printer profile (default: the prototype's [model] choice)")
     p.add_argument("--out", "-o", type=Path, help="output directory")
-    add_load_args(p, "verify")
+    add_load_args(p, "verify", several=True)
     p.add_argument("--step", action="store_true", help="also write STEP files (needs cadquery)")
     p.add_argument("--design", metavar="FILE", type=Path,
                    help="print this design.json (from printgen design) instead of select's")
@@ -57,25 +58,20 @@ def run(args: argparse.Namespace) -> int:
     out = args.out or Path("out") / f"{Path(args.prototype).stem}-1-{args.scale:g}"
     err = Console(stderr=True, highlight=False)
     t0 = time.perf_counter()
+    load, loads = load_specs(args)
     with err.status("planning") as status:
-        ctx = api.make(args.prototype, args.scale, out, printer=args.printer, load=args.load,
+        ctx = api.make(args.prototype, args.scale, out, printer=args.printer, load=load,
                        step=args.step, progress=Progress(status),
-                       options=MakeOptions(force=args.force,
+                       options=MakeOptions(force=args.force, loads=loads,
                                            command=getattr(args, "argv", None),
                                            design_file=args.design,
                                            time_limit_s=args.time_limit, pdf=args.pdf))
     seconds = time.perf_counter() - t0
-    ver = ctx.record.get("verification") or {}
-    code = EXIT_INCOMPLETE if ver.get("complete") is False else 0
     if args.json:
         emit_json(json_output(ctx.record))
-        return code
-    show_summary(ctx, out, seconds)
-    if code:
-        err.print(f"printgen make: the verdict rests on {ver['levels_compared']} of "
-                  f"{ver['levels_asked']} load levels (the others did not converge: see the "
-                  f"report); exit {code}")
-    return code
+    else:
+        show_summary(ctx, out, seconds)
+    return incomplete_code(ctx.record, "make")
 
 
 class Progress:

@@ -28,7 +28,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from printgen.design.design_file import load_design
-    from printgen.verification.panel import design_panel, lockup_strain
+    from printgen.verification.panel import design_panel, panel_lockup
     from printgen.verification.scenes import ORIENTATIONS
 
     d = load_design(args.design)
@@ -46,7 +46,7 @@ def run(args: argparse.Namespace) -> int:
                  "" if dp.measured is None else f"{dp.measured[i]:.4g}"]
                 for i, (e, n, k) in enumerate(zip(dp.curve.strains, dp.curve.force_per_width,
                                                   dp.curve.kappa, strict=True))]
-        lock = lockup_strain(dp.test.mesh_along, dp.test.mesh_across)
+        lock = panel_lockup(dp.test)
         c.print(table(f"panel test, {dp.orientation} diagonal: {dp.test.describe()}; meshes "
                       f"lie along the load at {lock:.1%}",
                       ["strain", "force/width N/m", "kappa kN/m/m", "profile N/m"], rows))

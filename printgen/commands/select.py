@@ -68,7 +68,8 @@ def show_selection(s: Selection, limit: int | None) -> None:
         rows = [_row(i + 1, c) for i, c in enumerate(cands[:limit])]
         cols = ["#", "material", "E source", "section mm", "passes", f"stiffness {unit}",
                 "error", "Pi3", "SF", "score", "printable"]
-        out.print(table(f"{what}: target {cands[0].target:.4g} {unit} "
+        name = f"{what} ({s.net_mesh})" if what == "net" and s.net_mesh else what
+        out.print(table(f"{name}: target {cands[0].target:.4g} {unit} "
                         f"({len(cands)} candidates, best first)", cols, rows))
         best = cands[0]
         if best.feasible and abs(best.error) > STIFFNESS_WARN:

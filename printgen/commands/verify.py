@@ -18,6 +18,8 @@ from printgen.commands.common import (
     add_time_limit_arg,
     console,
     emit_json,
+    incomplete_code,
+    load_specs,
     table,
 )
 from printgen.verification.measured import COLUMNS, FIT_KINDS, LEVEL_COLUMN
@@ -55,12 +57,12 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     with err.status("reading inputs") as status:
         res = api.verify_design(args.prototype, args.scale, args.design, out,
-                                measured=args.measured, fit=args.fit, load=args.load,
+                                measured=args.measured, fit=args.fit, load=load_specs(args)[0],
                                 force=args.force, progress=lambda s: status.update(f"{s} ..."),
                                 time_limit_s=args.time_limit)
     if args.json:
         emit_json(res.record)
-        return 0
+        return incomplete_code(res.record, "verify")
     c = console()
     v = res.record["verification"]
     c.print(f"[bold]{v['verdict']}[/bold]: {v['summary']}")
@@ -80,4 +82,4 @@ def run(args: argparse.Namespace) -> int:
                     "mounting, slack) before changing the material.")
     c.print(f"{len(res.files)} files in {out}/ ; open {out / 'report.html'}")
     sys.stdout.flush()
-    return 0
+    return incomplete_code(res.record, "verify")

@@ -1,5 +1,6 @@
 """Choose a polymer and pass layout for the border cables (axial stiffness E*A) and for the net
-(membrane law from the printed pattern's geometry, `PRINTED_PATTERN`) against the similitude targets.
+(membrane law from the printed pattern's geometry, `printed_pattern`) against the similitude
+targets.
 
 Every material x layout (beads side by side x stacked layers of the print style) is a
 candidate. Each gets its stiffness error, the Pi3 deviation of its equivalent section, a
@@ -15,7 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from printgen.barrier.loads import OVERFLOW  # peak relative loading of the loading test
-from printgen.barrier.patterns import get_pattern
+from printgen.barrier.patterns import AS_DRAWN, get_pattern, mesh_text
+from printgen.barrier.patterns.square import check_square
 from printgen.design.record import Section
 from printgen.design.section import area_m2, equal_area_diameter, net_membrane_law
 from printgen.design.similitude import ScaledTargets
@@ -29,7 +31,6 @@ from printgen.units import MM, G
 DEFAULT_PRINTER = "generic-350"
 DEFAULT_NET_PRINT = "net-3pass"
 DEFAULT_CABLE_PRINT = "cable-4pass"
-PRINTED_PATTERN = "diamond"  # the pattern of the printed net: what select prices, make prints
 
 MAX_BEADS_ACROSS = {"cable": 6, "net": 2}  # wider strands are no longer "strands"
 MAX_LAYERS = {"cable": 6, "net": 5}
@@ -39,8 +40,9 @@ PASS_PENALTY = 0.002  # per pass: prefer shorter prints among equals
 SCORE_DIGITS = 9  # scores equal to 1e-9 are ties (same E*A, different layout)
 MIN_SPEED_MM_S = 2.0  # slower than this, the flow limit makes the print impractical
 ASSUMED_SAG_RATIO = 0.2  # peak-force estimate: sag / span of a loaded cable or net strip
-CALIBRATE_FIRST = ("print the test pieces below and calibrate before printing the barrier "
-                   "(printgen calibrate, then printgen verify)")
+CALIBRATE_FIRST = ("print the test pieces (printgen testpieces DESIGN.json: strand coupons and "
+                   "a net panel) and calibrate before printing the barrier (printgen "
+                   "calibrate, then printgen verify)")
 NET_STRAINS = np.linspace(0.01, 0.40, 40)  # strain range over which net laws are compared
 CHECK_STRAINS = (0.05, 0.30)  # net law errors reported at low and high strain
 NET_ON_TARGET = 0.30  # a net within +-30 % of the small-strain target is on target (as design)
@@ -103,6 +105,7 @@ class Selection:
     printer: str
     net_print: str
     cable_print: str
+    net_mesh: str = ""  # the printed net's pattern and mesh (`mesh_text`): what was priced
 
     @property
     def cable(self) -> Candidate | None:
@@ -114,7 +117,8 @@ class Selection:
             "printer": self.printer, "net_print": self.net_print, "cable_print": self.cable_print,
             "cable": {"rationale": self.cable_rationale,
                       "ranked": [c.to_record() for c in self.cables]},
-            "net": {"rationale": self.net_rationale, "ranked": [c.to_record() for c in self.net]},
+            "net": {"mesh": self.net_mesh, "rationale": self.net_rationale,
+                    "ranked": [c.to_record() for c in self.net]},
         }
 
 
@@ -153,13 +157,21 @@ def peak_cable_force(t: ScaledTargets) -> float:
     return q * w_b / (8 * s) * math.sqrt(1 + 16 * s * s)
 
 
-def peak_strand_force(t: ScaledTargets, mesh_across: float, mesh_along: float) -> float:
+def printed_pattern(p: Prototype) -> str:
+    """The pattern of the printed net: [model] pattern, else the prototype's (a pattern drawn
+    as another, `AS_DRAWN`, is printed as that one: a water-drop net as a diamond)."""
+    return p.model.pattern or AS_DRAWN.get(p.net.pattern, p.net.pattern)
+
+
+def peak_strand_force(t: ScaledTargets, mesh_across: float, mesh_along: float,
+                      pattern: str) -> float:
     """Estimated peak net-strand tension (N): a vertical net strip of span h_B under the
-    bottom pressure at overflow, sag ratio ASSUMED_SAG_RATIO, shared by 2 / a strands."""
+    bottom pressure at overflow, sag ratio ASSUMED_SAG_RATIO, shared by the strands of
+    `pattern` (the diamond's 2 / a, the square's 1 / a)."""
     s = ASSUMED_SAG_RATIO
     h_b = t["height"]
     n = 1000.0 * G * OVERFLOW * h_b * h_b / (8 * s) * math.sqrt(1 + 16 * s * s)
-    return get_pattern(PRINTED_PATTERN).strand_force(n, mesh_along, mesh_across)
+    return get_pattern(pattern).strand_force(n, mesh_along, mesh_across)
 
 
 def cable_candidate(t: ScaledTargets, m: Material, sec: Section, printer: Printer) -> Candidate:
@@ -193,11 +205,14 @@ def target_net_law(p: Prototype, t: ScaledTargets) -> tuple[tuple[float, ...], t
 
 
 def model_mesh(p: Prototype, t: ScaledTargets) -> tuple[float, float]:
-    """(mesh_x, mesh_y) of the printed net in m: the lab's choice, else the scaled mesh."""
+    """(mesh_x, mesh_y) of the printed net in m: the lab's choice, else the scaled mesh;
+    GeometryError for a printed square net whose mesh is not square."""
     m = p.model
-    if m.mesh_x_mm is not None and m.mesh_y_mm is not None:
-        return m.mesh_x_mm * MM, m.mesh_y_mm * MM
-    return t["mesh_x"], t["mesh_y"]
+    mesh = ((m.mesh_x_mm * MM, m.mesh_y_mm * MM)
+            if m.mesh_x_mm is not None and m.mesh_y_mm is not None else (t["mesh_x"], t["mesh_y"]))
+    if printed_pattern(p) == "square":
+        check_square(*mesh, where="printed square net ([model] mesh_x_mm, mesh_y_mm)")
+    return mesh
 
 
 def net_candidate(p: Prototype, t: ScaledTargets, m: Material, sec: Section,
@@ -205,7 +220,8 @@ def net_candidate(p: Prototype, t: ScaledTargets, m: Material, sec: Section,
     """Score one net candidate: its membrane law (the printed pattern's geometry) against the
     target law."""
     mesh_x, mesh_y = model_mesh(p, t)
-    knees, slopes, source = net_membrane_law(m, sec, mesh_y, mesh_x, PRINTED_PATTERN)
+    pattern = printed_pattern(p)
+    knees, slopes, source = net_membrane_law(m, sec, mesh_y, mesh_x, pattern)
     t_knees, t_slopes = target_net_law(p, t)
     got = piecewise_linear(NET_STRAINS, knees, slopes)
     want = piecewise_linear(NET_STRAINS, t_knees, t_slopes)
@@ -213,7 +229,7 @@ def net_candidate(p: Prototype, t: ScaledTargets, m: Material, sec: Section,
     low, high = (float(np.interp(s, NET_STRAINS, got / want) - 1) for s in CHECK_STRAINS)
     speed, reasons = print_limits(sec, m, printer, f"net {m.name} strand "
                                   f"{sec.width_mm:g}x{sec.thickness_mm:g} mm")
-    force = peak_strand_force(t, mesh_x, mesh_y)
+    force = peak_strand_force(t, mesh_x, mesh_y, pattern)
     sf = m.failure_stress()[0] * area_m2(sec) / force
     if sf < MIN_SAFETY_FACTOR:
         reasons.append(f"safety factor {sf:.2f} below {MIN_SAFETY_FACTOR} at {force:.3g} N")
@@ -248,9 +264,11 @@ def select(p: Prototype, t: ScaledTargets, *, printer: str | None = None,
     if not any(c.feasible for c in nets):
         raise PrintabilityError(f"no material and pass layout can print the net on "
                                 f"{printer_obj.key}: {nets[0].reasons[0]}")
+    mesh_x, mesh_y = model_mesh(p, t)
     return Selection(tuple(cables), tuple(nets), _rationale(cables, "cable"),
                      _rationale(nets, "net") + _per_material(nets), printer_obj.key,
-                     net_style.key, cable_style.key)
+                     net_style.key, cable_style.key,
+                     mesh_text(printed_pattern(p), mesh_x / MM, mesh_y / MM))
 
 
 def _per_material(ranked: list[Candidate]) -> str:

@@ -2,7 +2,7 @@
 
 Every key names its unit; unknown keys are errors listing the allowed keys; every value is
 range-checked where it is read. Values are SI in the dataclasses. An optional `[model]` table
-holds the lab's choices for the printed model (mesh, printer, print styles, materials).
+holds the lab's choices for the printed model (mesh, pattern, printer, print styles, materials).
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from printgen.barrier.patterns import pattern_names
+from printgen.barrier.patterns import pattern_names, printed_pattern_names
 from printgen.errors import InputError
 from printgen.inputs.materials import MAX_MATERIALS
 from printgen.inputs.profiles import profile_name
@@ -69,6 +69,8 @@ MODEL = [positive("mesh_x_mm", 1000.0, MIN_MODEL_MESH_MM, si=False, required=Fal
                   help="printed mesh across (default: the prototype's mesh_x_m scaled)"),
          positive("mesh_y_mm", 1000.0, MIN_MODEL_MESH_MM, si=False, required=False,
                   help="printed mesh up (default: the prototype's mesh_y_m scaled)"),
+         Field("pattern", str, required=False, choices=printed_pattern_names(),
+               help="pattern of the printed net (default: the prototype's; water-drop: diamond)"),
          Field("printer", str, required=False), Field("net_print", str, required=False),
          Field("cable_print", str, required=False),
          # each entry is checked by _check_profile_names (a name, never a path or a number)
@@ -112,6 +114,7 @@ class ModelPrefs:
 
     mesh_x_mm: float | None = None
     mesh_y_mm: float | None = None
+    pattern: str | None = None
     printer: str | None = None
     net_print: str | None = None
     cable_print: str | None = None
@@ -229,6 +232,8 @@ CROSS_CHECKS = (
     "[flume] lateral = \"eyelets\" needs a [border] table (the eyelets are the cables' ends)",
     "[flume] froude_min <= froude_max",
     "[model] mesh_x_mm and mesh_y_mm: both or neither (neither: the prototype's mesh scaled)",
+    ("a printed square net ([model] pattern, default the prototype's) needs a square mesh "
+     "(mesh_x = mesh_y)"),
 )
 
 

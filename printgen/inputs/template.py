@@ -16,7 +16,8 @@ MEANING = {
     "width_m": "width",
     "height_m": "height h_B (the water depth at h / h_B = 1)",
     "anchors": "number of anchors of the border cables (4: the four corners)",
-    "pattern": "mesh pattern of the net",
+    "pattern": ("mesh pattern of the net (in [model]: of the printed net, default the "
+                "prototype's; a water-drop net is printed as diamond)"),
     "mesh_x_m": "mesh across the barrier: the diagonal of a diamond, the side of a square",
     "mesh_y_m": "mesh up the barrier: the diagonal of a diamond, the side of a square",
     "strand_diameter_mm": "diameter of a net strand (cable or wire)",
@@ -66,7 +67,7 @@ VALUES: dict[str, dict[str, Any]] = {  # the simple barrier: runs as written
     "[flow]": {"velocity_m_per_s": 6.0, "depth_m": 4.0, "density_kg_per_m3": 1000.0},
     "[flume]": {"width_m": 0.4, "max_discharge_l_per_s": 8.0, "free_section_m": 0.3,
                 "froude_min": 0.5, "froude_max": 1.4, "lateral": "walls"},
-    "[model]": {"mesh_x_mm": 5.0, "mesh_y_mm": 5.0, "printer": "generic-350",
+    "[model]": {"mesh_x_mm": 5.0, "mesh_y_mm": 5.0, "pattern": "square", "printer": "generic-350",
                 "net_print": "net-3pass", "cable_print": "cable-4pass", "materials": ["tpe"]},
 }
 

@@ -24,6 +24,7 @@ from printgen.outputs.folder import (
     check_inputs_outside,
     staged_dir,
     tracking_swaps,
+    write_folder,
 )
 from printgen.outputs.lock import LockError, folder_lock
 from printgen.outputs.manifest import (
@@ -41,4 +42,4 @@ __all__ = ["INPUT_LIMIT_BYTES", "MANIFEST", "TIMINGS", "InputFileError", "LockEr
            "OutputError", "check_destination", "check_folder", "check_inputs_outside",
            "describe_os_error", "file_digest", "folder_files", "folder_lock", "foreign_entry",
            "os_error_exit_code", "read_input", "read_input_text", "read_manifest", "staged_dir",
-           "tracking_swaps", "write_bytes", "write_manifest", "write_text"]
+           "tracking_swaps", "write_bytes", "write_folder", "write_manifest", "write_text"]

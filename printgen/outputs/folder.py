@@ -83,6 +83,21 @@ def staged_dir(final: str | Path, *, force: bool = False,
             shutil.rmtree(stage, ignore_errors=True)
 
 
+def write_folder(final: str | Path, files: dict[str, str | bytes], *, force: bool = False,
+                 volatile: tuple[str, ...] = (), inputs: Iterable[str | Path] = ()) -> list[str]:
+    """Write `files` (relative path -> text or bytes; sub-folders made) as the whole of
+    `final` through `staged_dir`; returns the relative paths, sorted."""
+    with staged_dir(final, force=force, volatile=volatile, inputs=inputs) as stage:
+        for name, data in files.items():
+            path = stage / name
+            path.parent.mkdir(parents=True, exist_ok=True)
+            if isinstance(data, bytes):
+                path.write_bytes(data)
+            else:
+                path.write_text(data)
+    return sorted(files)
+
+
 @contextlib.contextmanager
 def tracking_swaps() -> Iterator[list[Path]]:
     """Within the block, every output folder a run swaps in is appended to the list yielded

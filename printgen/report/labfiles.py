@@ -1,7 +1,9 @@
 """Files a lab takes to the flume, beside the report: the curves (curves.csv), the expected
 readings in flume units (expected-readings.csv) and a blank measurement sheet in the columns
 `printgen verify --measured` reads, with the model's expected readings beside them
-(measurement-sheet.csv). Column names carry their unit (`_pct`, `_mm`, `_n`, `_kn`; no
+(measurement-sheet.csv), and with `make --loads A,B` each load case's expected readings
+(expected-readings-<case>.csv: the nominal model at the case's own levels, with what the case
+used at each level, e.g. the jam's discharge in L/s). Column names carry their unit (`_pct`, `_mm`, `_n`, `_kn`; no
 suffix: normalised, dimensionless). The numbers are the record's (`lab_record`, in
 report.json under "lab"), so the files and the JSON say the same.
 """
@@ -13,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from printgen.units import MM
 from printgen.verification.bands import Band
 from printgen.verification.compare import METRICS
 from printgen.verification.measured import COLUMNS, LEVEL_COLUMN
@@ -60,13 +63,39 @@ def lab_record(v: Verification, band: Band, scale: float) -> dict[str, Any]:
         readings[col] = {"nominal": nominal * f, "min": low[key] * f, "max": high[key] * f}
     readings["max_strand_tension_n"] = m.max_strand_tension[im]
     readings["max_cable_tension_n"] = m.max_cable_tension[im]
+    by_load = {name: case_readings(c.model, c.load.get("model", {}), units.length_mm)
+               for name, c in v.by_load.items()}
     return {"units": units.to_record(), "curves": curves, "readings": readings,
-            "files": [CURVES, READINGS, SHEET]}
+            "by_load": by_load,
+            "files": [CURVES, READINGS, SHEET, *(case_file(name) for name in by_load)]}
+
+
+def case_file(name: str) -> str:
+    return f"expected-readings-{name}.csv"
+
+
+def case_readings(run: Any, used: dict[str, Any], mm_per: Any) -> dict[str, Any]:
+    """The nominal model's readings (mm, sensors zeroed at the first level, h/h_B = 0) at
+    its levels, with the per-level values its load case used (`used`: name -> values)."""
+    d = run.deformation
+    out: dict[str, Any] = {LEVEL_COLUMN: d.levels, DEPTH_COLUMN: d.levels * run.scene.height / MM}
+    for name, values in used.items():
+        if name != "levels" and np.ndim(values) == 1 and len(values) == len(d.levels):
+            out[name] = values
+    for col, key in RAW_COLUMNS.items():
+        x = d.values[key] - (d.values[key][0] if key.startswith("strain") else 0)
+        out[col] = x * mm_per(key)
+    out["max_strand_tension_n"] = d.max_strand_tension
+    out["max_cable_tension_n"] = d.max_cable_tension
+    return out
 
 
 def lab_files(lab: dict[str, Any]) -> dict[str, str]:
-    """The three CSV texts of `lab_record`'s output, by file name."""
-    return {CURVES: curves_csv(lab), READINGS: readings_csv(lab), SHEET: sheet_csv(lab)}
+    """The CSV texts of `lab_record`'s output, by file name."""
+    files = {CURVES: curves_csv(lab), READINGS: readings_csv(lab), SHEET: sheet_csv(lab)}
+    for name, r in lab.get("by_load", {}).items():
+        files[case_file(name)] = _csv(list(r), list(r.values()))
+    return files
 
 
 def curves_csv(lab: dict[str, Any]) -> str:

@@ -132,14 +132,19 @@ def series_figure(lams: np.ndarray, curves: dict[str, dict[str, np.ndarray]],
         axes[1].plot(lams, c["lowering"], "-o", color=f"C{i}", label=label)
     for ax, what in zip(axes, ("mid-height deflection / width", "top-centre lowering / height"),
                         strict=True):
-        ax.set_xscale("log")
-        ax.set_xlabel("scale lambda (-)")
-        ax.set_ylabel(f"{what} (-)")
-        ax.set_title(what, fontsize=10)
-        ax.grid(alpha=0.3, which="both")
+        lambda_axis(ax, what)
     axes[0].legend(fontsize=8)
     fig.suptitle(title)
     return _png(fig)
+
+
+def lambda_axis(ax, what: str) -> None:
+    """An axis of `what` (a normalised quantity) against the scale lambda, log-scaled."""
+    ax.set_xscale("log")
+    ax.set_xlabel("scale lambda (-)")
+    ax.set_ylabel(f"{what} (-)")
+    ax.set_title(what, fontsize=10)
+    ax.grid(alpha=0.3, which="both")
 
 
 def measured_figure(m: Measurement, band: Band, fit: Fit | None,

@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from printgen.barrier.patterns import mesh_text
 from printgen.design.record import Design
 from printgen.design.selection import Candidate, Selection
 from printgen.design.similitude import FORCE_EXPONENT, ScaledTargets, to_prototype
@@ -55,8 +56,8 @@ def design_sections(rep: Report, proto: Prototype, t: ScaledTargets, sel: Select
     rep.heading("Printed parts")
     n = design.net
     rows = [["net", n.material.upper(), f"{n.width_mm:g} x {n.height_mm:g}",
-             (f"diamond mesh {n.mesh_x_mm:g} x {n.mesh_y_mm:g}, strand {n.strand.width_mm:g} x "
-             f"{n.strand.thickness_mm:g} mm, {n.strand.passes} passes")]]
+             (f"{mesh_text(n.pattern, n.mesh_x_mm, n.mesh_y_mm)}, strand "
+              f"{n.strand.width_mm:g} x {n.strand.thickness_mm:g} mm, {n.strand.passes} passes")]]
     rows += [[f"cable {c.name}", c.material.upper(), f"{c.length_mm:g} long",
               (f"{c.section.width_mm:g} x {c.section.thickness_mm:g} mm, {c.section.passes} "
               f"passes, eyelets {c.eyelet_inner_mm:g}/{c.eyelet_outer_mm:g} mm")]
@@ -196,6 +197,32 @@ def _deformed_section(rep: Report, v: Verification) -> None:
 def _assumption_tables(rep: Report, v: Verification) -> None:
     for who, run in (("prototype", v.prototype), ("model", v.model)):
         rep.table([f"{who}: what", "value", "source"], [list(a) for a in run.scene.assumptions])
+
+
+def _small(x: float, noise: float = 1e-9) -> str:
+    return "0" if abs(x) < noise else f"{x:.3g}"  # solver round-off at h = 0
+
+
+def load_case_sections(rep: Report, v: Verification) -> None:
+    """`make --loads`: each load case's assumptions and the printed model's expected readings
+    at its own levels (nominal; the files expected-readings-<case>.csv)."""
+    if not v.by_load:
+        return
+    rep.heading("What the campaign will see: expected readings by load case")
+    rep.paragraph("The nominal printed model (and prototype) under each case of --loads, at "
+                  "the case's own levels (the jam: the flume's discharge steps); no band. "
+                  "Files: expected-readings-<case>.csv.")
+    for name, c in v.by_load.items():
+        rows = [list(a) for a in c.model.scene.assumptions if a[0].startswith("loading")]
+        rep.table([f"{c.spec}: what", "value", "source"], rows)
+        d, used = c.model.deformation, c.load.get("model", {})
+        q = used.get("discharge_l_per_s", used.get("velocity_m_per_s"))
+        head = "discharge (L/s)" if "discharge_l_per_s" in used else "velocity (m/s)"
+        table = [[f"{lv:.3f}", "" if q is None else f"{q[i]:.3g}",
+                  f"{100 * d.values['strain_mid'][i]:.2f}", f"{d.values['deflection'][i]:.4f}",
+                  _small(d.max_cable_tension[i])] for i, lv in enumerate(d.levels)]
+        rep.table([f"{name}: h/h_B", head, "mid-height strain (%)", "deflection / width",
+                   "max cable tension (N)"], table)
 
 
 def _counterexample_section(rep: Report, ce: CounterExample) -> None:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import html
 from typing import Any
 
+from printgen.barrier.patterns import mesh_text
 from printgen.verification.compare import METRICS
 
 NEXT_PASS = ("Print the parts (the .gcode files, or slice the .3mf files), assemble them as the "
@@ -73,8 +74,9 @@ def chosen_parts(record: dict[str, Any]) -> list[dict[str, Any]]:
     net = design["net"]
     pick = sel and _same_section(sel["net"]["ranked"], net["material"], net["strand"])
     out.append({"part": "net", "material": net["material"].upper(),
-                "section": (f"strand {_mm(net['strand'])}, mesh {net['mesh_x_mm']:g} x "
-                            f"{net['mesh_y_mm']:g} mm"),
+                "section": (f"strand {_mm(net['strand'])}, "
+                            + mesh_text(net.get("pattern", "diamond"), net["mesh_x_mm"],
+                                        net["mesh_y_mm"])),
                 "stiffness_error": None if pick is None else pick["error"]})
     if design["cables"]:
         c = design["cables"][0]

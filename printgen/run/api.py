@@ -28,7 +28,9 @@ if TYPE_CHECKING:
     from printgen.calibrate.sample import FitOptions
     from printgen.run.make import MakeContext, MakeOptions
     from printgen.run.search import DesignRun, SearchOptions
+    from printgen.run.series import SeriesRun
     from printgen.run.verify import VerifyRun
+    from printgen.verification.series import NetOptions
     from printgen.verification.verify import Verification
 
 PrototypeLike = str | Path | Prototype
@@ -77,6 +79,7 @@ def make(prototype: str | Path, scale: float, out: str | Path, *,
 
     opts = options or MakeOptions()
     opts = dataclasses.replace(opts, load=load_name(load or opts.load, drag),
+                               loads=tuple(load_name(x, False) for x in opts.loads),
                                step=step or opts.step)
     return _make(prototype, scale, out, printer=printer, options=opts, progress=progress)
 
@@ -87,9 +90,9 @@ def load_name(load: str | None, drag: bool) -> str:
     from printgen.barrier.loads import get_load
     from printgen.errors import InputError
 
-    if drag and load not in (None, "drag"):
+    if drag and load not in (None, "drag"):  # a spec with parameters names its case first
         raise InputError(f"--drag is --load drag, not --load {load}: give one of them")
-    return get_load("drag" if drag else load).name
+    return get_load("drag" if drag else load).spec
 
 
 def verify(prototype: PrototypeLike, scale: float, design_: Design | str | Path | None = None,
@@ -139,6 +142,29 @@ def search_nets(prototype: PrototypeLike, scales: float | Sequence[float], *,
     return search_at_scales(prototype, lams, options=options or SearchOptions(),
                            scheduler=scheduler, serial=serial, workers=workers,
                            progress=progress)
+
+
+def series(prototype: PrototypeLike, scales: Sequence[float] = (1, 10, 30, 50, 100), *,
+           materials: Sequence[str] = (), load: str | None = None,
+           net: NetOptions | str | None = None, out: str | Path | None = None,
+           serial: bool | None = None, scheduler: str | None = None,
+           workers: int | None = None, force: bool = False,
+           progress: Callable[[str], None] | None = None, bar: bool = False) -> SeriesRun:
+    """The virtual scale series (Lambert et al. 2023, Fig. 2): the prototype's scene at each
+    1:lambda with its material unscaled, with E / lambda and with each of `materials`, under
+    load case `load` at h = h_B; normalised deflection, lowering and mid-height elongation,
+    the lambda range where each material stays within +-10 % of the prototype, the check
+    against the (F/EA)^(1/3) law. `net`: the solver scene's options (NetOptions, or the
+    `--solver-net` text). Serial for few cases, on Dask for many (the same numbers); written
+    into the folder `out` when given."""
+    from printgen.run.series import run_series
+    from printgen.verification.series import net_options
+
+    opts = net if not isinstance(net, str | None) else net_options(net)
+    return run_series(prototype if isinstance(prototype, Prototype) else Path(prototype),
+                      [float(s) for s in scales], materials=tuple(materials), load=load,
+                      net=opts, out=out, serial=serial, scheduler=scheduler, workers=workers,
+                      force=force, progress=progress, bar=bar)
 
 
 def calibrate(paths: Sequence[str | Path], *, material: str,

@@ -68,13 +68,16 @@ log = logging.getLogger(__name__)
 class MakeOptions:
     """How `make` runs (what the command line gives).
 
-    load : the verification's load case (printgen/barrier/loads); step : also write STEP;
+    load : the verification's load case (printgen/barrier/loads, a spec with its parameters);
+    loads : the load cases whose expected readings are written side by side (--loads, the
+    verification's own included when listed); step : also write STEP;
     design_file : print this design.json instead of the selection's choice; time_limit_s :
     refuse runs estimated longer; force : replace a folder printgen did not write;
     command : the command line, recorded in the manifest; pdf : also print report.pdf.
     """
 
     load: str = DEFAULT_LOAD
+    loads: tuple[str, ...] = ()  # --loads: each case's expected readings (nominal sweeps)
     step: bool = False
     design_file: str | Path | None = None
     time_limit_s: float | None = None  # None: refused only when estimated over DEFAULT_LIMIT_S
@@ -215,7 +218,8 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]], short: b
     with helper() as h:
         ctx.helper = h
         ctx.background["verification sweeps"] = ctx.helper.submit(
-            timed, verification_sweeps, ctx.prototype, ctx.design, load=ctx.options.load)
+            timed, verification_sweeps, ctx.prototype, ctx.design, load=ctx.options.load,
+            loads=ctx.options.loads)
         try:
             with signals_deferred():  # a signal meanwhile would be lost in trimesh's imports
                 preload_parts()

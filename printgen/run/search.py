@@ -26,7 +26,7 @@ from pathlib import Path
 from printgen.design.similitude import scale_targets
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
-from printgen.outputs import check_destination, staged_dir
+from printgen.outputs import check_destination, write_folder
 from printgen.report.jsonout import dumps
 from printgen.search.nets import (
     SearchResult,
@@ -169,12 +169,5 @@ def write_outputs(run: DesignRun, out: str | Path, main_scale: float | None,
                 files["design.json"] = text
         files[f"pareto-1-{r.scale:g}.png"] = pareto_figure(r)
     inputs = design_inputs(prototype) if prototype is not None else []
-    with staged_dir(out, inputs=inputs) as stage:
-        for name, data in files.items():
-            path = stage / name
-            if isinstance(data, bytes):
-                path.write_bytes(data)
-            else:
-                path.write_text(data)
-    run.files = sorted(files)
+    run.files = write_folder(out, files, inputs=inputs)
     return run.files

@@ -250,7 +250,8 @@ def verify_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
         (blocks, figures, record), seconds = _collect(pending)
         ctx.record.setdefault("timings_s", {})[HELPER_REPORT] = seconds
     else:
-        v, band = verification_sweeps(ctx.prototype, ctx.design, load=ctx.options.load)
+        v, band = verification_sweeps(ctx.prototype, ctx.design, load=ctx.options.load,
+                                      loads=ctx.options.loads)
         blocks, figures, record = verification_report(v, band, ctx.targets.scale)
     ctx.report.blocks.extend(blocks)
     ctx.report.figures.extend(figures)
@@ -288,8 +289,8 @@ def timed(fn: Callable, /, *args: Any, **kwargs: Any) -> tuple[Any, float]:
     return fn(*args, **kwargs), time.perf_counter() - t
 
 
-def verification_sweeps(prototype: Prototype, design: Design, *, load: str | None = None
-                        ) -> tuple[Verification, Band]:
+def verification_sweeps(prototype: Prototype, design: Design, *, load: str | None = None,
+                        loads: tuple[str, ...] = ()) -> tuple[Verification, Band]:
     """Both barriers' load sweeps compared, and the model's uncertainty band.
 
     The sweep is the scene realistic-1:40 with border cables, simple-free-top without them
@@ -297,9 +298,10 @@ def verification_sweeps(prototype: Prototype, design: Design, *, load: str | Non
     the other steps, so it can run in a worker process while they run.
     """
     from printgen.verification.bands import free_section, model_band, model_load_kw
-    from printgen.verification.verify import verify
+    from printgen.verification.verify import verify, with_cases
 
-    v = verify(prototype, design, load=load, counterexample=True)
+    v = with_cases(verify(prototype, design, load=load, counterexample=True), prototype,
+                   design, loads)
     return v, model_band(design, v.model, load_kw=model_load_kw(prototype, design, load),
                          free_section=free_section(prototype))
 
@@ -310,12 +312,13 @@ def verification_report(v: Verification, band: Band, scale: float
     record (with the lab's curves and expected readings, printgen.report.labfiles)."""
     from printgen.report.html import Report
     from printgen.report.labfiles import lab_record
-    from printgen.report.report import verification_sections
+    from printgen.report.report import load_case_sections, verification_sections
     from printgen.report.uncertainty import band_record, band_sections
 
     rep = Report("")
     verification_sections(rep, v, v.counterexample, scale, band=band)
     band_sections(rep, v, band)
+    load_case_sections(rep, v)
     record = v.to_record()
     record["bands"] = band_record(v, band)
     record["lab"] = lab_record(v, band, scale)

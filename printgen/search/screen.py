@@ -156,7 +156,7 @@ def screen_point(ctx: SearchContext, point: NetPoint,
     where = f"net {m.name} strand {sec.width_mm:g}x{sec.thickness_mm:g} mm"
     speed, print_reasons = print_limits(sec, m, ctx.printer, where)
     violations = [("print", r) for r in print_reasons]
-    force = peak_strand_force(t, ax, ay)
+    force = peak_strand_force(t, ax, ay, "diamond")  # the search space is diamond nets
     sf = m.failure_stress()[0] * area_m2(sec) / force
     if sf < MIN_SAFETY_FACTOR:
         violations.append(("strength", (f"{where}: safety factor {sf:.2f} below "

@@ -68,6 +68,9 @@ class Variant:
     orientation: str | None = None  # panel-test orientation of the net's law (None: profile's)
     pressure: str = "flow"  # the water's force along the flow or normal to the net (scenes)
     span: float | None = None  # lateral supports this far apart (m; None: the printed width)
+    net_law: str = "formula"  # strand law: diamond formula or the virtual panel test's (forms)
+    bed: str = "free"  # the net's bottom row free or held on the flume bed (forms)
+    routing: str = "in-line"  # the sensor wires beyond the right edge (forms.ROUTINGS)
 
 
 def mounting_options() -> tuple[str, ...]:
@@ -115,28 +118,10 @@ def model_variants(d: Design, mounting: str | None = None, free_section: float |
         notes.append("mounting: the model scene has one mounting only; no mounting variant")
     out.append(Variant(f"initial slack {SLACK_MAX:.0%}", slack=SLACK_MAX,
                        source="printed net hung with 0 to 1 % slack (printgen; README: Uncertainty band)"))
-    out += _model_form_variants(d, free_section, notes)
+    from printgen.verification.forms import model_form_variants
+
+    out += model_form_variants(d, free_section, notes, nominal)
     return out, notes
-
-
-def _model_form_variants(d: Design, free_section: float | None, notes: list[str]
-                         ) -> list[Variant]:
-    """Issue 25: the water's force normal to the deformed net, and the net mounted in a free
-    section narrower than its printed width (printgen.verification.mount)."""
-    out = [Variant("pressure normal to the deformed net", pressure="normal",
-                   source="the folded film presses normal to the net (nominal: along the "
-                          "flow, reference section 3)")]
-    width = d.net.width_mm * MM
-    if d.cables and free_section is not None and free_section < width * (1 - SAME):
-        out.append(Variant(f"mounted in the {free_section * 1e3:g} mm free section",
-                           span=free_section, source=(
-                               f"net printed {width * 1e3:.4g} mm wide, side sheets "
-                               f"{free_section * 1e3:g} mm apart; how the excess is held is "
-                               "not stated (reference section 4)")))
-    else:
-        notes.append("mounting span: no free section narrower than the net given "
-                     "([flume] free_section_m); no span variant")
-    return out
 
 
 def _cable_variants(d: Design, notes: list[str]) -> list[Variant]:
@@ -202,6 +187,13 @@ def variant_scene(d: Design, v: Variant, coarsen: int = 1) -> BarrierScene:
     s = model_scene(d, **({"mounting": v.mounting} if v.mounting else {}),
                     orientation=v.orientation)
     laws = list(s.laws)
+    if v.net_law == "derived":  # issue 25: the virtual panel test's strand law
+        from printgen.verification.forms import derived_net_law
+
+        laws[0], how = derived_net_law(load_material(d.net.material), d.net, v.orientation)
+        s = dataclasses.replace(s, assumptions=tuple(
+            (w, f"{d.net.material}: {how}" if w == "net strands" else val, src)
+            for w, val, src in s.assumptions))
     laws[0] = _scaled(laws[0], v.net_factor * coarsen)
     if len(laws) > 1:  # the printed border frame, of the net's material
         laws[1] = _scaled(laws[1], v.frame_factor)
@@ -211,7 +203,10 @@ def variant_scene(d: Design, v: Variant, coarsen: int = 1) -> BarrierScene:
         from printgen.verification.mount import in_free_section
 
         s = in_free_section(s, v.span)
-    return s
+    from printgen.verification.forms import held_on_bed, routed
+
+    s = held_on_bed(s) if v.bed == "held" else s
+    return routed(s, v.routing)
 
 
 def _scaled(law: tuple, factor: float) -> tuple:

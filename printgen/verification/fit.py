@@ -6,7 +6,9 @@ Parameters, each bounded by what a lab would see or measure (`BOUNDS`):
 - net_slack: initial slack of the net's strands (a zero-force strain before they pull);
 - cable_slack: initial slack of the border cables (the same, on the cables);
 and, as discrete choices tried in turn, the flume mounting and the panel-test orientation
-(`printgen.verification.scenes`). Slack is a law with a first, (nearly) flat segment (`slackened`):
+(`printgen.verification.scenes`), the net's span (printed width or the flume's free section,
+`printgen.verification.mount`) and its bottom row free or held on the bed
+(`printgen.verification.forms`). Slack is a law with a first, (nearly) flat segment (`slackened`):
 the same to first order as a rest length (1 + slack) times longer.
 
 For every discrete choice the continuous parameters are searched (scipy's bounded
@@ -32,6 +34,7 @@ import numpy as np
 
 from printgen.design.record import Design
 from printgen.verification.bands import Variant, curves, variant_scene
+from printgen.verification.forms import BEDS
 from printgen.verification.measured import Measurement, mismatch, objective
 from printgen.verification.scenes import MOUNTINGS, ORIENTATIONS, BarrierScene
 from printgen.verification.verify import sweep
@@ -42,6 +45,7 @@ BOUNDS = {
     "net_slack": (0.0, 0.03, 0.0),  # 3 % slack sags visibly: a lab would see it
     "cable_slack": (0.0, 0.03, 0.0),  # a 3 % slack cable sags 10 % of its span at rest
 }
+Choice = tuple[str, "str | None", "float | None", str]  # mounting, orientation, span, bed
 EXPLAINS = 0.15  # issue 25: RMS mismatch below 15 % of the measured peak on every column
 SLACK_SLOPE = 1e-4  # slope of a slack segment / the law's first slope (keeps it solvable)
 MAX_EVALUATIONS = 15  # least-squares steps for a retained choice (each: 1 + free sweeps)
@@ -50,6 +54,7 @@ SCREEN_KEEP = 2  # choices searched on after the screen
 XTOL = 1e-4  # stop once a step moves the scaled parameters by less than this (relative)
 STEP = 0.01  # finite-difference step of the Jacobians, fraction of each range
 DETERMINED = 0.1  # a singular value above 10 % of the largest: that direction is determined
+AT_BOUND = 0.01  # a parameter within 1 % of its range from a bound (not its nominal) is at it
 
 
 @dataclass(frozen=True)
@@ -62,6 +67,7 @@ class Params:
     mounting: str = MOUNTINGS[0]
     orientation: str | None = None  # None: the orientation the material profile records
     span: float | None = None  # lateral supports this far apart (m; None: the printed width)
+    bed: str = BEDS[0]  # the net's bottom row free or held on the bed
 
     def scaled(self) -> np.ndarray:
         """The continuous parameters on [0, 1] (net_factor on a log scale)."""
@@ -98,7 +104,7 @@ def slackened(law: tuple, slack: float) -> tuple:
 def fit_scene(d: Design, p: Params, coarsen: int = 1) -> BarrierScene:
     """The printed model's scene with parameter set `p` (on the design's mesh x coarsen)."""
     v = Variant("fit", net_factor=p.net_factor, frame_factor=p.net_factor, mounting=p.mounting,
-                orientation=p.orientation, span=p.span)
+                orientation=p.orientation, span=p.span, bed=p.bed)
     s = variant_scene(d, v, coarsen)
     laws = [slackened(law, p.net_slack) for law in s.laws]
     cables = {k: (nodes, slackened(law, p.cable_slack)) for k, (nodes, law) in s.cables.items()}
@@ -154,10 +160,11 @@ class MultiFit:
     before: list
     after: list
     predicted: dict[str, np.ndarray]
-    choices: dict[tuple[str, str | None, float | None], tuple[Params, float]]
+    choices: dict[Choice, tuple[Params, float]]
     identifiability: Identifiability
     evaluations: int
     explains: bool
+    at_bounds: tuple[str, ...] = ()  # parameters the best set pushes against a bound
 
     kind = "multi"
     at_bound = False  # the one-factor fit's flag; a multi fit says `explains` instead
@@ -172,11 +179,11 @@ class MultiFit:
         """The fit in report.json: parameters, bounds, choices, identifiability, mismatches."""
         ident = self.identifiability
         return {"kind": self.kind, "explains": self.explains, "sentence": self.sentence(),
-                "params": dataclasses.asdict(self.params),
+                "params": dataclasses.asdict(self.params), "at_bounds": list(self.at_bounds),
                 "bounds": {k: {"low": lo, "high": hi, "nominal": nom}
                            for k, (lo, hi, nom) in BOUNDS.items()},
                 "choices": [{"mounting": k[0], "orientation": k[1], "span_m": k[2],
-                             "params": dataclasses.asdict(p), "objective": o}
+                             "bed": k[3], "params": dataclasses.asdict(p), "objective": o}
                             for k, (p, o) in self.choices.items()],
                 "identifiability": {"singular_values": ident.singular_values,
                                     "directions": ident.directions,
@@ -191,7 +198,13 @@ class MultiFit:
         what = (f"net law x {p.net_factor:.3g}, net slack {p.net_slack:.2%}, cable slack "
                 f"{p.cable_slack:.2%}, mounting {p.mounting}, orientation "
                 f"{p.orientation or 'as profiled'}, span "
-                f"{'printed width' if p.span is None else f'{p.span * 1e3:g} mm'}")
+                f"{'printed width' if p.span is None else f'{p.span * 1e3:g} mm'}, bottom row "
+                f"{p.bed}")
+        if self.at_bounds and worst < EXPLAINS:
+            edge = ", ".join(self.at_bounds)
+            return (f"NOT explained: the best set, {what}, leaves {worst:.0%} of the measured "
+                    f"peak, but only with {edge} at the end of its range (issue 25: "
+                    "parameters inside their bounds); no profile is written")
         if self.explains:
             return (f"explained within the bounds by {what} (worst RMS mismatch {worst:.0%} of "
                     f"the measured peak); determined: {', '.join(self.identifiability.determined()) or 'none'}")
@@ -212,11 +225,12 @@ def fit_levels(m: Measurement) -> np.ndarray:
 
 def fit_measured(d: Design, m: Measurement, lv: np.ndarray, *, coarsen: int = 1,
                  load_kw: dict | None = None,
-                 choices: list[tuple[str, str | None, float | None]] | None = None,
+                 choices: list[tuple] | None = None,
                  free: tuple[str, ...] = tuple(BOUNDS),
                  free_section: float | None = None) -> MultiFit:
-    """The bounded fit of the module docstring over every (mounting, orientation, span)
-    choice (or `choices`; span None or `free_section` when given), searching the continuous
+    """The bounded fit of the module docstring over every (mounting, orientation, span, bed)
+    choice (or `choices`, bed "free" when left out; span None or `free_section` when given),
+    searching the continuous
     parameters `free` (the others stay nominal); `lv` : the load path swept for each
     evaluation (0 first, up to the highest measured)."""
     from scipy.optimize import least_squares
@@ -231,7 +245,8 @@ def fit_measured(d: Design, m: Measurement, lv: np.ndarray, *, coarsen: int = 1,
 
     if choices is None:
         spans = [None] + ([free_section] if free_section is not None else [])
-        choices = list(itertools.product(MOUNTINGS, ORIENTATIONS, spans))
+        choices = list(itertools.product(MOUNTINGS, ORIENTATIONS, spans, BEDS))
+    choices = [(*c, BEDS[0]) if len(c) == 3 else tuple(c) for c in choices]
     idx = [list(BOUNDS).index(k) for k in free]
     nominal = run(Params())
 
@@ -250,7 +265,7 @@ def fit_measured(d: Design, m: Measurement, lv: np.ndarray, *, coarsen: int = 1,
         return fitted, objective(m, run(fitted))
 
     screen = len(choices) > SCREEN_KEEP
-    best = {c: search(Params(mounting=c[0], orientation=c[1], span=c[2]),
+    best = {c: search(Params(mounting=c[0], orientation=c[1], span=c[2], bed=c[3]),
                       SCREEN_EVALUATIONS if screen else MAX_EVALUATIONS) for c in choices}
     if screen:  # the most promising choices, searched on from their screened point
         for c in sorted(best, key=lambda k: best[k][1])[:SCREEN_KEEP]:
@@ -259,8 +274,21 @@ def fit_measured(d: Design, m: Measurement, lv: np.ndarray, *, coarsen: int = 1,
     pred = run(params)
     after = mismatch(m, pred)
     ident = _identifiability(m, params, pred, run)
-    ok = all(mm.rms_rel < EXPLAINS for mm in after if not math.isnan(mm.rms_rel))
-    return MultiFit(params, mismatch(m, nominal), after, pred, best, ident, len(cache), ok)
+    edge = at_bounds(params)
+    ok = all(mm.rms_rel < EXPLAINS for mm in after if not math.isnan(mm.rms_rel)) and not edge
+    return MultiFit(params, mismatch(m, nominal), after, pred, best, ident, len(cache), ok,
+                    edge)
+
+
+def at_bounds(p: Params) -> tuple[str, ...]:
+    """The continuous parameters of `p` within AT_BOUND of a bound other than their nominal
+    (a fit pushed there wants more than physics allows)."""
+    out = []
+    for k, (lo, hi, nom) in BOUNDS.items():
+        u, n = _to_unit(k, getattr(p, k)), _to_unit(k, nom)
+        if (u < AT_BOUND and n >= AT_BOUND) or (u > 1 - AT_BOUND and n <= 1 - AT_BOUND):
+            out.append(k)
+    return tuple(out)
 
 
 def _identifiability(m: Measurement, p: Params, pred: dict[str, np.ndarray], run

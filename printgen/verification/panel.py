@@ -3,8 +3,10 @@ its source ran it (barrier-physics.md, sections 4 and 5; Lambert et al. 2023,
 doi:10.1061/JHEND8.HYENG-13070), and the strand law derived so that the simulated test
 reproduces a measured panel law.
 
-Panel: a diamond net (`barrier.patterns.diamond.diamond_net`) of the net's strands only (no border
-frame), x across the load, z along it, y out of plane (held: the panel lies flat). The clamp
+Panel: a net of the test's pattern (`barrier.patterns`; the diamond by default) of the net's
+strands only (no border frame; the square's edge columns are strands of its net,
+`edge_strands`, so a square panel of nx meshes holds nx + 1 strands along the load over the
+width nx a it is read on), x across the load, z along it, y out of plane (held: the panel lies flat). The clamp
 rows are the panel's bottom and top node rows; the top clamp moves by eps L along z. Two
 boundary conditions, as the sources describe them:
 - "blocked": every node's transverse (x) displacement blocked (the prototype's 1.33 m panel);
@@ -33,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 import solver
-from printgen.barrier.patterns.diamond import diamond_net
+from printgen.barrier.patterns import get_pattern
 from printgen.errors import SolverError
 from printgen.inputs.laws import piecewise_linear
 from printgen.units import MM
@@ -52,19 +54,21 @@ Law = tuple[tuple[float, ...], tuple[float, ...]]  # (strain knees, slopes: N pe
 
 @dataclass(frozen=True)
 class PanelTest:
-    """One panel test set-up (SI): mesh diagonals along and across the load (m), panel length
-    along the load and clamp width (m), boundary mode (one of MODES)."""
+    """One panel test set-up (SI): mesh diagonals (the square's sides) along and across the
+    load (m), panel length along the load and clamp width (m), boundary mode (one of MODES),
+    the net's pattern (`printgen.barrier.patterns`)."""
 
     mesh_along: float
     mesh_across: float
     length: float
     width: float
     mode: str = "free"
+    pattern: str = "diamond"
 
     def describe(self) -> str:
         side = ("transverse displacement blocked" if self.mode == "blocked"
                 else "free between the clamps")
-        return (f"{self.length / MM:g} mm long x {self.width / MM:g} mm clamps, mesh "
+        return (f"{self.length / MM:g} mm long x {self.width / MM:g} mm clamps, {self.pattern} mesh "
                 f"{self.mesh_along / MM:g} mm along the load x {self.mesh_across / MM:g} mm "
                 f"across, {side}")
 
@@ -90,10 +94,11 @@ class PanelCurve:
 def _graph(t: PanelTest):
     if t.mode not in MODES:
         raise SolverError(f"panel mode {t.mode!r} is not one of {', '.join(MODES)}")
-    g = diamond_net(t.width / MM, t.length / MM, t.mesh_across / MM, t.mesh_along / MM)
+    pattern = get_pattern(t.pattern)
+    g = pattern.graph(t.width / MM, t.length / MM, t.mesh_across / MM, t.mesh_along / MM)
     xz = g.nodes_mm * MM
     nodes = np.column_stack([xz[:, 0], np.zeros(len(xz)), xz[:, 1]])
-    elements = g.segments[g.family != 0]
+    elements = g.segments if pattern.edge_strands else g.segments[g.family != 0]
     used = np.unique(elements)  # corner nodes the lattice adds without strands are dropped
     remap = -np.ones(len(nodes), int)
     remap[used] = np.arange(len(used))
@@ -106,7 +111,8 @@ def _graph(t: PanelTest):
 def lattice_size(t: PanelTest) -> tuple[float, float]:
     """(length, width) m of the simulated panel: the test's rounded to whole half-meshes
     (the lattice keeps its mesh exact); the reading divides by these."""
-    g = diamond_net(t.width / MM, t.length / MM, t.mesh_across / MM, t.mesh_along / MM)
+    g = get_pattern(t.pattern).graph(t.width / MM, t.length / MM, t.mesh_across / MM,
+                                     t.mesh_along / MM)
     xz = g.nodes_mm * MM
     return float(xz[:, 1].max()), float(xz[:, 0].max())
 
@@ -115,6 +121,12 @@ def lockup_strain(mesh_along: float, mesh_across: float) -> float:
     """Panel strain at which the diamonds' strands lie along the load (their meshes closed
     across it): strand length over its along-load half-diagonal, minus 1."""
     return math.hypot(mesh_along, mesh_across) / mesh_along - 1.0
+
+
+def panel_lockup(t: PanelTest) -> float:
+    """Panel strain of test `t` at which its strands lie along the load: the diamond's
+    `lockup_strain`; 0 for a square net, whose strands up lie along it from the start."""
+    return 0.0 if t.pattern == "square" else lockup_strain(t.mesh_along, t.mesh_across)
 
 
 def analytic_blocked(law: Law, t: PanelTest, strains: np.ndarray) -> np.ndarray:
@@ -241,21 +253,19 @@ def refined_knees(knees: tuple[float, ...]) -> tuple[float, ...]:
 def derive_law(knees: tuple[float, ...], slopes: tuple[float, ...], t: PanelTest,
                strains: np.ndarray | None = None) -> DerivedLaw:
     """The strand law (on `refined_knees`) whose simulated test `t` gives the membrane
-    law n = piecewise(eps; knees, slopes N/m). Starts from the analytic diamond mapping and
+    law n = piecewise(eps; knees, slopes N/m). Starts from the pattern's analytic mapping and
     repeats: solve the test, split the clamp force into each law segment's share at the
     solved strand strains (linear in the slopes at fixed geometry), refit the slopes by
     non-negative least squares and each strand knee as the clamp strands' mean strain at the
     panel knee, until the slopes settle."""
     from scipy.optimize import nnls
 
-    from printgen.verification.scenes import strand_law_from_membrane
-
     eps = law_strains(knees) if strains is None else np.asarray(strains, float)
     target = piecewise_linear(eps, knees, slopes)
     fine = refined_knees(knees)
     fine_slopes = tuple(slopes[int(np.searchsorted(knees, k, side="right"))]
                         for k in (0.0, *fine))  # the measured slope of each fine segment
-    law = strand_law_from_membrane(fine, fine_slopes, t.mesh_along, t.mesh_across)
+    law = get_pattern(t.pattern).strand_law(fine, fine_slopes, t.mesh_along, t.mesh_across)
     passes = 0
     for passes in range(1, DERIVE_STEPS + 1):
         shares, strand_eps = _segment_shares(law, t, eps)
@@ -297,6 +307,7 @@ def _segment_shares(law: Law, t: PanelTest, eps: np.ndarray) -> tuple[np.ndarray
 
 
 PRINTED_PANEL = (43 * MM, 23 * MM)  # the paper's printed panels: length, clamp width (m)
+TESTED_PATTERN = "diamond"  # the pattern of the nets the material profiles' panel laws tested
 
 
 @dataclass(frozen=True)
@@ -324,8 +335,11 @@ def design_panel(d, orientation: str, mode: str = "free",
     pl = mat.panel_law
     along, across = panel_axes(n.mesh_x_mm * MM, n.mesh_y_mm * MM, orientation)
     size = (pl.panel_length, pl.panel_width or PRINTED_PANEL[1]) if pl else PRINTED_PANEL
-    t = PanelTest(along, across, size[0], size[1], mode)
+    t = PanelTest(along, across, size[0], size[1], mode, n.pattern)
     law = model_net_law(mat, n, orientation if pl is not None and pl.has_geometry else None)[0]
     eps = law_strains(pl.knee_strains if pl else (), points)
     curve = simulate(law, t, eps)
-    return DesignPanel(orientation, t, law, curve, pl.force_per_width(eps) if pl else None)
+    # the profiles' panel laws were measured on diamond nets (`design.section`): another
+    # pattern's panel is not that test, and gets no measured column
+    same_net = pl is not None and n.pattern == TESTED_PATTERN
+    return DesignPanel(orientation, t, law, curve, pl.force_per_width(eps) if same_net else None)

@@ -3,8 +3,8 @@ the net and the water presses it normal to its surface, so each node's load is t
 at its height times its share of the net's current area vector, instead of a force along the
 flow (`solver.Hydrostatic`, the reference's section 3).
 
-Faces: the diamond meshes of the net's lattice (four strand corners; three at the edges, where
-the lattice cuts a mesh), found from the nodes' lattice positions. A node's area vector is a
+Faces: the meshes of the net's lattice (the diamond's or the square's: four strand corners;
+three at the edges, where the lattice cuts a mesh), found from the nodes' lattice positions. A node's area vector is a
 quarter (a third for an edge triangle) of each face it is a corner of, oriented downstream at
 rest and scaled so that at rest its magnitude is the scene's A* (the same tributary area as the
 load along the flow): the two variants then differ only by the direction of the force and by
@@ -21,20 +21,23 @@ from printgen.units import RHO_WATER, G
 
 
 def lattice_faces(nodes: np.ndarray, elements: np.ndarray) -> list[np.ndarray]:
-    """The net's meshes as node cycles (k,) of 3 or 4 nodes, from the diamond lattice of the
-    strands `elements` (their x and z steps are the half-diagonals)."""
+    """The net's meshes as node cycles (k,) of 3 or 4 nodes, from the lattice of the strands
+    `elements` (their non-zero x and z steps: the diamond's half-diagonals, the square's
+    side). A candidate is a diamond ring around a lattice point or a square cell from one;
+    it is a mesh when it has 3 or 4 nodes and at least two of its sides are strands."""
     d = np.abs(nodes[elements[:, 1]] - nodes[elements[:, 0]])
-    hx, hz = float(np.median(d[:, 0])), float(np.median(d[:, 2]))
+    hx, hz = (float(np.median(c[c > 0])) for c in (d[:, 0], d[:, 2]))
     ij = np.column_stack([np.round(nodes[:, 0] / hx), np.round(nodes[:, 2] / hz)]).astype(int)
     where = {(int(i), int(j)): k for k, (i, j) in enumerate(ij)}
     linked = {(min(a, b), max(a, b)) for a, b in elements}
     faces = []
     for ci, cj in {(i + di, j + dj) for i, j in where for di, dj in ((1, 0), (-1, 0))}:
-        ring = [where.get(c) for c in ((ci - 1, cj), (ci, cj - 1), (ci + 1, cj), (ci, cj + 1))]
-        ring = [r for r in ring if r is not None]
-        pairs = zip(ring, ring[1:] + ring[:1], strict=True)
-        if len(ring) >= 3 and sum((min(a, b), max(a, b)) in linked for a, b in pairs) >= 2:
-            faces.append(np.array(ring))
+        for corners in (((ci - 1, cj), (ci, cj - 1), (ci + 1, cj), (ci, cj + 1)),
+                        ((ci, cj), (ci + 1, cj), (ci + 1, cj + 1), (ci, cj + 1))):
+            ring = [r for r in (where.get(c) for c in corners) if r is not None]
+            pairs = zip(ring, ring[1:] + ring[:1], strict=True)
+            if len(ring) >= 3 and sum((min(a, b), max(a, b)) in linked for a, b in pairs) >= 2:
+                faces.append(np.array(ring))
     return faces
 
 

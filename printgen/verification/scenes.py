@@ -4,7 +4,8 @@ three extension sensors of the loading test (Lambert et al. 2023, doi:10.1061/JH
 
 Plane of the net: x across the barrier, z up (from the flume bed), y the flow direction.
 Net strands are the pattern's graph's strand segments (`printgen.barrier.patterns`: the
-diamond's diagonals); their force-strain law is the panel law turned into a strand law by the
+diamond's diagonals, the square's strands up and across, whose edge rows are strands of the
+prototype and the printed border frame of the model); their force-strain law is the panel law turned into a strand law by the
 pattern (`NetPattern.strand_law`). With border cables, the cables
 slide through the net's edge nodes between the four corner anchors; the lateral edges are
 held by the flume's side sheets along their whole height (`walls`, the default) or only the
@@ -31,7 +32,7 @@ import numpy as np
 
 from printgen.barrier.graph import NetGraph
 from printgen.barrier.loads import FLOW, LoadCase, get_load
-from printgen.barrier.patterns import AS_DRAWN, get_pattern
+from printgen.barrier.patterns import AS_DRAWN, get_pattern, mesh_text
 from printgen.barrier.patterns.diamond import strand_law as strand_law_from_membrane
 from printgen.design.record import Design
 from printgen.design.section import area_m2, net_membrane_law
@@ -196,6 +197,8 @@ def prototype_scene(p: Prototype, *, mounting: str | None = None,
     mounting = mounting or lateral_mounting(p)
     pattern = get_pattern(p.net.pattern)
     g = pattern.graph(p.width / MM, p.height / MM, p.net.mesh_x / MM, p.net.mesh_y / MM)
+    if pattern.edge_strands:  # the square's edge rows are strands of the prototype's net
+        g = dataclasses.replace(g, family=np.where(g.family == 0, 1, g.family))
     if p.net.panel_law is not None:
         knees, kappas, length = p.net.panel_law
         along, across = panel_axes(p.net.mesh_x, p.net.mesh_y, orientation)
@@ -248,12 +251,14 @@ def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
                      f"profile materials/{c.material}"))
     s = _scene(f"printed model 1:{d.scale:g}", d.scale, g, MM, net_law, cable_law,
                ((), (border_ea,)), mounting)
-    rows = [("net", (f"{pattern.name} mesh {n.mesh_x_mm:g} x {n.mesh_y_mm:g} mm, "
+    rows = [("net", (f"{mesh_text(pattern.name, n.mesh_x_mm, n.mesh_y_mm)}, "
              f"{len(s.nodes)} nodes, rigid junctions"), "design"),
             ("net strands", (f"{mat.name}: {how}, strand {n.strand.width_mm:g} x "
              f"{n.strand.thickness_mm:g} mm"), f"profile materials/{n.material}"),
             ("printed border frame", (f"{n.border_width_mm:g} mm wide, E = {e / 1e9:.3g} GPa "
-             f"({e_src})"), f"design; profile materials/{n.material}"), *rows]
+             f"({e_src})" + (", on the edge rows (the prototype's edge strands)"
+                             if pattern.edge_strands else "")),
+             f"design; profile materials/{n.material}"), *rows]
     return _finish(s, rows, sensors=True, load=load)
 
 

@@ -1,7 +1,7 @@
 """Pre-print verification: the prototype and the printed model, each as a tension-only net
 (`printgen.verification.scenes`), loaded hydrostatically from h / h_B = 0 to 1.1 (the reference's loading
 test: water raised behind a folded film), or another load case of `printgen.barrier.loads`
-(drag at the Froude-scaled velocity), and compared by their normalised deformations over the whole range (printgen.verification.compare).
+(flow, drag, jam: a case may bring its own levels and states what it used at each), and compared by their normalised deformations over the whole range (printgen.verification.compare).
 Also the counter-example the report warns about: the simple barrier with steel at every scale.
 """
 
@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 import solver
-from printgen.barrier.loads import OVERFLOW, LoadCase, LoadsAt, Site, get_load
+from printgen.barrier.loads import FLOW, OVERFLOW, LoadCase, LoadsAt, Site, get_load
 from printgen.design.record import Design
 from printgen.design.similitude import scale_targets
 from printgen.errors import SolverError
@@ -72,7 +72,7 @@ def loads_function(s: BarrierScene, *, load: str | LoadCase | None = None,
     free nodes, at `site` (the sensor wires are part of the net: `solver_net`). With the
     scene's pressure option "normal" the hydrostatic part presses normal to the deformed net
     (issue 25: the folded film presses normal to the surface) instead of along the flow."""
-    loads_at = get_load(load).loads(s, site)
+    loads_at = get_load(load).loads_for(s, site)
     if s.pressure != "normal":
         return loads_at
     from printgen.verification.pressure import normal_pressure
@@ -82,8 +82,9 @@ def loads_function(s: BarrierScene, *, load: str | LoadCase | None = None,
                              0.0)
 
     def normal_at(r: float) -> list:
-        return [dataclasses.replace(normal, level=r * s.height)
-                if isinstance(f, solver.Hydrostatic) else f for f in loads_at(r)]
+        return [dataclasses.replace(normal, level=f.level)  # the water behind a jam stays along
+                if isinstance(f, solver.Hydrostatic) and f.direction == tuple(FLOW) else f
+                for f in loads_at(r)]
 
     return normal_at
 
@@ -93,8 +94,11 @@ def load_keywords(p: Prototype, d: Design, load: str | LoadCase | None = None
     """`sweep`'s load keywords of the prototype and of the model under `load`: the case and
     each barrier's site, the model's flow velocity its similitude target (v / sqrt(lambda))."""
     case = get_load(load)
-    proto = Site(p.velocity, p.net.strand_diameter)
-    model = Site(scale_targets(p, d.scale)["velocity"], d.net.strand.width_mm * MM)
+    width = p.flume.free_section if p.flume is not None else None  # the flume's, m
+    proto = Site(p.velocity, p.net.strand_diameter, p.depth,
+                 None if width is None else width * d.scale)
+    model = Site(scale_targets(p, d.scale)["velocity"], d.net.strand.width_mm * MM,
+                 p.depth / d.scale, width, d.scale)
     return {"load": case, "site": proto}, {"load": case, "site": model}
 
 
@@ -172,6 +176,8 @@ class Verification:
     counterexample: CounterExample | None = None
     from_start: list[Mismatch] | None = None  # the same, counted from h / h_B = 0
     asked: int = 0  # load levels asked; the comparison used len(model.deformation.levels)
+    load: dict[str, Any] = field(default_factory=dict)  # the case's spec and per-level values
+    by_load: dict[str, CaseRuns] = field(default_factory=dict)  # --loads: each case's sweeps
 
     @property
     def ok(self) -> bool:
@@ -215,6 +221,8 @@ class Verification:
             "mounting": self.model.scene.mounting,
             "hold_share": {who: run.hold_share for who, run in runs},
             "deformed_shape": self.model.shape_record(),
+            "load": self.load,
+            "by_load": {name: c.to_record() for name, c in self.by_load.items()},
             "assumptions": {who: [dict(zip(("what", "value", "source"), a, strict=True))
                                   for a in run.scene.assumptions] for who, run in runs},
         }
@@ -226,12 +234,15 @@ def verify(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
     """Sweep both barriers under the same relative loading of load case `load` (default
     hydrostatic) and compare them; both are mounted by `mounting` (default: the prototype
     file's [flume] lateral)."""
-    lv = levels() if lv is None else np.asarray(lv, dtype=float)
     mounting = mounting or lateral_mounting(p)
     kw_p, kw_m = load_keywords(p, d, load)
     case = kw_m["load"]
     ps = prototype_scene(p, mounting=mounting, load=case)
     ms = model_scene(d, mounting=mounting, load=case)
+    if lv is None:  # the usual levels and the case's own (the jam's discharge steps)
+        own = case.levels_for(ms, kw_m["site"])
+        lv = levels() if own is None else np.unique(np.concatenate([levels(), own]))
+    lv = np.asarray(lv, dtype=float)
     jobs: list[tuple] = [(sweep, (ms, lv), kw_m), (sweep, (ps, lv), kw_p)]  # longest first
     if counterexample:
         jobs.append((steel_counterexample, (d.scale,), {}))
@@ -241,10 +252,80 @@ def verify(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
         keep = np.array([lvl not in bad for lvl in lv])
         proto = _only(proto, keep)
         model = _only(model, keep)
+    (proto, model), load_rec = stated(case, (proto, model), (kw_p["site"], kw_m["site"]))
     mm = compare(proto.deformation, model.deformation)
     start = compare(increments(proto.deformation), increments(model.deformation))
     return Verification(case.title, proto, model, mm, explain(mm), ce[0] if ce else None,
-                        start, len(lv))
+                        start, len(lv), load_rec)
+
+
+def stated(case: LoadCase, runs: tuple[Run, Run], sites: tuple[Site, Site]
+           ) -> tuple[tuple[Run, Run], dict[str, Any]]:
+    """The runs (prototype, model) with a row stating what `case` used at their levels (the
+    velocity, the discharge) added to their scenes' assumptions, and the record of it."""
+    rec: dict[str, Any] = {"case": case.name, "spec": case.spec, "title": case.title}
+    out = []
+    for who, run, site in zip(("prototype", "model"), runs, sites, strict=True):
+        values, text = case.describe(run.scene, site, run.deformation.levels)
+        rec[who] = {"levels": run.deformation.levels, **values}
+        if text:
+            row = (f"loading: {case.name} at each level", text,
+                   ("printgen (report.json: verification.load, or verification.by_load.<case> "
+                    "for make --loads)"))
+            run = dataclasses.replace(run, scene=dataclasses.replace(
+                run.scene, assumptions=(*run.scene.assumptions, row)))
+        out.append(run)
+    return (out[0], out[1]), rec
+
+
+@dataclass(frozen=True)
+class CaseRuns:
+    """One more load case's nominal sweeps (`make --loads`): the prototype and the model at
+    the case's own levels (the usual ones when it has none), and what it used at each."""
+
+    spec: str
+    prototype: Run
+    model: Run
+    load: dict[str, Any]
+
+    def to_record(self) -> dict[str, Any]:
+        return {"spec": self.spec, "load": self.load,
+                "assumptions": [dict(zip(("what", "value", "source"), a, strict=True))
+                                for a in self.model.scene.assumptions
+                                if a[0].startswith("loading")],
+                "model_levels": self.model.deformation.levels,
+                "not_converged": {"prototype": self.prototype.failed,
+                                  "model": self.model.failed}}
+
+
+def case_runs(p: Prototype, d: Design, load: str, mounting: str | None = None) -> CaseRuns:
+    """The nominal prototype and model of load case `load` at its own levels (no band)."""
+    mounting = mounting or lateral_mounting(p)
+    kw_p, kw_m = load_keywords(p, d, load)
+    case = kw_m["load"]
+    ps = prototype_scene(p, mounting=mounting, load=case)
+    ms = model_scene(d, mounting=mounting, load=case)
+    own = case.levels_for(ms, kw_m["site"])
+    lv = levels() if own is None else np.asarray(own, dtype=float)
+    model, proto = run_jobs([(sweep, (ms, lv), kw_m), (sweep, (ps, lv), kw_p)])
+    (proto, model), rec = stated(case, (proto, model), (kw_p["site"], kw_m["site"]))
+    return CaseRuns(case.spec, proto, model, rec)
+
+
+def with_cases(v: Verification, p: Prototype, d: Design, loads: tuple[str, ...] | list[str]
+               ) -> Verification:
+    """`v` with the sweeps of each load case of `loads` (`make --loads`): the verification's
+    own case reuses its runs, every other one sweeps its nominal barriers (`case_runs`)."""
+    if not loads:
+        return v
+    mounting = v.model.scene.mounting
+    out = {}
+    for spec in dict.fromkeys(get_load(x).spec for x in loads):
+        if spec == v.load.get("spec"):
+            out[get_load(spec).name] = CaseRuns(spec, v.prototype, v.model, v.load)
+        else:
+            out[get_load(spec).name] = case_runs(p, d, spec, mounting)
+    return dataclasses.replace(v, by_load=out)
 
 
 def _only(run: Run, keep: np.ndarray) -> Run:

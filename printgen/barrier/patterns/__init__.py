@@ -31,6 +31,8 @@ class NetPattern:
       along the load
     span(length, mesh) : `length` rounded to the lattice of `mesh` (any unit)
     nodes(width, height, mesh_x, mesh_y) : nodes of `graph` (any length unit)
+    edge_strands : the border loop's segments are strands of the prototype's net (the
+      square's edge rows); False: the border is only the printed frame (the diamond's)
     """
 
     name: str
@@ -40,6 +42,13 @@ class NetPattern:
     strand_force: Callable[[float, float, float], float]
     span: Callable[[float, float], float]
     nodes: Callable[[float, float, float, float], int]
+    edge_strands: bool = False
+
+
+def mesh_text(pattern: str, mesh_x_mm: float, mesh_y_mm: float) -> str:
+    """How a printed net is named in every output: "square mesh 5 x 5 mm" (the square's
+    sides), "diamond mesh 20.6 x 9.4 mm" (the diamond's diagonals), across x up."""
+    return f"{pattern} mesh {mesh_x_mm:g} x {mesh_y_mm:g} mm"
 
 
 def pattern_names() -> tuple[str, ...]:
@@ -49,6 +58,15 @@ def pattern_names() -> tuple[str, ...]:
     from printgen.barrier.registry import names
 
     return (*names(package), *AS_DRAWN)
+
+
+def printed_pattern_names() -> tuple[str, ...]:
+    """The patterns printgen builds (meshes, toolpaths, scenes), without importing them: the
+    choices of [model] pattern."""
+    import printgen.barrier.patterns as package
+    from printgen.barrier.registry import names
+
+    return tuple(names(package))
 
 
 def patterns() -> dict[str, NetPattern]:

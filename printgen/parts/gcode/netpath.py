@@ -1,6 +1,8 @@
-"""Direct toolpath of the diamond net (mm, mm/s), one layer per pass.
+"""Direct toolpath of the net (mm, mm/s), one layer per pass, for any pattern whose strands
+are straight lines of two families (the diamond's diagonals, the square's strands up and
+across; `printgen.barrier.patterns`).
 
-Each layer: the border first, then every diagonal strand of one family as one straight
+Each layer: the border first, then every strand of one family as one straight
 extrusion from border to border through the crossings, then the other family; the family
 order alternates from layer to layer ("crossed passes"). The strands laid second in a layer
 cross beads already there: over each crossing their flow is `crossing_flow_factor` (1 = full
@@ -10,7 +12,12 @@ With an `Attachment` (loops on the edge nodes, eyelets on the corners,
 `printgen.parts.geometry.attach`) the border beads detour around every hole on their own
 side of the edge (together they make each loop's ring), the corner eyelets get their extra
 full rings first, and each strand ends at its loop's hole; over the ring it overlaps, a
-strand lays the same reduced flow as over a crossing. Between strands the nozzle travels
+strand lays the same reduced flow as over a crossing (and over the border frame band
+it crosses beyond the ring). A strand of several beads side by side lays them there and
+back; each bead is trimmed, and reduced over the crossings, the ring and the frame, where
+that bead itself meets them (an offset bead meets a crossing strand o cot(theta) off the
+centre line's crossing point, and its end corner nearer the centre line meets the hole
+first). Between strands the nozzle travels
 along the inner border bead (over printed material, so the writer does not retract there).
 """
 
@@ -40,6 +47,7 @@ from printgen.parts.gcode.toolpath import (
     speeds,
 )
 from printgen.parts.geometry.attach import CORNER_EXTRA_RINGS, Attachment, Hole, holes
+from printgen.parts.geometry.lattice import crossing_direction, crossing_sin, end_sin
 
 
 def net_toolpath(net: NetDesign, printer: Printer, style: PrintStyle, material: Material, *,
@@ -76,14 +84,13 @@ def net_toolpath(net: NetDesign, printer: Printer, style: PrintStyle, material: 
             kind = STRAND_PLUS if fam == 1 else STRAND_MINUS
             for n, s in enumerate(fams[fam]):
                 s = s if n % 2 == 0 else s[::-1]
-                pieces = _strand_pieces(g.nodes_mm[s], sec, g, f_cross, f,
-                                        by_node.get(int(s[0])), by_node.get(int(s[-1])))
+                ends = (by_node.get(int(s[0])), by_node.get(int(s[-1])))
+                beads = _strand_beads(g.nodes_mm[s], sec, g, f_cross, f, ends,
+                                      net.border_width_mm)
                 if comb is not None and b.pos is not None and b.pos[2] == zk:
-                    b.travel(comb.route(b.part_xy(), pieces[0][0]), zk, k, travel, COMB)
-                for p0, p1, fl in pieces:
-                    for off in _bead_offsets(sec, p1 - p0):
-                        b.line(p0 + off, p1 + off, zk, sec.bead_width_mm, h, v, fl, k, kind,
-                               travel)
+                    b.travel(comb.route(b.part_xy(), beads[0][0][0]), zk, k, travel, COMB)
+                for p0, p1, fl in itertools.chain.from_iterable(beads):
+                    b.line(p0, p1, zk, sec.bead_width_mm, h, v, fl, k, kind, travel)
     return b.toolpath([float(round(x, 6)) for x in z], "net")
 
 
@@ -182,45 +189,86 @@ def _crossing_half_span(sec: Section, g: NetGraph) -> float:
 
 
 def _sin_crossing(g: NetGraph) -> float:
-    a, b = g.mesh_mm
-    return 2 * a * b / (a * a + b * b)  # sin of the angle between the two families
+    return crossing_sin(g)  # sin of the angle between the two families, any pattern
 
 
-def _strand_pieces(pts: np.ndarray, sec: Section, g: NetGraph, f_cross: float, f_end: float,
-                   start: Hole | None = None, end: Hole | None = None):
-    """Straight pieces (p0, p1, flow) of one strand: `f_cross` over the crossings, `f_end`
-    over the ring at an end with a hole (the strand stops where its beads meet the hole)."""
+def _strand_beads(pts: np.ndarray, sec: Section, g: NetGraph, f_cross: float, f_end: float,
+                  ends: tuple[Hole | None, Hole | None], bw: float):
+    """Pieces (p0, p1, flow) of each bead of one strand, beads side by side laid there and
+    back (serpentine): `f_cross` where the bead lies over a crossing strand, `f_end` where it
+    lies over the border frame or a ring at an end with a hole (it stops at the hole)."""
     d = pts[-1] - pts[0]
-    length = float(np.hypot(*d))
-    u = d / length
-    t0 = _trim(start, sec)
-    t1 = length - _trim(end, sec)
+    u = d / float(np.hypot(*d))
+    out = []
+    for j, off in enumerate(_bead_offsets(sec, d)):
+        pieces = _bead_pieces(pts, u, off, sec, g, f_cross, f_end, ends, bw)
+        if j % 2:
+            pieces = [(p1, p0, fl) for p0, p1, fl in reversed(pieces)]
+        out.append(pieces)
+    return out
+
+
+def _bead_pieces(pts: np.ndarray, u: np.ndarray, off: np.ndarray, sec: Section, g: NetGraph,
+                 f_cross: float, f_end: float, ends: tuple[Hole | None, Hole | None], bw: float):
+    """Straight pieces (p0, p1, flow) of the bead at lateral offset `off` from the strand's
+    centre line, in t (mm along the strand from pts[0]); see `_strand_beads`."""
+    start, end = ends
+    length = float(np.dot(pts[-1] - pts[0], u))
+    o = float(np.hypot(*off))
+    t0 = _trim(start, sec, o)
+    t1 = length - _trim(end, sec, o)
     spans = []
     if f_cross < 1.0:
         half = _crossing_half_span(sec, g)
-        spans += [(t - half, t + half, f_cross)
+        v = crossing_direction(g, u)  # the other family's direction (any pattern)
+        shift = _cross2(off, v) / _cross2(u, v)  # the offset line meets each crossing here
+        spans += [(t - shift - half, t - shift + half, f_cross)
                   for t in (float(np.dot(p - pts[0], u)) for p in pts[1:-1])]
     if start is not None:
-        spans.append((t0, start.outer_r_mm, f_end))
+        spans.append((t0, _border_exit(start, g, u, off, bw), f_end))
     if end is not None:
-        spans.append((length - end.outer_r_mm, t1, f_end))
+        spans.append((length - _border_exit(end, g, -u, off, bw), t1, f_end))
     cuts = sorted({t0, t1, *(min(max(c, t0), t1) for lo, hi, _ in spans for c in (lo, hi))})
+    p00 = pts[0] + off
     out: list[tuple[np.ndarray, np.ndarray, float]] = []
     for a, c in itertools.pairwise(cuts):
         mid = (a + c) / 2
         fl = min([fl for lo, hi, fl in spans if lo <= mid <= hi], default=1.0)
         if out and out[-1][2] == fl:
-            out[-1] = (out[-1][0], pts[0] + u * c, fl)
+            out[-1] = (out[-1][0], p00 + u * c, fl)
         else:
-            out.append((pts[0] + u * a, pts[0] + u * c, fl))
+            out.append((p00 + u * a, p00 + u * c, fl))
     return out
 
 
-def _trim(h: Hole | None, sec: Section) -> float:
-    """Distance from a strand's end node to where its beads' corners meet the hole (mm)."""
+def _cross2(a: np.ndarray, b: np.ndarray) -> float:
+    return float(a[0] * b[1] - a[1] * b[0])
+
+
+def _border_exit(h: Hole, g: NetGraph, u: np.ndarray, off: np.ndarray, bw: float) -> float:
+    """Distance from the hole's node along u (into the net) at which the bead centre line at
+    lateral offset `off` leaves the border's material there: the ring's disc or the frame
+    band `bw` wide on the edge, whichever reaches further (mm)."""
+    o = float(np.hypot(*off))
+    exits = [float(np.sqrt(max(h.outer_r_mm ** 2 - o ** 2, 0.0)))]
+    sx, sy = g.size_mm
+    x, y = h.centre_mm
+    for on_edge, n_in in ((np.isclose(x, 0.0), (1, 0)), (np.isclose(x, sx), (-1, 0)),
+                          (np.isclose(y, 0.0), (0, 1)), (np.isclose(y, sy), (0, -1))):
+        into = float(np.dot(u, n_in))
+        if on_edge and into > 0:
+            exits.append((bw / 2 - float(np.dot(off, n_in))) / into)
+    return max(exits)
+
+
+def _trim(h: Hole | None, sec: Section, o: float = 0.0) -> float:
+    """Distance from a strand's end node to where the end corners of its bead at lateral
+    offset `o` (mm) meet the hole, the corner nearer the centre line binding (mm)."""
     if h is None:
         return 0.0
-    return float(np.sqrt(max(h.hole_r_mm ** 2 - (sec.width_mm / 2) ** 2, 0.0)))
+    hw = sec.bead_width_mm / 2
+    near = min(abs(o - hw), abs(o + hw))
+    return float(np.sqrt(max(h.hole_r_mm ** 2 - near ** 2, 0.0)))
 
 
 def _bead_offsets(sec: Section, d: np.ndarray) -> list[np.ndarray]:
@@ -244,13 +292,7 @@ def net_volume_budget(net: NetDesign, style: PrintStyle, *,
     border = 2 * (size[0] + size[1]) * net.border_width_mm
     nominal = (strand_len * w + border) * t
     crossing = n_cross * w * w / _sin_crossing(g) * t
-    a, b = g.mesh_mm
-    diag = np.hypot(a, b)
-    junction = 0.0
-    for s in g.strands:
-        for end in (g.nodes_mm[s[0]], g.nodes_mm[s[-1]]):
-            on_side = np.isclose(end[0], 0) or np.isclose(end[0], size[0])
-            sin_phi = a / diag if on_side else b / diag  # strand vs the border edge it meets
-            junction += net.border_width_mm / 2 / sin_phi * w * t
+    # strand ends inside the frame, each at its angle to the border edge it meets
+    junction = float(np.sum(net.border_width_mm / 2 / end_sin(g))) * w * t
     return VolumeBudget(nominal, crossing, junction, f, n_cross)
 

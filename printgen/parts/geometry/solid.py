@@ -1,7 +1,8 @@
 """Watertight single-body meshes of the printed parts (mm), from 2D outlines (shapely)
 extruded to the section thickness (manifold3d), checked after every operation.
 
-Net: every diagonal strand of the `NetGraph` as one straight band of the strand width from
+Net: every strand of the `NetGraph` (the diamond's diagonals, the square's strands up and
+across) as one straight band of the strand width from
 border to border (rigid junctions where the bands cross), plus the border frame of
 `border_width_mm` centred on the panel edge, which the border cables thread along - the same
 layout the direct G-code lays. With an `Attachment` (`printgen.parts.geometry.attach`) a
@@ -29,6 +30,14 @@ from printgen.parts.geometry.cable import (
     circle_points,
     require_shapely,
 )
+from printgen.parts.geometry.lattice import (
+    crossing_sin,
+    end_poke,
+    end_sin,
+    first_inner_node_mm,
+    parallel_spacing,
+    strand_ends,
+)
 
 if TYPE_CHECKING:  # pragma: no cover
     import trimesh
@@ -49,20 +58,21 @@ def _graph(net: NetDesign) -> NetGraph:
     g = net.graph()
     a, b = g.mesh_mm
     w, bw = net.strand.width_mm, net.border_width_mm
-    spacing = a * b / np.hypot(a, b)  # between neighbouring parallel strands
+    spacing = parallel_spacing(g)  # between neighbouring parallel strands
     if w >= spacing:
         raise GeometryError(f"net strand {w:g} mm wide fills the {spacing:.3g} mm between "
                             f"parallel strands of a {a:g} x {b:g} mm mesh (no openings left); "
                             "use narrower strands or a larger mesh")
-    poke = w * max(a, b) / np.hypot(a, b)  # band end across the edge it meets, both sides
+    poke = end_poke(g, w)  # band end across the edge it meets, both sides
     if poke > bw:
         raise GeometryError(f"net strand ends ({w:g} mm wide, {poke:.3g} mm across the edge) "
                             f"stick out of the {bw:g} mm border; border_width_mm must be at "
                             f"least {poke:.3g} mm")
-    if bw / 2 + w >= min(a, b) / 2:
+    first = first_inner_node_mm(g)
+    if bw / 2 + w >= first:
         raise GeometryError(f"net border {bw:g} mm wide reaches the first strand crossings "
-                            f"{min(a, b) / 2:g} mm from the edge (strand {w:g} mm); use a "
-                            f"border narrower than {min(a, b) - 2 * w:.3g} mm or a larger mesh")
+                            f"{first:g} mm from the edge (strand {w:g} mm); use a "
+                            f"border narrower than {2 * (first - w):.3g} mm or a larger mesh")
     return g
 
 
@@ -104,24 +114,20 @@ def _frame(net: NetDesign, g: NetGraph):
 def analytic_net_area(net: NetDesign, attachment: Attachment | None = None) -> float:
     """Plan area of the net (mm^2), from the graph alone (no shapely).
 
-    Strand lengths x width, less one rhombus w^2 / sin(theta) per crossing and, per strand
-    end, the w x (bw/2) / sin(phi) inside the frame (phi: strand vs the edge it meets), plus
+    Strand lengths x width, less one rhombus w^2 / sin(theta) per crossing (theta between
+    the crossing strands: `lattice.crossing_sin`) and, per strand end, the w x (bw/2) /
+    sin(phi) inside the frame (phi: strand vs the edge it meets, `lattice.end_sin`), plus
     the frame 2 bw (sx + sy). Each ring adds its disc less the frame and strands already
     inside it (a polar-grid integral of numpy point tests) and removes its hole.
     """
     g = _graph(net)
-    a, b = g.mesh_mm
     sx, sy = g.size_mm
     w, bw = net.strand.width_mm, net.border_width_mm
-    diag = np.hypot(a, b)
-    ends = np.array([[g.nodes_mm[s[0]], g.nodes_mm[s[-1]]] for s in g.strands]).reshape(-1, 2)
+    ends = strand_ends(g).reshape(-1, 2)
     length = float(np.hypot(*(ends[1::2] - ends[::2]).T).sum())
     n_cross = sum(len(s) - 2 for s in g.strands) // 2
-    sin_theta = 2 * a * b / diag**2  # between the two strand families
-    on_top_bottom = np.isclose(ends[:, 1], 0.0) | np.isclose(ends[:, 1], sy)
-    sin_phi = np.where(on_top_bottom, b / diag, a / diag)
-    area = (length * w - n_cross * w * w / sin_theta - float(np.sum(bw / 2 / sin_phi)) * w
-            + 2 * bw * (sx + sy))
+    area = (length * w - n_cross * w * w / crossing_sin(g)
+            - float(np.sum(bw / 2 / end_sin(g))) * w + 2 * bw * (sx + sy))
     if attachment is not None:
         for h in holes(net, g, attachment):
             area += np.pi * (h.outer_r_mm**2 - h.hole_r_mm**2) - _base_in_disc(net, g, h)

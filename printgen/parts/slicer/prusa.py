@@ -1,7 +1,9 @@
 """PrusaSlicer 2.5 `.ini` profiles for a net or a cable, following slicers.md.
 
 One bead per strand in Arachne needs `min_bead_width < strand < extrusion width`: the
-extrusion widths are `slicer_width_factor` (about 1.15) x the strand's bead width, the
+extrusion widths are `slicer_width_factor` (about 1.15) x the strand's bead width (for an odd
+number of beads across; an even number is whole perimeter loops at the bead width: with 1.15 x
+a two-bead TPU strand had only 71-87 % of its path within 15 % of the bead section), the
 minimum bead `slicer_min_bead_factor` (about 0.85) x it, and the first-layer width equals the
 others. E is relative with `G92 E0` at each layer; the material's volumetric flow limit caps
 the speeds. Only keys in `prusa_keys.txt` are written (PrusaSlicer ignores unknown keys).
@@ -61,9 +63,14 @@ def prusa_settings(part_kind: str, design_part: NetDesign | CableDesign, printer
     return s
 
 
+# PrusaSlicer 2.5 lays short moves up to 5.3 % over its own max_volumetric_speed (a TPE
+# coupon's eyelet: 1.58 mm3/s at a 1.5 limit, issue 27); the cap it gets is this x the limit
+PRUSA_FLOW_MARGIN = 0.95
+
+
 def _filament(printer: Printer, material: Material) -> dict[str, str]:
     p = material.print
-    flow = f"{p.max_volumetric_flow_mm3_per_s:g}"
+    flow = f"{PRUSA_FLOW_MARGIN * p.max_volumetric_flow_mm3_per_s:.4g}"
     return {
         "filament_type": p.filament_type, "filament_diameter": f"{printer.filament_diameter_mm:g}",
         "filament_density": f"{material.density / 1000:g}", "extrusion_multiplier": "1",
@@ -85,8 +92,12 @@ def _filament(printer: Printer, material: Material) -> dict[str, str]:
 def _layers(part_kind: str, part: NetDesign | CableDesign, style: PrintStyle,
             heights: tuple[float, ...]) -> dict[str, str]:
     """Layer heights and Arachne widths: min_bead < strand bead < extrusion width."""
-    bead = part_section(part_kind, part).bead_width_mm
-    width = f"{style.slicer_width_factor * bead:.4g}"
+    sec = part_section(part_kind, part)
+    bead = sec.bead_width_mm
+    # an odd bead count leaves one medial bead, which needs the wider extrusion; an even one
+    # is filled by whole loops at the bead width (wider, 2-bead strands fail: issue 27)
+    factor = style.slicer_width_factor if sec.beads_across % 2 else 1.0
+    width = f"{factor * bead:.4g}"
     s = {
         "layer_height": f"{(heights[1] if len(heights) > 1 else heights[0]):g}",
         "first_layer_height": f"{heights[0]:g}",

@@ -1,0 +1,52 @@
+"""`printgen testpieces DESIGN [--orientation short|long] [--out DIR] [--force] [--json]`: the
+tensile coupons and the net test panel to print and test before the barrier
+(printgen.run.testpieces), written atomically into DIR (default `out/<design>-testpieces`)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from printgen.commands.common import add_json_arg, console, emit_json, table
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("testpieces", help="tensile coupons of the net strand and a net test "
+                                          "panel to print, test and calibrate first")
+    p.add_argument("design", type=Path, help="a design.json (printgen design or make)")
+    p.add_argument("--orientation", choices=("short", "long"), default="short",
+                   help="panel: mesh diagonal along the load (default short, as the paper's "
+                        "panels)")
+    p.add_argument("--out", "-o", type=Path, help="output directory")
+    p.add_argument("--force", action="store_true",
+                   help="replace --out even when it holds files printgen did not write")
+    add_json_arg(p)
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from printgen.run.testpieces import testpieces
+
+    out = args.out or Path("out") / f"{args.design.stem}-testpieces"
+    rec = testpieces(args.design, out, orientation=args.orientation, force=args.force,
+                     command=getattr(args, "argv", None))
+    if args.json:
+        emit_json(rec)
+        return 0
+    c = console()
+    if rec["material_source"] == "datasheet":
+        c.print(f"[bold yellow]{rec['material']} rests on datasheet values[/]: print the test "
+                "pieces below and calibrate before printing the barrier")
+    cg, pg = rec["coupon"]["geometry"], rec["panel"]["geometry"]
+    rows = [["coupon", (f"{cg['width_mm']:.4g} x {cg['thickness_mm']:.4g} mm strip, gauge "
+             f"{cg['gauge_length_mm']:.4g} mm, eyelet tabs {cg['eyelet_outer_mm']:.4g} mm on "
+             f"{cg['pin_hole_mm']:.4g} mm pins {cg['pin_distance_mm']:.4g} mm apart (print "
+             f"{cg['count']})"), f"{rec['coupon']['readback_vs_stl']:+.1%}"],
+            ["panel", (f"{pg['printed_mm'][0]:.4g} x {pg['printed_mm'][1]:.4g} mm, clamps "
+             f"{pg['width_mm']:.4g} mm wide, {pg['length_mm']:.4g} mm apart, "
+             f"{pg['clamp_depth_mm']:.4g} mm held each end"), 
+             f"{rec['panel']['readback_vs_stl']:+.1%}"]]
+    c.print(table(f"test pieces in {out}", ["piece", "geometry", "G-code vs STL"], rows))
+    for line in rec["loop"]:
+        c.print(line)
+    return 0

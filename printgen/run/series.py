@@ -1,0 +1,162 @@
+"""`printgen series`: the virtual scale series of a prototype (printgen.verification.series)
+run serially or on the design search's Dask runner, summarised (series_table) and written as
+one folder (`outputs.staged_dir`: whole or nothing, locked, with its manifest):
+
+- report.html: the sentences, the figure, the table, the law check, the assumptions;
+- report.json: every number of the series (points, curves, law check, assumptions);
+- series.csv: the table; figures/01-scale-series.png and .svg;
+- timings.json: the wall-clock times (the one file that differs between identical runs).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from printgen.barrier.loads import get_load
+from printgen.errors import InputError
+from printgen.inputs.profiles import search_dirs
+from printgen.inputs.prototype import Prototype, load_prototype
+from printgen.outputs import check_destination, write_folder
+from printgen.report.jsonout import dumps
+from printgen.report.series import series_csv, series_figure, series_report
+from printgen.run.provenance import TIMINGS
+from printgen.search.sweep import open_runner
+from printgen.verification.scenes import SENSOR_FORCE_N
+from printgen.verification.series import (
+    LEVEL,
+    LEVEL_STEP,
+    CaseResult,
+    NetOptions,
+    SeriesShared,
+    base_scene,
+    cases,
+    check_scales,
+    rows_for,
+    solve_case,
+)
+from printgen.verification.series_table import Series, summarise
+
+PARALLEL_FROM = 12  # cases from which the series runs on a local Dask cluster by default
+
+
+@dataclass
+class SeriesRun:
+    """What `printgen series` computed, where it ran and what it wrote."""
+
+    series: Series
+    results: list[CaseResult]
+    where: str
+    record: dict = field(default_factory=dict)
+    files: list[str] = field(default_factory=list)
+
+
+def run_series(prototype: str | Path | Prototype, scales: list[float], *,
+               materials: tuple[str, ...] = (), load: str | None = None,
+               net: NetOptions | None = None, level: float = LEVEL,
+               level_step: float = LEVEL_STEP, out: str | Path | None = None,
+               serial: bool | None = None, scheduler: str | None = None,
+               workers: int | None = None, force: bool = False,
+               progress: Callable[[str], None] | None = None, bar: bool = False) -> SeriesRun:
+    """Check every input, solve every (row, lambda) case, summarise, write `out` (if given).
+
+    `serial` None: serially up to PARALLEL_FROM cases, on a local Dask cluster from there (a
+    `scheduler` address or `workers` always mean Dask); the numbers are the same either way.
+    """
+    say = progress or (lambda _text: None)
+    t0 = time.perf_counter()
+    lams = check_scales(scales)
+    if serial and (workers is not None or scheduler):
+        raise InputError("--serial runs in this process: leave out --workers/--scheduler, or "
+                         "--serial")
+    p = prototype if isinstance(prototype, Prototype) else load_prototype(prototype)
+    inputs = [p.path, *search_dirs()] if p.path else list(search_dirs())
+    if out is not None:
+        check_destination(Path(out), force=force, inputs=inputs)  # before any solve
+    rows = tuple(rows_for(p, materials))
+    shared = SeriesShared(p, rows, get_load(load).spec, net or NetOptions(), level, level_step)
+    base = base_scene(shared)  # geometry errors now, not in a worker
+    todo = cases(shared, lams)
+    if serial is None:
+        serial = len(todo) < PARALLEL_FROM and scheduler is None and workers is None
+    say(f"{len(todo)} cases ({len(rows)} rows x {len(lams)} scales)"
+        + ("" if serial else ", starting Dask"))
+    with open_runner(scheduler=scheduler, workers=workers, serial=serial,
+                     progress=bar) as runner:
+        results = runner.map(solve_case, todo, shared=shared, label="series cases")
+        where = runner.where
+    scene = "simple-free-top" if not base.cables else f"border cables, {base.mounting}"
+    s = summarise(shared, lams, results, scene)
+    s.assumptions = [*scene_assumptions(base, shared.net), *scaling_assumptions(shared)]
+    record = {**s.to_record(), "load_case": shared.load, "ran_on": where, "level": level,
+              "level_step": level_step, "solver_net": shared.net.to_record(),
+              "curves": [{"row": r.row, "scale": r.scale, "levels": r.levels,
+                          "values": r.curves} for r in results]}
+    run = SeriesRun(s, results, where, record)
+    if out is not None:
+        say("writing the report")
+        run.files = write_series(run, Path(out), force, inputs,
+                                 {"total": time.perf_counter() - t0})
+    return run
+
+
+def scene_assumptions(base, net: NetOptions) -> list[tuple[str, str, str]]:
+    """The prototype scene's rows, its sensor row saying that the models' wires pull when
+    they do (the prototype's scene only reads them)."""
+    rows = list(base.assumptions)
+    if net.sensors:
+        rows = [(w, v.replace("read only (no sensors on a field barrier)",
+                              f"{SENSOR_FORCE_N:g} N along each wire on the models (lambda > 1), "
+                              "read only on the prototype (lambda = 1)"), src)
+                if w == "sensor wires" else (w, v, src) for w, v, src in rows]
+    return rows
+
+
+def scaling_assumptions(shared: SeriesShared) -> list[tuple[str, str, str]]:
+    """The series' own modelling choices, one row each."""
+    paper = "Lambert et al. 2023 (Fig. 2: the scale series)"
+    p = shared.prototype
+    mats = [r for r in shared.rows if r.kind == "material"]
+    out = [("scaling", ("every length / lambda (nodes, mesh, strand and cable diameters), so "
+            "sections / lambda^2; loads by Froude: A* / lambda^2, velocity / sqrt(lambda); the hold "
+            "of unloaded nodes / lambda^2 (a share of rho g A*)"), paper),
+           ("row: prototype material unscaled", ("the prototype's laws with E A / lambda^2 "
+            "(same E, the Froude-only practice)"), paper),
+           ("row: E / lambda", ("every law's force slope / lambda^3 (similitude: E A like every "
+            "force)"), paper)]
+    if mats:
+        sec = f"net d = {p.net.strand_diameter * 1e3:g} mm / lambda"
+        if p.border is not None:
+            sec += f", cables d = {p.border.diameter * 1e3:g} mm / lambda"
+        law = "" if p.net.panel_law is None else "; the prototype's panel law is replaced"
+        out.append(("rows: materials", (f"E of the profile on the prototype's sections scaled "
+                    f"({sec}), linear, tension-only{law} (not select's section: the series "
+                    "isolates the material)"), "; ".join(r.source for r in mats)))
+    out.append(("reading", (f"at h / h_B = {shared.level:g}, reached in steps of "
+                f"{shared.level_step:g} (warm-started)"), paper))
+    sensors = ("three 1 N wires pulling on every model (lambda > 1): a force that does not "
+               "scale" if shared.net.sensors else "wires read only (they pull nothing)")
+    out.append(("sensors", sensors, "--solver-net sensors=on|off"))
+    o = shared.net
+    out.append(("solver net", (f"water pressure {o.pressure} ('flow': along the flow, 'normal': "
+                f"normal to the deformed net), initial slack {o.slack:.1%} of every strand and "
+                f"cable, panel law read along its {o.orientation} diagonal (if any), mounting "
+                f"{o.mounting or 'of the file'}"), "--solver-net (defaults: the prototype's scene)"))
+    out.append(("prototype reference", ("the prototype row at lambda = 1 (its own material); "
+                "ratio = value / reference"), "printgen"))
+    return out
+
+
+def write_series(run: SeriesRun, out: Path, force: bool, inputs: list,
+                 timings: dict) -> list[str]:
+    """The folder, staged and swapped in whole."""
+    fig = series_figure(run.series)
+    rep = series_report(run.series, fig)
+    files: dict[str, str | bytes] = {"report.html": rep.html(), "report.json": dumps(run.record),
+                                     "series.csv": series_csv(run.series),
+                                     TIMINGS: dumps({"timings_s": timings})}
+    for f in rep.figures:
+        files[f"figures/01-{f.name}.png"], files[f"figures/01-{f.name}.svg"] = f.png, f.svg
+    return write_folder(out, files, force=force, volatile=(TIMINGS,), inputs=inputs)
