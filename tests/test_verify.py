@@ -148,6 +148,9 @@ def test_unconverged_level_is_left_out_and_reported(monkeypatch):
                 else r for r in out]
 
     monkeypatch.setattr(solver, "solve_path", one_fails)
+    # in this process: a worker started by forkserver (the parent runs other threads, e.g.
+    # left by an earlier test's Dask cluster) would not see the patch
+    monkeypatch.setenv("PRINTGEN_SERIAL", "1")
     p, d = _design(REALISTIC)
     v = verify(p, d, lv=np.array([0.0, 0.5, 1.0]))
     rec = v.to_record()
