@@ -16,17 +16,12 @@ same energy line search and step cap), computed with less work per step and fewe
   follower load can make the damped tangent indefinite);
 - inexact Newton: linear solves to a residual of min(FORCING, |R| / force scale);
 - an active set on the tension-only law: the slack strands a step stretches past their
-  rest length pull in its model as their law does at the step's linearised strain (the
-  piece of the law it lies on: its slope and the pull its strain offset implies), and the
-  step is solved again until those pieces stop changing (a primal-dual active set on the
-  piecewise linear law, at most PDAS_PASSES re-solves, starting from the last step's
-  pieces; taut strands keep their piece: letting them go slack in the model too cost more
-  iterations). The re-solves reuse the step's factorization as a preconditioner (GMRES on
-  the changed matrix; a fresh factorization only when that misses). Without the active set
-  a free-top net's dry strands, slack and held only by the hold of unloaded nodes, let a
-  step run through their rest length unresisted: the line search cut it to a few per cent
-  for hundreds of iterations (simple barrier's model at 1:40, h/h_B = 0.05: 311
-  iterations, now ~50).
+  rest length get their stiffness (and the pull their strain offset implies) in its model, and the step is solved again until that set
+  stops changing (a primal-dual active set on the piecewise quadratic model, at most
+  PDAS_PASSES re-solves, starting from the last step's set). Without it a free-top net's
+  dry strands, slack and held only by the hold of unloaded nodes, let a step run through
+  their rest length unresisted: the line search cut it to a few per cent for hundreds of
+  iterations (simple barrier's model at 1:40, h/h_B = 0.05: 311 iterations, now ~45).
 
 The tangent is not symmetric (hydrostatic follower term): every step solves the true
 system; the symmetric part only serves as a factorization to precondition it
@@ -56,11 +51,7 @@ from solver.state import NetSystem, State, evaluate, potential, tangent_values
 FORCING = 0.1  # inexact Newton: linear solves to min(FORCING, |R| / force scale), relative
 MU_GROWTH = 10.0  # mu grows by this factor when no damped step descends
 MU_RETRIES = 6  # ... at most this many times in one iteration
-NONMONOTONE = 20  # Armijo against the highest potential of the last NONMONOTONE Newton states.
-# A free-top net's dry strands give soft modes where full steps alternate (|R| up 100-1000x,
-# then down below the start): simple barrier's model at 1:40, h/h_B = 0.5 from 0.45, with the
-# active set: window 1 (monotone) 191 iterations, 5: 104, 20: 47, unbounded: 51; at 0.05
-# from rest 5: 50, 20: 52
+NONMONOTONE = 5  # Armijo against the highest potential of the last 5 Newton states
 CHORD_RATE = 0.5  # a chord step is kept when it at least halves the out-of-balance force
 CHORD_MIN_DOFS = 10_000  # below, a factorization costs less than the trial state a chord step
 # needs (1:40 verification nets, ~1000 unknowns: 0.7 ms against 1-2 ms), so no chord steps
@@ -79,8 +70,7 @@ class Stepper:
         self.backend = backend or choose_backend(ns.pattern.size)
         self.handle = None
         self.factorizations = 0
-        self.reuses = 0  # active-set re-solves preconditioned by the last factorization
-        self.segments: np.ndarray | None = None  # law pieces the last step's model ended on
+        self.active: np.ndarray | None = None  # slack strands the last step's model stretched
 
     def factor(self, data: np.ndarray) -> Factorization:
         fact = Factorization(self.ns.pattern, data, self.backend, self.handle)
@@ -121,7 +111,7 @@ def iterate(ns: NetSystem, st: State, tol: float, max_iter: int, stepper: Steppe
             if trial is not None:
                 st = trial
                 continue
-        recent = [*recent, st.potential(st.f)][-NONMONOTONE:]
+        recent = [*recent[-(NONMONOTONE - 1):], st.potential(st.f)]
         fact, found = _newton_step(ns, st, stepper, max(recent))
         if st.r_norm <= ROUND_OFF and (found is None or found[0].r_norm >= st.r_norm):
             return st, it, True, "converged (round-off)"
@@ -149,52 +139,37 @@ def _newton_step(ns: NetSystem, st: State, stepper: Stepper, reference: float):
 
 def _active_set_step(ns: NetSystem, st: State, stepper: Stepper, boost: float, forcing: float):
     """(factorization, step, right-hand side): the damped Newton step on the piecewise
-    linear model of the strand laws: each strand pulls as its law at the step's linearised
-    strain eps + B s, on the piece (slack, or one of its slopes) that strain lies on. The
-    pieces are iterated to a fixed point (a primal-dual active set), at most PDAS_PASSES
-    re-solves, from the pieces the last step's model ended on."""
+    quadratic model in which a slack strand pulls once the step's linearised strain
+    eps + B s turns positive; the set of such strands is iterated to a fixed point
+    (primal-dual active set), at most PDAS_PASSES times, from the last step's set."""
     eps, force, tangent, d, l = st.bar
     b = ns.bars
+    slack = force <= 0
     nvec = d / l[:, None]
-    now = ns.segments(eps)
-    slack = now == 0
-    seg = now if stepper.segments is None else np.where(slack & (stepper.segments > 0),
-                                                        stepper.segments, now)
+    active = np.zeros_like(slack)
+    if stepper.active is not None:
+        active = slack & stepper.active
     fact = step = rhs = None
     for _ in range(PDAS_PASSES + 1):
-        moved = seg != now
-        a, k = ns.affine(seg)
-        fm = np.where(moved, a + k * eps, force)  # the model's force at the current strain
-        tan = np.where(moved, k, tangent)
-        data = stepper.matrix(dataclasses.replace(st, bar=(eps, force, tan, d, l)), boost)
-        trial = None
-        if fact is not None:  # a re-solve: the last factorization preconditions it
-            trial = fact.preconditioned(data)
-            if trial is not None:
-                stepper.reuses += 1
-        if trial is None:
-            trial = stepper.factor(data)
-        fo = (fm - force)[:, None] * nvec
+        tan = np.where(active, ns.first_slope, tangent)
+        trial = stepper.newton(dataclasses.replace(st, bar=(eps, force, tan, d, l)), boost)
+        fo = np.where(active, ns.first_slope * eps, 0.0)[:, None] * nvec
         off = np.zeros((ns.n, 3))
-        for c in range(3):
-            off[:, c] = np.bincount(b.j, fo[:, c], ns.n) - np.bincount(b.i, fo[:, c], ns.n)
+        for k in range(3):
+            off[:, k] = np.bincount(b.j, fo[:, k], ns.n) - np.bincount(b.i, fo[:, k], ns.n)
         new_rhs = -st.r - off.ravel()[ns.free]
         new_step = trial.solve(new_rhs, forcing)
-        if new_step is None and trial.reused:  # GMRES missed: factorize this matrix after all
-            trial = stepper.factor(data)
-            new_step = trial.solve(new_rhs, forcing)
         if new_step is None:
             if fact is None:
                 fact, rhs = trial, new_rhs
             break
         fact, step, rhs = trial, new_step, new_rhs
         du = _moved(ns, np.zeros_like(st.u), step)
-        new = ns.segments(eps + np.einsum("ij,ij->i", nvec, du[b.j] - du[b.i]) / b.rest)
-        new = np.where(slack, new, now)  # taut strands keep their piece (see the docstring)
-        if np.array_equal(new, seg) or PDAS_PASSES == 0:
+        new = slack & (eps + np.einsum("ij,ij->i", nvec, du[b.j] - du[b.i]) / b.rest > 0)
+        if np.array_equal(new, active) or PDAS_PASSES == 0:
             break
-        seg = new
-    stepper.segments = seg
+        active = new
+    stepper.active = active
     return fact, step, rhs
 
 

@@ -66,19 +66,6 @@ class Law:
         seg = np.clip(e[..., None] - self._lo, 0.0, self._width)  # strain on each segment
         return (self._slopes * 0.5 * seg**2 + self._before * seg).sum(axis=-1)
 
-    def segment(self, eps: np.ndarray) -> np.ndarray:
-        """Index of the law's piece each strain lies on: 0 slack (eps <= 0), k >= 1 the k-th
-        slope's segment."""
-        e = np.asarray(eps, dtype=float)
-        return np.where(e > 0, 1 + np.searchsorted(self._knees, e, side="right"), 0)
-
-    def affine(self, seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(intercept N, slope N) of the force on piece `seg` (see `segment`), extended over
-        every strain: F = intercept + slope x eps on that piece; (0, 0) when slack."""
-        k = np.maximum(np.asarray(seg) - 1, 0)
-        slope = np.where(seg > 0, self._slopes[k], 0.0)
-        return np.where(seg > 0, self._before[k] - self._slopes[k] * self._lo[k], 0.0), slope
-
     def scaled(self, factor: float) -> Law:
         return Law(self.knees, tuple(s * factor for s in self.slopes))
 

@@ -19,7 +19,6 @@ SuperLU on A is the last resort. The answer is always that of A.
 
 from __future__ import annotations
 
-import copy
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -118,7 +117,6 @@ class Factorization:
         self.symmetric = False
         self.lu: Any = None  # scipy's SuperLU, when it is needed
         self.ok = True
-        self.reused = False  # a preconditioner borrowed from another matrix (`preconditioned`)
         try:
             if backend == "ldl":
                 self._factor_ldl(data, handle)
@@ -130,17 +128,6 @@ class Factorization:
             self.handle, self.direct = None, None
         if self.direct is None:
             self._factor_lu()
-
-    def preconditioned(self, data: np.ndarray) -> Factorization | None:
-        """This factorization as the preconditioner of a nearby matrix `data` (the same
-        pattern; e.g. a few strands' stiffness switched): its solves run GMRES on the new A
-        (see `_refined`) and return None, never a SuperLU fallback, when that misses the
-        target. None when there is no direct factorization to reuse."""
-        if self.direct is None:
-            return None
-        other = copy.copy(self)
-        other.A, other.reused = self.pattern.csr(data), True
-        return other
 
     def _factor_ldl(self, data: np.ndarray, handle) -> None:
         upper = self.pattern.symmetric_upper(data)
@@ -164,7 +151,7 @@ class Factorization:
         max |b - A x| <= forcing max |b|; None when A is singular."""
         if self.direct is not None:
             x = self._refined(b, forcing)
-            if x is not None or self.reused:
+            if x is not None:
                 return x
             if self.lu is None:
                 self._factor_lu()

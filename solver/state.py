@@ -33,22 +33,9 @@ class NetSystem:
                                [c.nodes for c in self.cables])
         self.damping = self._damping()
         self.loads: list = []
-        self._law_sel = [(law, np.flatnonzero(self.bars.law_index == k))
-                         for k, law in enumerate(self.bars.laws)]
-
-    def segments(self, eps: np.ndarray) -> np.ndarray:
-        """The piece of its law each strand's strain lies on (`Law.segment`; 0: slack)."""
-        seg = np.zeros(len(eps), dtype=int)
-        for law, sel in self._law_sel:
-            seg[sel] = law.segment(eps[sel])
-        return seg
-
-    def affine(self, seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(intercept, slope) of each strand's force on its piece `seg` (`Law.affine`)."""
-        a, k = np.zeros(len(seg)), np.zeros(len(seg))
-        for law, sel in self._law_sel:
-            a[sel], k[sel] = law.affine(seg[sel])
-        return a, k
+        # each strand's slope just above zero strain: its stiffness once a slack strand pulls
+        self.first_slope = np.array([law.slopes[0] for law in self.bars.laws])[
+            self.bars.law_index] if len(self.bars.laws) else np.zeros(0)
 
     def _damping(self) -> np.ndarray:
         """CSR data of D = (graph Laplacian, weights 1 / rest length) x I3, scaled to a mean
