@@ -275,3 +275,13 @@ def test_square_net_with_border_cables_has_loops_and_lays_its_volume(tmp_path):
     tp = net_toolpath(n, printer, load_print_style(n.print_style), load_material(n.material),
                       attachment=att)
     assert abs(tp.volume_mm3 / mesh.volume - 1) < VOLUME_TOL
+
+
+def test_square_prototype_with_unequal_sides_is_refused(tmp_path):
+    """A square prototype mesh is its side both ways: unequal mesh_x and mesh_y are refused
+    when the file is read, naming both values (the graph would silently use mesh_x)."""
+    from printgen.errors import InputError
+
+    bad = write_variant(tmp_path, {("net", "mesh_y_m"): 0.25}, base=SIMPLE)
+    with pytest.raises(InputError, match=r'pattern "square" needs mesh_x_m = mesh_y_m.*0\.2 x 0\.25'):
+        load_prototype(bad)

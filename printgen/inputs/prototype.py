@@ -7,10 +7,12 @@ holds the lab's choices for the printed model (mesh, pattern, printer, print sty
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from printgen.barrier.patterns import pattern_names, printed_pattern_names
+from printgen.barrier.patterns.square import SQUARE_REL
 from printgen.errors import InputError
 from printgen.inputs.materials import MAX_MATERIALS
 from printgen.inputs.profiles import profile_name
@@ -179,6 +181,11 @@ def load_prototype(path: str | Path) -> Prototype:
         if mesh > limit / 2:
             raise InputError(f"{where} [net]: {label} = {mesh:g} m exceeds half the barrier "
                              f"({limit / 2:g} m); a net needs at least two meshes each way")
+    if net["pattern"] == "square" and not math.isclose(net["mesh_x"], net["mesh_y"],
+                                                       rel_tol=SQUARE_REL):
+        raise InputError(f"{where} [net]: pattern \"square\" needs mesh_x_m = mesh_y_m (the "
+                         f"square's side), got {net['mesh_x']:g} x {net['mesh_y']:g} m; give "
+                         "equal sides")
     return Prototype(
         name=top["name"], description=top["description"], width=bar["width"],
         height=bar["height"], anchors=bar["anchors"],
@@ -226,6 +233,7 @@ SCHEMA_TABLES = (("", TOP), ("[barrier]", BARRIER), ("[net]", NET),
                  ("[flume]", FLUME), ("[model]", MODEL))
 CROSS_CHECKS = (
     "[net] mesh_x_m <= barrier width / 2 and mesh_y_m <= barrier height / 2 (two meshes each way)",
+    "[net] pattern = \"square\": mesh_x_m = mesh_y_m (the square's side)",
     f"[flow] depth_m <= {DEPTH_OVER_HEIGHT_MAX:g} x barrier height_m (deeper flows drown it)",
     "[net.panel_law]: increasing knees, one kappa per segment (knees + 1), all > 0 and < 1e9",
     "[net]: strand_modulus_gpa or a [net.panel_law] is required",
