@@ -121,10 +121,13 @@ def test_summary_of_a_verify_record_without_selection():
     d = reference_design_1_40()
     rec = {"verification": {"verdict": "FAIL", "summary": "model too stiff", "ok": False,
                             "mismatches": []},
-           "bands": {"verdicts": [{"metric": "deflection", "text": "model stiffer by 20%"}]},
+           "bands": {"verdicts": [{"metric": "deflection", "text": "model stiffer by 20%"},
+                                  {"metric": "strain_bottom", "levels": 0,
+                                   "text": "no deformation to compare"}]},
            "design": d.to_dict()}
     s = summary_record(rec, "fitted: stiffness 0.8 x")
     assert s["verdict"] == "FAIL" and s["next"] == "fitted: stiffness 0.8 x"
+    assert list(s["band"]) == ["deflection"]  # a quantity nothing deforms is not listed
     assert [p["stiffness_error"] for p in s["parts"]] == [None, None]
     box = summary_html(s)
     assert 'id="summary"' in box and "model stiffer by 20%" in box and "TPE" in box

@@ -60,7 +60,8 @@ def summary_record(record: dict[str, Any], next_step: str = "") -> dict[str, Any
         nxt = NEXT_STIFF if ratios and min(ratios) < 1 else NEXT_SOFT
     out: dict[str, Any] = {
         "verdict": v.get("verdict", "not run"), "reason": v.get("summary", ""),
-        "band": {b["metric"]: b["text"] for b in verdicts},
+        "band": {b["metric"]: b["text"] for b in verdicts  # none where nothing deforms
+                 if b.get("levels", 1) > 0},
         "parts": chosen_parts(record), "next": next_step or nxt}
     if record.get("gcode"):
         out["print"] = print_totals(record["gcode"])
