@@ -102,20 +102,15 @@ def _coupon_files(stage: Path, c, printer) -> dict[str, Any]:
     from printgen.parts.geometry.solid import analytic_cable_volume, cable_solid
 
     comp = printer.hole_compensation_mm
-    rec = _write_part(stage, "coupon", "cable", c, cable_solid(c, comp), printer, None,
-                      analytic_cable_volume(c, comp))
-    mat = load_material(c.material)
-    tp = cable_toolpath(c, printer, load_print_style(c.print_style), mat)
-    rec.update(_ini_and_gcode(stage, "coupon", "cable", c, printer, tp, rec["volume_mm3"]))
+    tp = cable_toolpath(c, printer, load_print_style(c.print_style), load_material(c.material))
     sidecar = {"kind": "cable", "width_mm": c.section.width_mm,
                "thickness_mm": c.section.thickness_mm,
                "gauge_length_mm": coupon_gauge_mm(c), "grip_distance_mm": coupon_gauge_mm(c)}
-    rec["files"] += [_sidecar(stage, "coupon", sidecar,
-                              "strain = crosshead displacement / the free strip between the "
-                              "rings (the rings taken as rigid); with an extensometer on the "
-                              "strip, its strain is used instead")]
-    rec["sidecar"] = sidecar
-    return rec
+    return _piece_files(stage, "coupon", "cable", c, (cable_solid(c, comp),
+                        analytic_cable_volume(c, comp)), tp, printer, sidecar,
+                        "strain = crosshead displacement / the free strip between the rings "
+                        "(the rings taken as rigid); with an extensometer on the strip, its "
+                        "strain is used instead")
 
 
 def _panel_files(stage: Path, piece: PanelPiece, printer) -> dict[str, Any]:
@@ -123,16 +118,22 @@ def _panel_files(stage: Path, piece: PanelPiece, printer) -> dict[str, Any]:
     from printgen.parts.geometry.solid import analytic_net_volume, net_solid
 
     n = piece.net
-    rec = _write_part(stage, "panel", "net", n, net_solid(n), printer, None,
-                      analytic_net_volume(n))
     tp = net_toolpath(n, printer, load_print_style(n.print_style), load_material(n.material))
-    rec.update(_ini_and_gcode(stage, "panel", "net", n, printer, tp, rec["volume_mm3"]))
     sidecar = {"kind": "panel", "width_mm": piece.width_mm, "gauge_length_mm": piece.length_mm,
                "grip_distance_mm": piece.length_mm}
-    rec["files"] += [_sidecar(stage, "panel", sidecar,
-                              "width: across the load at the clamp edges; length: clamp edge "
-                              "to clamp edge (the force per width over the length is the "
-                              "panel law)")]
+    return _piece_files(stage, "panel", "net", n, (net_solid(n), analytic_net_volume(n)), tp,
+                        printer, sidecar, "width: across the load at the clamp edges; length: "
+                        "clamp edge to clamp edge (the force per width over the length is the "
+                        "panel law)")
+
+
+def _piece_files(stage: Path, name: str, kind: str, part, solid: tuple, tp, printer,
+                 sidecar: dict[str, Any], note: str) -> dict[str, Any]:
+    """One piece's files: mesh (`solid`: the mesh and its analytic volume), slicer profile,
+    direct G-code and the specimen sidecar; their record."""
+    rec = _write_part(stage, name, kind, part, solid[0], printer, None, solid[1])
+    rec.update(_ini_and_gcode(stage, name, kind, part, printer, tp, rec["volume_mm3"]))
+    rec["files"] += [_sidecar(stage, name, sidecar, note)]
     rec["sidecar"] = sidecar
     return rec
 
