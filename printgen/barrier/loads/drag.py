@@ -18,16 +18,21 @@ from printgen.barrier.loads import FLOW, LoadCase, LoadsAt, Site, hydrostatic
 from printgen.units import RHO_WATER
 
 
+def strand_per_node(s: Any) -> float:
+    """l (m): the scene's strand length per node (the drag and the jam's net loss use it)."""
+    d = s.nodes[s.elements[:, 1]] - s.nodes[s.elements[:, 0]]
+    return float(np.linalg.norm(d, axis=1).sum()) / len(s.nodes)
+
+
 def strand_drag(s: Any, diameter: float) -> Callable[[float, float], solver.Drag]:
     """(r, v) -> the drag 0.5 rho v^2 l d on the scene's free nodes wetted at level r h_B
     (l the strand length per node, d = `diameter`), ramped in over one node row."""
     free = np.flatnonzero(~s.fixed)
-    d = s.nodes[s.elements[:, 1]] - s.nodes[s.elements[:, 0]]
-    strand_per_node = float(np.linalg.norm(d, axis=1).sum()) / len(s.nodes)
+    per_node = strand_per_node(s)
     row_gap = float(np.diff(np.unique(np.round(s.nodes[:, 2], 12))).min())  # node rows apart
 
     def drag_at(r: float, v: float) -> solver.Drag:
-        return solver.Drag(free, strand_per_node, diameter, v, r * s.height, tuple(FLOW),
+        return solver.Drag(free, per_node, diameter, v, r * s.height, tuple(FLOW),
                            rho=RHO_WATER, ramp=row_gap)
 
     return drag_at

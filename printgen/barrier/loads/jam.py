@@ -36,13 +36,14 @@ import numpy as np
 from scipy.optimize import brentq
 
 import solver
-from printgen.barrier.loads import FLOW, OVERFLOW, LoadCase, LoadsAt, Param, Site
-from printgen.barrier.loads.drag import strand_drag
+from printgen.barrier.loads import FLOW, OVERFLOW, LoadCase, LoadsAt, Param, Site, hydrostatic
+from printgen.barrier.loads.drag import strand_drag, strand_per_node
 from printgen.units import L_PER_S, NU_WATER, RHO_WATER, G
 
 DISCHARGES_L_PER_S = (2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0)  # the flume's steps (paper, 1:40)
 CYLINDER_DP = 1.5  # surface-volume diameter of a long cylinder / its diameter (6 V / S)
 NEWTON_STEPS = 30  # the net's head loss: Newton steps on a convex cubic (converges in < 10)
+BEHIND = tuple(-x for x in FLOW)  # the water between jam and net pushes upstream
 ROOT_TOL = 1e-12  # m (depth) and m^2/s (discharge per width): far below any flume reading
 PARAMS = (Param("porosity", 0.6, 0.0, 0.99, "(void fraction)", "jam porosity"),
           Param("thickness_m", 4.0, 0.01, 50.0, "m at the prototype's scale",
@@ -62,8 +63,7 @@ def ergun_gradient(u: float, porosity: float, log_d: float) -> float:
 def net_factor(s: Any) -> float:
     """l / A* (1/m): strand length per unit net area; times d, the strands' frontal area
     per unit net area."""
-    d = s.nodes[s.elements[:, 1]] - s.nodes[s.elements[:, 0]]
-    return float(np.linalg.norm(d, axis=1).sum()) / len(s.nodes) / s.area_per_node
+    return strand_per_node(s) / s.area_per_node
 
 
 def behind_net(q: float, k: float, froude: float) -> tuple[float, float]:
@@ -107,14 +107,13 @@ def loads(s: Any, site: Site, **values: float) -> LoadsAt:
     the seepage through the strands below h_m."""
     jam = _jam(s, site, values)
     free = np.flatnonzero(~s.fixed)
+    upstream = hydrostatic.loads(s, site)
     drag_at = strand_drag(s, site.strand_diameter)
 
     def loads_at(r: float) -> list:
         q, hm, _ = seepage(r * s.height, **jam)
-        behind = tuple(-x for x in FLOW)
-        return [solver.Hydrostatic(free, s.area_per_node, r * s.height, tuple(FLOW),
-                                   rho=RHO_WATER, g=G),
-                solver.Hydrostatic(free, s.area_per_node, hm, behind, rho=RHO_WATER, g=G),
+        return [*upstream(r),
+                solver.Hydrostatic(free, s.area_per_node, hm, BEHIND, rho=RHO_WATER, g=G),
                 drag_at(hm / s.height, q / hm if hm > 0 else 0.0)]
 
     return loads_at
@@ -127,9 +126,10 @@ def levels(s: Any, site: Site, **values: float) -> np.ndarray:
     width = site.flow_width or s.width
     top = OVERFLOW * s.height
     out = [0.0]
+    q_top = seepage(top, **jam)[0]  # the most the jam passes below the overflow
     for discharge in DISCHARGES_L_PER_S:
         q = discharge * L_PER_S / width
-        if seepage(top, **jam)[0] < q:
+        if q_top < q:
             out.append(OVERFLOW)
             continue
         low = behind_net(q, jam["k"], jam["froude"])[0]  # no jam passes q below this
