@@ -297,8 +297,8 @@ def verification_sweeps(prototype: Prototype, design: Design, *, load: str | Non
     (README: Pre-print verification); every load level is solved on both. Needs nothing from
     the other steps, so it can run in a worker process while they run.
     """
-    from printgen.verification.bands import free_section, model_band, model_load_kw
-    from printgen.verification.verify import verify, with_cases
+    from printgen.verification.bands import model_band, model_load_kw
+    from printgen.verification.verify import free_section, verify, with_cases
 
     v = with_cases(verify(prototype, design, load=load, counterexample=True), prototype,
                    design, loads)

@@ -36,7 +36,6 @@ from printgen.run.budget import DEFAULT_LIMIT_S, Work, check_budget, sweep_cores
 from printgen.verification.bands import (
     Band,
     band_verdicts,
-    free_section,
     model_band,
     model_load_kw,
 )
@@ -51,7 +50,7 @@ from printgen.verification.measured import (
     read_measured,
 )
 from printgen.verification.readings import design_units
-from printgen.verification.verify import Verification, verify
+from printgen.verification.verify import Verification, free_section, verify
 
 
 @dataclass

@@ -157,18 +157,13 @@ def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
 def _orientation_variants(d: Design) -> list[Variant]:
     """The panel law read along each mesh diagonal its profile does not record (issue 25:
     the paper does not say which diagonal its printed panels were loaded along)."""
-    from printgen.verification.scenes import ORIENTATIONS
+    from printgen.verification.scenes import ORIENTATIONS, recorded_orientation
 
     law = load_material(d.net.material).panel_law
-    recorded = "short" if law.mesh_along_load <= law.mesh_across_load else "long"
+    recorded = recorded_orientation(law)
     return [Variant(f"panel test along the {o} diagonal", orientation=o,
                     source=f"panel-test orientation not stated (profile: {recorded})")
             for o in ORIENTATIONS if o != recorded]
-
-
-def free_section(p: Prototype) -> float | None:
-    """The flume's free section (m) of the prototype file's [flume] table, or None."""
-    return p.flume.free_section if p.flume is not None else None
 
 
 def model_load_kw(p: Prototype, d: Design, load: str | LoadCase | None = None

@@ -32,7 +32,7 @@ import numpy as np
 from printgen.design.record import Design
 from printgen.inputs.materials import load_material
 from printgen.units import MM
-from printgen.verification.scenes import BarrierScene, Law, panel_axes
+from printgen.verification.scenes import BarrierScene, Law, panel_axes, recorded_orientation
 
 if TYPE_CHECKING:
     from printgen.verification.bands import Variant
@@ -73,7 +73,7 @@ def derived_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
     if law is None or not law.has_geometry:
         return model_net_law(mat, n, orientation)
     if orientation is None:
-        orientation = "short" if law.mesh_along_load <= law.mesh_across_load else "long"
+        orientation = recorded_orientation(law)
     along, across = panel_axes(law.mesh_along_load, law.mesh_across_load, orientation)
     width = law.panel_width or law.panel_length
     strand, mode, err = _derived(tuple(law.knee_strains),

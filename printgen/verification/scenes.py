@@ -37,7 +37,7 @@ from printgen.barrier.patterns.diamond import strand_law as strand_law_from_memb
 from printgen.design.record import Design
 from printgen.design.section import area_m2, net_membrane_law
 from printgen.errors import GeometryError
-from printgen.inputs.materials import load_material
+from printgen.inputs.materials import PanelLaw, load_material
 from printgen.inputs.prototype import LATERAL, Prototype
 from printgen.units import MM, RHO_WATER, G
 
@@ -105,6 +105,12 @@ class BarrierScene:
     assumptions: tuple[Assumption, ...] = ()
     pressure: str = "flow"  # one of PRESSURES: the water's force along the flow or normal
     rest_nodes: np.ndarray | None = None  # (n, 3) m printed geometry when mounted otherwise
+
+
+def recorded_orientation(law: PanelLaw) -> str:
+    """The diagonal a measured panel law was loaded along, as its profile records the meshes:
+    "short" when the mesh along the load is the shorter one, else "long"."""
+    return "short" if law.mesh_along_load <= law.mesh_across_load else "long"
 
 
 def panel_axes(mesh_a: float, mesh_b: float, orientation: str) -> tuple[float, float]:

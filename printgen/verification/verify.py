@@ -89,12 +89,17 @@ def loads_function(s: BarrierScene, *, load: str | LoadCase | None = None,
     return normal_at
 
 
+def free_section(p: Prototype) -> float | None:
+    """The flume's free section (m) of the prototype file's [flume] table, or None."""
+    return p.flume.free_section if p.flume is not None else None
+
+
 def load_keywords(p: Prototype, d: Design, load: str | LoadCase | None = None
                   ) -> tuple[dict[str, Any], dict[str, Any]]:
     """`sweep`'s load keywords of the prototype and of the model under `load`: the case and
     each barrier's site, the model's flow velocity its similitude target (v / sqrt(lambda))."""
     case = get_load(load)
-    width = p.flume.free_section if p.flume is not None else None  # the flume's, m
+    width = free_section(p)  # the flume's, m
     proto = Site(p.velocity, p.net.strand_diameter, p.depth,
                  None if width is None else width * d.scale)
     model = Site(scale_targets(p, d.scale)["velocity"], d.net.strand.width_mm * MM,
