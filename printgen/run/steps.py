@@ -77,7 +77,8 @@ def gcode_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
         mat = load_material(part.material)
         t0 = time.perf_counter()
         tp = part_toolpath(ctx, name, part, printer)
-        text = gcode_text(tp, printer, mat, title=f"{name}, 1:{d.scale:g}")
+        est = print_estimate(tp, printer, mat)
+        text = gcode_text(tp, printer, mat, title=f"{name}, 1:{d.scale:g}", estimate=est)
         back = read_gcode_text(text, filament_diameter_mm=printer.filament_diameter_mm)
         seconds = time.perf_counter() - t0
         path = stage / f"{name}.gcode"
@@ -91,7 +92,7 @@ def gcode_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
                      "volume_mm3": tp.volume_mm3, "readback_volume_mm3": back.volume_mm3,
                      "readback_error": err, "readback_vs_stl": vs_stl,
                      "retractions": retractions, "seconds": seconds,
-                     "print": print_estimate(tp, printer, mat).to_record()}
+                     "print": est.to_record()}
     gcode_section(ctx.report, rec)
     return {"gcode": rec}
 

@@ -148,12 +148,13 @@ def _ini_and_gcode(stage: Path, name: str, kind: str, part, printer, tp, stl_mm3
 
     mat, style = load_material(part.material), load_print_style(part.print_style)
     (stage / f"{name}.prusa.ini").write_text(prusa_ini_text(kind, part, printer, style, mat))
-    text = gcode_text(tp, printer, mat, title=f"test piece {name}")
+    est = print_estimate(tp, printer, mat)
+    text = gcode_text(tp, printer, mat, title=f"test piece {name}", estimate=est)
     (stage / f"{name}.gcode").write_text(text)
     back = read_gcode_text(text, filament_diameter_mm=printer.filament_diameter_mm)
     return {"slicer_profile": f"{name}.prusa.ini", "gcode": f"{name}.gcode",
             "gcode_volume_mm3": tp.volume_mm3, "readback_vs_stl": back.volume_mm3 / stl_mm3 - 1,
-            "layers": len(back.layer_z_mm), "print": print_estimate(tp, printer, mat).to_record()}
+            "layers": len(back.layer_z_mm), "print": est.to_record()}
 
 
 def _sidecar(stage: Path, name: str, keys: dict[str, Any], note: str) -> str:
