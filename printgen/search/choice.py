@@ -19,6 +19,21 @@ if TYPE_CHECKING:
     from printgen.search.nets import SearchResult
 
 SMALL_STRAIN_TOLERANCE = NET_ON_TARGET  # on target: small-strain membrane stiffness within +-30 %
+
+
+def near_target(s: Screened) -> bool:
+    """Small-strain membrane stiffness within SMALL_STRAIN_TOLERANCE of the target."""
+    return abs(s.error_small) <= SMALL_STRAIN_TOLERANCE
+
+
+def rank_key(s: Screened) -> tuple:
+    """The search's order: screening score, then print time, then search order."""
+    return (round(s.score, 12), s.print_time_s, s.point.index)
+
+
+def closest_key(s: Screened) -> tuple:
+    """Closest to the target at small strain first, then search order."""
+    return (abs(s.error_small), s.point.index)
 LABELS = {"strength": f"strength (safety factor < {MIN_SAFETY_FACTOR} at the overflow force)",
           "print": "printability (bead, layer or flow limits of the printer and material)",
           "bed": "bed size (the panel does not fit the printer)",
@@ -32,8 +47,8 @@ def binding_constraints(screened: list[Screened], space: SearchSpace
     feasible = [s for s in screened if s.feasible]
     if not feasible:
         return None, tuple(_kinds(screened, f"of the {len(screened)} candidates"))
-    best = min(feasible, key=lambda s: (abs(s.error_small), s.point.index))
-    if abs(best.error_small) <= SMALL_STRAIN_TOLERANCE:
+    best = min(feasible, key=closest_key)
+    if near_target(best):
         return best.point.index, ()
     closer = [s for s in screened if abs(s.error_small) < abs(best.error_small)]
     out = _kinds(closer, f"of the {len(closer)} candidates closer to the target")
@@ -102,7 +117,7 @@ def choice_reasons(res: SearchResult) -> list[str]:
         out.append(f"lowest membrane-law error of {n_ok} printable candidates "
                    f"({len(res.screened)} screened): RMS log error {s.error_rms_log:.3f} over "
                    "1-40 % strain (not verified by the solver: --objective deformation does)")
-    on = abs(s.error_small) <= SMALL_STRAIN_TOLERANCE
+    on = near_target(s)
     out.append(f"membrane stiffness {s.membrane_n_per_m:.4g} N/m at small strain against the "
                f"target {s.target_n_per_m:.4g} N/m ({s.error_small:+.0%}): "
                f"{'within' if on else 'outside'} +-{SMALL_STRAIN_TOLERANCE:.0%}")

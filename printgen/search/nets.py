@@ -30,7 +30,7 @@ from printgen.design.similitude import scale_targets
 from printgen.errors import InputError
 from printgen.inputs.materials import load_material
 from printgen.inputs.prototype import Prototype
-from printgen.search.choice import binding_constraints, choice_reasons
+from printgen.search.choice import binding_constraints, choice_reasons, rank_key
 from printgen.search.pareto import pareto_mask
 from printgen.search.per_material import target_sentence
 from printgen.search.screen import Screened, screen_batch, strand_section
@@ -131,7 +131,7 @@ def stage_two(screened: list[Screened], nets: int) -> list[Screened]:
     """The candidates the solver verifies: the best printable net (lowest screening score) of
     each of the `nets` best material x section pairs, each with every border width."""
     feasible = sorted((s for s in screened if s.feasible),
-                      key=lambda s: (round(s.score, 12), s.print_time_s, s.point.index))
+                      key=rank_key)
     pairs: dict[tuple, tuple] = {}
     for s in feasible:
         pair = (s.point.material, s.point.beads_across, s.point.layers)

@@ -12,16 +12,12 @@ must be measured on the test pieces before the barrier is printed.
 from __future__ import annotations
 
 from printgen.design.selection import CALIBRATE_FIRST, MIN_SAFETY_FACTOR
-from printgen.search.choice import SMALL_STRAIN_TOLERANCE, short
+from printgen.search.choice import SMALL_STRAIN_TOLERANCE, closest_key, near_target, rank_key, short
 from printgen.search.screen import Screened
 
 
 def on_target(s: Screened) -> bool:
-    return s.feasible and abs(s.error_small) <= SMALL_STRAIN_TOLERANCE
-
-
-def _key(s: Screened) -> tuple:
-    return (round(s.score, 12), s.print_time_s, s.point.index)
+    return s.feasible and near_target(s)
 
 
 def per_material(screened: tuple[Screened, ...] | list[Screened]) -> list[dict]:
@@ -36,10 +32,9 @@ def per_material(screened: tuple[Screened, ...] | list[Screened]) -> list[dict]:
             "material": mat, "candidates": len(mine), "feasible": len(ok),
             "on_target": len(hits),
             "datasheet": any(s.datasheet for s in mine),
-            "best": min(ok, key=_key).to_record() if ok else None,
-            "first_on_target": min(hits, key=_key).to_record() if hits else None,
-            "closest": (min(ok, key=lambda s: (abs(s.error_small), s.point.index)).to_record()
-                        if ok else None),
+            "best": min(ok, key=rank_key).to_record() if ok else None,
+            "first_on_target": min(hits, key=rank_key).to_record() if hits else None,
+            "closest": min(ok, key=closest_key).to_record() if ok else None,
         })
     return rows
 
@@ -47,7 +42,7 @@ def per_material(screened: tuple[Screened, ...] | list[Screened]) -> list[dict]:
 def first_on_target(screened: tuple[Screened, ...] | list[Screened]) -> Screened | None:
     """The lowest-score net of any material that is on target, or None."""
     hits = [s for s in screened if on_target(s)]
-    return min(hits, key=_key) if hits else None
+    return min(hits, key=rank_key) if hits else None
 
 
 def target_sentence(screened: tuple[Screened, ...] | list[Screened]) -> list[str]:
