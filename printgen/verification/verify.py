@@ -233,17 +233,24 @@ class Verification:
         }
 
 
+def _barriers(p: Prototype, d: Design, load: str | LoadCase | None, mounting: str | None
+              ) -> tuple[LoadCase, dict[str, Any], dict[str, Any], BarrierScene, BarrierScene]:
+    """(the load case, the prototype's and the model's sweep keywords, their scenes), both
+    mounted by `mounting` (default: the prototype file's [flume] lateral)."""
+    mounting = mounting or lateral_mounting(p)
+    kw_p, kw_m = load_keywords(p, d, load)
+    case = kw_m["load"]
+    return (case, kw_p, kw_m, prototype_scene(p, mounting=mounting, load=case),
+            model_scene(d, mounting=mounting, load=case))
+
+
 def verify(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
            lv: np.ndarray | None = None, counterexample: bool = False,
            mounting: str | None = None) -> Verification:
     """Sweep both barriers under the same relative loading of load case `load` (default
     hydrostatic) and compare them; both are mounted by `mounting` (default: the prototype
     file's [flume] lateral)."""
-    mounting = mounting or lateral_mounting(p)
-    kw_p, kw_m = load_keywords(p, d, load)
-    case = kw_m["load"]
-    ps = prototype_scene(p, mounting=mounting, load=case)
-    ms = model_scene(d, mounting=mounting, load=case)
+    case, kw_p, kw_m, ps, ms = _barriers(p, d, load, mounting)
     if lv is None:  # the usual levels and the case's own (the jam's discharge steps)
         own = case.levels_for(ms, kw_m["site"])
         lv = levels() if own is None else np.unique(np.concatenate([levels(), own]))
@@ -305,11 +312,7 @@ class CaseRuns:
 
 def case_runs(p: Prototype, d: Design, load: str, mounting: str | None = None) -> CaseRuns:
     """The nominal prototype and model of load case `load` at its own levels (no band)."""
-    mounting = mounting or lateral_mounting(p)
-    kw_p, kw_m = load_keywords(p, d, load)
-    case = kw_m["load"]
-    ps = prototype_scene(p, mounting=mounting, load=case)
-    ms = model_scene(d, mounting=mounting, load=case)
+    case, kw_p, kw_m, ps, ms = _barriers(p, d, load, mounting)
     own = case.levels_for(ms, kw_m["site"])
     lv = levels() if own is None else np.asarray(own, dtype=float)
     model, proto = run_jobs([(sweep, (ms, lv), kw_m), (sweep, (ps, lv), kw_p)])
