@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from printgen.barrier.loads import DEFAULT as DEFAULT_LOAD
+from printgen.barrier.loads import get_load
 from printgen.design.design_file import load_design
 from printgen.design.plan import make_design
 from printgen.design.record import Design
@@ -37,7 +38,9 @@ from printgen.report.parts_report import provenance_section
 from printgen.report.report import design_record, design_sections
 from printgen.run.budget import (
     DEFAULT_LIMIT_S,
+    LONG_RUN_S,
     Estimate,
+    Work,
     check_budget,
     level_bars,
     sweep_cores,
@@ -129,9 +132,6 @@ def plan(prototype_path: str | Path, scale: float, *, printer: str | None = None
         ctx.record["design_file"] = shown
         ctx.record["design_net"] = own.to_record()  # its own stiffness error, not select's
     return ctx
-
-
-LONG_RUN_S = 30.0  # runs estimated longer than this show their estimate and progress
 
 
 def make(prototype_path: str | Path, scale: float, out: str | Path, *,
@@ -236,10 +236,18 @@ def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
     limit = ctx.options.time_limit_s
     est = check_budget(ctx.prototype, ctx.design, cores=sweep_cores(),
                        limit_s=DEFAULT_LIMIT_S if limit is None else float(limit),
-                       sweep=verifies)
+                       work=Work(sweep=verifies, cases=swept_cases(ctx.options)))
     ctx.record["size"] = est.to_record()
-    ctx.record.setdefault("timings_s", {})["estimate"] = est.seconds
+    ctx.record.setdefault("timings_s", {}).update(
+        {"estimate": est.seconds, "estimate_verification": est.verification_s,
+         "estimate_parts": est.parts_s})
     return est
+
+
+def swept_cases(options: MakeOptions) -> int:
+    """Load cases the verification sweeps: its own and each other one of --loads."""
+    own = get_load(options.load).spec
+    return 1 + len({get_load(x).spec for x in options.loads} - {own})
 
 
 def run_bound(options: MakeOptions) -> float | None:

@@ -241,6 +241,7 @@ class Band:
     seconds: float = 0.0
     failed: dict[str, list[float]] = field(default_factory=dict)
     mounting: str | None = None  # the nominal run's mounting, kept by every variant
+    work: list[dict[str, Any]] = field(default_factory=list)  # Run.work() of every sweep run
 
     def envelope(self, *, from_start: bool = False
                  ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
@@ -263,16 +264,19 @@ def _nan_reduce(stack: np.ndarray, fn) -> np.ndarray:
 
 
 def refinement_test(d: Design, nominal: dict[str, np.ndarray], lv: np.ndarray,
-                    load_kw: dict | None = None, base: Variant | None = None
-                    ) -> tuple[int, dict[int, float]]:
+                    load_kw: dict | None = None, base: Variant | None = None,
+                    work: list[dict[str, Any]] | None = None) -> tuple[int, dict[int, float]]:
     """Coarsest mesh multiplier whose nominal sweep stays within REFINE_TOL of `nominal` (the
     design's own net) on every metric, and each tried multiplier's largest change. The
-    multipliers are tried from the finest: once one fails, coarser ones are not run."""
+    multipliers are tried from the finest: once one fails, coarser ones are not run. `work`
+    gets each sweep's Run.work()."""
     best, change = 1, {}
     for k in COARSENINGS:
         if not _meshable(d, k):
             break
         run = run_variant(d, base or Variant(), lv, k, load_kw)
+        if work is not None:
+            work.append(run.work())
         change[k] = _largest_change(curves(run), nominal)
         if change[k] >= REFINE_TOL:
             break
@@ -316,11 +320,13 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
     variants = [v if v.mounting else dataclasses.replace(v, mounting=mounting)
                 for v in variants]
     nom = curves(nominal)
-    k, change = refinement_test(d, nom, lv, load_kw, Variant(mounting=mounting))
+    work: list[dict[str, Any]] = []
+    k, change = refinement_test(d, nom, lv, load_kw, Variant(mounting=mounting), work)
     jobs: list[tuple] = [(run_variant, (d, v, lv, k, load_kw), {}) for v in variants]
     if k > 1:
         jobs.append((run_variant, (d, Variant(mounting=mounting), lv, k, load_kw), {}))
     runs = run_jobs(jobs)
+    work += [r.work() for r in runs]
     base = curves(runs.pop()) if k > 1 else None
     out, failed = {}, {}
     for v, r in zip(variants, runs, strict=True):
@@ -329,7 +335,7 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
         if r.failed:
             failed[v.label] = sorted(r.failed)
     return Band(lv, nom, out, {v.label: v.source for v in variants}, list(notes or []), k,
-                change, time.perf_counter() - t0, failed, mounting)
+                change, time.perf_counter() - t0, failed, mounting, work)
 
 
 SIGNIFICANT = 0.1  # levels where the prototype is below 10 % of its peak carry no verdict
