@@ -50,12 +50,19 @@ ITERATIONS_PER_LEVEL = {"border cables": 8.2, "free top": 10.3}
 # each sweep's CPU within 0.69 to 1.28 of the fit given its counted iterations).
 ITERATION_S = 2.7e-3
 ITERATION_S_PER_UNKNOWN = 7.9e-6
-VERIFY_FIXED_S = 1.5  # worker start, the steel counter-example, the comparison, its figures
+# CPU beside the sweeps (bench make; PRINTGEN_SERIAL=1 on the 1:40 example): the steel
+# counter-example (1.9 s, a job beside the nominal pair) and the verification's report: the
+# comparison, its figures and tables (5.7 s; the simple barrier's step: 8.0 s with the jobs'
+# start and results)
+COUNTEREXAMPLE_S = 2.0
+VERIFY_REPORT_S = 6.0
 MESH_S_PER_SEGMENT = 1e-4  # meshes step per model net segment (simple 1:40: 4962 in 0.46 s)
-# The parts' steps (toolpaths built once, verification in a helper process beside them)
-CABLE_PARTS_S = 1.0  # the four cables, their eyelets and plate
-CABLE_PART_S = CABLE_PARTS_S / 4  # one cable: mesh, 3MF, slicer profile, G-code, its place
-FIXED_S = 1.5  # planning, slicer profiles, G-code, previews, report
+# The parts' steps, CPU of make's own process (bench make, 1:40): 1.1 s on the simple barrier
+# (no cables), 7.2 s on the 1:40 example, whose kit step draws the assembly and toolpath
+# previews of its four cables (5.2 s)
+CABLE_PARTS_S = 6.0  # the four cables: meshes, 3MF, plate, slicer profiles, G-code, previews
+CABLE_PART_S = CABLE_PARTS_S / 4  # one cable
+FIXED_S = 2.0  # start-up, planning, the net's parts and slicer profile, the report
 # verify --measured: the fit's bounded Brent search runs this many sweeps of the model on the
 # band's net (coarsened COARSENED_BY each way, so about COARSENED_BY^2 fewer nodes)
 FIT_SWEEPS = 20
@@ -181,8 +188,9 @@ def band_variants(p: Prototype, d: Design) -> int:
 
 
 def sweeps(p: Prototype, d: Design, *, proto_factor: float = 1.0, model_factor: float = 1.0,
-           work: Work = MAKE) -> tuple[SweepWork, ...]:
-    """The verification's sweeps and each one's predicted work (module docstring)."""
+           work: Work = MAKE, variants: int | None = None) -> tuple[SweepWork, ...]:
+    """The verification's sweeps and each one's predicted work (module docstring);
+    `variants`: the band's count when known (default: `band_variants`)."""
     from printgen.verification.bands import COARSENINGS
 
     per_level = ITERATIONS_PER_LEVEL["border cables" if d.cables else "free top"]
@@ -196,31 +204,39 @@ def sweeps(p: Prototype, d: Design, *, proto_factor: float = 1.0, model_factor: 
         out += [one("prototype", prototype_nodes(p, proto_factor), "nominal"),
                 one("model", m_nodes, "nominal")]
     out.append(one(f"refinement x{COARSENINGS[0]}", m_nodes / COARSENINGS[0] ** 2, "serial"))
-    out += [one("band variant", m_nodes, "band")] * band_variants(p, d)
+    n_band = band_variants(p, d) if variants is None else variants
+    out += [one("band variant", m_nodes, "band")] * n_band
     if work.fit:
         out += [one("fit", m_nodes / COARSENED_BY**2, "serial")] * FIT_SWEEPS
     return tuple(out)
 
 
 def verification_seconds(work: tuple[SweepWork, ...], cores: int) -> tuple[float, float]:
-    """(wall, CPU) seconds of the sweeps on `cores`: each case's prototype and model side by
-    side, the serial ones alone, the band's variants shared out (equal jobs: ceil(n / cores)
-    rounds); both with VERIFY_FIXED_S."""
+    """(wall, CPU) seconds of the verification on `cores`: each case's prototype and model
+    side by side (the first case's with the counter-example), the serial sweeps alone, the
+    band's variants shared out, then the report (VERIFY_REPORT_S)."""
     c = max(1, min(cores, 2))
     nominal = [s.seconds for s in work if s.group == "nominal"]
     pairs = [nominal[i:i + 2] for i in range(0, len(nominal), 2)]
+    if pairs:
+        pairs[0].append(COUNTEREXAMPLE_S)
     band = [s.seconds for s in work if s.group == "band"]
-    wall = (sum(max(x) if c > 1 else sum(x) for x in pairs)
-            + sum(s.seconds for s in work if s.group == "serial")
-            + (math.ceil(len(band) / c) * max(band) if band else 0.0))
-    return VERIFY_FIXED_S + wall, VERIFY_FIXED_S + sum(s.seconds for s in work)
+    wall = (sum(_shared(x, c) for x in pairs) + _shared(band, c)
+            + sum(s.seconds for s in work if s.group == "serial"))
+    cpu = sum(s.seconds for s in work) + (COUNTEREXAMPLE_S if pairs else 0.0)
+    return VERIFY_REPORT_S + wall, VERIFY_REPORT_S + cpu
+
+
+def _shared(jobs: list[float], cores: int) -> float:
+    """Wall time of independent jobs on `cores` workers: the longest, or their sum shared."""
+    return max(max(jobs), sum(jobs) / cores) if jobs else 0.0
 
 
 def estimate(p: Prototype, d: Design, *, cores: int, sweep: bool = True,
              proto_factor: float = 1.0, model_factor: float = 1.0,
-             work: Work | None = None) -> Estimate:
+             work: Work | None = None, variants: int | None = None) -> Estimate:
     """The run's size (`sweep`: the verification runs; `work`: what else, default make's);
-    the factors coarsen the prototype's or the model's meshes. A short make (at most
+    the factors coarsen the prototype's or the model's meshes; `variants`: as `sweeps`. A short make (at most
     LONG_RUN_S) runs its verification in a helper process beside the parts' steps: its wall
     time is then the longer of the two, or their CPU shared out on the cores when more."""
     work = work or Work(sweep=sweep)
@@ -229,7 +245,8 @@ def estimate(p: Prototype, d: Design, *, cores: int, sweep: bool = True,
     run: tuple[SweepWork, ...] = ()
     verify = verify_cpu = 0.0
     if work.sweep:
-        run = sweeps(p, d, proto_factor=proto_factor, model_factor=model_factor, work=work)
+        run = sweeps(p, d, proto_factor=proto_factor, model_factor=model_factor, work=work,
+                     variants=variants)
         nets = tuple(NetSize(s.name, s.unknowns // 3, s.unknowns, s.seconds,
                              MEMORY_B_PER_NODE * s.unknowns / 3) for s in run[:2])
         verify, verify_cpu = verification_seconds(run, cores)
@@ -252,10 +269,11 @@ def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
     if not (math.isfinite(limit_s) and limit_s > 0):
         raise InputError(f"--time-limit {limit_s:g} s must be a positive number of seconds")
     work = work or Work(sweep=sweep)
-    est = estimate(p, d, cores=cores, work=work)
+    variants = band_variants(p, d) if work.sweep else 0  # read once: the profiles' files
+    est = estimate(p, d, cores=cores, work=work, variants=variants)
     if est.seconds <= limit_s:
         return est
-    fix = coarsest_fix(p, d, limit_s=limit_s, cores=cores, work=work)
+    fix = coarsest_fix(p, d, limit_s=limit_s, cores=cores, work=work, variants=variants)
     which = ("the default, about a minute of make on 2 cores" if limit_s == DEFAULT_LIMIT_S
              else "from --time-limit")
     raise InputError(f"this run is too big: {est.summary()}; the limit is {limit_s:g} s "
@@ -264,19 +282,22 @@ def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
 
 
 def coarsest_fix(p: Prototype, d: Design, *, limit_s: float, cores: int,
-                 work: Work = MAKE) -> str:
-    """The smallest uniform coarsening of the meshes that fits `limit_s`, as advice."""
+                 work: Work = MAKE, variants: int | None = None) -> str:
+    """The smallest uniform coarsening of the meshes that fits `limit_s`, as advice
+    (`variants`: the band's, as `sweeps`)."""
+    if variants is None and work.sweep:
+        variants = band_variants(p, d)
     user_model = p.model.mesh_x_mm is not None or not work.model_follows
     model_scales = not user_model  # the model mesh follows the prototype's unless [model] sets it
 
     def fits(f: float) -> bool:
-        return estimate(p, d, cores=cores, work=work, proto_factor=f,
+        return estimate(p, d, cores=cores, work=work, proto_factor=f, variants=variants,
                         model_factor=f if model_scales else 1.0).seconds <= limit_s
 
     lo, hi = 1.0, COARSEN_MAX
     if not fits(hi):
         if user_model and estimate(p, d, cores=cores, work=work, proto_factor=hi,
-                                   model_factor=hi).seconds <= limit_s:
+                                   model_factor=hi, variants=variants).seconds <= limit_s:
             return ("coarsen [model] mesh_x_mm / mesh_y_mm (or the design's mesh) as well as "
                     "the prototype's net")
         return "no mesh coarsening alone fits; raise --time-limit"

@@ -163,13 +163,15 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
         for label, step in steps:
             if progress:
                 progress(label)
-            t = time.perf_counter()
+            t, cpu = time.perf_counter(), time.process_time()
             try:
                 ctx.record.update(step(ctx, stage))
                 check_deadline(label)
             except TimeLimitError as exc:
                 raise TimeLimitError(time_limit_line(label, exc, est, bound, t0)) from exc
-            ctx.record.setdefault("timings_s", {})[label] = time.perf_counter() - t
+            times = ctx.record.setdefault("timings_s", {})
+            times[label] = time.perf_counter() - t
+            times.setdefault("cpu_s", {})[label] = time.process_time() - cpu  # this process
         meta.update(provenance(ctx))
         provenance_section(ctx.report, meta)
         for name, data in report_files(ctx.record, ctx.report).items():
