@@ -79,16 +79,18 @@ def predicted_cpu(example: Path) -> float:
 
 
 def fitted_constants(runs: list[dict]) -> dict:
-    """budget.py's constants from the runs: iterations per level by kind of net, and the
-    CPU per iteration (least squares of every sweep's relative error)."""
+    """budget.py's constants from the runs: iterations per level by kind of net (its growth
+    with the unknowns, ITERATION_GROWTH, kept), and the CPU per iteration (least squares of
+    every sweep's relative error)."""
     import numpy as np
 
     from printgen.run import budget
 
-    per_level = {}
+    per_level = {}  # at budget.REFERENCE_UNKNOWNS: scaled by the counted / predicted totals
     for kind, rs in runs_by_kind(runs).items():
-        rows = [s for r in rs for s in r["sweeps"]]
-        per_level[kind] = sum(s["iterations"] for s in rows) / sum(s["levels"] for s in rows)
+        counted = sum(r["work"]["counted"]["iterations"] for r in rs)
+        predicted = sum(r["work"]["predicted"]["iterations"] for r in rs)
+        per_level[kind] = budget.ITERATIONS_PER_LEVEL[kind] * counted / predicted
     rows = [s for r in runs for s in r["sweeps"] if s["iterations"] and s["cpu_s"] > 0]
     it = np.array([s["iterations"] for s in rows], float)
     n = np.array([s["unknowns"] for s in rows], float)

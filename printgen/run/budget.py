@@ -10,7 +10,7 @@ times coarser), then each band variant of the model (`printgen.verification.band
 refinement test may pick a coarser one, which the estimate does not foresee (on both examples
 it keeps the design's net), so a run whose variants coarsen is estimated high. A sweep's work is
 its levels times the Newton iterations per level (ITERATIONS_PER_LEVEL, for a net with border
-cables or one with a free top), its CPU time on one core that many iterations of
+cables or one with a free top, growing slowly with the unknowns), its CPU time on one core that many iterations of
 ITERATION_S + ITERATION_S_PER_UNKNOWN x its unknowns (3 per node). The run counts the same work
 (`counted_work`, report.json "verification" -> "solver_work" against "size" -> "solver_work");
 tests/test_budget.py checks the prediction against the count on both examples and
@@ -42,9 +42,13 @@ LONG_RUN_S = 30.0  # runs estimated longer show their estimate and progress (mak
 LEVELS = 23  # load levels of a sweep (verify.levels(): 0 to 1.1 by 0.05; tests/test_budget.py)
 # Newton iterations (chord steps included) per load level, averaged over a run's sweeps (the
 # nominal pair, the refinement test and the band's variants; a variant's slack strands may
-# take 4 x the nominal's). Counted by bench make at 1:40 on the solver of this commit: the 1:40
-# example (border cables) 2252 over 12 sweeps, the simple barrier (free top) 1897 over 8.
-ITERATIONS_PER_LEVEL = {"border cables": 8.2, "free top": 10.3}
+# take 4 x the nominal's), at REFERENCE_UNKNOWNS, growing as unknowns^ITERATION_GROWTH.
+# Counted by bench make at 1:40 on the solver of this commit: the 1:40 example (border cables,
+# ~1000 unknowns) 2252 over 12 sweeps; the simple barrier (free top, 3540) 1897 over 8, and
+# 1170 on the mesh twice as coarse (870 unknowns; tests' shared run): 0.34 from one to the other.
+ITERATIONS_PER_LEVEL = {"border cables": 8.2, "free top": 6.8}
+REFERENCE_UNKNOWNS = 1000
+ITERATION_GROWTH = 0.34
 # CPU of one iteration on one core: ITERATION_S + ITERATION_S_PER_UNKNOWN x unknowns, a least-
 # squares fit (bench make) over the 20 sweeps of both examples at 1:40 (1000 to 3500 unknowns;
 # each sweep's CPU within 0.69 to 1.28 of the fit given its counted iterations).
@@ -193,10 +197,11 @@ def sweeps(p: Prototype, d: Design, *, proto_factor: float = 1.0, model_factor: 
     `variants`: the band's count when known (default: `band_variants`)."""
     from printgen.verification.bands import COARSENINGS
 
-    per_level = ITERATIONS_PER_LEVEL["border cables" if d.cables else "free top"]
+    kind = "border cables" if d.cables else "free top"
 
     def one(name: str, nodes: float, group: str) -> SweepWork:
-        return SweepWork(name, round(3 * nodes), LEVELS, LEVELS * per_level, group)
+        return SweepWork(name, round(3 * nodes), LEVELS,
+                         LEVELS * iterations_per_level(kind, 3 * nodes), group)
 
     m_nodes = model_nodes(d, model_factor)
     out = []
@@ -209,6 +214,11 @@ def sweeps(p: Prototype, d: Design, *, proto_factor: float = 1.0, model_factor: 
     if work.fit:
         out += [one("fit", m_nodes / COARSENED_BY**2, "serial")] * FIT_SWEEPS
     return tuple(out)
+
+
+def iterations_per_level(kind: str, unknowns: float) -> float:
+    """Predicted Newton iterations per load level of a net of `kind` (ITERATIONS_PER_LEVEL)."""
+    return ITERATIONS_PER_LEVEL[kind] * (unknowns / REFERENCE_UNKNOWNS) ** ITERATION_GROWTH
 
 
 def verification_seconds(work: tuple[SweepWork, ...], cores: int) -> tuple[float, float]:
