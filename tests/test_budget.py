@@ -7,6 +7,10 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -24,6 +28,7 @@ WORK_FACTOR = 2.0  # issue 28: the estimate within x2 of the run (here its work,
 VERIFY_ONLY = [s for s in make_mod.default_steps() if s[1] is make_mod.verify_step]
 FEW_LEVELS = np.array([0.0, 0.5, 1.0])  # a cheap sweep; 0.5 is made to fail
 SHORT_LIMIT_S = 0.5  # --time-limit far below the verification's few seconds
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def within(predicted: float, counted: float) -> bool:
@@ -124,3 +129,34 @@ def test_time_limit_stops_the_helper_process_run(tmp_path, monkeypatch):
         make_mod.make(REALISTIC, 40, out, options=make_mod.MakeOptions(
             time_limit_s=SHORT_LIMIT_S))
     assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+PETG30 = ROOT / "tests" / "data" / "issue28"  # issue 28's file and its 500 mm bed printer
+HELPER_LIMIT_S = 6.0  # the helper is well into its sweeps' worker pools by then
+
+
+def test_time_limit_stop_is_one_line_on_stderr(tmp_path):
+    """The whole process's stderr (the CLI in a subprocess, issue 28's PETG barrier at 1:30,
+    estimated within the limit by a bypass, its verification step only): the helper, killed at the limit while its
+    workers' queues are registered, leaves no "leaked semaphore" warning from
+    multiprocessing's resource tracker after make's line (there was one)."""
+    script = (
+        "import sys\n"
+        "import printgen.run.make as m\n"
+        "from printgen.run.budget import estimate\n"
+        "m.check_budget = lambda p, d, *, limit_s, cores, work: estimate(p, d, cores=cores, "
+        "work=work)\n"
+        "steps = m.default_steps()\n"  # the verification only: make waits for the helper
+        "m.default_steps = lambda: [s for s in steps if s[1] is m.verify_step]\n"
+        "from printgen.cli import main\n"
+        f"sys.exit(main(['make', {str(PETG30 / 'simple_petg_1to30.toml')!r}, '-s', '30', "
+        f"'--printer', 'bed-500', '--out', {str(tmp_path / 'out')!r}, '--time-limit', "
+        f"'{HELPER_LIMIT_S:g}']))\n")
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "PRINTGEN_PROFILES": str(PETG30)}
+    env.pop("PRINTGEN_SERIAL", None)
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          env=env, cwd=ROOT, check=False)
+    assert proc.returncode == EXIT_TIME_LIMIT, proc.stderr
+    assert proc.stderr.count("\n") == 1 and proc.stderr.startswith("printgen make: stopped"), \
+        proc.stderr
+    assert not (tmp_path / "out").exists()

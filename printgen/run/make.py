@@ -218,6 +218,7 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]], short: b
     if serial or not short or not any(s is verify_step for _, s in steps):
         yield
         return
+    quiet_tracker()
     with helper() as h:
         ctx.helper = h
         ctx.background["verification sweeps"] = ctx.helper.submit(
@@ -230,6 +231,23 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]], short: b
         finally:
             ctx.background.clear()
             ctx.helper = None
+
+
+TRACKER_WARNING = "ignore:resource_tracker:UserWarning"  # a -W option (sys.warnoptions)
+
+
+def quiet_tracker() -> None:
+    """Start multiprocessing's resource tracker without its "leaked semaphore objects" warning.
+    A run stopped at its time limit (or by a signal) kills the helper while its workers' queues
+    are registered with the tracker, which unlinks them when it exits and says so on stderr: a
+    second line after make's one. The tracker inherits the -W options of sys.warnoptions
+    when it starts (at the helper's first queue); one already running is left as it is."""
+    import sys
+    from multiprocessing import resource_tracker
+
+    if TRACKER_WARNING not in sys.warnoptions:
+        sys.warnoptions.append(TRACKER_WARNING)
+    resource_tracker.ensure_running()
 
 
 def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
