@@ -135,6 +135,16 @@ def comparison(rs: list[dict], example: Path) -> dict:
             "exit": [r["exit"] for r in rs]}
 
 
+def summary(estimates: dict) -> str:
+    """One line per example for the terminal: estimate, measured, CPU, work, load."""
+    return "; ".join(
+        f"{name}: estimate {e['estimate_s']:.0f} s, measured {e['measured_s']:.0f} s "
+        f"(load {max(x for pair in e['load_average'] for x in pair):.1f}), sweeps' CPU "
+        f"{e['sweeps_cpu_estimate_s']:.0f} s estimated / {e['sweeps_cpu_s']:.0f} s, iterations "
+        f"{e['work']['predicted']['iterations']} / {e['work']['counted']['iterations']}"
+        for name, e in estimates.items())
+
+
 def run(out: Path, repeat: int) -> dict:
     out.mkdir(parents=True, exist_ok=True)
     runs = [{**one_run(out / f"run{k}"), "example": EXAMPLE.name} for k in range(repeat)]
@@ -149,7 +159,7 @@ def run(out: Path, repeat: int) -> dict:
               "repeat": repeat, "cores": os.cpu_count(), "runs": runs, "simple_run": simple,
               "median_wall_s": median, "median_steps_s": median_steps,
               "outside_steps_s": median - median_steps.get("total", 0.0),
-              "estimate_vs_measured": estimates,
+              "estimate_vs_measured": estimates, "estimates": summary(estimates),
               "constants": fitted_constants([*runs, simple]),
               "goal_s": GOAL_S, "goal_met": median < GOAL_S}
     (out / "bench_make.json").write_text(json.dumps(report, indent=1) + "\n")
