@@ -137,9 +137,9 @@ HELPER_LIMIT_S = 6.0  # the helper is well into its sweeps' worker pools by then
 
 def test_time_limit_stop_is_one_line_on_stderr(tmp_path):
     """The whole process's stderr (the CLI in a subprocess, issue 28's PETG barrier at 1:30,
-    estimated within the limit by a bypass, its verification step only): the helper, killed at the limit while its
-    workers' queues are registered, leaves no "leaked semaphore" warning from
-    multiprocessing's resource tracker after make's line (there was one)."""
+    estimated within the limit by a bypass, its verification step only): the helper, killed
+    at the limit while its workers' queues are registered, leaves no "leaked semaphore"
+    warning from multiprocessing's resource tracker after make's line (there was one)."""
     script = (
         "import sys\n"
         "import printgen.run.make as m\n"

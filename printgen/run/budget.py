@@ -8,16 +8,16 @@ case of `make --loads` the same, the band's refinement test (the model on a net 
 times coarser), then each band variant of the model (`printgen.verification.bands
 .model_variants`: 5 on the simple barrier, 9 on the 1:40 example) on the design's own net: the
 refinement test may pick a coarser one, which the estimate does not foresee (on both examples
-it keeps the design's net), so a run whose variants coarsen is estimated high. A sweep's work is
-its levels times the Newton iterations per level (ITERATIONS_PER_LEVEL, for a net with border
-cables or one with a free top, growing slowly with the unknowns), its CPU time on one core that many iterations of
-ITERATION_S + ITERATION_S_PER_UNKNOWN x its unknowns (3 per node). The run counts the same work
-(`counted_work`, report.json "verification" -> "solver_work" against "size" -> "solver_work");
-tests/test_budget.py checks the prediction against the count on both examples and
-`printgen bench make` (benchmarks/bench_make.py) measures the constants, the estimate against
-the measured time and the CPU. The parts' steps (meshes, slicer profiles, G-code, previews)
-have constants of their own. The estimate is meant to be right within a factor of about two,
-enough to stop a run that would take an hour.
+it keeps the design's net), so a run whose variants coarsen is estimated high. A sweep's work
+is its levels times the Newton iterations per level (ITERATIONS_PER_LEVEL, for a net with
+border cables or one with a free top, growing slowly with the unknowns), its CPU time on one
+core that many iterations of ITERATION_S + ITERATION_S_PER_UNKNOWN x its unknowns (3 per
+node). The run counts the same work (`counted_work`, report.json "verification" ->
+"solver_work" against "size" -> "solver_work"); tests/test_budget.py checks the prediction
+against the count on both examples and `printgen bench make` (benchmarks/bench_make.py)
+measures the constants, the estimate against the measured time and the CPU. The parts' steps
+(meshes, slicer profiles, G-code, previews) have constants of their own. The estimate is meant
+to be right within a factor of about two, enough to stop a run that would take an hour.
 """
 
 from __future__ import annotations
@@ -246,9 +246,10 @@ def estimate(p: Prototype, d: Design, *, cores: int, sweep: bool = True,
              proto_factor: float = 1.0, model_factor: float = 1.0,
              work: Work | None = None, variants: int | None = None) -> Estimate:
     """The run's size (`sweep`: the verification runs; `work`: what else, default make's);
-    the factors coarsen the prototype's or the model's meshes; `variants`: as `sweeps`. A short make (at most
-    LONG_RUN_S) runs its verification in a helper process beside the parts' steps: its wall
-    time is then the longer of the two, or their CPU shared out on the cores when more."""
+    the factors coarsen the prototype's or the model's meshes; `variants`: as `sweeps`. A
+    short make (at most LONG_RUN_S) runs its verification in a helper process beside the
+    parts' steps: its wall time is then the longer of the two, or their CPU shared out on the
+    cores when more."""
     work = work or Work(sweep=sweep)
     m_nodes = model_nodes(d, model_factor)
     nets: tuple[NetSize, ...] = ()

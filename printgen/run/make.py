@@ -287,7 +287,8 @@ def time_limit_line(label: str, cause: Exception, est: Estimate, bound: float | 
     where = str(cause).removesuffix(": past the time limit")
     inside = f" ({where})" if where and where != label else ""
     return (f"stopped in step '{label}'{inside} after {spent:.0f} s, past the time limit of "
-            f"{bound or 0:g} s (--time-limit); the run was estimated at about {est.seconds:.0f} s; nothing written. "
+            f"{bound or 0:g} s (--time-limit); the run was estimated at about "
+            f"{est.seconds:.0f} s; nothing written. "
             f"Raise it with --time-limit {math.ceil(max(spent, bound or 0) * 2 / 60) * 60:g}, or "
             "coarsen the nets")
 
