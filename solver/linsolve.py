@@ -23,15 +23,13 @@ from __future__ import annotations
 
 import contextlib
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from solver.pattern import Pattern
-
-if TYPE_CHECKING:
-    import scipy.sparse as sp
 
 LINEAR_RTOL = 1e-13  # backward error a solve must reach: |b - A x| <= tol (|A| |x| + |b|)
 GMRES_RTOL = 1e-14  # GMRES stops at this relative 2-norm residual at the latest
@@ -102,6 +100,7 @@ class Pardiso:
         self.solver = self._solver(2)
         self.analysed = False
         self.S = None
+        self.empty = sp.csr_matrix((0, 0))  # what MKL's release phase is called with
 
     @staticmethod
     def _solver(mtype: int):
@@ -139,10 +138,12 @@ class Pardiso:
     def free(self) -> None:
         """Release MKL's memory of this instance (factors and analysis)."""
         with contextlib.suppress(self.error):  # nothing allocated yet
-            self.solver.free_memory(everything=True)
+            self.solver.set_phase(-1)
+            self.solver._call_pardiso(self.empty, np.zeros(0))
 
     def __del__(self) -> None:
-        self.free()
+        with contextlib.suppress(Exception):  # at interpreter exit, modules may be gone
+            self.free()
 
 
 class Factorization:
