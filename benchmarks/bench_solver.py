@@ -355,8 +355,8 @@ def run(out: Path, sizes: list[int], with_paths: bool = True, threads: int = THR
     report = {"benchmark": "bench_solver", "scene": "simple-pinned",
               "load": "hydrostatic at h = h_B + drag at 6 m/s, at the initial node height",
               "reference_tol": REFERENCE_TOL, "goal_tol": GOAL_TOL, "blas_threads": threads,
-              "load_average": list(os.getloadavg()) if hasattr(os, "getloadavg") else None, "size_table": size_table(results, threads),
-              "sizes": results,
+              "load_average": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
+              "size_table": size_table(results, threads), "sizes": results,
               "verification_paths": paths, "tent": tent, "robustness": robustness(),
               "opensees_paired": paired, "goals": goals(results, paths, tent, paired),
               "total_s": time.perf_counter() - t0}
