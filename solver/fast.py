@@ -36,7 +36,14 @@ from collections.abc import Callable
 
 import numpy as np
 
-from solver.linsolve import Factorization, choose_backend
+from solver.linsolve import (
+    GMRES_RESTART,
+    GMRES_RTOL,
+    LINEAR_RTOL,
+    Factorization,
+    choose_backend,
+    gmres,
+)
 from solver.newton import (
     ARMIJO,
     MAX_BACKTRACK,
@@ -150,13 +157,13 @@ def _active_set_step(ns: NetSystem, st: State, stepper: Stepper, boost: float, f
     if stepper.active is not None:
         active = slack & stepper.active
     fact = step = rhs = None
+    new = active
     for _ in range(PDAS_PASSES + 1):
         tan = np.where(active, ns.first_slope, tangent)
-        trial = stepper.newton(dataclasses.replace(st, bar=(eps, force, tan, d, l)), boost)
-        fo = np.where(active, ns.first_slope * eps, 0.0)[:, None] * nvec
-        off = np.zeros((ns.n, 3))
-        for k in range(3):
-            off[:, k] = np.bincount(b.j, fo[:, k], ns.n) - np.bincount(b.i, fo[:, k], ns.n)
+        at = dataclasses.replace(st, bar=(eps, force, tan, d, l))
+        trial = stepper.newton(at, boost) if fact is None else Updated(
+            ns.pattern.csr(stepper.matrix(at, boost)), getattr(fact, "base", fact))
+        off = ns.incidence @ (np.where(active, ns.first_slope * eps, 0.0)[:, None] * nvec)
         new_rhs = -st.r - off.ravel()[ns.free]
         new_step = trial.solve(new_rhs, forcing)
         if new_step is None:
@@ -166,11 +173,41 @@ def _active_set_step(ns: NetSystem, st: State, stepper: Stepper, boost: float, f
         fact, step, rhs = trial, new_step, new_rhs
         du = _moved(ns, np.zeros_like(st.u), step)
         new = slack & (eps + np.einsum("ij,ij->i", nvec, du[b.j] - du[b.i]) / b.rest > 0)
-        if np.array_equal(new, active) or PDAS_PASSES == 0:
+        if np.array_equal(new, active):
             break
         active = new
-    stepper.active = active
+    stepper.active = new  # the set the last step predicts: the next step's first guess
     return fact, step, rhs
+
+
+class Updated:
+    """The system of an active-set re-pass, solved by GMRES preconditioned by the pass
+    before's factorization (the matrices differ by the few strands whose state changed), and
+    factorized afresh only when that misses the target."""
+
+    def __init__(self, A, base: Factorization) -> None:
+        self.A, self.base = A, base
+        self.handle = base.handle
+
+    def solve(self, b: np.ndarray, forcing: float = 0.0) -> np.ndarray | None:
+        base = self.base
+        precondition = base.direct if base.direct is not None else (
+            base.lu.solve if base.lu is not None else None)
+        if precondition is not None:
+            with np.errstate(all="ignore"):
+                x0 = np.zeros_like(b)
+                target = max(forcing * float(np.abs(b).max()), 0.0)
+                x = gmres(self.A, precondition, b, x0, max(target, GMRES_RTOL * float(
+                    np.linalg.norm(b))), GMRES_RESTART)
+            if np.all(np.isfinite(x)) and float(np.abs(b - self.A @ x).max()) <= max(
+                    target, LINEAR_RTOL * (float(abs(self.A).sum(axis=1).max())
+                                           * float(np.abs(x).max()) + float(np.abs(b).max()))):
+                return x
+        fresh = Factorization(base.pattern, self.A.data, base.backend, None)
+        return fresh.solve(b, forcing)
+
+    def symmetric_solve(self, b: np.ndarray) -> np.ndarray | None:
+        return self.base.symmetric_solve(b)
 
 
 def _chord_step(ns: NetSystem, st: State, fact: Factorization) -> State | None:
