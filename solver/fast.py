@@ -16,12 +16,14 @@ same energy line search and step cap), computed with less work per step and fewe
   follower load can make the damped tangent indefinite);
 - inexact Newton: linear solves to a residual of min(FORCING, |R| / force scale);
 - an active set on the tension-only law: the slack strands a step stretches past their
-  rest length get their stiffness (and the pull their strain offset implies) in its model, and the step is solved again until that set
-  stops changing (a primal-dual active set on the piecewise quadratic model, at most
-  PDAS_PASSES re-solves, starting from the last step's set). Without it a free-top net's
-  dry strands, slack and held only by the hold of unloaded nodes, let a step run through
-  their rest length unresisted: the line search cut it to a few per cent for hundreds of
-  iterations (simple barrier's model at 1:40, h/h_B = 0.05: 311 iterations, now ~45).
+  rest length get their stiffness (and the pull their strain offset implies) in its model,
+  and the step is solved again until that set stops changing (a primal-dual active set on
+  the piecewise quadratic model, at most PDAS_PASSES re-solves, each by GMRES preconditioned
+  by the step's own factorization: one factorization per Newton step); the set the last
+  pass predicts is the next step's first guess. Without it a free-top net's dry strands,
+  slack and held only by the hold of unloaded nodes, let a step run through their rest
+  length unresisted: the line search cut it to a few per cent for hundreds of iterations
+  (simple barrier's model at 1:40, first loaded level: 311 iterations, now 39).
 
 The tangent is not symmetric (hydrostatic follower term): every step solves the true
 system; the symmetric part only serves as a factorization to precondition it
@@ -65,8 +67,9 @@ CHORD_MIN_DOFS = 10_000  # below, a factorization costs less than the trial stat
 START_SPAN = (-6.0, 0.0)  # log10 of the membrane start's largest displacement / net extent
 START_GRID = 13  # potentials sampled over START_SPAN before the scalar minimisation
 START_XTOL = 0.01  # log10 resolution of the membrane start's scale
-PDAS_PASSES = 3  # active-set re-solves per Newton step at most (simple barrier's model at
-# 1:40, h/h_B = 0.05: 3 passes 45 iterations / 162 factorizations, 8 passes 36 / 207, none 311)
+PDAS_PASSES = 1  # active-set re-solves per Newton step at most, each by GMRES on the first
+# pass's factorization (simple barrier 1:40, worst level of the model / prototype sweeps: 1 pass
+# 39 / 44 iterations, 3 passes 35 / 50, 6 passes 32 / 47 at 1.3-1.8 x the CPU of 1 pass)
 
 
 class Stepper:
