@@ -62,8 +62,8 @@ def alone(named: list, repeat: int) -> dict[str, float]:
 
 
 def timed_draw(todo: list) -> dict[str, float]:
-    """`draw_all` in this (helper) process: its wall time, this process's CPU and that of
-    the workers it started (reaped by then)."""
+    """`draw_all` in this (helper) process: its wall time, this process's CPU (matplotlib's
+    import, as in make's helper) and that of the workers it started (reaped by then)."""
     from printgen.run.steps import draw_all
 
     c0, k0 = (resource.getrusage(w) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
@@ -93,9 +93,10 @@ def run(out: Path, repeat: int) -> dict:
         print(f"bench figures: {key}: sweeps (not timed)", file=sys.stderr)
         named = drawings(example)
         print(f"bench figures: {key}: {len(named)} figures", file=sys.stderr)
+        both = side_by_side(named, repeat)  # first: its helper imports matplotlib, as make's
         each = alone(named, repeat)
         rows[key] = {"figures_cpu_s": each, "serial_cpu_s": sum(each.values()),
-                     "side_by_side": side_by_side(named, repeat)}
+                     "side_by_side": both}
     simple = rows["simple"]["side_by_side"]["wall_s"]
     report = {"benchmark": "bench_figures", "scale": SCALE, "repeat": repeat,
               "cores": os.cpu_count(), "load_average": os.getloadavg(), "examples": rows,
