@@ -88,15 +88,17 @@ def side_by_side(named: list, repeat: int) -> dict[str, float]:
 
 def run(out: Path, repeat: int) -> dict:
     out.mkdir(parents=True, exist_ok=True)
-    rows = {}
-    for key, example in EXAMPLES.items():
+    named, both = {}, {}
+    for key, example in EXAMPLES.items():  # first: the helpers import matplotlib, as make's
         print(f"bench figures: {key}: sweeps (not timed)", file=sys.stderr)
-        named = drawings(example)
-        print(f"bench figures: {key}: {len(named)} figures", file=sys.stderr)
-        both = side_by_side(named, repeat)  # first: its helper imports matplotlib, as make's
-        each = alone(named, repeat)
+        named[key] = drawings(example)
+        print(f"bench figures: {key}: {len(named[key])} figures", file=sys.stderr)
+        both[key] = side_by_side(named[key], repeat)
+    rows = {}
+    for key, figures in named.items():
+        each = alone(figures, repeat)
         rows[key] = {"figures_cpu_s": each, "serial_cpu_s": sum(each.values()),
-                     "side_by_side": both}
+                     "side_by_side": both[key]}
     simple = rows["simple"]["side_by_side"]["wall_s"]
     report = {"benchmark": "bench_figures", "scale": SCALE, "repeat": repeat,
               "cores": os.cpu_count(), "load_average": os.getloadavg(), "examples": rows,
