@@ -85,16 +85,21 @@ def test_the_checklist_gives_the_kit_numbers(kit):
 
 
 def test_make_shows_the_kit_and_the_toolpath_previews(tmp_path):
-    """The kit step writes the labelled assembly picture and per-pass previews into the
-    output and the report, with the checklist and the closing verdict."""
+    """The kit step puts the labelled assembly picture and per-pass previews into the report
+    (drawn with the report's other figures), each also a file beside the report, with the
+    checklist and the closing verdict."""
+    from printgen.report.extras import report_files
     from printgen.run.make import kit_step
 
     ctx = plan(EXAMPLES / "realistic_barrier.toml", 60)
     rec = kit_step(ctx, tmp_path)
-    pngs = sorted(p.name for p in tmp_path.glob("*.png"))
+    assert len(ctx.report.pending()) == 4  # drawn once the verification's sweeps are done
+    files = report_files(ctx.record, ctx.report)
+    pngs = sorted(n for n in files if "/" not in n and n.endswith(".png"))
     assert pngs == ["assembly.png", "preview-cable-left.png", "preview-net-whole.png",
                     "preview-net.png"]
-    assert all((tmp_path / p).read_bytes().startswith(b"\x89PNG") for p in pngs)
+    assert all(files[p].startswith(b"\x89PNG") for p in pngs)
+    assert files["assembly.png"] == files["figures/01-assembly.png"]
     html = ctx.report.html()
     assert "Assembly" in html and "Toolpath previews" in html and "Check after printing" in html
     assert html.count("<img") == 4 and "PASS" in html
