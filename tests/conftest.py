@@ -89,13 +89,16 @@ def shared_run(tmp_path_factory, name: str, build: Callable[[Path], Any]) -> Any
     """`build(folder)` once per test session, also under pytest-xdist: a session-scoped
     fixture is per worker there, so the first worker to ask builds (into its own temporary
     folder) and pickles the result; the other workers wait for it and load it. The result
-    and its folder are read only (a test that changes them copies them first)."""
+    and its folder are read only (a test that changes them copies them first). The files are
+    named for the test run (xdist's run id): a --basetemp reused by a later run, whose workers
+    empty only their own folders, never hands that run an old result."""
     if os.environ.get("PYTEST_XDIST_WORKER") is None:
         return build(tmp_path_factory.mktemp(name))
     root = tmp_path_factory.getbasetemp().parent  # the session's, above each worker's
-    done, failed = root / f"{name}.pickle", root / f"{name}.failed"
+    stem = f"{name}.{os.environ.get('PYTEST_XDIST_TESTRUNUID', 'run')}"
+    done, failed = root / f"{stem}.pickle", root / f"{stem}.failed"
     try:
-        fd = os.open(root / f"{name}.claim", os.O_CREAT | os.O_EXCL | os.O_WRONLY)
+        fd = os.open(root / f"{stem}.claim", os.O_CREAT | os.O_EXCL | os.O_WRONLY)
     except FileExistsError:
         return _wait_for(done, failed)
     os.close(fd)
@@ -104,7 +107,7 @@ def shared_run(tmp_path_factory, name: str, build: Callable[[Path], Any]) -> Any
     except BaseException as exc:
         failed.write_text(f"{type(exc).__name__}: {exc}")
         raise
-    part = root / f"{name}.pickle.part"
+    part = root / f"{stem}.pickle.part"
     part.write_bytes(pickle.dumps(result))
     part.replace(done)  # the waiting workers see the whole file or none
     return result

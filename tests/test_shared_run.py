@@ -53,6 +53,16 @@ def test_a_failed_build_fails_the_waiting_workers(tmp_path, monkeypatch):
         shared_run(Workers(tmp_path, "gw1"), "run", broken)
 
 
+def test_a_later_run_in_the_same_basetemp_builds_its_own(tmp_path, monkeypatch):
+    """--basetemp reused: the second test run (another xdist run id) never loads the first's."""
+    monkeypatch.setenv("PYTEST_XDIST_WORKER", "gw0")
+    monkeypatch.setenv("PYTEST_XDIST_TESTRUNUID", "first")
+    assert shared_run(Workers(tmp_path, "gw0"), "run", lambda folder: "old") == "old"
+    monkeypatch.setenv("PYTEST_XDIST_TESTRUNUID", "second")
+    monkeypatch.setenv("PYTEST_XDIST_WORKER", "gw1")
+    assert shared_run(Workers(tmp_path, "gw1"), "run", lambda folder: "new") == "new"
+
+
 def test_without_xdist_it_builds_in_place(tmp_path, monkeypatch):
     monkeypatch.delenv("PYTEST_XDIST_WORKER", raising=False)
     got = shared_run(Workers(tmp_path, "main"), "run", lambda folder: folder)
