@@ -7,9 +7,11 @@ the load paths of the 1:40 verification; the robustness table of the hard cases.
 
 Errors are the mid-height centre deflection against a tight-tolerance solve of the same size
 (relative). Loads at the initial node height (the variant OpenSees can model); printgen's
-current-height variant is timed too. Times are wall-clock, best of REPEAT at GOAL_TOL; the
-ratio to OpenSeesPy at 61 x 21 is also measured pair by pair (`paired_ratio`: PAIRS pairs,
-alternating, one BLAS thread each; median and range).
+current-height variant is timed too. Times are wall-clock (perf_counter) and CPU
+(process_time), each the best of REPEAT at GOAL_TOL, with BLAS/MKL pinned to --threads
+threads (threadpoolctl; default 1); `size_table` lists them per size with the backend and
+the microseconds per unknown. The ratio to OpenSeesPy at 61 x 21 is also measured pair by
+pair (`paired_ratio`: PAIRS pairs, alternating, one BLAS thread each; median and range).
 Writes bench_solver.json and bench_solver.png.
 """
 
@@ -17,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
 from pathlib import Path
@@ -33,6 +36,8 @@ GOAL_TOL = 1e-6  # issue 11's goals are stated at this tolerance
 REPEAT = 3  # timing repeats at GOAL_TOL (best kept)
 PAIRS = 7  # printgen / OpenSeesPy timing pairs at 61 x 21, alternating which runs first
 SIZES = {1: "61 x 21", 2: "121 x 41", 4: "241 x 81", 8: "481 x 161"}
+LINEAR_FROM = 10_000  # issue 28: cost per unknown within 1.5x from here (14k) to 228k unknowns
+THREADS = 1  # BLAS/MKL threads of the size runs (--threads)
 COMPARED = (1, 2, 4)  # sizes also run by OpenSeesPy and by the reference path
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "realistic_barrier.toml"
 EXAMPLE_SCALE = 40.0  # the 1:40 verification whose load paths are timed
@@ -111,16 +116,19 @@ def robustness() -> list[dict]:
 
 
 def _run(sc, tol: float, d_ref: float, *, method: str = "fast", repeat: int = 1) -> dict:
-    """One printgen solve at `tol` (best wall time of `repeat`)."""
-    best = None
+    """One printgen solve at `tol` (best wall time and best CPU time of `repeat`)."""
+    best, cpu = None, float("inf")
     for _ in range(repeat):
+        c0 = time.process_time()
         r = solve(sc.net, sc.loads_at(1.0), tol=tol, method=method)
+        cpu = min(cpu, time.process_time() - c0)
         best = r if best is None or r.seconds < best.seconds else best
     d = float(best.displacements[sc.centre, 1])
     return {"tool": "printgen" if method == "fast" else "printgen reference path (before)",
             "tol": tol, "converged": best.converged, "max_strain": float(best.strains.max()),
             "max_tension_n": float(best.tensions.max()), "iterations": best.iterations,
-            "factorizations": best.factorizations, "time_s": best.seconds, "deflection_m": d,
+            "factorizations": best.factorizations, "backend": best.backend,
+            "time_s": best.seconds, "cpu_s": cpu, "deflection_m": d,
             "error": abs(d / d_ref - 1)}
 
 
@@ -146,14 +154,27 @@ def bench_size(refine: int) -> dict:
             "reference_deflection_m": d_ref, "reference_time_s": ref.seconds,
             "reference_iterations": ref.iterations,
             "slack_strands_at_reference": int(ref.slack.sum()),
-            "us_per_unknown_at_goal_tol": 1e6 * goal["time_s"] / unknowns, "runs": runs}
+            "us_per_unknown_at_goal_tol": 1e6 * goal["time_s"] / unknowns,
+            "cpu_us_per_unknown_at_goal_tol": 1e6 * goal["cpu_s"] / unknowns, "runs": runs}
+
+
+def size_table(results: list[dict], threads: int) -> list[dict]:
+    """Issue 28's size table: printgen at GOAL_TOL per size, best of REPEAT."""
+    out = []
+    for res in results:
+        goal = next(r for r in res["runs"] if r["tool"] == "printgen" and r["tol"] == GOAL_TOL)
+        out.append({"size": res["size"], "unknowns": res["unknowns"],
+                    "backend": goal["backend"], "blas_threads": threads,
+                    "iterations": goal["iterations"], "factorizations": goal["factorizations"],
+                    "wall_s": goal["time_s"], "cpu_s": goal["cpu_s"],
+                    "us_per_unknown_wall": res["us_per_unknown_at_goal_tol"],
+                    "us_per_unknown_cpu": res["cpu_us_per_unknown_at_goal_tol"]})
+    return out
 
 
 def capture_verification_paths() -> list[tuple]:
     """(net, loads_at, levels, keywords) of every load path the 1:40 verification solves,
     recorded while it runs (serially, in this process)."""
-    import os
-
     import solver
     from printgen.run.api import verify
 
@@ -294,8 +315,14 @@ def goals(results: list[dict], paths: list[dict], tent: dict | None,
     big = at("241 x 81", "printgen")
     if big:
         out["time_241x81_s"] = big["time_s"]
+        out["cpu_241x81_s"] = big["cpu_s"]
     per = {res["size"]: res["us_per_unknown_at_goal_tol"] for res in results}
     out["us_per_unknown"] = per
+    cpu = {res["size"]: res["cpu_us_per_unknown_at_goal_tol"] for res in results
+           if res["unknowns"] >= LINEAR_FROM}
+    out["cpu_us_per_unknown"] = cpu
+    if len(cpu) > 1:  # issue 28: within 1.5x from 14k to 228k unknowns
+        out["cpu_us_per_unknown_spread"] = max(cpu.values()) / min(cpu.values())
     if tent:
         out["tent_iterations"] = {m: tent[m]["iterations"] for m in ("fast", "reference")}
     if paths:
@@ -305,14 +332,20 @@ def goals(results: list[dict], paths: list[dict], tent: dict | None,
     return out
 
 
-def run(out: Path, sizes: list[int], with_paths: bool = True) -> dict:
+def run(out: Path, sizes: list[int], with_paths: bool = True, threads: int = THREADS) -> dict:
+    from threadpoolctl import threadpool_limits
+
+    from solver.linsolve import pardiso_available
+
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     results = []
-    for k, size in enumerate(sizes, 1):  # progress on stderr: the largest size takes minutes
-        print(f"[{k}/{len(sizes)}] mesh x{size} ({time.perf_counter() - t0:.0f} s so far)",
-              file=sys.stderr, flush=True)
-        results.append(bench_size(size))
+    pardiso_available()  # loads MKL (when installed) before threadpoolctl pins its threads
+    with threadpool_limits(limits=threads):
+        for k, size in enumerate(sizes, 1):  # progress on stderr: the largest takes minutes
+            print(f"[{k}/{len(sizes)}] mesh x{size} ({time.perf_counter() - t0:.0f} s so far)",
+                  file=sys.stderr, flush=True)
+            results.append(bench_size(size))
     if with_paths:
         print("verification load paths ...", file=sys.stderr, flush=True)
     captured = capture_verification_paths() if with_paths else []
@@ -321,7 +354,9 @@ def run(out: Path, sizes: list[int], with_paths: bool = True) -> dict:
     paired = paired_ratio() if 1 in sizes else None
     report = {"benchmark": "bench_solver", "scene": "simple-pinned",
               "load": "hydrostatic at h = h_B + drag at 6 m/s, at the initial node height",
-              "reference_tol": REFERENCE_TOL, "goal_tol": GOAL_TOL, "sizes": results,
+              "reference_tol": REFERENCE_TOL, "goal_tol": GOAL_TOL, "blas_threads": threads,
+              "load_average": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
+              "size_table": size_table(results, threads), "sizes": results,
               "verification_paths": paths, "tent": tent, "robustness": robustness(),
               "opensees_paired": paired, "goals": goals(results, paths, tent, paired),
               "total_s": time.perf_counter() - t0}
@@ -336,9 +371,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sizes", type=int, nargs="+", default=list(SIZES),
                     help="mesh refinements: 1 = 61 x 21, 2 = 121 x 41, 4 = 241 x 81, 8 = 481 x 161")
     ap.add_argument("--no-paths", action="store_true", help="skip the verification load paths")
+    ap.add_argument("--threads", type=int, default=THREADS,
+                    help=f"BLAS/MKL threads of the size runs (default {THREADS})")
     ap.add_argument("--json", action="store_true", help="print the goals as JSON")
     a = ap.parse_args(argv)
-    report = run(a.out, a.sizes, not a.no_paths)
+    report = run(a.out, a.sizes, not a.no_paths, a.threads)
     for res in report["sizes"]:
         for r in res["runs"]:
             err = r.get("error")
@@ -349,6 +386,11 @@ def main(argv: list[str] | None = None) -> int:
                   f"{r.get('time_s', float('nan')):7.2f} s  it {r.get('iterations', '-')!s:4s} "
                   f"fact {r.get('factorizations', '-')!s:4s} error "
                   f"{'-' if err is None else f'{err:.1e}'}")
+    for row in report["size_table"]:
+        print(f"{row['size']:9s} {row['unknowns']:7d} unknowns  {row['backend']:8s} "
+              f"{row['blas_threads']} thread(s)  wall {row['wall_s']:6.2f} s  cpu "
+              f"{row['cpu_s']:6.2f} s  {row['us_per_unknown_cpu']:5.1f} us/unknown (cpu)  it "
+              f"{row['iterations']} fact {row['factorizations']}")
     for p in report["verification_paths"]:
         print(f"path {p['path']} ({p['nodes']} nodes, {p['levels']} levels): fast "
               f"{p['fast']['time_s']:.2f} s, {sum(p['fast']['iterations'])} it, "

@@ -5,12 +5,14 @@ rises: a (flow, z) entry with no (z, flow) partner). Backends, each optional and
 lazily (the `fast` extra), in the order `choose_backend` prefers them:
 
 - "pardiso" (MKL PARDISO via `pypardiso`, nets of PARDISO_MIN_DOFS unknowns and more): a
-  supernodal LU of A itself; its fill-reducing analysis runs once per net, every later step
-  only refactorizes numerically;
-- "ldl" (`qdldl`): a sparse LDL^T of the symmetric part S = (A + A^T) / 2, ordering computed
-  once per net, then GMRES on A preconditioned by S^-1 (a few iterations: the follower term
-  is a small part of A);
+  supernodal Cholesky (LDL^T once S proves indefinite) of the symmetric part
+  S = (A + A^T) / 2; its fill-reducing analysis runs once per net, every later step only
+  refactorizes numerically;
+- "ldl" (`qdldl`): a sparse LDL^T of S, ordering computed once per net;
 - "lu": scipy's SuperLU on A (always there; also the reference path's solver).
+
+With "pardiso" and "ldl", GMRES on A preconditioned by S^-1 takes care of the follower term
+(a few iterations: it is a small part of A).
 
 Every result is checked against A (backward error LINEAR_RTOL, or the inexact-Newton
 forcing); GMRES preconditioned by the factorization repairs a result that misses it, and
@@ -19,23 +21,26 @@ SuperLU on A is the last resort. The answer is always that of A.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from solver.pattern import Pattern
 
-if TYPE_CHECKING:
-    import scipy.sparse as sp
-
 LINEAR_RTOL = 1e-13  # backward error a solve must reach: |b - A x| <= tol (|A| |x| + |b|)
 GMRES_RTOL = 1e-14  # GMRES stops at this relative 2-norm residual at the latest
 GMRES_RESTART = 30  # GMRES iterations (one restart cycle) before falling back to SuperLU
-PARDISO_MIN_DOFS = 100_000  # from here on PARDISO's supernodal LU beats qdldl's LDL^T
-# (simple-pinned at 1e-6, 2 cores: even at 57k unknowns, 0.9 s against 2.5 s CPU per
-# factorization at 226k; its import and threads cost more than they save on small nets)
+PARDISO_MIN_DOFS = 6_500  # from here on PARDISO's supernodal Cholesky of S beats qdldl's
+# LDL^T (simple-pinned, 1 thread, CPU per numeric factorization: 3.4k unknowns 4 / 5 ms, 14k
+# 21 / 64 ms, 57k 76 / 690 ms; whole solve at tol 1e-6: 5.3k 0.29 / 0.21 s, 7.7k 0.37 /
+# 0.48 s, 14k 0.87 / 1.26 s: PARDISO's solves and set-up cost more on small nets)
+PARDISO_IPARM = {1: 1, 2: 2, 8: 0, 10: 13, 11: 0, 13: 0, 21: 1}  # MKL's iparm (1-based):
+# own settings, METIS ordering, no refinement, pivot perturbation 1e-13, no scaling or
+# matching, Bunch-Kaufman pivots (mtype -2); everything else MKL's zero default
 
 
 def ldl_available() -> bool:
@@ -78,28 +83,68 @@ def choose_backend(size: int) -> str:
 
 
 class Pardiso:
-    """One PARDISO instance per net: symbolic analysis once, numeric refactorizations after."""
+    """One MKL PARDISO instance per net, on the symmetric part S: its fill-reducing analysis
+    (METIS nested dissection) runs once, every later step only refactorizes numerically.
+
+    A Cholesky factorization (mtype 2) while S is positive definite; from the first
+    non-positive pivot on, Bunch-Kaufman LDL^T (mtype -2, pivots perturbed at 1e-13 of the
+    norm, analysed again once). No iterative refinement inside PARDISO (iparm 8 = 0) and no
+    scaling or matching (iparm 11, 13 = 0: S is symmetric): `Factorization` checks every
+    result against A and repairs it with GMRES.
+    """
 
     def __init__(self) -> None:
+        _mkl_hint()
         import pypardiso
 
-        self.solver = pypardiso.PyPardisoSolver(mtype=11)  # real, non-symmetric
+        self.error = pypardiso.pardiso_wrapper.PyPardisoError
+        self.solver = self._solver(2)
         self.analysed = False
-        self.A = None
+        self.S = None
+        self.empty = sp.csr_matrix((0, 0))  # what MKL's release phase is called with
 
-    def factor(self, A: sp.csr_matrix) -> None:
-        zero = np.zeros(A.shape[0])
-        if not self.analysed:
-            self.solver.set_phase(11)
-            self.solver._call_pardiso(A, zero)  # the documented direct call (pypardiso)
-            self.analysed = True
-        self.solver.set_phase(22)
-        self.solver._call_pardiso(A, zero)
-        self.A = A
+    @staticmethod
+    def _solver(mtype: int):
+        import pypardiso
+
+        solver = pypardiso.PyPardisoSolver(mtype=mtype)
+        for k, value in PARDISO_IPARM.items():
+            solver.iparm[k - 1] = value  # the 1-based numbering of MKL's documentation
+        return solver
+
+    def _call(self, phase: int, rhs: np.ndarray) -> np.ndarray:
+        self.solver.set_phase(phase)
+        return self.solver._call_pardiso(self.S, rhs)  # the documented direct call (pypardiso)
+
+    def factor(self, S: sp.csr_matrix) -> None:
+        """Factorize S, given as the CSR upper triangle of the same pattern at every call."""
+        self.S = S
+        zero = np.zeros(S.shape[0])
+        try:
+            if not self.analysed:
+                self._call(11, zero)
+                self.analysed = True
+            self._call(22, zero)
+        except self.error:
+            if self.solver.mtype != 2:
+                raise
+            self.free()
+            self.solver, self.analysed = self._solver(-2), True
+            self._call(11, zero)
+            self._call(22, zero)
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        self.solver.set_phase(33)
-        return self.solver._call_pardiso(self.A, np.asfortranarray(b))
+        return self._call(33, np.asfortranarray(b))
+
+    def free(self) -> None:
+        """Release MKL's memory of this instance (factors and analysis)."""
+        with contextlib.suppress(self.error):  # nothing allocated yet
+            self.solver.set_phase(-1)
+            self.solver._call_pardiso(self.empty, np.zeros(0))
+
+    def __del__(self) -> None:
+        with contextlib.suppress(Exception):  # at interpreter exit, modules may be gone
+            self.free()
 
 
 class Factorization:
@@ -117,13 +162,15 @@ class Factorization:
         self.symmetric = False
         self.lu: Any = None  # scipy's SuperLU, when it is needed
         self.ok = True
+        self.a_norm: float | None = None  # max row sum of |A|, once a solve needs it
+        self.last: tuple[np.ndarray, np.ndarray] | None = None  # (b, S^-1 b) of the last solve
         try:
             if backend == "ldl":
                 self._factor_ldl(data, handle)
             elif backend == "pardiso":
                 handle = handle if handle is not None else Pardiso()
-                handle.factor(self.A)
-                self.handle, self.direct = handle, handle.solve
+                handle.factor(pattern.symmetric_upper_csr(data))
+                self.handle, self.direct, self.symmetric = handle, handle.solve, True
         except Exception:  # noqa: BLE001 - a zero pivot or a solver error: SuperLU decides
             self.handle, self.direct = None, None
         if self.direct is None:
@@ -162,17 +209,24 @@ class Factorization:
         return x if np.all(np.isfinite(x)) else None
 
     def symmetric_solve(self, b: np.ndarray) -> np.ndarray | None:
-        """S^-1 b alone (a direction on the symmetric model), or None without an LDL^T."""
+        """S^-1 b alone (a direction on the symmetric model), or None without an LDL^T.
+        The last `solve` already computed it when `b` is its right-hand side: then no new
+        solve (and no reliance on the backend's object still holding this factorization)."""
         if not self.symmetric or self.direct is None:
             return None
-        with np.errstate(all="ignore"):
-            x = self.direct(b)
+        if self.last is not None and self.last[0] is b:
+            x = self.last[1].copy()
+        else:
+            with np.errstate(all="ignore"):
+                x = self.direct(b)
         return x if np.all(np.isfinite(x)) else None
 
     def _refined(self, b: np.ndarray, forcing: float) -> np.ndarray | None:
         """The direct solve, then GMRES on A preconditioned by it when that misses the
         target (the follower term, with an LDL^T of S); None unless the target is met."""
-        a_norm = float(abs(self.A).sum(axis=1).max()) if self.A.nnz else 0.0
+        if self.a_norm is None:
+            self.a_norm = float(abs(self.A).sum(axis=1).max()) if self.A.nnz else 0.0
+        a_norm = self.a_norm
         b_norm = float(np.abs(b).max()) if b.size else 0.0
 
         def good(x: np.ndarray) -> bool:
@@ -190,6 +244,7 @@ class Factorization:
         try:
             with np.errstate(all="ignore"):
                 x = direct(b)
+                self.last = (b, x.copy())
                 if good(x):
                     return x
                 if not np.all(np.isfinite(x)):

@@ -77,6 +77,11 @@ class Pattern:
                               shape=(self.size, self.size))
         self.upper = upper[order.data.astype(np.int64) - 1]
         self.upper_indices, self.upper_indptr = order.indices, order.indptr
+        self.upper_rows = np.flatnonzero(self.rows <= self.cols)  # CSR order: row, then column
+        self.upper_cols = self.cols[self.upper_rows]
+        self.upper_mirror = self.transpose[self.upper_rows]
+        self.upper_rows_indptr = np.concatenate(
+            [[0], np.cumsum(np.bincount(self.rows[self.upper_rows], minlength=self.size))])
 
     def scatter(self, values: np.ndarray) -> np.ndarray:
         """CSR data (nnz,) of all slot values (in slot order; summed where they coincide)."""
@@ -90,3 +95,9 @@ class Pattern:
         sym = 0.5 * (data + data[self.transpose])
         return sp.csc_matrix((sym[self.upper], self.upper_indices, self.upper_indptr),
                              shape=(self.size, self.size))
+
+    def symmetric_upper_csr(self, data: np.ndarray) -> sp.csr_matrix:
+        """The same upper triangle in CSR (what MKL PARDISO reads for a symmetric matrix)."""
+        sym = 0.5 * (data[self.upper_rows] + data[self.upper_mirror])
+        return sp.csr_matrix((sym, self.upper_cols,
+                              self.upper_rows_indptr), shape=(self.size, self.size))

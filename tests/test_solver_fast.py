@@ -10,7 +10,13 @@ import pytest
 
 from solver import Hydrostatic, Net, SlidingCable, linear, solve, solve_path
 from solver.driver import FastSolver
-from solver.linsolve import Factorization, choose_backend, ldl_available, pardiso_available
+from solver.linsolve import (
+    PARDISO_MIN_DOFS,
+    Factorization,
+    choose_backend,
+    ldl_available,
+    pardiso_available,
+)
 from solver.scenes import simple_scene, square_net
 from solver.state import NetSystem, evaluate, tangent_values
 
@@ -110,3 +116,101 @@ def test_unknown_method_is_rejected():
     sc = simple_scene()
     with pytest.raises(ValueError, match="method"):
         solve(sc.net, sc.loads_at(1.0), method="fastest")
+
+
+needs_pardiso = pytest.mark.skipif(not pardiso_available(), reason="pypardiso not installed")
+
+
+def _tangent(net: Net, loads: list) -> tuple[NetSystem, np.ndarray]:
+    """The fast path's tangent data of a net near its equilibrium (follower term included
+    when the water loads at the current node height)."""
+    ns = NetSystem(net)
+    ns.loads = loads
+    u = solve(net, loads, tol=1e-4).displacements / ns.L
+    return ns, tangent_values(ns, evaluate(ns, u))
+
+
+@needs_pardiso
+@pytest.mark.parametrize("case", ["pinned, follower load", "sliding cable"])
+def test_pardiso_backend_and_reference_agree(case):
+    """PARDISO (a Cholesky of the symmetric part, GMRES for the follower term) forced on
+    small nets, below PARDISO_MIN_DOFS: the reference path's equilibrium."""
+    if case == "sliding cable":
+        net, loads = _sliding_net()
+    else:
+        sc = simple_scene(current_z=True)
+        net, loads = sc.net, sc.loads_at(1.0)
+    fast = FastSolver(net, backend="pardiso").solve(loads, [], TIGHT, 400)
+    ref = solve(net, loads, tol=TIGHT, method="reference")
+    assert fast.converged and ref.converged and fast.backend == "pardiso"
+    assert _agree(fast.displacements, ref.displacements) < AGREE
+    assert _agree(fast.tensions, ref.tensions) < AGREE
+
+
+@needs_pardiso
+def test_pardiso_turns_to_ldlt_when_the_matrix_is_indefinite():
+    """A shift of the diagonal by half its largest entry makes S indefinite: the Cholesky
+    meets a negative pivot, PARDISO switches to Bunch-Kaufman LDL^T, the solve stays exact."""
+    ns, data = _tangent(*_sliding_net())
+    data = data.copy()
+    data[ns.pattern.diagonal] -= 0.5 * data[ns.pattern.diagonal].max()
+    A = ns.pattern.csr(data)
+    assert np.linalg.eigvalsh(0.5 * (A + A.T).toarray()).min() < 0  # indefinite indeed
+    fact = Factorization(ns.pattern, data, "pardiso")
+    assert fact.handle is not None and fact.handle.solver.mtype == -2
+    b = np.random.default_rng(2).normal(size=ns.pattern.size)
+    x = fact.solve(b)
+    assert np.linalg.norm(A @ x - b) <= LINEAR * np.linalg.norm(b)
+
+
+@needs_pardiso
+def test_a_failing_pardiso_falls_back_to_superlu(monkeypatch):
+    """PARDISO raising at the factorization or at a solve: SuperLU on A decides, and the
+    whole solve still ends on the reference equilibrium."""
+    from solver import linsolve
+
+    sc = simple_scene(current_z=True)
+    ns, data = _tangent(sc.net, sc.loads_at(1.0))
+    A = ns.pattern.csr(data)
+    b = np.random.default_rng(3).normal(size=ns.pattern.size)
+
+    def broken(self, *args):
+        raise RuntimeError("PARDISO failed")
+
+    monkeypatch.setattr(linsolve.Pardiso, "solve", broken)
+    fact = Factorization(ns.pattern, data, "pardiso")
+    assert fact.direct is not None  # factorized, then every solve fails
+    x = fact.solve(b)
+    assert fact.lu is not None and np.linalg.norm(A @ x - b) <= LINEAR * np.linalg.norm(b)
+    monkeypatch.setattr(linsolve.Pardiso, "factor", broken)
+    fact = Factorization(ns.pattern, data, "pardiso")
+    assert fact.direct is None and fact.lu is not None
+    fast = FastSolver(sc.net, backend="pardiso").solve(sc.loads_at(1.0), [], TIGHT, 400)
+    ref = solve(sc.net, sc.loads_at(1.0), tol=TIGHT, method="reference")
+    assert fast.converged and _agree(fast.displacements, ref.displacements) < AGREE
+
+
+def test_backend_by_size():
+    expect_small = "ldl" if ldl_available() else "lu"
+    assert choose_backend(PARDISO_MIN_DOFS - 1) == expect_small
+    assert choose_backend(PARDISO_MIN_DOFS) == ("pardiso" if pardiso_available() else expect_small)
+
+
+@pytest.mark.parametrize("backend", ["ldl", "pardiso"])
+def test_symmetric_solve_is_that_of_the_symmetric_part(backend):
+    """symmetric_solve(b) solves S x = b, whether b is the last solve's right-hand side (its
+    result is reused) or a new one."""
+    if (backend == "ldl" and not ldl_available()) or (
+            backend == "pardiso" and not pardiso_available()):
+        pytest.skip(f"{backend} not installed")
+    ns, data = _tangent(*_sliding_net())
+    A = ns.pattern.csr(data)
+    S = 0.5 * (A + A.T)
+    rng = np.random.default_rng(4)
+    fact = Factorization(ns.pattern, data, backend)
+    for b in (rng.normal(size=ns.pattern.size), rng.normal(size=ns.pattern.size)):
+        x = fact.solve(b)
+        assert np.linalg.norm(A @ x - b) <= LINEAR * np.linalg.norm(b)
+        for rhs in (b, rng.normal(size=ns.pattern.size)):
+            y = fact.symmetric_solve(rhs)
+            assert np.linalg.norm(S @ y - rhs) <= LINEAR * np.linalg.norm(rhs)
