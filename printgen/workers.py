@@ -24,6 +24,7 @@ import signal
 import sys
 import threading
 import time
+import warnings
 from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures import TimeoutError as FutureTimeout
@@ -36,6 +37,7 @@ PR_SET_PDEATHSIG = 1  # linux/prctl.h
 SIGNAL_NAMES = ("SIGINT", "SIGTERM", "SIGHUP")  # the stop signals; SIGHUP is POSIX only
 SYSTEM = sys.platform  # "linux", "darwin", "win32", ...
 READER_JOIN_S = 5.0  # the progress reader has only the queued reports left to pass on
+WATCH_THREAD = "printgen-parent-watch"  # the thread of `_watch_parent`
 
 
 @dataclass(frozen=True)
@@ -71,15 +73,34 @@ def platform() -> Platform:
 def start_method(plat: Platform | None = None) -> str:
     """`fork` on Linux while this process runs no other Python thread (forking a threaded
     process can deadlock the child on a lock another thread held, and Python 3.12+ warns: a
-    notebook kernel, a Dask client); else `forkserver` where it exists, except on macOS, whose
-    system libraries are unsafe after fork; else `spawn` (Windows)."""
+    notebook kernel, a Dask client) but this module's parent watch (`_watch_parent`: it only
+    waits on a file descriptor, holding no lock, and the child does not inherit it); else
+    `forkserver` where it exists, except on macOS, whose system libraries are unsafe after
+    fork; else `spawn` (Windows). A forked worker starts with its parent's imports; one of
+    the fork server imports printgen, numpy and scipy again (about 1 s of CPU each)."""
     plat = plat or platform()
     linux = plat.system.startswith("linux")
-    if "fork" in plat.start_methods and linux and threading.active_count() == 1:
+    if "fork" in plat.start_methods and linux and _one_thread():
         return "fork"
     if "forkserver" in plat.start_methods and plat.system != "darwin":
         return "forkserver"
     return "spawn"
+
+
+def _one_thread() -> bool:
+    """No Python thread runs here but the main one and the parent watch."""
+    return all(t is threading.main_thread() or t.name == WATCH_THREAD
+               for t in threading.enumerate())
+
+
+@contextlib.contextmanager
+def _watch_is_safe() -> Iterator[None]:
+    """Within the block, Python 3.12+'s warning that forking a process running threads may
+    deadlock the child is not shown: `start_method` forks only beside the parent watch."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=r".*multi-threaded, use of fork\(\)",
+                                category=DeprecationWarning)
+        yield
 
 
 class Interrupted(BaseException):
@@ -188,7 +209,7 @@ def _watch_parent() -> None:
         parent.join()
         os._exit(1)
 
-    threading.Thread(target=watch, name="printgen-parent-watch", daemon=True).start()
+    threading.Thread(target=watch, name=WATCH_THREAD, daemon=True).start()
 
 
 _listener: Callable[[str, float, float], None] | None = None  # set by `reporting`
@@ -282,7 +303,8 @@ def run_jobs(jobs: list[tuple]) -> list:
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=init_worker,
                                initargs=(plat, queue, _deadline))
     try:
-        futures = [pool.submit(fn, *args, **kw) for fn, args, kw in jobs]
+        with _watch_is_safe():
+            futures = [pool.submit(fn, *args, **kw) for fn, args, kw in jobs]
         if queue is not None:  # started once the workers are: fork only a one-thread process
             reader = threading.Thread(target=_drain, args=(queue, _listener), daemon=True)
             reader.start()

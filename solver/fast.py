@@ -16,12 +16,14 @@ same energy line search and step cap), computed with less work per step and fewe
   follower load can make the damped tangent indefinite);
 - inexact Newton: linear solves to a residual of min(FORCING, |R| / force scale);
 - an active set on the tension-only law: the slack strands a step stretches past their
-  rest length get their stiffness (and the pull their strain offset implies) in its model, and the step is solved again until that set
-  stops changing (a primal-dual active set on the piecewise quadratic model, at most
-  PDAS_PASSES re-solves, starting from the last step's set). Without it a free-top net's
-  dry strands, slack and held only by the hold of unloaded nodes, let a step run through
-  their rest length unresisted: the line search cut it to a few per cent for hundreds of
-  iterations (simple barrier's model at 1:40, h/h_B = 0.05: 311 iterations, now ~45).
+  rest length get their stiffness (and the pull their strain offset implies) in its model,
+  and the step is solved again until that set stops changing (a primal-dual active set on
+  the piecewise quadratic model, at most PDAS_PASSES re-solves, each by GMRES preconditioned
+  by the step's own factorization: one factorization per Newton step); the set the last
+  pass predicts is the next step's first guess. Without it a free-top net's dry strands,
+  slack and held only by the hold of unloaded nodes, let a step run through their rest
+  length unresisted: the line search cut it to a few per cent for hundreds of iterations
+  (simple barrier's model at 1:40, first loaded level: 311 iterations, now 39).
 
 The tangent is not symmetric (hydrostatic follower term): every step solves the true
 system; the symmetric part only serves as a factorization to precondition it
@@ -36,7 +38,14 @@ from collections.abc import Callable
 
 import numpy as np
 
-from solver.linsolve import Factorization, choose_backend
+from solver.linsolve import (
+    GMRES_RESTART,
+    GMRES_RTOL,
+    LINEAR_RTOL,
+    Factorization,
+    choose_backend,
+    gmres,
+)
 from solver.newton import (
     ARMIJO,
     MAX_BACKTRACK,
@@ -58,8 +67,9 @@ CHORD_MIN_DOFS = 10_000  # below, a factorization costs less than the trial stat
 START_SPAN = (-6.0, 0.0)  # log10 of the membrane start's largest displacement / net extent
 START_GRID = 13  # potentials sampled over START_SPAN before the scalar minimisation
 START_XTOL = 0.01  # log10 resolution of the membrane start's scale
-PDAS_PASSES = 3  # active-set re-solves per Newton step at most (simple barrier's model at
-# 1:40, h/h_B = 0.05: 3 passes 45 iterations / 162 factorizations, 8 passes 36 / 207, none 311)
+PDAS_PASSES = 1  # active-set re-solves per Newton step at most, each by GMRES on the first
+# pass's factorization (simple barrier 1:40, worst level of the model / prototype sweeps: 1 pass
+# 39 / 44 iterations, 3 passes 35 / 50, 6 passes 32 / 47 at 1.3-1.8 x the CPU of 1 pass)
 
 
 class Stepper:
@@ -150,13 +160,13 @@ def _active_set_step(ns: NetSystem, st: State, stepper: Stepper, boost: float, f
     if stepper.active is not None:
         active = slack & stepper.active
     fact = step = rhs = None
+    new = active
     for _ in range(PDAS_PASSES + 1):
         tan = np.where(active, ns.first_slope, tangent)
-        trial = stepper.newton(dataclasses.replace(st, bar=(eps, force, tan, d, l)), boost)
-        fo = np.where(active, ns.first_slope * eps, 0.0)[:, None] * nvec
-        off = np.zeros((ns.n, 3))
-        for k in range(3):
-            off[:, k] = np.bincount(b.j, fo[:, k], ns.n) - np.bincount(b.i, fo[:, k], ns.n)
+        at = dataclasses.replace(st, bar=(eps, force, tan, d, l))
+        trial = stepper.newton(at, boost) if fact is None else Updated(
+            ns.pattern.csr(stepper.matrix(at, boost)), getattr(fact, "base", fact))
+        off = ns.incidence @ (np.where(active, ns.first_slope * eps, 0.0)[:, None] * nvec)
         new_rhs = -st.r - off.ravel()[ns.free]
         new_step = trial.solve(new_rhs, forcing)
         if new_step is None:
@@ -166,11 +176,41 @@ def _active_set_step(ns: NetSystem, st: State, stepper: Stepper, boost: float, f
         fact, step, rhs = trial, new_step, new_rhs
         du = _moved(ns, np.zeros_like(st.u), step)
         new = slack & (eps + np.einsum("ij,ij->i", nvec, du[b.j] - du[b.i]) / b.rest > 0)
-        if np.array_equal(new, active) or PDAS_PASSES == 0:
+        if np.array_equal(new, active):
             break
         active = new
-    stepper.active = active
+    stepper.active = new  # the set the last step predicts: the next step's first guess
     return fact, step, rhs
+
+
+class Updated:
+    """The system of an active-set re-pass, solved by GMRES preconditioned by the pass
+    before's factorization (the matrices differ by the few strands whose state changed), and
+    factorized afresh only when that misses the target."""
+
+    def __init__(self, A, base: Factorization) -> None:
+        self.A, self.base = A, base
+        self.handle = base.handle
+
+    def solve(self, b: np.ndarray, forcing: float = 0.0) -> np.ndarray | None:
+        base = self.base
+        precondition = base.direct if base.direct is not None else (
+            base.lu.solve if base.lu is not None else None)
+        if precondition is not None:
+            with np.errstate(all="ignore"):
+                x0 = np.zeros_like(b)
+                target = max(forcing * float(np.abs(b).max()), 0.0)
+                x = gmres(self.A, precondition, b, x0, max(target, GMRES_RTOL * float(
+                    np.linalg.norm(b))), GMRES_RESTART)
+            if np.all(np.isfinite(x)) and float(np.abs(b - self.A @ x).max()) <= max(
+                    target, LINEAR_RTOL * (float(abs(self.A).sum(axis=1).max())
+                                           * float(np.abs(x).max()) + float(np.abs(b).max()))):
+                return x
+        fresh = Factorization(base.pattern, self.A.data, base.backend, None)
+        return fresh.solve(b, forcing)
+
+    def symmetric_solve(self, b: np.ndarray) -> np.ndarray | None:
+        return self.base.symmetric_solve(b)
 
 
 def _chord_step(ns: NetSystem, st: State, fact: Factorization) -> State | None:

@@ -260,29 +260,44 @@ def gmres(A: sp.csr_matrix, precondition: Callable[[np.ndarray], np.ndarray], b:
           x0: np.ndarray, target: float, m: int) -> np.ndarray:
     """One cycle of right-preconditioned GMRES(m): x0 + M^-1 V y minimising |b - A x|_2 over
     the Krylov space of A M^-1, stopped when |b - A x|_2 <= target (classical Gram-Schmidt,
-    twice; least squares on the small Hessenberg matrix)."""
+    twice; the Hessenberg matrix reduced by Givens rotations as it grows, so the residual
+    norm is known at every step without a least-squares solve)."""
     r0 = b - A @ x0
     beta = float(np.linalg.norm(r0))
     if beta <= target or beta == 0.0:
         return x0
-    V = np.zeros((m + 1, len(b)))
-    Z = np.zeros((m, len(b)))
-    H = np.zeros((m + 1, m))
-    V[0] = r0 / beta
-    e1 = np.zeros(m + 1)
-    e1[0] = beta
-    y: np.ndarray = np.zeros(0)
+    V, Z = [r0 / beta], []
+    R = np.zeros((m, m))  # the rotated (upper triangular) Hessenberg matrix
+    cs, sn = np.zeros(m), np.zeros(m)
+    g = np.zeros(m + 1)
+    g[0] = beta
+    k = 0
     for k in range(m):
-        Z[k] = precondition(V[k])
+        Z.append(precondition(V[k]))
         w = A @ Z[k]
+        Vk = np.array(V)
+        h = np.zeros(k + 2)
         for _ in range(2):
-            h = V[: k + 1] @ w
-            w -= h @ V[: k + 1]
-            H[: k + 1, k] += h
-        H[k + 1, k] = float(np.linalg.norm(w))
-        y, *_ = np.linalg.lstsq(H[: k + 2, : k + 1], e1[: k + 2], rcond=None)
-        res = float(np.linalg.norm(H[: k + 2, : k + 1] @ y - e1[: k + 2]))
-        if res <= target or H[k + 1, k] == 0.0:
+            c = Vk @ w
+            w = w - c @ Vk
+            h[: k + 1] += c
+        h[k + 1] = float(np.linalg.norm(w))
+        for i in range(k):  # the earlier rotations, then this column's own
+            h[i], h[i + 1] = cs[i] * h[i] + sn[i] * h[i + 1], -sn[i] * h[i] + cs[i] * h[i + 1]
+        rho = float(np.hypot(h[k], h[k + 1]))
+        cs[k], sn[k] = (h[k] / rho, h[k + 1] / rho) if rho > 0 else (1.0, 0.0)
+        R[: k + 1, k] = h[: k + 1]
+        R[k, k] = rho
+        g[k + 1] = -sn[k] * g[k]
+        g[k] = cs[k] * g[k]
+        if abs(g[k + 1]) <= target or h[k + 1] == 0.0 or rho == 0.0:
             break
-        V[k + 1] = w / H[k + 1, k]
-    return x0 + y @ Z[: len(y)]
+        V.append(w / h[k + 1])
+    n = k + 1
+    diag = np.abs(np.diag(R[:n, :n]))
+    while n and diag[n - 1] == 0.0:  # a breakdown column: solve on the ones before it
+        n -= 1
+    if not n:
+        return x0
+    y = np.linalg.solve(np.triu(R[:n, :n]), g[:n])
+    return x0 + y @ np.array(Z[:n])

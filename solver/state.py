@@ -32,6 +32,9 @@ class NetSystem:
         self.pattern = Pattern(self.n, self.free, self.bars.i, self.bars.j,
                                [c.nodes for c in self.cables])
         self.damping = self._damping()
+        m = len(self.bars.rest)  # node-by-strand incidence: +1 at the strand's j, -1 at its i
+        self.incidence = sp.csr_matrix((np.repeat([1.0, -1.0], m), (np.concatenate(
+            [self.bars.j, self.bars.i]), np.tile(np.arange(m), 2))), shape=(self.n, m))
         self.loads: list = []
         # each strand's slope just above zero strain: its stiffness once a slack strand pulls
         self.first_slope = np.array([law.slopes[0] for law in self.bars.laws])[
@@ -160,10 +163,7 @@ def evaluate(ns: NetSystem, u: np.ndarray) -> State:
     """Forces, energy and strand states at u, in one pass over the strands."""
     b = ns.bars
     eps, force, tangent, d, l = _bar_pass(b, u)
-    fn = (force / l)[:, None] * d
-    g = np.zeros((ns.n, 3))
-    for k in range(3):
-        g[:, k] = (np.bincount(b.j, fn[:, k], ns.n) - np.bincount(b.i, fn[:, k], ns.n))
+    g = ns.incidence @ ((force / l)[:, None] * d)
     energy = bar_energy(b, eps)
     scales = [float(force.max()) if force.size else 0.0]
     cab: tuple = ()
@@ -197,10 +197,10 @@ def tangent_values(ns: NetSystem, st: State) -> np.ndarray:
     """CSR data of the tangent K - dF_ext/du at a state (the pattern's slot order)."""
     _, force, tangent, d, l = st.bar
     n = d / l[:, None]
-    nn = np.einsum("ki,kj->kij", n, n)
-    geo = np.where(force > 0, force / l, 0.0)[:, None, None]
-    mat = (tangent / ns.bars.rest)[:, None, None]
-    vals = [pair_values(geo * (np.eye(3)[None] - nn) + mat * nn).ravel()]
+    geo = np.where(force > 0, force / l, 0.0)
+    blocks = (tangent / ns.bars.rest - geo)[:, None, None] * (n[:, :, None] * n[:, None, :])
+    blocks[:, [0, 1, 2], [0, 1, 2]] += geo[:, None]  # geo (I - n n^T) + mat n n^T
+    vals = []
     cs = ns.cable_set
     for k, c in enumerate(ns.cables):
         t, kt = st.cab[0][k], st.cab[1][k]
@@ -219,4 +219,4 @@ def tangent_values(ns: NetSystem, st: State) -> np.ndarray:
     hyd = np.zeros((ns.n, 3, 3))
     hyd[:, :, 2] = -st.dz
     vals.append(hyd.ravel())
-    return ns.pattern.scatter(np.concatenate(vals))
+    return ns.pattern.assemble(blocks, np.concatenate(vals))

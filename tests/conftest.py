@@ -3,8 +3,12 @@
 from __future__ import annotations
 
 import os
+import pickle
 import shutil
+import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -77,17 +81,64 @@ def design_1_40():
     return reference_design_1_40()
 
 
+SHARED_RUN_WAIT_S = 3600.0  # a whole make on a machine loaded many times over, with slack
+POLL_S = 0.2
+
+
+def shared_run(tmp_path_factory, name: str, build: Callable[[Path], Any]) -> Any:
+    """`build(folder)` once per test session, also under pytest-xdist: a session-scoped
+    fixture is per worker there, so the first worker to ask builds (into its own temporary
+    folder) and pickles the result; the other workers wait for it and load it. The result
+    and its folder are read only (a test that changes them copies them first). The files are
+    named for the test run (xdist's run id): a --basetemp reused by a later run, whose workers
+    empty only their own folders, never hands that run an old result."""
+    if os.environ.get("PYTEST_XDIST_WORKER") is None:
+        return build(tmp_path_factory.mktemp(name))
+    root = tmp_path_factory.getbasetemp().parent  # the session's, above each worker's
+    stem = f"{name}.{os.environ.get('PYTEST_XDIST_TESTRUNUID', 'run')}"
+    done, failed = root / f"{stem}.pickle", root / f"{stem}.failed"
+    try:
+        fd = os.open(root / f"{stem}.claim", os.O_CREAT | os.O_EXCL | os.O_WRONLY)
+    except FileExistsError:
+        return _wait_for(done, failed)
+    os.close(fd)
+    try:
+        result = build(tmp_path_factory.mktemp(name))
+    except BaseException as exc:
+        failed.write_text(f"{type(exc).__name__}: {exc}")
+        raise
+    part = root / f"{stem}.pickle.part"
+    part.write_bytes(pickle.dumps(result))
+    part.replace(done)  # the waiting workers see the whole file or none
+    return result
+
+
+def _wait_for(done: Path, failed: Path) -> Any:
+    deadline = time.monotonic() + SHARED_RUN_WAIT_S
+    while not done.exists():
+        if failed.exists():
+            pytest.fail(f"the shared run failed in another worker: {failed.read_text()}")
+        if time.monotonic() > deadline:
+            pytest.fail(f"{done.name} not written within {SHARED_RUN_WAIT_S:g} s")
+        time.sleep(POLL_S)
+    return pickle.loads(done.read_bytes())
+
+
 @pytest.fixture(scope="session")
 def made_1_40(tmp_path_factory):
-    """One whole `make` of the 1:40 example (examples/realistic_barrier.toml) per session,
-    (its MakeContext, its output folder), for every test that only reads the outputs: a
-    test that changes them makes its own run."""
+    """One whole `make` of the 1:40 example (examples/realistic_barrier.toml) per session
+    (`shared_run`: one for all xdist workers), (its MakeContext, its output folder), for every
+    test that only reads the outputs: a test that changes them copies them or makes its own
+    run."""
+    return shared_run(tmp_path_factory, "make-1-40", _make_1_40)
+
+
+def _make_1_40(tmp: Path):
     from proto_files import REALISTIC
 
     import printgen.run.make as make_mod
 
-    out = tmp_path_factory.mktemp("make-1-40") / "out"
-    return make_mod.make(REALISTIC, 40, out), out
+    return make_mod.make(REALISTIC, 40, tmp / "out"), tmp / "out"
 
 
 COARSE_SIMPLE = {("net", "mesh_x_m"): 0.4, ("net", "mesh_y_m"): 0.4,
@@ -98,14 +149,17 @@ COARSE_SIMPLE = {("net", "mesh_x_m"): 0.4, ("net", "mesh_y_m"): 0.4,
 def made_simple_drag(tmp_path_factory):
     """One `make` of the simple barrier (no border cables) on a coarse mesh (COARSE_SIMPLE),
     its verification step only, under the drag load case, run inline (PRINTGEN_SERIAL=1: no
-    helper process) per session: (its MakeContext, its output folder, its prototype file),
-    for the tests that read the verification step's record and report."""
+    helper process) per session (`shared_run`): (its MakeContext, its output folder, its
+    prototype file), for the tests that read the verification step's record and report."""
+    return shared_run(tmp_path_factory, "make-simple-drag", _make_simple_drag)
+
+
+def _make_simple_drag(tmp: Path):
     from proto_files import SIMPLE, write_variant
 
     import printgen.run.make as make_mod
     from printgen.run import api
 
-    tmp = tmp_path_factory.mktemp("make-simple-drag")
     path = write_variant(tmp, COARSE_SIMPLE, base=SIMPLE)
     verify_only = [s for s in make_mod.default_steps() if s[1] is make_mod.verify_step]
     with pytest.MonkeyPatch.context() as mp:

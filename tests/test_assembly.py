@@ -84,18 +84,20 @@ def test_the_checklist_gives_the_kit_numbers(kit):
     assert f"{a.net_size_mm[0]:.1f} mm" in text
 
 
-def test_make_shows_the_kit_and_the_toolpath_previews(tmp_path):
-    """The kit step writes the labelled assembly picture and per-pass previews into the
-    output and the report, with the checklist and the closing verdict."""
-    from printgen.run.make import kit_step
-
-    ctx = plan(EXAMPLES / "realistic_barrier.toml", 60)
-    rec = kit_step(ctx, tmp_path)
-    pngs = sorted(p.name for p in tmp_path.glob("*.png"))
+def test_make_shows_the_kit_and_the_toolpath_previews(made_1_40):
+    """The kit step (of the session's 1:40 run) writes the labelled assembly picture and
+    per-pass previews into the output and the report, with the checklist and the closing
+    verdict."""
+    ctx, out = made_1_40
+    pngs = sorted(p.name for p in out.glob("*.png"))
     assert pngs == ["assembly.png", "preview-cable-left.png", "preview-net-whole.png",
                     "preview-net.png"]
-    assert all((tmp_path / p).read_bytes().startswith(b"\x89PNG") for p in pngs)
-    html = ctx.report.html()
-    assert "Assembly" in html and "Toolpath previews" in html and "Check after printing" in html
-    assert html.count("<img") == 4 and "PASS" in html
-    assert rec["assembly"]["closes"] is True
+    assert all((out / p).read_bytes().startswith(b"\x89PNG") for p in pngs)
+    assert (out / "assembly.png").read_bytes() == (out / "figures" / "01-assembly.png").read_bytes()
+    html = (out / "report.html").read_text()
+    start = html.index("<h2>Assembly</h2>")
+    previews = html.index("<h2>Toolpath previews</h2>", start)
+    kit = html[start:html.index("<h2>", previews + 1)]
+    assert "Check after printing" in kit[:previews - start]
+    assert kit.count("<img") == 4 and '<span class="pass">PASS</span>' in kit
+    assert ctx.record["assembly"]["closes"] is True

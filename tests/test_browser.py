@@ -12,8 +12,10 @@ Without Chromium the test skips locally and fails under CI (`require_tool`); `sc
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 import re
+import shutil
 import subprocess
 
 import numpy as np
@@ -57,12 +59,23 @@ window.addEventListener("load", function () {
 
 
 @pytest.fixture(scope="module")
-def made(tmp_path_factory):
-    """One whole `make` of the 1:40 example for the module, with report.pdf when Chromium is
-    there: (output folder, the run's context)."""
-    out = tmp_path_factory.mktemp("browser") / "out"
-    ctx = make_mod.make(REALISTIC, 40, out, options=make_mod.MakeOptions(pdf=True))
+def made(made_1_40):
+    """The session's whole `make` of the 1:40 example: (output folder, the run's context)."""
+    ctx, out = made_1_40
     return out, ctx
+
+
+@pytest.fixture(scope="module")
+def printed(made, tmp_path_factory):
+    """report.pdf of the 1:40 example: make's PDF step (`report_pdf`, what `make --pdf` runs
+    after writing report.html) on a copy of the shared run's folder, with a context of its own
+    (the shared one is read only): (the copy, the files the step added)."""
+    out, ctx = made
+    copy = tmp_path_factory.mktemp("printed") / "out"
+    shutil.copytree(out, copy)
+    own = dataclasses.replace(ctx, record={}, files=[])
+    make_mod.report_pdf(own, copy, None)
+    return copy, own.files
 
 
 @pytest.fixture(scope="module")
@@ -199,17 +212,27 @@ def test_no_reference_to_a_file_the_package_lacks(made):
         assert name in shipped, name
 
 
-def test_report_pdf_has_pages_and_text(made):
+def test_report_pdf_has_pages_and_text(printed):
     require_tool("chromium")
     pypdf = pytest.importorskip("pypdf")
-    out, _ = made
-    pdf = out / "report.pdf"
-    assert pdf.is_file() and "report.pdf" in json.loads((out / "manifest.json").read_text())[
-        "files"]
-    reader = pypdf.PdfReader(pdf)
+    out, added = printed
+    assert added == ["report.pdf"]
+    reader = pypdf.PdfReader(out / "report.pdf")
     assert len(reader.pages) >= MIN_PDF_PAGES
     first = reader.pages[0].extract_text()
     assert "Summary" in first and "FAIL" in first
+
+
+def test_make_pdf_writes_report_pdf_into_the_folder_and_its_manifest(tmp_path):
+    """`make` with options.pdf runs that step and lists report.pdf (targets, selection and
+    design only: the PDF step does not depend on the other steps' files)."""
+    require_tool("chromium")
+    pypdf = pytest.importorskip("pypdf")
+    out = tmp_path / "out"
+    ctx = make_mod.make(REALISTIC, 40, out, steps=[], options=make_mod.MakeOptions(pdf=True))
+    assert "report.pdf" in json.loads((out / "manifest.json").read_text())["files"]
+    assert "report.pdf" in ctx.record["files"] and "pdf_skipped" not in ctx.record
+    assert len(pypdf.PdfReader(out / "report.pdf").pages) >= 1
 
 
 def _read_csv(path) -> dict[str, list[float]]:

@@ -2,11 +2,13 @@
 
 The platform is simulated on this Linux machine: those calls are removed (monkeypatched, or
 blocked in a child interpreter) and printgen must import, answer --help, start its workers by
-`spawn` with a watchdog in place of the parent-death signal, and run `make` end to end.
+`spawn` with a watchdog in place of the parent-death signal, and run `make` end to end,
+writing the same files as on Linux.
 """
 
 from __future__ import annotations
 
+import json
 import multiprocessing
 import os
 import signal
@@ -20,9 +22,11 @@ import pytest
 from conftest import alive
 from proto_files import REALISTIC
 
+import printgen.run.make as make_mod
 from printgen import workers
 from printgen.cli import main
-from printgen.outputs import lock
+from printgen.outputs import folder_files, lock
+from printgen.report.jsonout import dumps
 
 ROOT = Path(__file__).resolve().parents[1]
 LINUX_ONLY = ("fcntl", "termios", "resource", "pty", "tty", "grp", "pwd")  # absent on Windows
@@ -161,14 +165,32 @@ def test_the_watchdog_ends_workers_whose_parent_was_killed(tmp_path):
 
 
 @pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="workers need 2 cores")
-def test_make_end_to_end_on_a_platform_without_fork_prctl_sighup_fcntl(tmp_path, monkeypatch):
+def test_make_on_a_platform_without_fork_prctl_sighup_fcntl_gives_the_same_files(
+        made_1_40, tmp_path, monkeypatch):
+    """`make` end to end where there is no fork, prctl, SIGHUP or fcntl: the verification's
+    helper process and its pool start by spawn, the output folder is locked the exclusive
+    way, `printgen check` (the command line's signal handling without SIGHUP) passes, and every
+    file but the volatile timings.json is byte-identical to the shared run's (made on Linux,
+    with fork), its `--json` record too but for "timings": the same input gives the same files
+    on any platform and in any run. (One second whole make of the 1:40 example for both
+    checks; they were two runs, issue 24.)"""
+    made, first = made_1_40
     locked = simulate_windows(monkeypatch)
     asked: list[str] = []
     get_context = multiprocessing.get_context
     monkeypatch.setattr(multiprocessing, "get_context",
                         lambda method=None: asked.append(method) or get_context(method))
     out = tmp_path / "o"
-    assert main(["make", str(REALISTIC), "-s", "40", "--out", str(out)]) == 0
+    again = make_mod.make(REALISTIC, 40, out)
     assert asked and set(asked) == {"spawn"}  # the verification's helper process and its pool
     assert locked == [out] and not lock.lock_path(out).exists()  # lock file created, removed
     assert main(["check", str(out)]) == 0
+    names = folder_files(first)
+    assert names == folder_files(out)
+    volatile = json.loads((first / "manifest.json").read_text())["volatile"]
+    assert volatile == ["timings.json"]
+    for name in set(names) - set(volatile):
+        assert (out / name).read_bytes() == (first / name).read_bytes(), name
+    one, two = make_mod.json_output(made.record), make_mod.json_output(again.record)
+    assert one.pop("timings") != two.pop("timings")  # wall-clock times differ
+    assert dumps(one) == dumps(two)

@@ -96,3 +96,30 @@ def _state(pid: int) -> str:
     except OSError:
         return "Z"
     return text[text.rindex(")") + 2]
+
+
+def _how_it_starts_workers() -> tuple[str, list[str], list[str]]:
+    """In a helper: its start method, its threads, and how its own workers started."""
+    names = [t.name for t in threading.enumerate()]
+    return workers.start_method(), names, workers.run_jobs([(workers.start_method, (), {})] * 2)
+
+
+@two_cores
+@pytest.mark.skipif(not workers.SYSTEM.startswith("linux"), reason="fork: Linux only")
+def test_a_helper_started_by_the_fork_server_forks_its_own_workers(monkeypatch):
+    """Under the command line a spinner thread runs beside make, so its helper starts by the
+    fork server and watches its parent from a thread; the helper's workers (the sweeps', the
+    figures') still start by fork, with its imports, not from a fork server of their own."""
+    monkeypatch.delenv("PRINTGEN_SERIAL", raising=False)
+    stop = threading.Event()
+    spinner = threading.Thread(target=stop.wait)
+    spinner.start()
+    try:
+        assert workers.start_method() == "forkserver"
+        with workers.helper() as h:
+            method, threads, theirs = h.submit(_how_it_starts_workers).result()
+    finally:
+        stop.set()
+        spinner.join()
+    assert workers.WATCH_THREAD in threads and method == "fork"
+    assert theirs == ["fork", "fork"]  # in the helper's workers: no watch, one thread

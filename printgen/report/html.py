@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import base64
 import html
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 CSS = """
 body { font-family: system-ui, sans-serif; max-width: 1100px; margin: 2em auto; color: #222;
@@ -34,6 +36,30 @@ class FigureFile:
     png: bytes
     svg: bytes
     labels: tuple[tuple[str, tuple[str, ...]], ...] = ()  # (axis title, its axis labels)
+    also: str = ""  # a file beside the report the PNG is written to as well (assembly.png)
+
+
+@dataclass(frozen=True)
+class Drawing:
+    """A figure still to be drawn: `fn(*args, **kwargs)` gives its PNG bytes (carrying their
+    SVG: printgen.report.plots). A module-level function and picklable arguments, so that
+    `Report.draw` can draw a report's figures side by side in worker processes."""
+
+    fn: Callable[..., bytes]
+    args: tuple = ()
+    kwargs: dict[str, Any] = field(default_factory=dict)
+
+    def job(self) -> tuple:
+        """(fn, args, kwargs), as printgen.workers.run_jobs takes it."""
+        return self.fn, self.args, self.kwargs
+
+
+class _Slot(str):
+    """The place in `Report.blocks` of a figure not drawn yet (its HTML comes with
+    `Report.fill`); `file` holds its place in `Report.figures`."""
+
+    drawing: Drawing
+    file: FigureFile
 
 
 @dataclass
@@ -62,24 +88,69 @@ class Report:
         body = "".join("<tr>" + "".join(_cell(v) for v in r) + "</tr>" for r in rows)
         self.blocks.append(f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
 
-    def figure(self, png: bytes, caption: str, name: str = "") -> None:
+    def figure(self, png: bytes | Drawing, caption: str, name: str = "", also: str = ""
+               ) -> None:
         """Embed `png`; when it carries its SVG (printgen.report.plots), keep both as the
-        figure `name` (default: from the caption) for the files beside the report."""
-        svg = getattr(png, "svg", None)
-        if svg is not None:
-            labels = tuple((t, tuple(names)) for t, names in getattr(png, "labels", ()))
-            self.figures.append(FigureFile(name or slug(caption), caption, bytes(png), svg,
-                                           labels))
-        data = base64.b64encode(png).decode("ascii")
-        self.blocks.append(f'<figure><img alt="{html.escape(caption)}" '
-                           f'src="data:image/png;base64,{data}"><figcaption>'
-                           f"{html.escape(caption)}</figcaption></figure>")
+        figure `name` (default: from the caption) for the files beside the report (and the
+        PNG as `also` too, when given). A `Drawing` keeps its places (in `blocks` and
+        `figures`) until `fill` puts it in."""
+        name = name or slug(caption)
+        if isinstance(png, Drawing):
+            slot = _Slot(f"<!-- figure {name}: to be drawn -->")
+            slot.drawing, slot.file = png, FigureFile(name, caption, b"", b"", also=also)
+            self.blocks.append(slot)
+            self.figures.append(slot.file)
+            return
+        file = _figure_file(png, caption, name, also)
+        if file is not None:
+            self.figures.append(file)
+        self.blocks.append(_figure_block(png, caption))
+
+    def pending(self) -> list[Drawing]:
+        """The drawings of the figures not drawn yet, in report order."""
+        return [b.drawing for b in self.blocks if isinstance(b, _Slot)]
+
+    def fill(self, pngs: list[bytes]) -> None:
+        """Put in the figures of `pending`, drawn (`pngs`, in its order)."""
+        slots = [(k, b) for k, b in enumerate(self.blocks) if isinstance(b, _Slot)]
+        if len(pngs) != len(slots):
+            raise ValueError(f"{len(pngs)} figures drawn for {len(slots)} to draw")
+        for (k, slot), png in zip(slots, pngs, strict=True):
+            at = next(i for i, f in enumerate(self.figures) if f is slot.file)
+            file = _figure_file(png, slot.file.caption, slot.file.name, slot.file.also)
+            self.figures[at:at + 1] = [] if file is None else [file]
+            self.blocks[k] = _figure_block(png, slot.file.caption)
+
+    def draw(self) -> None:
+        """Draw the figures not drawn yet, side by side in worker processes when there are
+        several and two cores (printgen.workers.run_jobs), and put them in."""
+        from printgen.workers import run_jobs
+
+        todo = self.pending()
+        if todo:
+            self.fill(run_jobs([d.job() for d in todo]))
 
     def html(self) -> str:
+        self.draw()
         body = "\n".join(self.blocks)
         return (f"<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
                 f"<title>{html.escape(self.title)}</title><style>{CSS}</style></head>\n"
                 f"<body><h1>{html.escape(self.title)}</h1>\n{self.lead}\n{body}\n</body></html>\n")
+
+
+def _figure_file(png: bytes, caption: str, name: str, also: str) -> FigureFile | None:
+    """The figure's files when `png` carries its SVG (printgen.report.plots), else None."""
+    svg = getattr(png, "svg", None)
+    if svg is None:
+        return None
+    labels = tuple((t, tuple(names)) for t, names in getattr(png, "labels", ()))
+    return FigureFile(name, caption, bytes(png), svg, labels, also)
+
+
+def _figure_block(png: bytes, caption: str) -> str:
+    data = base64.b64encode(png).decode("ascii")
+    return (f'<figure><img alt="{html.escape(caption)}" src="data:image/png;base64,{data}">'
+            f"<figcaption>{html.escape(caption)}</figcaption></figure>")
 
 
 def _cell(v: object) -> str:

@@ -1,5 +1,6 @@
-"""Figures of the kit for the report (PNG bytes): how the parts go together, and top views
-of the direct toolpaths per pass with every bead at its true width, coloured by path."""
+"""Figures of the kit for the report (PNG bytes, and `kit_figures`' drawings of them): how
+the parts go together, and top views of the direct toolpaths per pass with every bead at its
+true width, coloured by path."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import numpy as np
 
 from printgen.parts.assembly import Assembly
 from printgen.parts.gcode.toolpath import Toolpath
+from printgen.report.html import Drawing
 from printgen.report.plots import _png, _pyplot
 
 if TYPE_CHECKING:
@@ -23,7 +25,7 @@ def assembly_figure(a: Assembly, outline: Polygon) -> bytes:
     """The net (`outline`, shapely polygon in net coordinates), the four cables threading its
     loops, and the eyelets on the flume's anchor pins; a corner enlarged below."""
     plt = _pyplot()
-    fig, (ax, zoom) = plt.subplots(2, 1, figsize=(10, 7.6),
+    fig, (ax, zoom) = plt.subplots(2, 1, figsize=(10, 7.6), layout="tight",
                                    gridspec_kw={"height_ratios": [1.0, 1.25]})
     r_pin = a.attachment.pin_hole_mm / 2
     for axis in (ax, zoom):
@@ -54,7 +56,6 @@ def assembly_figure(a: Assembly, outline: Polygon) -> bytes:
         axis.set_aspect("equal")
         axis.set_xlabel("across the flume (mm)")
         axis.set_ylabel("up (mm)")
-    fig.tight_layout()
     return _png(fig)
 
 
@@ -85,8 +86,11 @@ def _polygon(ax, poly, face: str, edge: str) -> None:
         xy = np.asarray(ring.coords)
         verts.append(xy)
         codes += [Path.MOVETO] + [Path.LINETO] * (len(xy) - 2) + [Path.CLOSEPOLY]
-    ax.add_patch(PathPatch(Path(np.vstack(verts), codes), fc=face, ec=edge, lw=0.3, zorder=1,
-                           rasterized=True))  # thousands of holes: a raster in the SVG
+    # thousands of holes: a raster in the SVG; add_artist, not add_patch: the axes' limits
+    # are set by the caller, and add_patch's data limits walk every hole's outline in Python
+    # (half of the figure's time)
+    ax.add_artist(PathPatch(Path(np.vstack(verts), codes), fc=face, ec=edge, lw=0.3, zorder=1,
+                            rasterized=True))
 
 
 def toolpath_preview(tp: Toolpath, title: str, *, window_mm: tuple[float, float] | None = None
@@ -98,7 +102,7 @@ def toolpath_preview(tp: Toolpath, title: str, *, window_mm: tuple[float, float]
     from matplotlib.collections import PolyCollection
 
     n = len(tp.layer_z_mm)
-    fig, axes = plt.subplots(1, n, figsize=(4.6 * n, 3.8), squeeze=False)
+    fig, axes = plt.subplots(1, n, figsize=(4.6 * n, 3.8), squeeze=False, layout="tight")
     ext = np.flatnonzero(tp.extruding)
     new_path = np.concatenate([[True], np.diff(ext) > 1])
     path_id = np.cumsum(new_path)
@@ -109,45 +113,48 @@ def toolpath_preview(tp: Toolpath, title: str, *, window_mm: tuple[float, float]
     quads = np.stack([p0 + half, p1 + half, p1 - half, p0 - half], axis=1)
     colours = plt.get_cmap("tab20")(path_id % 20)
     colours[:, 3] = np.where(tp.flow[ext] < 1.0, 0.45, 1.0)
-    lo = quads.reshape(-1, 2).min(axis=0)
-    corner = tp.xyz_mm[ext][np.argmin(tp.xyz_mm[ext, 0] + tp.xyz_mm[ext, 1]), :2]
+    lo, hi = quads.reshape(-1, 2).min(axis=0) - 1, quads.reshape(-1, 2).max(axis=0) + 1
+    if window_mm is not None:
+        lo = tp.xyz_mm[ext][np.argmin(tp.xyz_mm[ext, 0] + tp.xyz_mm[ext, 1]), :2] - 2
+        hi = lo + window_mm
+    seen = _overlaps(quads, lo, hi)  # the beads in view: the others are clipped away anyway
     for k, ax in enumerate(axes[0]):
         on = tp.layer[ext] == k
-        ax.add_collection(PolyCollection(quads[on], facecolors=colours[on],
-                                         edgecolors=colours[on], linewidths=0.3,
+        ax.add_collection(PolyCollection(quads[on & seen], facecolors=colours[on & seen],
+                                         edgecolors=colours[on & seen], linewidths=0.3,
                                          rasterized=True))  # every bead: a raster in the SVG
-        if window_mm is None:
-            hi = quads.reshape(-1, 2).max(axis=0)
-            ax.set_xlim(lo[0] - 1, hi[0] + 1)
-            ax.set_ylim(lo[1] - 1, hi[1] + 1)
-        else:
-            ax.set_xlim(corner[0] - 2, corner[0] - 2 + window_mm[0])
-            ax.set_ylim(corner[1] - 2, corner[1] - 2 + window_mm[1])
+        ax.set_xlim(lo[0], hi[0])
+        ax.set_ylim(lo[1], hi[1])
         ax.set_aspect("equal")
         ax.set_title(f"pass {k + 1}: z = {tp.layer_z_mm[k]:.2f} mm, "
                      f"{len(np.unique(path_id[on]))} paths", fontsize=9)
         ax.set_xlabel("bed x (mm)")
         ax.set_ylabel("bed y (mm)")
     fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
     return _png(fig)
 
 
+def _overlaps(quads: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Which quads ((m, 4, 2) mm) have a bounding box that meets the window lo..hi (mm)."""
+    qlo, qhi = quads.min(axis=1), quads.max(axis=1)
+    return np.all((qhi >= lo) & (qlo <= hi), axis=1)
+
+
 def kit_figures(a: Assembly, outline: Polygon, net_tp: Toolpath, cable_tp: Toolpath,
-                cable_name: str) -> list[tuple[str, bytes, str]]:
-    """(file name, PNG, caption) of the assembly picture and the toolpath previews."""
+                cable_name: str) -> list[tuple[str, Drawing, str]]:
+    """(file name, drawing, caption) of the assembly picture and the toolpath previews."""
     return [
-        ("assembly.png", assembly_figure(a, outline),
+        ("assembly.png", Drawing(assembly_figure, (a, outline)),
          ("How the kit goes together: the net's corner eyelets and both cables' eyelets on "
           "each anchor pin, each cable threaded through the loops of its side.")),
-        ("preview-net.png", toolpath_preview(net_tp, "net, lower-left corner",
-                                             window_mm=NET_ZOOM_MM),
+        ("preview-net.png", Drawing(toolpath_preview, (net_tp, "net, lower-left corner"),
+                                    {"window_mm": NET_ZOOM_MM}),
          ("Direct net G-code per pass, beads at true width, one colour per path (pale: "
           "reduced flow over crossings and rings).")),
-        ("preview-net-whole.png", toolpath_preview(net_tp, "net, whole"),
+        ("preview-net-whole.png", Drawing(toolpath_preview, (net_tp, "net, whole")),
          "Direct net G-code per pass, whole net."),
         (f"preview-cable-{cable_name}.png",
-         toolpath_preview(cable_tp, f"cable {cable_name}, first eyelet",
-                          window_mm=CABLE_ZOOM_MM),
+         Drawing(toolpath_preview, (cable_tp, f"cable {cable_name}, first eyelet"),
+                 {"window_mm": CABLE_ZOOM_MM}),
          "Direct cable G-code per pass: the strip's beads run into the eyelet ring."),
     ]

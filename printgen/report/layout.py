@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from printgen.report.html import Report
+from printgen.report.html import Drawing, Report
 from printgen.verification.layout import FlumeLayout
 
 LAYOUT_CSV = "sensor-layout.csv"
@@ -62,8 +62,6 @@ def layout_csv(lay: dict[str, Any]) -> str:
 
 def layout_section(rep: Report, layout: FlumeLayout) -> None:
     """The layout's heading, drawing and table."""
-    from printgen.report.plots import _png
-
     lay = layout.to_record()
     strands = layout.strands_mm
 
@@ -72,8 +70,15 @@ def layout_section(rep: Report, layout: FlumeLayout) -> None:
                   f"(mounting: {lay['mounting']}); the same positions are in {LAYOUT_CSV} and "
                   "in report.json (verification.lab.layout). The routing of the wires is "
                   "printgen's assumption (README: The flume test as it is run).")
-    rep.figure(_png(layout_figure(lay, strands)), CAPTION, "sensor-and-anchor-layout")
+    rep.figure(Drawing(layout_png, (lay, strands)), CAPTION, "sensor-and-anchor-layout")
     rep.table(["item", "x (mm)", "z (mm)", "note"], layout_rows(lay))
+
+
+def layout_png(lay: dict[str, Any], strands: np.ndarray | None = None) -> bytes:
+    """The drawing of `layout_figure` as PNG bytes carrying its SVG."""
+    from printgen.report.plots import _png
+
+    return _png(layout_figure(lay, strands))
 
 
 def layout_figure(lay: dict[str, Any], strands: np.ndarray | None = None):
@@ -88,7 +93,7 @@ def layout_figure(lay: dict[str, Any], strands: np.ndarray | None = None):
         from matplotlib.collections import LineCollection
 
         ax.add_collection(LineCollection(strands, colors="0.8", linewidths=0.4,
-                                         label="net strands"))
+                                         label="net strands", rasterized=True))
     ax.plot([0, w, w, 0, 0], [0, 0, h, h, 0], c="0.5", lw=0.8)
     ax.axhline(0, c="saddlebrown", lw=2.5, zorder=1, label="flume bed (z = 0)")
     shown = set()

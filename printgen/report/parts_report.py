@@ -7,7 +7,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from printgen.outputs import MANIFEST
-from printgen.report.html import Report
+from printgen.report.html import Drawing, Report
 from printgen.report.summary import print_rows
 
 if TYPE_CHECKING:
@@ -47,9 +47,10 @@ def gcode_section(rep: Report, gcode: dict[str, Any]) -> None:
     rep.table(*print_rows(gcode))  # print time, filament and mass per part
 
 
-def assembly_section(rep: Report, a: Assembly, figures: list[tuple[str, bytes, str]]) -> None:
+def assembly_section(rep: Report, a: Assembly,
+                     figures: list[tuple[str, bytes | Drawing, str]]) -> None:
     """The kit's verdict, its labelled picture with the checks after printing, and the
-    toolpath previews (`figures`: file name, PNG, caption)."""
+    toolpath previews (`figures`: file name, PNG or its drawing, caption)."""
     rep.heading("Assembly")
     problems = a.problems()
     rep.verdict(not problems, "; ".join(problems) or
@@ -58,7 +59,7 @@ def assembly_section(rep: Report, a: Assembly, figures: list[tuple[str, bytes, s
     for name, png, caption in figures:
         if name == "preview-net.png":
             rep.heading("Toolpath previews")
-        rep.figure(png, caption, name.removesuffix(".png"))
+        rep.figure(png, caption, name.removesuffix(".png"), also=name)
         if name == "assembly.png":
             rep.paragraph("Check after printing:")
             for k, line in enumerate(a.checklist(), 1):

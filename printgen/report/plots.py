@@ -50,13 +50,18 @@ def load_pyplot() -> None:
 
 
 def _png(fig) -> PlotBytes:
+    """The PNG and the SVG of one drawing of `fig` (then closed). The layout (constrained or
+    tight) is worked out once, for the PNG, and kept for the SVG: laying out again costs as
+    much as drawing. Rasterized artists (dense strand and bead collections) are a PNG inside
+    the SVG at the PNG's resolution."""
     import matplotlib
 
     buf, svg = io.BytesIO(), io.BytesIO()
     # fixed metadata: the same figure gives the same bytes
     fig.savefig(buf, format="png", dpi=DPI, metadata={"Software": None})
+    fig.set_layout_engine("none")  # the axes keep the positions the PNG's layout gave them
     with matplotlib.rc_context({"svg.hashsalt": SVG_SALT}):
-        fig.savefig(svg, format="svg", metadata={"Date": None, "Creator": None})
+        fig.savefig(svg, format="svg", dpi=DPI, metadata={"Date": None, "Creator": None})
     out = PlotBytes(buf.getvalue())
     out.svg, out.labels = svg.getvalue(), axis_labels(fig)
     _pyplot().close(fig)
@@ -201,7 +206,8 @@ def deformed_figure(shapes: list[tuple[str, BarrierScene, np.ndarray]], level: f
     depth = max(float(np.abs(x[:, 1]).max()) for _, _, x in norm) or 1.0
     for k, (label, s, x) in enumerate(norm):
         ax = fig.add_subplot(1, len(norm), k + 1, projection="3d")
-        ax.add_collection3d(Line3DCollection(x[s.elements], colors=f"C{k}", linewidths=0.4))
+        ax.add_collection3d(Line3DCollection(x[s.elements], colors=f"C{k}", linewidths=0.4,
+                                             rasterized=True))  # every strand: a raster in the SVG
         for nodes, _ in s.cables.values():
             ax.plot(*x[nodes].T, color="k", lw=1.2)
         ax.set_xlim(0, 1), ax.set_ylim(0, depth), ax.set_zlim(0, 1)

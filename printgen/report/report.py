@@ -12,7 +12,7 @@ from printgen.design.record import Design
 from printgen.design.selection import Candidate, Selection
 from printgen.design.similitude import FORCE_EXPONENT, ScaledTargets, to_prototype
 from printgen.inputs.prototype import Prototype
-from printgen.report.html import Report
+from printgen.report.html import Drawing, Report
 from printgen.verification.bands import Band
 from printgen.verification.verify import SHAPE_LEVELS, CounterExample, Verification
 
@@ -161,8 +161,8 @@ def _sweep_sections(rep: Report, v: Verification, scale: float, band: Band | Non
                ["border cables", f"{p.max_cable_tension[-1] / 1e3:.1f}",
                 f"{to_prototype(m.max_cable_tension[-1], FORCE_EXPONENT, scale) / 1e3:.1f}",
                 f"{m.max_cable_tension[-1]:.3g}"]])
-    rep.figure(verification_figure(p, m, scale, "Normalised deformation against relative "
-                                   "loading", band=band),
+    title = "Normalised deformation against relative loading"
+    rep.figure(Drawing(verification_figure, (p, m, scale, title), {"band": band}),
                "Prototype (black) and printed model (orange"
                + ("; shaded: the model's uncertainty band)." if band is not None else ")."),
                "verification")
@@ -189,7 +189,8 @@ def _deformed_section(rep: Report, v: Verification) -> None:
               for who, run in (("prototype", v.prototype), ("model", v.model))
               if SHOWN_LEVEL in run.shapes]
     if len(shapes) == 2:
-        rep.figure(deformed_figure(shapes, SHOWN_LEVEL), "Both nets deformed at h/h_B = "
+        rep.figure(Drawing(deformed_figure, (shapes, SHOWN_LEVEL)),
+                   "Both nets deformed at h/h_B = "
                    f"{SHOWN_LEVEL:g}, normalised by their own width (x, deflection) and height "
                    "(z); black: border cables. Model node positions at 0.5, 1.0 and 1.1 are in "
                    "report.json (verification.deformed_shape).", "deformed-nets")

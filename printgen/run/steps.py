@@ -1,8 +1,10 @@
 """The steps of `printgen make`: plain functions `step(ctx, stage)` that add files under
 `stage` and return their records (report.json key -> record); their report sections are
 built in printgen/report from those records (the pipeline is `printgen.run.make`). The
-verification's sweeps (`verification_sweeps`) and its sections (`verification_report`) run
-in a helper process from the start of the run while the other steps run here.
+verification's sweeps (`verification_sweeps`) run in a helper process from the start of the
+run while the other steps run here. The report's figures are drawings
+(printgen.report.html.Drawing) until the sweeps are done; then the last step draws them all
+at once, side by side in the helper's worker processes (`draw_figures`).
 """
 
 from __future__ import annotations
@@ -21,18 +23,18 @@ from printgen.errors import TimeLimitError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
 from printgen.report.parts_report import assembly_section, gcode_section, meshes_section
-from printgen.workers import seconds_left
+from printgen.workers import run_jobs, seconds_left
 
 HELPER_SWEEPS = "helper: verification sweeps"  # timings_s keys of work done in the helper
-HELPER_REPORT = "helper: verification figures and tables"
 WAIT_SWEEPS = "waiting for the verification sweeps"  # in this process, within a step
+FIGURES = "figures (PNG and SVG, side by side)"  # within the verification step
 
 if TYPE_CHECKING:  # pragma: no cover
     from printgen.design.record import Design
     from printgen.inputs.printers import Printer
     from printgen.inputs.prototype import Prototype
     from printgen.parts.gcode.toolpath import Toolpath
-    from printgen.report.html import FigureFile
+    from printgen.report.html import Drawing, FigureFile
     from printgen.run.make import MakeContext
     from printgen.verification.bands import Band
     from printgen.verification.verify import Verification
@@ -103,7 +105,6 @@ def kit_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     from printgen.parts.assembly import assemble
     from printgen.parts.geometry.solid import net_outline
     from printgen.report.kit import kit_figures
-    from printgen.report.plots import load_pyplot
 
     d = ctx.design
     if not d.cables:
@@ -114,13 +115,9 @@ def kit_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     c = min(d.cables, key=lambda c: c.length_mm)
     cable_tp = part_toolpath(ctx, f"cable-{c.name}", c, printer)
     outline = net_outline(d.net, a.attachment)
-    load_pyplot()
-    sweeps_done(ctx)  # the figures: see there
-    figs = kit_figures(a, outline, net_tp, cable_tp, c.name)
-    for name, png, _caption in figs:
-        (stage / name).write_bytes(png)
-        ctx.files.append(name)
-    assembly_section(ctx.report, a, figs)
+    # drawn with the verification's figures, side by side, once the sweeps are done (see
+    # `draw_figures`); the pictures are also written beside the report (report_files)
+    assembly_section(ctx.report, a, kit_figures(a, outline, net_tp, cable_tp, c.name))
     return {"assembly": a.to_record()}
 
 
@@ -243,45 +240,67 @@ def part_thickness(kind: str, part) -> float:
 def verify_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     """Prototype vs model over the loading sweep, the model's uncertainty band
     (printgen.verification.bands), and the steel counter-example: the sections and record of
-    `verification_report`, collected from the helper process `make` started the sweeps in,
-    or computed here."""
-    sweeps_done(ctx)
-    pending = ctx.background.pop("verification report", None)
-    if pending is not None:
-        (blocks, figures, record), seconds = _collect(pending)
-        ctx.record.setdefault("timings_s", {})[HELPER_REPORT] = seconds
-    else:
-        v, band = verification_sweeps(ctx.prototype, ctx.design, load=ctx.options.load,
-                                      loads=ctx.options.loads)
-        blocks, figures, record = verification_report(v, band, ctx.targets.scale)
+    `verification_report` on the sweeps of the helper process `make` started them in, or
+    computed here; then every figure of the report, drawn (`draw_figures`)."""
+    sweeps = sweeps_done(ctx)
+    if sweeps is None:
+        sweeps = verification_sweeps(ctx.prototype, ctx.design, load=ctx.options.load,
+                                     loads=ctx.options.loads)
+    blocks, figures, record = verification_report(*sweeps, ctx.targets.scale)
     ctx.report.blocks.extend(blocks)
     ctx.report.figures.extend(figures)
+    draw_figures(ctx)
     return {"verification": record}
 
 
-def sweeps_done(ctx: MakeContext) -> None:
-    """Wait for the verification's sweeps when they run in the helper process and start its
-    figures there. The figure steps call this first: drawn meanwhile, they would take the
-    cores from the sweeps' workers, and the verification's figures would be left to draw on
-    one core at the end; drawn after, both sets of figures share the two cores."""
+def sweeps_done(ctx: MakeContext) -> tuple[Verification, Band] | None:
+    """The verification's sweeps when they ran in the helper process (waiting for them), else
+    None."""
     pending = ctx.background.pop("verification sweeps", None)
-    if pending is not None and ctx.helper is not None:
-        t = time.perf_counter()
-        (v, band), seconds = _collect(pending)
-        times = ctx.record.setdefault("timings_s", {})
-        times[HELPER_SWEEPS], times[WAIT_SWEEPS] = seconds, time.perf_counter() - t
-        ctx.background["verification report"] = ctx.helper.submit(
-            timed, verification_report, v, band, ctx.targets.scale)
+    if pending is None:
+        return None
+    t = time.perf_counter()
+    sweeps, seconds = _collect(pending, "the verification's sweeps")
+    times = ctx.record.setdefault("timings_s", {})
+    times[HELPER_SWEEPS], times[WAIT_SWEEPS] = seconds, time.perf_counter() - t
+    return sweeps
 
 
-def _collect(pending: Future) -> Any:
+def draw_figures(ctx: MakeContext) -> None:
+    """Draw the report's figures not drawn yet (the kit's and the verification's), side by
+    side in worker processes: those of the helper process when there is one (forked from a
+    process running one thread, they start with matplotlib imported), else `Report.draw`'s.
+    Their wall time goes to timings_s[FIGURES]."""
+    t = time.perf_counter()
+    todo = ctx.report.pending()
+    if todo and ctx.helper is not None:
+        pngs, _ = _collect(ctx.helper.submit(timed, draw_all, todo), "the report's figures")
+        ctx.report.fill(pngs)
+    else:
+        ctx.report.draw()
+    if todo:
+        ctx.record.setdefault("timings_s", {})[FIGURES] = time.perf_counter() - t
+
+
+def draw_all(drawings: list[Drawing]) -> list[bytes]:
+    """Each drawing's PNG (carrying its SVG), side by side in worker processes when there are
+    several and two cores (printgen.workers.run_jobs); matplotlib is imported here first, so
+    that forked workers start with it."""
+    from printgen.report.plots import load_pyplot
+
+    load_pyplot()
+    return run_jobs([d.job() for d in drawings])
+
+
+def _collect(pending: Future, what: str) -> Any:
     """A helper job's result, waiting no longer than the run's deadline
-    (`printgen.workers.deadline`): past it, TimeLimitError (the helper is then stopped)."""
+    (`printgen.workers.deadline`): past it, TimeLimitError naming `what` (the helper is then
+    stopped)."""
     left = seconds_left()
     try:
         return pending.result(timeout=None if left is None else max(left, 0.0))
     except FutureTimeout as exc:
-        raise TimeLimitError("the verification's sweeps: past the time limit") from exc
+        raise TimeLimitError(f"{what}: past the time limit") from exc
 
 
 def timed(fn: Callable, /, *args: Any, **kwargs: Any) -> tuple[Any, float]:

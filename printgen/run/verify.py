@@ -116,6 +116,7 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     record["summary"] = summary_record(record, record["measured"]["fit"]["sentence"]
                                        if m is not None and result else "")
     rep.lead = summary_html(record["summary"])
+    rep.draw()  # the figures, side by side in worker processes
     record["timings_s"] = {"total": time.perf_counter() - t0, "band": band.seconds}
     files = _write(out, rep, record, d, text, force, inputs)
     return VerifyRun(p, d, v, band, m, result, text, record, files)

@@ -322,12 +322,16 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
     nom = curves(nominal)
     work: list[dict[str, Any]] = []
     k, change = refinement_test(d, nom, lv, load_kw, Variant(mounting=mounting), work)
-    jobs: list[tuple] = [(run_variant, (d, v, lv, k, load_kw), {}) for v in variants]
+    # longest first (the worker that takes the last job should not start a long one late):
+    # a slack variant is a mechanism until its strands tighten, the slowest sweep by far
+    order = sorted(range(len(variants)), key=lambda i: -variants[i].slack)
+    jobs: list[tuple] = [(run_variant, (d, variants[i], lv, k, load_kw), {}) for i in order]
     if k > 1:
         jobs.append((run_variant, (d, Variant(mounting=mounting), lv, k, load_kw), {}))
-    runs = run_jobs(jobs)
-    work += [r.work() for r in runs]
-    base = curves(runs.pop()) if k > 1 else None
+    done = run_jobs(jobs)
+    work += [r.work() for r in done]
+    base = curves(done.pop()) if k > 1 else None
+    runs = [done[order.index(i)] for i in range(len(variants))]
     out, failed = {}, {}
     for v, r in zip(variants, runs, strict=True):
         c = curves(r)
