@@ -43,28 +43,31 @@ LEVELS = 23  # load levels of a sweep (verify.levels(): 0 to 1.1 by 0.05; tests/
 # Newton iterations (chord steps included) per load level, averaged over a run's sweeps (the
 # nominal pair, the refinement test and the band's variants; a variant's slack strands may
 # take 4 x the nominal's), at REFERENCE_UNKNOWNS, growing as unknowns^ITERATION_GROWTH.
-# Counted by bench make at 1:40 on the solver of this commit: the 1:40 example (border cables,
-# ~1000 unknowns) 2252 over 12 sweeps; the simple barrier (free top, 3540) 1897 over 8, and
-# 1170 on the mesh twice as coarse (870 unknowns; tests' shared run): 0.34 from one to the other.
-ITERATIONS_PER_LEVEL = {"border cables": 8.2, "free top": 6.8}
+# Counted by bench make at 1:40: the 1:40 example (border cables, ~1000 unknowns) 2504 over 12
+# sweeps; the simple barrier (free top, 3540) 2167 over 8 (solver of main's 7e27773: one
+# factorization per Newton step; before it 2252 and 1897, and 1170 on the simple barrier's mesh
+# twice as coarse, 870 unknowns: 0.34 from one size to the other).
+ITERATIONS_PER_LEVEL = {"border cables": 9.0, "free top": 7.8}
 REFERENCE_UNKNOWNS = 1000
 ITERATION_GROWTH = 0.34
 # CPU of one iteration on one core: ITERATION_S + ITERATION_S_PER_UNKNOWN x unknowns, a least-
 # squares fit (bench make) over the 20 sweeps of both examples at 1:40 (1000 to 3500 unknowns;
-# each sweep's CPU within 0.69 to 1.28 of the fit given its counted iterations).
-ITERATION_S = 2.7e-3
-ITERATION_S_PER_UNKNOWN = 7.9e-6
+# each sweep's CPU within 0.66 to 1.59 of the fit given its counted iterations; before
+# 7e27773: 2.7 ms + 7.9 us per unknown).
+ITERATION_S = 3.3e-3
+ITERATION_S_PER_UNKNOWN = 5.1e-6
 # CPU beside the sweeps (bench make; PRINTGEN_SERIAL=1 on the 1:40 example): the steel
 # counter-example (1.9 s, a job beside the nominal pair) and the verification's report: the
 # comparison, its figures and tables (5.7 s; the simple barrier's step: 8.0 s with the jobs'
-# start and results)
+# start and results; measured before the figures were drawn side by side in the helper's
+# workers, main's ad2ac34: not measured since)
 COUNTEREXAMPLE_S = 2.0
 VERIFY_REPORT_S = 6.0
 MESH_S_PER_SEGMENT = 1e-4  # meshes step per model net segment (simple 1:40: 4962 in 0.46 s)
 # The parts' steps, CPU of make's own process (bench make, 1:40): 1.1 s on the simple barrier
-# (no cables), 7.2 s on the 1:40 example, whose kit step draws the assembly and toolpath
-# previews of its four cables (5.2 s)
-CABLE_PARTS_S = 6.0  # the four cables: meshes, 3MF, plate, slicer profiles, G-code, previews
+# (no cables), 2.4 s on the 1:40 example (its kit's previews now drawn in the helper's workers;
+# 7.2 s before)
+CABLE_PARTS_S = 1.3  # the four cables: meshes, 3MF, plate, slicer profiles, G-code
 CABLE_PART_S = CABLE_PARTS_S / 4  # one cable
 FIXED_S = 2.0  # start-up, planning, the net's parts and slicer profile, the report
 # verify --measured: the fit's bounded Brent search runs this many sweeps of the model on the
