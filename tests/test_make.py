@@ -191,8 +191,8 @@ def test_time_limit_stops_the_run_in_its_step(tmp_path, monkeypatch):
     bypassed: this run is estimated over the short limit)."""
     from printgen.run.budget import estimate
 
-    monkeypatch.setattr(make_mod, "check_budget", lambda p, d, *, limit_s, cores, sweep:
-                        estimate(p, d, cores=cores, sweep=sweep))
+    monkeypatch.setattr(make_mod, "check_budget", lambda p, d, *, limit_s, cores, work:
+                        estimate(p, d, cores=cores, work=work))
 
     def slow(ctx, stage):
         (stage / "half.txt").write_text("x")

@@ -1,14 +1,23 @@
-"""The size of a `make` run, before any of it is done: nodes, unknowns, memory and time.
+"""The size of a `make` run, before any of it is done: nodes, unknowns, solver work, memory and
+time.
 
-The verification solves two nets over 23 load levels (prototype and model, in parallel on two
-cores), then the model's uncertainty-band variants; the meshes step builds one solid strand per
-model net segment. Both costs grow with the node count, which follows from the meshes alone (no
-net is built here). The constants are measured on the 1:40 example with the solver's fast path
-(`examples/realistic_barrier.toml`, one core per sweep: 518 prototype nodes in 0.43 s, 365
-model nodes in 0.40 s, 1998 nodes in 2.5 s, 7776 nodes in 21 s; bands 2.7 s; meshes 2.9 s;
-whole `make` 9.0 s) and on the simple barrier (free top, sensor wires as segments: model 2481
-nodes in ~16 s beside the prototype's sweep, bands 26 s, whole `make` 45 s); the estimate is meant to be right within a factor of about two, enough
-to stop a run that would take an hour.
+The verification's solver work is predicted sweep by sweep (`sweeps`), from the run's structure
+and the meshes alone (no net is built here): the prototype's and the model's nets over the load
+levels (23: h / h_B = 0 to 1.1 by 0.05, `printgen.verification.verify.levels`), each more load
+case of `make --loads` the same, the band's refinement test (the model on a net COARSENINGS[0]
+times coarser), then each band variant of the model (`printgen.verification.bands
+.model_variants`: 5 on the simple barrier, 9 on the 1:40 example) on the design's own net: the
+refinement test may pick a coarser one, which the estimate does not foresee (on both examples
+it keeps the design's net), so a run whose variants coarsen is estimated high. A sweep's work
+is its levels times the Newton iterations per level (ITERATIONS_PER_LEVEL, for a net with
+border cables or one with a free top, growing slowly with the unknowns), its CPU time on one
+core that many iterations of ITERATION_S + ITERATION_S_PER_UNKNOWN x its unknowns (3 per
+node). The run counts the same work (`counted_work`, report.json "verification" ->
+"solver_work" against "size" -> "solver_work"); tests/test_budget.py checks the prediction
+against the count on both examples and `printgen bench make` (benchmarks/bench_make.py)
+measures the constants, the estimate against the measured time and the CPU. The parts' steps
+(meshes, slicer profiles, G-code, previews) have constants of their own. The estimate is meant
+to be right within a factor of about two, enough to stop a run that would take an hour.
 """
 
 from __future__ import annotations
@@ -16,8 +25,9 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
+from typing import Any
 
 from printgen.barrier.patterns import get_pattern
 from printgen.design.record import Design
@@ -25,28 +35,41 @@ from printgen.errors import InputError
 from printgen.inputs.prototype import Prototype
 from printgen.workers import cores, reporting
 
-# About a minute of `make` on 2 cores (issue 16); the bundled simple barrier
-# (examples/simple_barrier.toml, free top) is estimated at ~45 s and takes ~45 s.
+# About a minute of `make` on 2 cores (issue 16): the bundled simple barrier (free top) and
+# the 1:40 example both fit.
 DEFAULT_LIMIT_S = 60.0
-SWEEP_S_AT_REFERENCE = 0.45  # one net over the 23 load levels of the sweep, one core
-REFERENCE_NODES = 500  # node count at which SWEEP_S_AT_REFERENCE was measured
-SWEEP_EXPONENT = 1.45  # sweep time grows as nodes^1.45 (518 -> 1998 -> 7776 nodes)
-# Uncertainty bands (verification/bands.py): refinement test and model variants on coarsened nets
-# after the nominal sweeps: 2.7 s on the 1:40 example, ~1.4 x the model's sweep on the simple.
-BANDS_FACTOR = 1.5
-BANDS_MIN_S = 2.5
-# A net without border cables (free top, anchored on bed and banks) is slack at low water:
-# the simple barrier's 1:40 model takes ~1450 Newton iterations against 197 for the realistic
-# (its sweep: 16 s in make against 4.6 s for a net of its size with border cables).
-FREE_TOP_MODEL_FACTOR = 3.5
-VERIFY_FIXED_S = 1.5  # worker start, the steel counter-example, the comparison
+LONG_RUN_S = 30.0  # runs estimated longer show their estimate and progress (make, on a terminal)
+LEVELS = 23  # load levels of a sweep (verify.levels(): 0 to 1.1 by 0.05; tests/test_budget.py)
+# Newton iterations (chord steps included) per load level, averaged over a run's sweeps (the
+# nominal pair, the refinement test and the band's variants; a variant's slack strands may
+# take 4 x the nominal's), at REFERENCE_UNKNOWNS, growing as unknowns^ITERATION_GROWTH.
+# Counted by bench make at 1:40: the 1:40 example (border cables, ~1000 unknowns) 2504 over 12
+# sweeps; the simple barrier (free top, 3540) 2167 over 8 (solver of main's 7e27773: one
+# factorization per Newton step; before it 2252 and 1897, and 1170 on the simple barrier's mesh
+# twice as coarse, 870 unknowns: 0.34 from one size to the other).
+ITERATIONS_PER_LEVEL = {"border cables": 9.0, "free top": 7.8}
+REFERENCE_UNKNOWNS = 1000
+ITERATION_GROWTH = 0.34
+# CPU of one iteration on one core: ITERATION_S + ITERATION_S_PER_UNKNOWN x unknowns, a least-
+# squares fit (bench make) over the 20 sweeps of both examples at 1:40 (1000 to 3500 unknowns;
+# each sweep's CPU within 0.66 to 1.59 of the fit given its counted iterations; before
+# 7e27773: 2.7 ms + 7.9 us per unknown).
+ITERATION_S = 3.3e-3
+ITERATION_S_PER_UNKNOWN = 5.1e-6
+# CPU beside the sweeps (bench make; PRINTGEN_SERIAL=1 on the 1:40 example): the steel
+# counter-example (1.9 s, a job beside the nominal pair) and the verification's report: the
+# comparison, its figures and tables (5.7 s; the simple barrier's step: 8.0 s with the jobs'
+# start and results; measured before the figures were drawn side by side in the helper's
+# workers, main's ad2ac34: not measured since)
+COUNTEREXAMPLE_S = 2.0
+VERIFY_REPORT_S = 6.0
 MESH_S_PER_SEGMENT = 1e-4  # meshes step per model net segment (simple 1:40: 4962 in 0.46 s)
-# The parts' steps got faster (toolpaths built once, verification in a helper process beside
-# them): make of the 1:40 example measures ~3.9 s (bench make) to ~5 s (README's demo), which
-# the sum of the constants below puts at ~7 s (was 9.5 s: 2.4x the measured run).
-CABLE_PARTS_S = 1.0  # the four cables, their eyelets and plate
-CABLE_PART_S = CABLE_PARTS_S / 4  # one cable: mesh, 3MF, slicer profile, G-code, its place
-FIXED_S = 1.5  # planning, slicer profiles, G-code, previews, report
+# The parts' steps, CPU of make's own process (bench make, 1:40): 1.1 s on the simple barrier
+# (no cables), 2.4 s on the 1:40 example (its kit's previews now drawn in the helper's workers;
+# 7.2 s before)
+CABLE_PARTS_S = 1.3  # the four cables: meshes, 3MF, plate, slicer profiles, G-code
+CABLE_PART_S = CABLE_PARTS_S / 4  # one cable
+FIXED_S = 2.0  # start-up, planning, the net's parts and slicer profile, the report
 # verify --measured: the fit's bounded Brent search runs this many sweeps of the model on the
 # band's net (coarsened COARSENED_BY each way, so about COARSENED_BY^2 fewer nodes)
 FIT_SWEEPS = 20
@@ -68,14 +91,37 @@ class NetSize:
 
 
 @dataclass(frozen=True)
+class SweepWork:
+    """One predicted sweep: its net's unknowns, load levels and Newton iterations; `group`:
+    what runs beside it ("nominal": the prototype and model pair of a load case, "band": the
+    variants, run on the sweep cores; "serial": alone)."""
+
+    name: str
+    unknowns: int
+    levels: int
+    iterations: float
+    group: str = "serial"
+
+    @property
+    def seconds(self) -> float:
+        """CPU on one core."""
+        return self.iterations * (ITERATION_S + ITERATION_S_PER_UNKNOWN * self.unknowns)
+
+
+@dataclass(frozen=True)
 class Estimate:
-    """The whole run: the nets, the meshes step, wall-clock time on `cores`, peak memory."""
+    """The whole run: the nets, the meshes step, wall-clock time on `cores`, peak memory;
+    `sweeps`: the verification's predicted solver work; `verification_s`, `parts_s`: the
+    wall times of the verification and of the parts' steps alone."""
 
     nets: tuple[NetSize, ...]
     mesh_segments: int
     seconds: float
     memory_b: float
     cores: int
+    sweeps: tuple[SweepWork, ...] = ()
+    verification_s: float = 0.0
+    parts_s: float = 0.0
 
     def summary(self) -> str:
         nets = ", ".join(f"{n.name} {n.nodes:,} nodes / {n.unknowns:,} unknowns"
@@ -86,7 +132,23 @@ class Estimate:
     def to_record(self) -> dict:
         return {"nets": {n.name: {"nodes": n.nodes, "unknowns": n.unknowns} for n in self.nets},
                 "mesh_segments": self.mesh_segments, "memory_bytes": round(self.memory_b),
-                "cores": self.cores}
+                "cores": self.cores, "solver_work": work_totals(
+                    (s.unknowns, s.iterations) for s in self.sweeps)}
+
+
+def work_totals(sweeps: Iterable[tuple[int, float]]) -> dict[str, int]:
+    """The sweeps' count, Newton iterations and iterations x unknowns, from (unknowns,
+    iterations) pairs."""
+    rows = list(sweeps)
+    return {"sweeps": len(rows), "iterations": round(sum(it for _, it in rows)),
+            "iteration_unknowns": round(sum(n * it for n, it in rows))}
+
+
+def counted_work(runs: Iterable[dict[str, Any]]) -> dict[str, Any]:
+    """What the solver did in a run, from each sweep's `Run.work()`: the totals of
+    `work_totals` and the rows (their CPU seconds under the volatile key "time_s")."""
+    rows = list(runs)
+    return {**work_totals((r["unknowns"], r["iterations"]) for r in rows), "runs": rows}
 
 
 def prototype_nodes(p: Prototype, factor: float = 1.0) -> int:
@@ -107,51 +169,110 @@ def sweep_cores() -> int:
     return 1 if os.environ.get("PRINTGEN_SERIAL") else min(2, cores())
 
 
-def sweep_seconds(nodes: int) -> float:
-    """One net over the load path on one core."""
-    return SWEEP_S_AT_REFERENCE * (nodes / REFERENCE_NODES) ** SWEEP_EXPONENT
-
-
 @dataclass(frozen=True)
 class Work:
     """What a command runs: `sweep` the verification, `parts` the printable files (make),
-    `fit` a measured test's fit (verify --measured)."""
+    `fit` a measured test's fit (verify --measured); `cases`: the load cases swept (make
+    --loads adds its other cases' nominal pairs)."""
 
     sweep: bool = True
     parts: bool = True
     fit: bool = False
     model_follows: bool = True  # the model's mesh is the prototype's scaled (not a design's)
+    cases: int = 1
 
 
 MAKE = Work()
 
 
+def band_variants(p: Prototype, d: Design) -> int:
+    """The model variants the uncertainty band sweeps (as `verify` mounts the model)."""
+    from printgen.verification.bands import model_variants
+    from printgen.verification.scenes import lateral_mounting
+    from printgen.verification.verify import free_section
+
+    return len(model_variants(d, lateral_mounting(p), free_section(p))[0])
+
+
+def sweeps(p: Prototype, d: Design, *, proto_factor: float = 1.0, model_factor: float = 1.0,
+           work: Work = MAKE, variants: int | None = None) -> tuple[SweepWork, ...]:
+    """The verification's sweeps and each one's predicted work (module docstring);
+    `variants`: the band's count when known (default: `band_variants`)."""
+    from printgen.verification.bands import COARSENINGS
+
+    kind = "border cables" if d.cables else "free top"
+
+    def one(name: str, nodes: float, group: str) -> SweepWork:
+        return SweepWork(name, round(3 * nodes), LEVELS,
+                         LEVELS * iterations_per_level(kind, 3 * nodes), group)
+
+    m_nodes = model_nodes(d, model_factor)
+    out = []
+    for _ in range(work.cases):
+        out += [one("prototype", prototype_nodes(p, proto_factor), "nominal"),
+                one("model", m_nodes, "nominal")]
+    out.append(one(f"refinement x{COARSENINGS[0]}", m_nodes / COARSENINGS[0] ** 2, "serial"))
+    n_band = band_variants(p, d) if variants is None else variants
+    out += [one("band variant", m_nodes, "band")] * n_band
+    if work.fit:
+        out += [one("fit", m_nodes / COARSENED_BY**2, "serial")] * FIT_SWEEPS
+    return tuple(out)
+
+
+def iterations_per_level(kind: str, unknowns: float) -> float:
+    """Predicted Newton iterations per load level of a net of `kind` (ITERATIONS_PER_LEVEL)."""
+    return ITERATIONS_PER_LEVEL[kind] * (unknowns / REFERENCE_UNKNOWNS) ** ITERATION_GROWTH
+
+
+def verification_seconds(work: tuple[SweepWork, ...], cores: int) -> tuple[float, float]:
+    """(wall, CPU) seconds of the verification on `cores`: each case's prototype and model
+    side by side (the first case's with the counter-example), the serial sweeps alone, the
+    band's variants shared out, then the report (VERIFY_REPORT_S)."""
+    c = max(1, min(cores, 2))
+    nominal = [s.seconds for s in work if s.group == "nominal"]
+    pairs = [nominal[i:i + 2] for i in range(0, len(nominal), 2)]
+    if pairs:
+        pairs[0].append(COUNTEREXAMPLE_S)
+    band = [s.seconds for s in work if s.group == "band"]
+    wall = (sum(_shared(x, c) for x in pairs) + _shared(band, c)
+            + sum(s.seconds for s in work if s.group == "serial"))
+    cpu = sum(s.seconds for s in work) + (COUNTEREXAMPLE_S if pairs else 0.0)
+    return VERIFY_REPORT_S + wall, VERIFY_REPORT_S + cpu
+
+
+def _shared(jobs: list[float], cores: int) -> float:
+    """Wall time of independent jobs on `cores` workers: the longest, or their sum shared."""
+    return max(max(jobs), sum(jobs) / cores) if jobs else 0.0
+
+
 def estimate(p: Prototype, d: Design, *, cores: int, sweep: bool = True,
              proto_factor: float = 1.0, model_factor: float = 1.0,
-             work: Work | None = None) -> Estimate:
+             work: Work | None = None, variants: int | None = None) -> Estimate:
     """The run's size (`sweep`: the verification runs; `work`: what else, default make's);
-    the factors coarsen the prototype's or the model's meshes."""
+    the factors coarsen the prototype's or the model's meshes; `variants`: as `sweeps`. A
+    short make (at most LONG_RUN_S) runs its verification in a helper process beside the
+    parts' steps: its wall time is then the longer of the two, or their CPU shared out on the
+    cores when more."""
     work = work or Work(sweep=sweep)
     m_nodes = model_nodes(d, model_factor)
-    slow = 1.0 if d.cables else FREE_TOP_MODEL_FACTOR
     nets: tuple[NetSize, ...] = ()
+    run: tuple[SweepWork, ...] = ()
+    verify = verify_cpu = 0.0
     if work.sweep:
-        nets = tuple(NetSize(name, n, 3 * n, factor * sweep_seconds(n), MEMORY_B_PER_NODE * n)
-                     for name, n, factor in (("prototype", prototype_nodes(p, proto_factor), 1.0),
-                                             ("model", m_nodes, slow)))
-    verify = 0.0
-    if nets:
-        times = [n.seconds for n in nets]
-        nominal = sum(times) if cores < 2 else max(times)
-        bands = max(BANDS_MIN_S, BANDS_FACTOR * nets[1].seconds)
-        verify = VERIFY_FIXED_S + nominal + bands
-        if work.fit:
-            verify += FIT_SWEEPS * slow * sweep_seconds(m_nodes / COARSENED_BY**2)
+        run = sweeps(p, d, proto_factor=proto_factor, model_factor=model_factor, work=work,
+                     variants=variants)
+        nets = tuple(NetSize(s.name, s.unknowns // 3, s.unknowns, s.seconds,
+                             MEMORY_B_PER_NODE * s.unknowns / 3) for s in run[:2])
+        verify, verify_cpu = verification_seconds(run, cores)
     segments = 2 * m_nodes if work.parts else 0
     parts = (FIXED_S + MESH_S_PER_SEGMENT * segments + CABLE_PART_S * len(d.cables)
              if work.parts else 0.0)
+    seconds = parts + verify
+    if work.parts and work.sweep and cores > 1:
+        beside = max(verify, parts, (verify_cpu + parts) / min(cores, 2))
+        seconds = beside if beside <= LONG_RUN_S else seconds
     memory = BASE_MEMORY_B + sum(n.memory_b for n in nets)
-    return Estimate(nets, segments, parts + verify, memory, cores)
+    return Estimate(nets, segments, seconds, memory, cores, run, verify, parts)
 
 
 def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
@@ -162,10 +283,11 @@ def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
     if not (math.isfinite(limit_s) and limit_s > 0):
         raise InputError(f"--time-limit {limit_s:g} s must be a positive number of seconds")
     work = work or Work(sweep=sweep)
-    est = estimate(p, d, cores=cores, work=work)
+    variants = band_variants(p, d) if work.sweep else 0  # read once: the profiles' files
+    est = estimate(p, d, cores=cores, work=work, variants=variants)
     if est.seconds <= limit_s:
         return est
-    fix = coarsest_fix(p, d, limit_s=limit_s, cores=cores, work=work)
+    fix = coarsest_fix(p, d, limit_s=limit_s, cores=cores, work=work, variants=variants)
     which = ("the default, about a minute of make on 2 cores" if limit_s == DEFAULT_LIMIT_S
              else "from --time-limit")
     raise InputError(f"this run is too big: {est.summary()}; the limit is {limit_s:g} s "
@@ -174,19 +296,22 @@ def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
 
 
 def coarsest_fix(p: Prototype, d: Design, *, limit_s: float, cores: int,
-                 work: Work = MAKE) -> str:
-    """The smallest uniform coarsening of the meshes that fits `limit_s`, as advice."""
+                 work: Work = MAKE, variants: int | None = None) -> str:
+    """The smallest uniform coarsening of the meshes that fits `limit_s`, as advice
+    (`variants`: the band's, as `sweeps`)."""
+    if variants is None and work.sweep:
+        variants = band_variants(p, d)
     user_model = p.model.mesh_x_mm is not None or not work.model_follows
     model_scales = not user_model  # the model mesh follows the prototype's unless [model] sets it
 
     def fits(f: float) -> bool:
-        return estimate(p, d, cores=cores, work=work, proto_factor=f,
+        return estimate(p, d, cores=cores, work=work, proto_factor=f, variants=variants,
                         model_factor=f if model_scales else 1.0).seconds <= limit_s
 
     lo, hi = 1.0, COARSEN_MAX
     if not fits(hi):
         if user_model and estimate(p, d, cores=cores, work=work, proto_factor=hi,
-                                   model_factor=hi).seconds <= limit_s:
+                                   model_factor=hi, variants=variants).seconds <= limit_s:
             return ("coarsen [model] mesh_x_mm / mesh_y_mm (or the design's mesh) as well as "
                     "the prototype's net")
         return "no mesh coarsening alone fits; raise --time-limit"

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from printgen.barrier.loads import DEFAULT as DEFAULT_LOAD
+from printgen.barrier.loads import get_load
 from printgen.design.design_file import load_design
 from printgen.design.plan import make_design
 from printgen.design.record import Design
@@ -37,7 +38,9 @@ from printgen.report.parts_report import provenance_section
 from printgen.report.report import design_record, design_sections
 from printgen.run.budget import (
     DEFAULT_LIMIT_S,
+    LONG_RUN_S,
     Estimate,
+    Work,
     check_budget,
     level_bars,
     sweep_cores,
@@ -131,9 +134,6 @@ def plan(prototype_path: str | Path, scale: float, *, printer: str | None = None
     return ctx
 
 
-LONG_RUN_S = 30.0  # runs estimated longer than this show their estimate and progress
-
-
 def make(prototype_path: str | Path, scale: float, out: str | Path, *,
          printer: str | None = None, steps: list[tuple[str, Step]] | None = None,
          options: MakeOptions | None = None,
@@ -163,13 +163,15 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
         for label, step in steps:
             if progress:
                 progress(label)
-            t = time.perf_counter()
+            t, cpu = time.perf_counter(), time.process_time()
             try:
                 ctx.record.update(step(ctx, stage))
                 check_deadline(label)
             except TimeLimitError as exc:
                 raise TimeLimitError(time_limit_line(label, exc, est, bound, t0)) from exc
-            ctx.record.setdefault("timings_s", {})[label] = time.perf_counter() - t
+            times = ctx.record.setdefault("timings_s", {})
+            times[label] = time.perf_counter() - t
+            times.setdefault("cpu_s", {})[label] = time.process_time() - cpu  # this process
         meta.update(provenance(ctx))
         provenance_section(ctx.report, meta)
         for name, data in report_files(ctx.record, ctx.report).items():
@@ -216,6 +218,7 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]], short: b
     if serial or not short or not any(s is verify_step for _, s in steps):
         yield
         return
+    quiet_tracker()
     with helper() as h:
         ctx.helper = h
         ctx.background["verification sweeps"] = ctx.helper.submit(
@@ -230,16 +233,41 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]], short: b
             ctx.helper = None
 
 
+TRACKER_WARNING = "ignore:resource_tracker:UserWarning"  # a -W option (sys.warnoptions)
+
+
+def quiet_tracker() -> None:
+    """Start multiprocessing's resource tracker without its "leaked semaphore objects" warning.
+    A run stopped at its time limit (or by a signal) kills the helper while its workers' queues
+    are registered with the tracker, which unlinks them when it exits and says so on stderr: a
+    second line after make's one. The tracker inherits the -W options of sys.warnoptions
+    when it starts (at the helper's first queue); one already running is left as it is."""
+    import sys
+    from multiprocessing import resource_tracker
+
+    if TRACKER_WARNING not in sys.warnoptions:
+        sys.warnoptions.append(TRACKER_WARNING)
+    resource_tracker.ensure_running()
+
+
 def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
     """Estimate the run before any of it is done; InputError when it is over the limit
     (options.time_limit_s, default about a minute on 2 cores)."""
     limit = ctx.options.time_limit_s
     est = check_budget(ctx.prototype, ctx.design, cores=sweep_cores(),
                        limit_s=DEFAULT_LIMIT_S if limit is None else float(limit),
-                       sweep=verifies)
+                       work=Work(sweep=verifies, cases=swept_cases(ctx.options)))
     ctx.record["size"] = est.to_record()
-    ctx.record.setdefault("timings_s", {})["estimate"] = est.seconds
+    ctx.record.setdefault("timings_s", {}).update(
+        {"estimate": est.seconds, "estimate_verification": est.verification_s,
+         "estimate_parts": est.parts_s})
     return est
+
+
+def swept_cases(options: MakeOptions) -> int:
+    """Load cases the verification sweeps: its own and each other one of --loads."""
+    own = get_load(options.load).spec
+    return 1 + len({get_load(x).spec for x in options.loads} - {own})
 
 
 def run_bound(options: MakeOptions) -> float | None:
@@ -259,7 +287,8 @@ def time_limit_line(label: str, cause: Exception, est: Estimate, bound: float | 
     where = str(cause).removesuffix(": past the time limit")
     inside = f" ({where})" if where and where != label else ""
     return (f"stopped in step '{label}'{inside} after {spent:.0f} s, past the time limit of "
-            f"{bound or 0:g} s (--time-limit); the run was estimated at about {est.seconds:.0f} s; nothing written. "
+            f"{bound or 0:g} s (--time-limit); the run was estimated at about "
+            f"{est.seconds:.0f} s; nothing written. "
             f"Raise it with --time-limit {math.ceil(max(spent, bound or 0) * 2 / 60) * 60:g}, or "
             "coarsen the nets")
 

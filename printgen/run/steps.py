@@ -326,6 +326,16 @@ def verification_sweeps(prototype: Prototype, design: Design, *, load: str | Non
                          free_section=free_section(prototype))
 
 
+def solver_work(v: Verification, band: Band) -> dict[str, Any]:
+    """What the solver did over the whole verification (`printgen.run.budget.counted_work`):
+    the nominal sweeps of every load case, the band's refinement test and variants."""
+    from printgen.run.budget import counted_work
+
+    cases = [c for c in v.by_load.values() if c.spec != v.load.get("spec")]  # not v's own
+    nominal = [r for c in [v, *cases] for r in (c.model, c.prototype)]
+    return counted_work([*(r.work() for r in nominal), *band.work])
+
+
 def verification_report(v: Verification, band: Band, scale: float
                         ) -> tuple[list[str], list[FigureFile], dict[str, Any]]:
     """The verification's report blocks (figures included), its figures' files and its
@@ -343,6 +353,7 @@ def verification_report(v: Verification, band: Band, scale: float
     load_case_sections(rep, v)
     layout_section(rep, flume_layout(v.model.scene))
     record = v.to_record()
+    record["solver_work"] = solver_work(v, band)
     record["bands"] = band_record(v, band)
     record["lab"] = lab_record(v, band, scale)
     return rep.blocks, rep.figures, record

@@ -241,6 +241,7 @@ class Band:
     seconds: float = 0.0
     failed: dict[str, list[float]] = field(default_factory=dict)
     mounting: str | None = None  # the nominal run's mounting, kept by every variant
+    work: list[dict[str, Any]] = field(default_factory=list)  # Run.work() of every sweep run
 
     def envelope(self, *, from_start: bool = False
                  ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
@@ -263,16 +264,19 @@ def _nan_reduce(stack: np.ndarray, fn) -> np.ndarray:
 
 
 def refinement_test(d: Design, nominal: dict[str, np.ndarray], lv: np.ndarray,
-                    load_kw: dict | None = None, base: Variant | None = None
-                    ) -> tuple[int, dict[int, float]]:
+                    load_kw: dict | None = None, base: Variant | None = None,
+                    work: list[dict[str, Any]] | None = None) -> tuple[int, dict[int, float]]:
     """Coarsest mesh multiplier whose nominal sweep stays within REFINE_TOL of `nominal` (the
     design's own net) on every metric, and each tried multiplier's largest change. The
-    multipliers are tried from the finest: once one fails, coarser ones are not run."""
+    multipliers are tried from the finest: once one fails, coarser ones are not run. `work`
+    gets each sweep's Run.work()."""
     best, change = 1, {}
     for k in COARSENINGS:
         if not _meshable(d, k):
             break
         run = run_variant(d, base or Variant(), lv, k, load_kw)
+        if work is not None:
+            work.append(run.work())
         change[k] = _largest_change(curves(run), nominal)
         if change[k] >= REFINE_TOL:
             break
@@ -316,7 +320,8 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
     variants = [v if v.mounting else dataclasses.replace(v, mounting=mounting)
                 for v in variants]
     nom = curves(nominal)
-    k, change = refinement_test(d, nom, lv, load_kw, Variant(mounting=mounting))
+    work: list[dict[str, Any]] = []
+    k, change = refinement_test(d, nom, lv, load_kw, Variant(mounting=mounting), work)
     # longest first (the worker that takes the last job should not start a long one late):
     # a slack variant is a mechanism until its strands tighten, the slowest sweep by far
     order = sorted(range(len(variants)), key=lambda i: -variants[i].slack)
@@ -324,6 +329,7 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
     if k > 1:
         jobs.append((run_variant, (d, Variant(mounting=mounting), lv, k, load_kw), {}))
     done = run_jobs(jobs)
+    work += [r.work() for r in done]
     base = curves(done.pop()) if k > 1 else None
     runs = [done[order.index(i)] for i in range(len(variants))]
     out, failed = {}, {}
@@ -333,7 +339,7 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
         if r.failed:
             failed[v.label] = sorted(r.failed)
     return Band(lv, nom, out, {v.label: v.source for v in variants}, list(notes or []), k,
-                change, time.perf_counter() - t0, failed, mounting)
+                change, time.perf_counter() - t0, failed, mounting, work)
 
 
 SIGNIFICANT = 0.1  # levels where the prototype is below 10 % of its peak carry no verdict

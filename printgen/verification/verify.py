@@ -112,7 +112,8 @@ class Run:
     """One barrier's sweep: its deformation and solver statistics; `shapes`: node positions
     (n, 3) m at the SHAPE_LEVELS it reached; `hold_share`: the largest force of the hold of
     unloaded nodes over the applied load (0 without a hold); `backend`: the solver's linear
-    backend(s) ("ldl", "pardiso", "lu"; comma-separated if several)."""
+    backend(s) ("ldl", "pardiso", "lu"; comma-separated if several); `unknowns`: the solver
+    net's free degrees of freedom; `cpu_s`: the sweep's CPU time in its process."""
 
     scene: BarrierScene
     deformation: Deformation
@@ -122,6 +123,16 @@ class Run:
     shapes: dict[float, np.ndarray] = field(default_factory=dict)
     hold_share: float = 0.0
     backend: str = ""
+    unknowns: int = 0
+    cpu_s: float = 0.0
+
+    def work(self) -> dict[str, Any]:
+        """What the solver did (printgen.run.budget.counted_work): the net's unknowns, the
+        load levels, the Newton iterations (chord steps included) and, under "time_s" (a
+        volatile key: timings.json), the CPU seconds."""
+        return {"name": self.scene.name, "unknowns": self.unknowns,
+                "levels": len(self.iterations), "iterations": int(sum(self.iterations)),
+                "time_s": self.cpu_s}
 
     def shape_record(self) -> dict[str, Any]:
         """The node positions (m, rounded to SHAPE_DECIMALS) at rest and at each kept level."""
@@ -136,7 +147,7 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw: Any
     """Solve the load path (`load_kw`: the load case and site of `loads_function`); levels
     that do not converge are kept in `Run.failed` (left out of the comparison); SolverError
     only when fewer than MIN_COMPARED levels converge."""
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), time.process_time()
     net, ex = build(s, slack=slack)
     loads_at = loads_function(s, **load_kw)
 
@@ -166,7 +177,8 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw: Any
     shapes = {float(r.level): r.positions[:n] for r in results
               if r.converged and np.any(np.isclose(r.level, SHAPE_LEVELS))}
     return Run(s, d, [r.iterations for r in results], time.perf_counter() - t0, failed, shapes,
-               share, ",".join(sorted({r.backend for r in results})))
+               share, ",".join(sorted({r.backend for r in results})),
+               int((~net.fixed_dofs).sum()), time.process_time() - cpu0)
 
 
 @dataclass(frozen=True)
