@@ -38,14 +38,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from solver.linsolve import (
-    GMRES_RESTART,
-    GMRES_RTOL,
-    LINEAR_RTOL,
-    Factorization,
-    choose_backend,
-    gmres,
-)
+from solver.linsolve import Factorization, choose_backend, refine, row_sum_norm
 from solver.newton import (
     ARMIJO,
     MAX_BACKTRACK,
@@ -69,7 +62,8 @@ START_GRID = 13  # potentials sampled over START_SPAN before the scalar minimisa
 START_XTOL = 0.01  # log10 resolution of the membrane start's scale
 # backends whose re-passes are GMRES on the first pass's factorization: a triangular solve of
 # qdldl's LDL^T costs ~1/10 of its factorization; PARDISO refactorizes cheaper than the 5-10
-# preconditioned iterations (241 x 81 at tol 1e-6: 5.3 s CPU by GMRES, ~3.6 s refactorizing)
+# preconditioned iterations (241 x 81 at tol 1e-6, 1 thread: 5.0-5.4 s wall by GMRES, 2.6 s
+# refactorizing)
 REPASS_BY_GMRES = ("ldl",)
 PDAS_PASSES = 1  # active-set re-solves per Newton step at most, each by GMRES on the first
 # pass's factorization (simple barrier 1:40, worst level of the model / prototype sweeps: 1 pass
@@ -196,7 +190,6 @@ class Updated:
 
     def __init__(self, A, base: Factorization) -> None:
         self.A, self.base = A, base
-        self.handle = base.handle
 
     def solve(self, b: np.ndarray, forcing: float = 0.0) -> np.ndarray | None:
         base = self.base
@@ -204,13 +197,9 @@ class Updated:
             base.lu.solve if base.lu is not None else None)
         if precondition is not None:
             with np.errstate(all="ignore"):
-                x0 = np.zeros_like(b)
-                target = max(forcing * float(np.abs(b).max()), 0.0)
-                x = gmres(self.A, precondition, b, x0, max(target, GMRES_RTOL * float(
-                    np.linalg.norm(b))), GMRES_RESTART)
-            if np.all(np.isfinite(x)) and float(np.abs(b - self.A @ x).max()) <= max(
-                    target, LINEAR_RTOL * (float(abs(self.A).sum(axis=1).max())
-                                           * float(np.abs(x).max()) + float(np.abs(b).max()))):
+                x = refine(self.A, precondition, b, np.zeros_like(b), forcing,
+                           row_sum_norm(self.A))
+            if x is not None:
                 return x
         fresh = Factorization(base.pattern, self.A.data, base.backend, None)
         return fresh.solve(b, forcing)

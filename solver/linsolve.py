@@ -225,19 +225,7 @@ class Factorization:
         """The direct solve, then GMRES on A preconditioned by it when that misses the
         target (the follower term, with an LDL^T of S); None unless the target is met."""
         if self.a_norm is None:
-            self.a_norm = float(abs(self.A).sum(axis=1).max()) if self.A.nnz else 0.0
-        a_norm = self.a_norm
-        b_norm = float(np.abs(b).max()) if b.size else 0.0
-
-        def good(x: np.ndarray) -> bool:
-            if not np.all(np.isfinite(x)):
-                return False
-            res = b - self.A @ x
-            if float(np.abs(res).max()) <= forcing * b_norm:
-                return True
-            return float(np.abs(res).max()) <= LINEAR_RTOL * (a_norm * float(np.abs(x).max())
-                                                              + b_norm)
-
+            self.a_norm = row_sum_norm(self.A)
         direct = self.direct
         if direct is None:
             return None
@@ -245,15 +233,40 @@ class Factorization:
             with np.errstate(all="ignore"):
                 x = direct(b)
                 self.last = (b, x.copy())
-                if good(x):
-                    return x
-                if not np.all(np.isfinite(x)):
-                    return None
-                target = max(forcing * b_norm, GMRES_RTOL * float(np.linalg.norm(b)))
-                x = gmres(self.A, direct, b, x, target, GMRES_RESTART)
+                return refine(self.A, direct, b, x, forcing, self.a_norm)
         except Exception:  # noqa: BLE001 - a failing backend: SuperLU decides
             return None
-        return x if good(x) else None
+
+
+def row_sum_norm(A: sp.csr_matrix) -> float:
+    """max row sum of |A| (the infinity norm of the backward-error test)."""
+    return float(abs(A).sum(axis=1).max()) if A.nnz else 0.0
+
+
+def meets(A: sp.csr_matrix, b: np.ndarray, x: np.ndarray, forcing: float, a_norm: float
+          ) -> bool:
+    """x solves A x = b to a backward error of LINEAR_RTOL, or (inexact Newton) to a
+    residual max |b - A x| <= forcing max |b|."""
+    if not np.all(np.isfinite(x)):
+        return False
+    b_norm = float(np.abs(b).max()) if b.size else 0.0
+    res = float(np.abs(b - A @ x).max()) if b.size else 0.0
+    return res <= forcing * b_norm or res <= LINEAR_RTOL * (a_norm * float(np.abs(x).max())
+                                                            + b_norm)
+
+
+def refine(A: sp.csr_matrix, precondition: Callable[[np.ndarray], np.ndarray], b: np.ndarray,
+           x: np.ndarray, forcing: float, a_norm: float) -> np.ndarray | None:
+    """x when it `meets` the target, else GMRES on A preconditioned by `precondition` from
+    x; None unless the result meets it."""
+    if meets(A, b, x, forcing, a_norm):
+        return x
+    if not np.all(np.isfinite(x)):
+        return None
+    b_norm = float(np.abs(b).max()) if b.size else 0.0
+    target = max(forcing * b_norm, GMRES_RTOL * float(np.linalg.norm(b)))
+    x = gmres(A, precondition, b, x, target, GMRES_RESTART)
+    return x if meets(A, b, x, forcing, a_norm) else None
 
 
 def gmres(A: sp.csr_matrix, precondition: Callable[[np.ndarray], np.ndarray], b: np.ndarray,
