@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import time
 from collections.abc import Callable
 from typing import Any
 
@@ -49,6 +50,8 @@ PARDISO_IPARM = {1: 1, 2: 0, 8: 0, 10: 13, 11: 0, 13: 0, 21: 1}  # MKL's iparm (
 # 21.5 s. Measured at 57k and not chosen: parallel METIS (3) and two-level factorization
 # (iparm 24) no faster on 1 thread, VBSR (37) 1.5x slower, MKL's low-rank update (39) no
 # faster for mtype 2, single precision (28) a 20 % faster factor but 5 digits (2 more solves)
+
+PHASES = {11: "analysis", 22: "factorization", 33: "solve"}  # MKL's phases, as Pardiso counts
 
 
 def ldl_available() -> bool:
@@ -113,6 +116,8 @@ class Pardiso:
         self.S: sp.csr_matrix | None = None  # the factorized matrix (MKL may read it at solves)
         self.ia: np.ndarray | None = None  # S.indptr + 1 as int32
         self.ja: np.ndarray | None = None  # S.indices + 1 as int32
+        self.cpu = dict.fromkeys(PHASES.values(), 0.0)  # CPU seconds (process_time) by phase
+        self.calls = dict.fromkeys(PHASES.values(), 0)
 
     @staticmethod
     def _solver(mtype: int):
@@ -143,6 +148,7 @@ class Pardiso:
         data = np.ascontiguousarray(S.data, dtype=np.float64)
         x = np.zeros_like(rhs)
         error = ctypes.c_int32(0)
+        t0 = time.process_time()
         i32 = ctypes.POINTER(ctypes.c_int32)
         solver._mkl_pardiso(
             solver.pt.ctypes.data_as(ctypes.POINTER(solver._pt_type[0])),
@@ -154,6 +160,10 @@ class Pardiso:
             solver.iparm.ctypes.data_as(i32), ctypes.byref(ctypes.c_int32(0)),  # msglvl
             rhs.ctypes.data_as(ctypes.c_void_p), x.ctypes.data_as(ctypes.c_void_p),
             ctypes.byref(error))
+        name = PHASES.get(phase)
+        if name is not None:
+            self.cpu[name] += time.process_time() - t0
+            self.calls[name] += 1
         if error.value != 0:
             raise self.error(error.value)
         return x
