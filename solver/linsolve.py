@@ -36,10 +36,11 @@ from solver.pattern import Pattern
 LINEAR_RTOL = 1e-13  # backward error a solve must reach: |b - A x| <= tol (|A| |x| + |b|)
 GMRES_RTOL = 1e-14  # GMRES stops at this relative 2-norm residual at the latest
 GMRES_RESTART = 30  # GMRES iterations (one restart cycle) before falling back to SuperLU
-PARDISO_MIN_DOFS = 6_500  # from here on PARDISO's supernodal Cholesky of S beats qdldl's
-# LDL^T (simple-pinned, 1 thread, CPU per numeric factorization: 3.4k unknowns 4 / 5 ms, 14k
-# 21 / 64 ms, 57k 76 / 690 ms; whole solve at tol 1e-6: 5.3k 0.29 / 0.21 s, 7.7k 0.37 /
-# 0.48 s, 14k 0.87 / 1.26 s: PARDISO's solves and set-up cost more on small nets)
+PARDISO_MIN_DOFS = 5_000  # from here on PARDISO's Cholesky of S beats qdldl's LDL^T (simple
+# scene with 0.3 / 0.25 / 0.18 / 0.15 / 0.12 / 0.1 m meshes, 1 thread, whole solve at tol 1e-6,
+# CPU, best of 3, qdldl against PARDISO with its minimum-degree ordering: 1.4k unknowns 0.031-
+# 0.042 / 0.037-0.040 s, 2.1k 0.044 / 0.045 s, 4.2k 0.10-0.15 / 0.12-0.13 s, 6.2k 0.25 / 0.20 s,
+# 9.5k 0.48 / 0.36 s, 14k 0.77-0.86 / 0.48 s; was 6500 with METIS)
 PARDISO_IPARM = {1: 1, 2: 0, 8: 0, 10: 13, 11: 0, 13: 0, 21: 1}  # MKL's iparm (1-based):
 # own settings, minimum-degree ordering, no refinement, pivot perturbation 1e-13, no scaling
 # or matching, Bunch-Kaufman pivots (mtype -2); everything else MKL's zero default.
