@@ -28,8 +28,8 @@ def pair_values(k: np.ndarray) -> np.ndarray:
 
 def _node_slots(bar_i: np.ndarray, bar_j: np.ndarray, cable_nodes: list[np.ndarray],
                 n_nodes: int) -> tuple[list[np.ndarray], list[np.ndarray], list[tuple]]:
-    """The node pairs (p, q) of every slot group, in slot order, and how each group's slots
-    expand them: (pair-array shape, axes of a, axes of b) for broadcasting (pair, a, b)."""
+    """The node pairs (p, q) of every slot group, in slot order, and each group's kind (how
+    its slots expand a pair: `_expand`)."""
     every = np.arange(n_nodes)
     p_parts, q_parts, shapes = [], [], []
 
@@ -155,12 +155,15 @@ class Pattern:
         n = len(diagonal_entry)
         n_cable = n_slots - 36 * m - 9 * n
         strand = np.flatnonzero(self.keep[:36 * m])
-        pos = self.slot[:len(strand)][::-1]
-        order = np.argsort(pos, kind="stable")  # by position, later strands first
+        k = len(strand)  # grouped by position, later strands first: a counting sort (CSR ->
+        # CSC keeps the row order within a column) of the strand slots in reverse order
+        by_slot = sp.csr_matrix((np.ones(k), self.slot[:k][::-1], np.arange(k + 1)),
+                                shape=(k, self.nnz)).tocsc()
+        order = strand[k - 1 - by_slot.indices]
         sign = np.repeat([1.0, 1.0, -1.0, -1.0], 9)  # slot (e, block, a, b) of strand e
-        src = (strand // 36) * 6 + np.tile(SYM_INDEX.ravel(), 4)[strand % 36]
-        ptr = np.concatenate([[0], np.cumsum(np.bincount(pos, minlength=self.nnz))])
-        self.strand_map = sp.csr_matrix((sign[strand % 36][::-1][order], src[::-1][order], ptr),
+        strand_of, within = np.divmod(order, 36)
+        src = strand_of * 6 + np.tile(SYM_INDEX.ravel(), 4)[within]
+        self.strand_map = sp.csr_matrix((sign[within], src, by_slot.indptr),
                                         shape=(self.nnz, 6 * m))
         cable = np.flatnonzero(self.keep[36 * m:36 * m + n_cable])
         self.cable_map = sp.csr_matrix(
