@@ -29,7 +29,7 @@ def pair_values(k: np.ndarray) -> np.ndarray:
 def _node_slots(bar_i: np.ndarray, bar_j: np.ndarray, cable_nodes: list[np.ndarray],
                 n_nodes: int) -> tuple[list[np.ndarray], list[np.ndarray], list[tuple]]:
     """The node pairs (p, q) of every slot group, in slot order, and each group's kind (how
-    its slots expand a pair: `_expand`)."""
+    its slots expand a pair: `_positions`)."""
     every = np.arange(n_nodes)
     p_parts, q_parts, shapes = [], [], []
 
@@ -50,22 +50,20 @@ def _node_slots(bar_i: np.ndarray, bar_j: np.ndarray, cable_nodes: list[np.ndarr
     return p_parts, q_parts, shapes
 
 
-def _expand(e: np.ndarray, kind: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(node entry, a, b) of every slot of a group whose node pairs have entries e."""
-    a3 = np.arange(3)
-    if kind == "member":  # e (k, 4) -> (k, 4, 3, 3)
-        shape = (*e.shape, 3, 3)
-        return (np.broadcast_to(e[:, :, None, None], shape),
-                np.broadcast_to(a3[:, None], shape), np.broadcast_to(a3[None, :], shape))
-    if kind == "dense":  # e (k, k) -> (k, 3, k, 3)
-        k = e.shape[0]
-        shape = (k, 3, k, 3)
-        return (np.broadcast_to(e[:, None, :, None], shape),
-                np.broadcast_to(a3[None, :, None, None], shape),
-                np.broadcast_to(a3[None, None, None, :], shape))
-    shape = (len(e), 3, 3)  # node: e (n,) -> (n, 3, 3)
-    return (np.broadcast_to(e[:, None, None], shape), np.broadcast_to(a3[:, None], shape),
-            np.broadcast_to(a3[None, :], shape))
+def _positions(kind: str, p: np.ndarray, e: np.ndarray, row_at: np.ndarray,
+               row_free: np.ndarray, col_at: np.ndarray, col_free: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """(kept, CSR positions of the kept) slots of a group with node pairs (p, entry e), from
+    the CSR start of every dof's row (row_at, n x 3) and every node entry's column offset
+    per free dof (col_at, entries x 3): a broadcast sum, one array the size of the group."""
+    if kind == "dense":  # pairs (s, t) -> slots (s, a, t, b)
+        rows, rf = row_at[p[:, 0]][:, :, None, None], row_free[p[:, 0]][:, :, None, None]
+        cols, cf = col_at[e][:, None], col_free[e][:, None]
+    else:  # pairs (...) -> slots (..., a, b)
+        rows, rf = row_at[p][..., :, None], row_free[p][..., :, None]
+        cols, cf = col_at[e][..., None, :], col_free[e][..., None, :]
+    keep = rf & cf
+    return keep.ravel(), (rows + cols)[keep]
 
 
 class Pattern:
@@ -104,16 +102,16 @@ class Pattern:
         self.indptr = np.concatenate([[0], np.cumsum(row_len)])
         self.nnz = int(self.indptr[-1])
 
-        parts, at = [], 0
+        row_at = np.where(fmask, self.indptr[:-1][np.maximum(index, 0)].reshape(n, 3), 0)
+        col_at, col_free = offset[:, None] + rank.reshape(n, 3)[ecol], fmask[ecol]
+        keep, slot, at = [], [], 0
         for p, kind in zip(p_parts, kinds):
-            parts.append([x.ravel() for x in _expand(inverse[at:at + p.size].reshape(p.shape),
-                                                       kind)])
+            k, pos = _positions(kind, p, inverse[at:at + p.size].reshape(p.shape), row_at,
+                                fmask, col_at, col_free)
+            keep.append(k)
+            slot.append(pos)
             at += p.size
-        e_s, a_s, b_s = (np.concatenate(x) for x in zip(*parts))
-        col_dof = 3 * ecol[e_s] + b_s
-        fr, fc = index[3 * erow[e_s] + a_s], index[col_dof]
-        self.keep = (fr >= 0) & (fc >= 0)
-        self.slot = self.indptr[fr[self.keep]] + offset[e_s[self.keep]] + rank[col_dof[self.keep]]
+        self.keep, self.slot = np.concatenate(keep), np.concatenate(slot)
 
         # the entries, row by row: node row p's widened entries, repeated for each free dof
         entry_cols = index.reshape(n, 3)[ecol][fmask[ecol]]
