@@ -27,27 +27,29 @@ def pair_values(k: np.ndarray) -> np.ndarray:
 
 
 def _node_slots(bar_i: np.ndarray, bar_j: np.ndarray, cable_nodes: list[np.ndarray],
-                n_nodes: int) -> tuple[list[np.ndarray], list[np.ndarray], list[tuple]]:
+                n_nodes: int) -> tuple[list[np.ndarray], list[np.ndarray], list[str]]:
     """The node pairs (p, q) of every slot group, in slot order, and each group's kind (how
     its slots expand a pair: `_positions`)."""
     every = np.arange(n_nodes)
-    p_parts, q_parts, shapes = [], [], []
+    p_parts: list[np.ndarray] = []
+    q_parts: list[np.ndarray] = []
+    kinds: list[str] = []
 
     def members(i: np.ndarray, j: np.ndarray) -> None:  # blocks ii, jj, ij, ji: (k, 4, 3, 3)
         p_parts.append(np.stack([i, j, i, j], axis=1))
         q_parts.append(np.stack([i, j, j, i], axis=1))
-        shapes.append("member")
+        kinds.append("member")
 
     members(bar_i, bar_j)
     for nodes in cable_nodes:
         members(nodes[:-1], nodes[1:])
         p_parts.append(np.repeat(nodes, len(nodes)).reshape(len(nodes), len(nodes)))
         q_parts.append(np.tile(nodes, len(nodes)).reshape(len(nodes), len(nodes)))
-        shapes.append("dense")  # (s, a, t, b): the rows and columns of the cable's dofs
+        kinds.append("dense")  # (s, a, t, b): the rows and columns of the cable's dofs
     p_parts.append(every)
     q_parts.append(every)
-    shapes.append("node")
-    return p_parts, q_parts, shapes
+    kinds.append("node")
+    return p_parts, q_parts, kinds
 
 
 def _positions(kind: str, p: np.ndarray, e: np.ndarray, row_at: np.ndarray,
@@ -76,7 +78,7 @@ class Pattern:
     CSR is that graph with every node entry widened to its column node's free dofs, so a
     slot's CSR position is its row's start, plus its node entry's offset in the row, plus
     its column's rank among that node's free dofs; no sort of the slots, no COO -> CSR
-    conversion (241 x 81 nodes: 0.37 -> 0.1 s CPU).
+    conversion (CPU, 241 x 81 nodes: 0.41 -> 0.22 s; 481 x 161: 1.7 -> 1.0 s).
     """
 
     def __init__(self, n_nodes: int, free: np.ndarray, bar_i: np.ndarray, bar_j: np.ndarray,
@@ -95,7 +97,7 @@ class Pattern:
         width = fmask.sum(axis=1)[ecol]  # free columns of each node entry
         before = np.cumsum(width) - width
         node_ptr = np.concatenate([[0], np.cumsum(np.bincount(erow, minlength=n))])
-        row_start = np.append(before, before[-1] + width[-1] if len(width) else 0)[node_ptr[:-1]]
+        row_start = before[node_ptr[:-1]]  # every node has an entry: its diagonal block
         offset = before - row_start[erow]  # each node entry's first column within its row
         free_dofs = np.flatnonzero(free)
         row_len = np.bincount(erow, width, n).astype(np.int64)[free_dofs // 3]
@@ -113,18 +115,25 @@ class Pattern:
             at += p.size
         self.keep, self.slot = np.concatenate(keep), np.concatenate(slot)
 
-        # the entries, row by row: node row p's widened entries, repeated for each free dof
+        self._entries(node_keys, n, width, offset, row_start[free_dofs // 3], row_len, rank,
+                      index, fmask)
+        self._triangles()
+        self._maps(len(bar_i), len(self.keep), inverse[-n:], offset, rank, index)
+
+    def _entries(self, node_keys: np.ndarray, n: int, width: np.ndarray, offset: np.ndarray,
+                 row_start: np.ndarray, row_len: np.ndarray, rank: np.ndarray,
+                 index: np.ndarray, fmask: np.ndarray) -> None:
+        """Rows, columns and mirror positions of the CSR entries, row by row: each free dof's
+        row is its node row's widened entries (from row_start, row_len long)."""
+        erow, ecol = node_keys // n, node_keys % n
         entry_cols = index.reshape(n, 3)[ecol][fmask[ecol]]
         entry_node = np.repeat(np.arange(len(node_keys)), width)
-        src = np.arange(self.nnz) + np.repeat(row_start[free_dofs // 3] - self.indptr[:-1],
-                                              row_len)
+        src = np.arange(self.nnz) + np.repeat(row_start - self.indptr[:-1], row_len)
         self.rows = np.repeat(np.arange(self.size), row_len)
         self.cols = entry_cols[src]
         mirror = np.searchsorted(node_keys, ecol * n + erow)  # node entry (q, p) of (p, q)
         self.transpose = (self.indptr[self.cols] + offset[mirror[entry_node[src]]]
-                          + rank[free_dofs[self.rows]])
-        self._triangles()
-        self._maps(len(bar_i), len(self.keep), inverse[-n:], offset, rank, index)
+                          + rank[np.flatnonzero(fmask.ravel())[self.rows]])
 
     def _triangles(self) -> None:
         """Diagonal and upper-triangle selections: the upper triangle in CSC order (column,
