@@ -61,9 +61,22 @@ from printgen.run.steps import (
     verification_sweeps,
     verify_step,
 )
-from printgen.workers import Helper, check_deadline, cores, deadline, helper, signals_deferred
+from printgen.workers import (
+    Helper,
+    check_deadline,
+    cores,
+    deadline,
+    helper,
+    preload,
+    signals_deferred,
+    span,
+)
 
 log = logging.getLogger(__name__)
+# what the workers' jobs import (the verification's sweeps, the report's figures): a fork
+# server imports them once (printgen.workers.preload)
+JOB_MODULES = ("printgen.run.steps", "printgen.verification.bands", "printgen.report.plots",
+               "matplotlib.pyplot")
 
 
 @dataclass(frozen=True)
@@ -144,11 +157,13 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     only file that differs between runs).
     """
     t0 = time.perf_counter()
+    preload(JOB_MODULES)  # a fork server's imports, beside the planning and the parts
     options = options or MakeOptions()
     inputs = [prototype_path, options.design_file, *search_dirs()]
     check_destination(Path(out), force=options.force, inputs=inputs)  # fail fast
-    ctx = plan(prototype_path, scale, printer=printer, options=options)
-    est = size_check(ctx, steps is None or any(s is verify_step for _, s in steps))
+    with span("make: plan and estimate"):
+        ctx = plan(prototype_path, scale, printer=printer, options=options)
+        est = size_check(ctx, steps is None or any(s is verify_step for _, s in steps))
     if progress and est.seconds > LONG_RUN_S:
         progress(f"estimate: {est.summary()}")
     meta: dict[str, Any] = {}
@@ -165,20 +180,16 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
                 progress(label)
             t, cpu = time.perf_counter(), time.process_time()
             try:
-                ctx.record.update(step(ctx, stage))
+                with span(f"step: {label}"):
+                    ctx.record.update(step(ctx, stage))
                 check_deadline(label)
             except TimeLimitError as exc:
                 raise TimeLimitError(time_limit_line(label, exc, est, bound, t0)) from exc
             times = ctx.record.setdefault("timings_s", {})
             times[label] = time.perf_counter() - t
             times.setdefault("cpu_s", {})[label] = time.process_time() - cpu  # this process
-        meta.update(provenance(ctx))
-        provenance_section(ctx.report, meta)
-        for name, data in report_files(ctx.record, ctx.report).items():
-            (stage / name).parent.mkdir(exist_ok=True)
-            (stage / name).write_bytes(data)
-            ctx.files.append(name)
-        (stage / "report.html").write_text(ctx.report.html())
+        with span("make: report files"):
+            write_report(ctx, stage, meta)
         if ctx.options.pdf:
             report_pdf(ctx, stage, progress)
         ctx.record["files"] = sorted([*ctx.files, "report.html", "report.json", "design.json",
@@ -190,6 +201,17 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
         (stage / TIMINGS).write_text(dumps(timings))
     log.info("make finished in %.2f s", time.perf_counter() - t0)
     return ctx
+
+
+def write_report(ctx: MakeContext, stage: Path, meta: dict[str, Any]) -> None:
+    """The provenance section, the report's files (figures, lab files) and report.html."""
+    meta.update(provenance(ctx))
+    provenance_section(ctx.report, meta)
+    for name, data in report_files(ctx.record, ctx.report).items():
+        (stage / name).parent.mkdir(exist_ok=True)
+        (stage / name).write_bytes(data)
+        ctx.files.append(name)
+    (stage / "report.html").write_text(ctx.report.html())
 
 
 def report_pdf(ctx: MakeContext, stage: Path, progress: Callable[[str], None] | None) -> None:

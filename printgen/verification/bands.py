@@ -42,6 +42,7 @@ from printgen.units import MM
 from printgen.verification.compare import METRICS
 from printgen.verification.scenes import BarrierScene, model_scene
 from printgen.verification.verify import Run, load_keywords, run_jobs, sweep
+from printgen.workers import span
 
 SLACK_MAX = 0.01  # initial slack of the printed net, upper end of the range (issue 10: 0-1 %)
 COARSENINGS = (2, 3)  # mesh multipliers tried in turn for the variant sweeps
@@ -321,7 +322,8 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
                 for v in variants]
     nom = curves(nominal)
     work: list[dict[str, Any]] = []
-    k, change = refinement_test(d, nom, lv, load_kw, Variant(mounting=mounting), work)
+    with span("band: refinement test"):
+        k, change = refinement_test(d, nom, lv, load_kw, Variant(mounting=mounting), work)
     # longest first (the worker that takes the last job should not start a long one late):
     # a slack variant is a mechanism until its strands tighten, the slowest sweep by far
     order = sorted(range(len(variants)), key=lambda i: -variants[i].slack)
