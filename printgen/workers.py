@@ -193,8 +193,8 @@ def _main_thread() -> bool:
 def init_worker(plat: Platform, sink: Any = None, at: float | None = None) -> None:
     """Pool initializer: die with the parent, leave signals to the parent, report progress to
     `sink` (the parent's queue, or None), keep the parent's deadline `at` (`deadline`)."""
-    global _inherited, _sink, _deadline
-    _inherited, _sink, _deadline = plat, sink, at
+    global _inherited, _sink, _deadline, _shared
+    _inherited, _sink, _deadline, _shared = plat, sink, at, None  # not its parent's pool
     for s in plat.signals:
         signal.signal(s, signal.SIG_IGN)
     parent = multiprocessing.parent_process()
@@ -284,6 +284,11 @@ def _result(f: Future) -> Any:
         raise TimeLimitError("a worker's job: past the time limit") from exc
 
 
+def collect(futures: list[Future]) -> list:
+    """The futures' results, each waited for no longer than the deadline (`deadline`)."""
+    return [_result(f) for f in futures]
+
+
 def report_progress(task: str, done: float, total: float) -> None:
     """From inside a job: `task` has reached `done` of `total` (e.g. load level 0.35 of 1.1).
     A no-op unless the caller of `run_jobs` is listening."""
@@ -343,6 +348,8 @@ def run_jobs(jobs: list[tuple]) -> list:
     On any exception or signal in the parent the workers are killed before it propagates.
     """
     global _sink
+    if _shared is not None:  # within `shared_pool`: its workers
+        return collect([_shared.submit(fn, *args, **kw) for fn, args, kw in jobs])
     workers = min(len(jobs), cores())
     if workers < 2 or os.environ.get("PRINTGEN_SERIAL"):
         previous, _sink = _sink, _listener or _sink  # in a worker: its parent's queue
@@ -375,6 +382,82 @@ def _in_pool(jobs: list[tuple], workers: int) -> list:
         queue.put(None)  # the workers are done: end the helper thread after the last report
         reader.join(timeout=READER_JOIN_S)
     return results
+
+
+class Pool:
+    """Worker processes for the jobs of a block (`shared_pool`): `submit` starts a job now and
+    returns its Future (`collect` waits for futures within the deadline). With one core or
+    PRINTGEN_SERIAL=1, `submit` runs the job at once (its Future is done)."""
+
+    def __init__(self, workers: int) -> None:
+        self.pool: ProcessPoolExecutor | None = None
+        self.queue, self.reader = None, None
+        if workers < 2 or os.environ.get("PRINTGEN_SERIAL"):
+            return
+        plat = platform()
+        ctx = multiprocessing.get_context(start_method(plat))
+        self.queue = ctx.SimpleQueue() if _listener else None
+        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
+                                        initializer=init_worker,
+                                        initargs=(plat, self.queue, _deadline))
+
+    def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> Future:
+        fn, args, kwargs = _job(fn, args, kwargs)
+        if self.pool is None:
+            return _done(fn, args, kwargs)
+        with _watch_is_safe():
+            f = self.pool.submit(fn, *args, **kwargs)
+        if self.queue is not None and self.reader is None:  # once the workers are forked
+            self.reader = threading.Thread(target=_drain, args=(self.queue, _listener),
+                                           daemon=True)
+            self.reader.start()
+        return f
+
+    def close(self) -> None:
+        if self.pool is not None:
+            self.pool.shutdown(wait=True)
+        if self.reader is not None:
+            self.queue.put(None)  # the workers are done: end the reader after the last report
+            self.reader.join(timeout=READER_JOIN_S)
+
+
+def _done(fn: Callable, args: tuple, kwargs: dict) -> Future:
+    """A Future holding fn(*args, **kwargs), run here (reporting progress as `run_jobs`
+    does when serial; its error raised here, as serial `run_jobs` raises it)."""
+    global _sink
+    f: Future = Future()
+    previous, _sink = _sink, _listener or _sink
+    try:
+        f.set_result(fn(*args, **kwargs))
+    finally:
+        _sink = previous
+    return f
+
+
+_shared: Pool | None = None  # set by `shared_pool` (None in every worker: `init_worker`)
+
+
+@contextlib.contextmanager
+def shared_pool(workers: int | None = None) -> Iterator[Pool]:
+    """One set of worker processes (`workers`, default: the cores) for the block: its jobs
+    submitted as their inputs are ready (`Pool.submit`), and every `run_jobs` of the block in
+    this process, start on them instead of on pools of their own, so that a core freed by one
+    sweep takes the next job at once. On any exception or signal the workers are killed
+    before it propagates."""
+    global _shared
+    previous = _shared
+    pool = Pool(cores() if workers is None else workers)
+    _shared = pool
+    try:
+        with span("shared pool"):
+            yield pool
+    except BaseException:
+        if pool.pool is not None:
+            stop(pool.pool)
+        raise
+    finally:
+        _shared = previous
+    pool.close()
 
 
 class Helper:

@@ -323,15 +323,12 @@ def verification_sweeps(prototype: Prototype, design: Design, *, load: str | Non
     (README: Pre-print verification); every load level is solved on both. Needs nothing from
     the other steps, so it can run in a worker process while they run.
     """
-    from printgen.verification.bands import model_band, model_load_kw
-    from printgen.verification.verify import free_section, verify, with_cases
+    from printgen.verification.pooled import verify_with_band
+    from printgen.verification.verify import free_section, with_cases
 
-    with span("verify: nominal sweeps"):
-        v = with_cases(verify(prototype, design, load=load, counterexample=True), prototype,
-                       design, loads)
-    with span("verify: band"):
-        return v, model_band(design, v.model, load_kw=model_load_kw(prototype, design, load),
-                             free_section=free_section(prototype))
+    v, band = verify_with_band(prototype, design, load=load, counterexample=True,
+                               free_section=free_section(prototype))
+    return with_cases(v, prototype, design, loads), band
 
 
 def solver_work(v: Verification, band: Band) -> dict[str, Any]:

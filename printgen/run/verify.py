@@ -33,12 +33,7 @@ from printgen.report.uncertainty import (
     measured_sections,
 )
 from printgen.run.budget import DEFAULT_LIMIT_S, Work, check_budget, sweep_cores
-from printgen.verification.bands import (
-    Band,
-    band_verdicts,
-    model_band,
-    model_load_kw,
-)
+from printgen.verification.bands import Band, band_verdicts, model_load_kw
 from printgen.verification.fit import MultiFit, fit_levels, fit_measured
 from printgen.verification.layout import flume_layout
 from printgen.verification.measured import (
@@ -49,8 +44,9 @@ from printgen.verification.measured import (
     model_predictor,
     read_measured,
 )
+from printgen.verification.pooled import verify_with_band
 from printgen.verification.readings import design_units
-from printgen.verification.verify import Verification, free_section, verify
+from printgen.verification.verify import Verification, free_section
 
 
 @dataclass
@@ -90,10 +86,9 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     check_budget(p, d, limit_s=limit, cores=sweep_cores(),
                  work=Work(parts=False, fit=m is not None, model_follows=False))
     load_kw = model_load_kw(p, d, load)
-    say("verification (prototype and model load sweeps)")
-    v = verify(p, d, load=load)
-    say("uncertainty band (model variants)")
-    band = model_band(d, v.model, load_kw=load_kw, free_section=free_section(p))
+    say("verification (prototype and model load sweeps) and its uncertainty band (model "
+        "variants)")
+    v, band = verify_with_band(p, d, load=load, free_section=free_section(p))
     result, text = None, ""
     if m is not None and fit == "multi":
         say(f"multi-parameter fit of the printed net to {Path(measured).name}")

@@ -25,6 +25,7 @@ from __future__ import annotations
 import dataclasses
 import inspect
 import time
+from concurrent.futures import Future
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -42,7 +43,7 @@ from printgen.units import MM
 from printgen.verification.compare import METRICS
 from printgen.verification.scenes import BarrierScene, model_scene
 from printgen.verification.verify import Run, load_keywords, run_jobs, sweep
-from printgen.workers import span
+from printgen.workers import collect, span
 
 SLACK_MAX = 0.01  # initial slack of the printed net, upper end of the range (issue 10: 0-1 %)
 COARSENINGS = (2, 3)  # mesh multipliers tried in turn for the variant sweeps
@@ -266,16 +267,20 @@ def _nan_reduce(stack: np.ndarray, fn) -> np.ndarray:
 
 def refinement_test(d: Design, nominal: dict[str, np.ndarray], lv: np.ndarray,
                     load_kw: dict | None = None, base: Variant | None = None,
-                    work: list[dict[str, Any]] | None = None) -> tuple[int, dict[int, float]]:
+                    work: list[dict[str, Any]] | None = None,
+                    ahead: dict[int, Future] | None = None) -> tuple[int, dict[int, float]]:
     """Coarsest mesh multiplier whose nominal sweep stays within REFINE_TOL of `nominal` (the
     design's own net) on every metric, and each tried multiplier's largest change. The
     multipliers are tried from the finest: once one fails, coarser ones are not run. `work`
-    gets each sweep's Run.work()."""
+    gets each sweep's Run.work(). `ahead`: multiplier -> the sweep of `base` on it, started
+    before `lv` was known (used when it ran at `lv`, else run again)."""
     best, change = 1, {}
     for k in COARSENINGS:
-        if not _meshable(d, k):
+        if not meshable(d, k):
             break
-        run = run_variant(d, base or Variant(), lv, k, load_kw)
+        run = collect([ahead[k]])[0] if ahead and k in ahead else None
+        if run is None or not np.array_equal(run.deformation.levels, lv):
+            run = run_variant(d, base or Variant(), lv, k, load_kw)
         if work is not None:
             work.append(run.work())
         change[k] = _largest_change(curves(run), nominal)
@@ -285,7 +290,7 @@ def refinement_test(d: Design, nominal: dict[str, np.ndarray], lv: np.ndarray,
     return best, change
 
 
-def _meshable(d: Design, k: int) -> bool:
+def meshable(d: Design, k: int) -> bool:
     try:
         variant_scene(d, Variant(), k)
     except GeometryError:
@@ -305,12 +310,14 @@ def _largest_change(c: dict[str, np.ndarray], ref: dict[str, np.ndarray]) -> flo
 
 def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
                variants: list[Variant] | None = None, notes: list[str] | None = None,
-               free_section: float | None = None) -> Band:
+               free_section: float | None = None, ahead: dict[int, Future] | None = None
+               ) -> Band:
     """Sweep every variant of design `d` and collect them around the `nominal` run (the
     model's sweep on the design's own net, as `verify` ran it), at the same levels.
 
-    The variants run on the coarsest net that passes the refinement test; there a variant's
-    curve is the nominal plus the variant's change on the coarse net.
+    The variants run on the coarsest net that passes the refinement test (`ahead`: its
+    sweeps already started, `refinement_test`); there a variant's curve is the nominal plus
+    the variant's change on the coarse net.
     """
     t0 = time.perf_counter()
     lv = nominal.deformation.levels
@@ -323,7 +330,8 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
     nom = curves(nominal)
     work: list[dict[str, Any]] = []
     with span("band: refinement test"):
-        k, change = refinement_test(d, nom, lv, load_kw, Variant(mounting=mounting), work)
+        k, change = refinement_test(d, nom, lv, load_kw, Variant(mounting=mounting), work,
+                                    ahead)
     # longest first (the worker that takes the last job should not start a long one late):
     # a slack variant is a mechanism until its strands tighten, the slowest sweep by far
     order = sorted(range(len(variants)), key=lambda i: -variants[i].slack)

@@ -256,31 +256,61 @@ def _barriers(p: Prototype, d: Design, load: str | LoadCase | None, mounting: st
             model_scene(d, mounting=mounting, load=case))
 
 
+@dataclass(frozen=True)
+class VerifyPlan:
+    """What `verify` sweeps: the load case, the prototype's and the model's sweep keywords and
+    scenes, the load levels; `jobs` starts the two sweeps (model first: the longer one),
+    `verified` compares what they gave."""
+
+    case: LoadCase
+    kw_p: dict[str, Any]
+    kw_m: dict[str, Any]
+    ps: BarrierScene
+    ms: BarrierScene
+    lv: np.ndarray
+
+    def jobs(self) -> list[tuple]:
+        """(sweep, args, kwargs) of the model, then of the prototype (run_jobs' form)."""
+        return [(sweep, (self.ms, self.lv), self.kw_m), (sweep, (self.ps, self.lv), self.kw_p)]
+
+    def verified(self, model: Run, proto: Run, ce: CounterExample | None = None
+                 ) -> Verification:
+        """The comparison of the two sweeps, at the levels where both converged."""
+        bad = set(proto.failed) | set(model.failed)
+        if bad:  # compare only where both barriers converged
+            keep = np.array([lvl not in bad for lvl in self.lv])
+            proto = _only(proto, keep)
+            model = _only(model, keep)
+        (proto, model), load_rec = stated(self.case, (proto, model),
+                                          (self.kw_p["site"], self.kw_m["site"]))
+        mm = compare(proto.deformation, model.deformation)
+        start = compare(increments(proto.deformation), increments(model.deformation))
+        return Verification(self.case.title, proto, model, mm, explain(mm), ce, start,
+                            len(self.lv), load_rec)
+
+
+def verify_plan(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
+                lv: np.ndarray | None = None, mounting: str | None = None) -> VerifyPlan:
+    """The sweeps of `verify` (default levels: the usual ones and the case's own)."""
+    case, kw_p, kw_m, ps, ms = _barriers(p, d, load, mounting)
+    if lv is None:  # the usual levels and the case's own (the jam's discharge steps)
+        own = case.levels_for(ms, kw_m["site"])
+        lv = levels() if own is None else np.unique(np.concatenate([levels(), own]))
+    return VerifyPlan(case, kw_p, kw_m, ps, ms, np.asarray(lv, dtype=float))
+
+
 def verify(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
            lv: np.ndarray | None = None, counterexample: bool = False,
            mounting: str | None = None) -> Verification:
     """Sweep both barriers under the same relative loading of load case `load` (default
     hydrostatic) and compare them; both are mounted by `mounting` (default: the prototype
     file's [flume] lateral)."""
-    case, kw_p, kw_m, ps, ms = _barriers(p, d, load, mounting)
-    if lv is None:  # the usual levels and the case's own (the jam's discharge steps)
-        own = case.levels_for(ms, kw_m["site"])
-        lv = levels() if own is None else np.unique(np.concatenate([levels(), own]))
-    lv = np.asarray(lv, dtype=float)
-    jobs: list[tuple] = [(sweep, (ms, lv), kw_m), (sweep, (ps, lv), kw_p)]  # longest first
+    plan = verify_plan(p, d, load=load, lv=lv, mounting=mounting)
+    jobs = plan.jobs()  # longest first
     if counterexample:
         jobs.append((steel_counterexample, (d.scale,), {}))
     model, proto, *ce = run_jobs(jobs)
-    bad = set(proto.failed) | set(model.failed)
-    if bad:  # compare only where both barriers converged
-        keep = np.array([lvl not in bad for lvl in lv])
-        proto = _only(proto, keep)
-        model = _only(model, keep)
-    (proto, model), load_rec = stated(case, (proto, model), (kw_p["site"], kw_m["site"]))
-    mm = compare(proto.deformation, model.deformation)
-    start = compare(increments(proto.deformation), increments(model.deformation))
-    return Verification(case.title, proto, model, mm, explain(mm), ce[0] if ce else None,
-                        start, len(lv), load_rec)
+    return plan.verified(model, proto, ce[0] if ce else None)
 
 
 def stated(case: LoadCase, runs: tuple[Run, Run], sites: tuple[Site, Site]
