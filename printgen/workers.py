@@ -193,8 +193,9 @@ def _main_thread() -> bool:
 def init_worker(plat: Platform, sink: Any = None, at: float | None = None) -> None:
     """Pool initializer: die with the parent, leave signals to the parent, report progress to
     `sink` (the parent's queue, or None), keep the parent's deadline `at` (`deadline`)."""
-    global _inherited, _sink, _deadline, _shared
-    _inherited, _sink, _deadline, _shared = plat, sink, at, None  # not its parent's pool
+    global _inherited, _sink, _deadline, _shared, _listener
+    _inherited, _sink, _deadline = plat, sink, at
+    _shared, _listener = None, None  # a forked worker's copies of its parent's
     for s in plat.signals:
         signal.signal(s, signal.SIG_IGN)
     parent = multiprocessing.parent_process()
@@ -299,6 +300,12 @@ def report_progress(task: str, done: float, total: float) -> None:
         sink(task, done, total) if callable(sink) else sink.put((task, done, total))
 
 
+def _relay() -> Any:
+    """In a worker reporting to its parent's queue: that queue, for the workers it starts
+    (their reports go straight to the first process); else None."""
+    return _sink if _sink is not None and not callable(_sink) else None
+
+
 def _drain(queue: Any, listener: Callable[[str, float, float], None]) -> None:
     while (item := queue.get()) is not None:
         with contextlib.suppress(Exception):
@@ -366,7 +373,7 @@ def _in_pool(jobs: list[tuple], workers: int) -> list:
     ctx = multiprocessing.get_context(start_method(plat))
     queue = ctx.SimpleQueue() if _listener else None
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=init_worker,
-                               initargs=(plat, queue, _deadline))
+                               initargs=(plat, queue or _relay(), _deadline))
     try:
         with _watch_is_safe():
             futures = [pool.submit(fn, *args, **kw) for fn, args, kw in (_job(*j) for j in jobs)]
@@ -399,7 +406,7 @@ class Pool:
         self.queue = ctx.SimpleQueue() if _listener else None
         self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
                                         initializer=init_worker,
-                                        initargs=(plat, self.queue, _deadline))
+                                        initargs=(plat, self.queue or _relay(), _deadline))
 
     def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> Future:
         fn, args, kwargs = _job(fn, args, kwargs)
@@ -465,16 +472,29 @@ class Helper:
 
     def __init__(self) -> None:
         plat = platform()
-        self.pool = ProcessPoolExecutor(
-            max_workers=1, mp_context=multiprocessing.get_context(start_method(plat)),
-            initializer=init_worker, initargs=(plat, None, _deadline))
+        ctx = multiprocessing.get_context(start_method(plat))
+        self.queue = ctx.SimpleQueue() if _listener else None  # its workers' progress too
+        self.reader: threading.Thread | None = None
+        self.pool = ProcessPoolExecutor(max_workers=1, mp_context=ctx, initializer=init_worker,
+                                        initargs=(plat, self.queue or _relay(), _deadline))
         self.futures: list[Future] = []
 
     def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> Future:
         """Start `fn(*args, **kwargs)` there; `.result()` collects it (or raises its error)."""
         fn, args, kwargs = _job(fn, args, kwargs)
-        self.futures.append(self.pool.submit(fn, *args, **kwargs))
+        with _watch_is_safe():
+            self.futures.append(self.pool.submit(fn, *args, **kwargs))
+        if self.queue is not None and self.reader is None:  # once the worker is forked
+            self.reader = threading.Thread(target=_drain, args=(self.queue, _listener),
+                                           daemon=True)
+            self.reader.start()
         return self.futures[-1]
+
+    def end_reports(self) -> None:
+        """The worker is gone: pass on the reports left, then end the reader."""
+        if self.reader is not None:
+            self.queue.put(None)
+            self.reader.join(timeout=READER_JOIN_S)
 
 
 @contextlib.contextmanager
@@ -494,6 +514,7 @@ def helper() -> Iterator[Helper]:
         h.pool.shutdown(wait=True)
     else:
         stop(h.pool)
+    h.end_reports()
 
 
 def stop(pool: ProcessPoolExecutor) -> None:

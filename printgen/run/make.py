@@ -174,7 +174,7 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     with deadline(None if bound is None else time.time() + bound - (time.perf_counter() - t0)), \
             staged_dir(out, force=ctx.options.force, meta=meta,
                        volatile=(TIMINGS,), inputs=inputs) as stage, level_bars(long_run), \
-            verification_ahead(ctx, steps, long_run is None):
+            verification_ahead(ctx, steps):
         for label, step in steps:
             if progress:
                 progress(label)
@@ -230,14 +230,13 @@ def report_pdf(ctx: MakeContext, stage: Path, progress: Callable[[str], None] | 
 
 
 @contextlib.contextmanager
-def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]], short: bool
-                       ) -> Iterator[None]:
+def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]]) -> Iterator[None]:
     """Start the verification's sweeps (`verification_sweeps`) in a helper process now, so
     that they run while the parts are built here; `sweeps_done` and `verify_step` collect
-    them. Only for short runs on 2 cores or more: a long run's per-level progress bars come
-    from the sweeps' workers to this process, and on one core there is nothing to gain."""
+    them (a long run's per-level progress comes from the sweeps' workers straight to this
+    process: printgen.workers). Only on 2 cores or more: on one there is nothing to gain."""
     serial = os.environ.get("PRINTGEN_SERIAL") or cores() < 2
-    if serial or not short or not any(s is verify_step for _, s in steps):
+    if serial or not any(s is verify_step for _, s in steps):
         yield
         return
     quiet_tracker()
