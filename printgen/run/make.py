@@ -74,9 +74,9 @@ from printgen.workers import (
 
 log = logging.getLogger(__name__)
 # what the workers' jobs import (the verification's sweeps, the report's figures): a fork
-# server imports them once (printgen.workers.preload)
-JOB_MODULES = ("printgen.run.steps", "printgen.verification.bands", "printgen.report.plots",
-               "matplotlib.pyplot")
+# server imports them once (printgen.workers.preload); matplotlib's pyplot is imported by the
+# helper while its sweeps run (`verification_sweeps`), not here: the helper would wait for it
+JOB_MODULES = ("printgen.run.steps", "printgen.verification.pooled", "printgen.report.plots")
 
 
 @dataclass(frozen=True)

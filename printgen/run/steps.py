@@ -23,7 +23,7 @@ from printgen.errors import TimeLimitError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
 from printgen.report.parts_report import assembly_section, gcode_section, meshes_section
-from printgen.workers import run_jobs, seconds_left, span
+from printgen.workers import seconds_left, span
 
 HELPER_SWEEPS = "helper: verification sweeps"  # timings_s keys of work done in the helper
 WAIT_SWEEPS = "waiting for the verification sweeps"  # in this process, within a step
@@ -292,10 +292,11 @@ def draw_all(drawings: list[Drawing]) -> list[bytes]:
     """Each drawing's PNG (carrying its SVG), side by side in worker processes when there are
     several and two cores (printgen.workers.run_jobs); matplotlib is imported here first, so
     that forked workers start with it."""
+    from printgen.report.html import drawn
     from printgen.report.plots import load_pyplot
 
     load_pyplot()
-    return run_jobs([d.job() for d in drawings])
+    return drawn(drawings)
 
 
 def _collect(pending: Future, what: str) -> Any:
@@ -323,11 +324,13 @@ def verification_sweeps(prototype: Prototype, design: Design, *, load: str | Non
     (README: Pre-print verification); every load level is solved on both. Needs nothing from
     the other steps, so it can run in a worker process while they run.
     """
+    from printgen.report.plots import load_pyplot
     from printgen.verification.pooled import verify_with_band
     from printgen.verification.verify import free_section, with_cases
 
+    # matplotlib is imported while the sweeps run: the figures' workers start with it
     v, band = verify_with_band(prototype, design, load=load, counterexample=True,
-                               free_section=free_section(prototype))
+                               free_section=free_section(prototype), meanwhile=load_pyplot)
     return with_cases(v, prototype, design, loads), band
 
 

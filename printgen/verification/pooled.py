@@ -14,6 +14,7 @@ the pair and the refinement sweep are done. The results are those of `verify` th
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 
 from printgen.barrier.loads import LoadCase
 from printgen.design.record import Design
@@ -31,10 +32,12 @@ from printgen.workers import collect, shared_pool, span
 
 
 def verify_with_band(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
-                     counterexample: bool = False, free_section: float | None = None
+                     counterexample: bool = False, free_section: float | None = None,
+                     meanwhile: Callable[[], object] | None = None
                      ) -> tuple[Verification, Band]:
     """`verify(p, d, load=load, counterexample=...)` and the model's uncertainty band around
-    its model run (`model_band`), on one pool."""
+    its model run (`model_band`), on one pool; `meanwhile` is called here once the first
+    sweeps have started (this process then only waits)."""
     plan = verify_plan(p, d, load=load)
     base, first = Variant(mounting=plan.ms.mounting), COARSENINGS[0]
     with shared_pool() as pool:
@@ -42,6 +45,8 @@ def verify_with_band(p: Prototype, d: Design, *, load: str | LoadCase | None = N
         ahead = ({first: pool.submit(run_variant, d, base, plan.lv, first, plan.kw_m)}
                  if meshable(d, first) else {})
         ce = pool.submit(steel_counterexample, d.scale) if counterexample else None
+        if meanwhile is not None:
+            meanwhile()
         with span("verify: nominal sweeps"):
             v = plan.verified(*collect(pair))
         with span("verify: band"):
