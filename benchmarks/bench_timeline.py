@@ -1,7 +1,7 @@
 """Benchmark: where the wall time of `printgen make` goes, process by process. One make per
 example at 1:40 (examples/simple_barrier.toml, the free top; examples/realistic_barrier.toml,
 border cables), run as a user runs it, with PRINTGEN_TRACE set: every process appends a line
-per span (printgen.workers.span: make's steps, the helper's sweeps and band, each job of a
+per span (printgen.trace.span: make's steps, the helper's sweeps and band, each job of a
 worker pool, each pool's life in its parent). From them: a Gantt chart per process, the time
 before make's first span (interpreter start-up and imports), the wall time when 0, 1 or 2+
 worker jobs ran, and the idle core-seconds (cores x wall - the CPU of every process of the run,
@@ -29,7 +29,7 @@ EXAMPLES = {"simple": ROOT / "examples" / "simple_barrier.toml",
             "realistic": ROOT / "examples" / "realistic_barrier.toml"}
 SCALE = 40.0
 GOAL_S = 15.0  # issue 28 item 1: the simple barrier's make in under 15 s on 2 cores
-TRACE = "PRINTGEN_TRACE"  # printgen.workers.TRACE
+TRACE = "PRINTGEN_TRACE"  # printgen.trace.TRACE
 POOL = "pool of"  # a pool's life in its parent (printgen.workers.run_jobs), not a job
 
 

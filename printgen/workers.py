@@ -18,7 +18,6 @@ for Ctrl-C, 143 for SIGTERM). What the platform offers is found once in the firs
 from __future__ import annotations
 
 import contextlib
-import json
 import multiprocessing
 import os
 import signal
@@ -33,13 +32,13 @@ from dataclasses import dataclass
 from typing import Any
 
 from printgen.errors import TimeLimitError
+from printgen.trace import span, traced_job
 
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
 SIGNAL_NAMES = ("SIGINT", "SIGTERM", "SIGHUP")  # the stop signals; SIGHUP is POSIX only
 SYSTEM = sys.platform  # "linux", "darwin", "win32", ...
 READER_JOIN_S = 5.0  # the progress reader has only the queued reports left to pass on
 WATCH_THREAD = "printgen-parent-watch"  # the thread of `_watch_parent`
-TRACE = "PRINTGEN_TRACE"  # env var: a file every process appends its spans to (`span`)
 
 
 @dataclass(frozen=True)
@@ -312,41 +311,6 @@ def _drain(queue: Any, listener: Callable[[str, float, float], None]) -> None:
             listener(*item)
 
 
-@contextlib.contextmanager
-def span(what: str) -> Iterator[None]:
-    """With PRINTGEN_TRACE set to a file, append one JSON line for the block to it: process
-    id, parent's, `what`, start and end (time.time(), comparable across processes), its CPU
-    (benchmarks/bench_timeline.py draws them). Without it, nothing."""
-    path = os.environ.get(TRACE)
-    if not path:
-        yield
-        return
-    t, cpu = time.time(), time.process_time()
-    try:
-        yield
-    finally:
-        line = json.dumps({"pid": os.getpid(), "ppid": os.getppid(), "what": what, "start": t,
-                           "end": time.time(), "cpu": time.process_time() - cpu})
-        with contextlib.suppress(OSError), open(path, "a") as f:  # one short append per line
-            f.write(line + "\n")
-
-
-def _traced(what: str, fn: Callable, /, *args: Any, **kwargs: Any) -> Any:
-    with span(what):
-        return fn(*args, **kwargs)
-
-
-def _job(fn: Callable, args: tuple, kwargs: dict) -> tuple:
-    """The job (fn, args, kwargs), in a `span` named by fn and its first argument with a
-    `label` or `name` (a variant, a scene) when tracing."""
-    if not os.environ.get(TRACE):
-        return fn, args, kwargs
-    named = [str(getattr(a, k)) for k in ("label", "name") for a in args
-             if isinstance(getattr(a, k, None), str)]
-    what = getattr(fn, "__name__", "job") + (f" {named[0]}" if named else "")
-    return _traced, (what, fn, *args), kwargs
-
-
 def run_jobs(jobs: list[tuple]) -> list:
     """Run each (fn, args, kwargs) and return the results in order: in worker processes when
     the machine has two cores or more (the jobs are independent; the results are identical
@@ -361,7 +325,7 @@ def run_jobs(jobs: list[tuple]) -> list:
     if workers < 2 or os.environ.get("PRINTGEN_SERIAL"):
         previous, _sink = _sink, _listener or _sink  # in a worker: its parent's queue
         try:
-            return [fn(*args, **kw) for fn, args, kw in (_job(*j) for j in jobs)]
+            return [fn(*args, **kw) for fn, args, kw in (traced_job(*j) for j in jobs)]
         finally:
             _sink = previous
     with span(f"pool of {workers} for {len(jobs)} jobs"):
@@ -376,7 +340,8 @@ def _in_pool(jobs: list[tuple], workers: int) -> list:
                                initargs=(plat, queue or _relay(), _deadline))
     try:
         with _watch_is_safe():
-            futures = [pool.submit(fn, *args, **kw) for fn, args, kw in (_job(*j) for j in jobs)]
+            futures = [pool.submit(fn, *args, **kw)
+                       for fn, args, kw in (traced_job(*j) for j in jobs)]
         if queue is not None:  # started once the workers are: fork only a one-thread process
             reader = threading.Thread(target=_drain, args=(queue, _listener), daemon=True)
             reader.start()
@@ -409,7 +374,7 @@ class Pool:
                                         initargs=(plat, self.queue or _relay(), _deadline))
 
     def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> Future:
-        fn, args, kwargs = _job(fn, args, kwargs)
+        fn, args, kwargs = traced_job(fn, args, kwargs)
         if self.pool is None:
             return _done(fn, args, kwargs)
         with _watch_is_safe():
@@ -481,7 +446,7 @@ class Helper:
 
     def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> Future:
         """Start `fn(*args, **kwargs)` there; `.result()` collects it (or raises its error)."""
-        fn, args, kwargs = _job(fn, args, kwargs)
+        fn, args, kwargs = traced_job(fn, args, kwargs)
         with _watch_is_safe():
             self.futures.append(self.pool.submit(fn, *args, **kwargs))
         if self.queue is not None and self.reader is None:  # once the worker is forked

@@ -61,6 +61,7 @@ from printgen.run.steps import (
     verification_sweeps,
     verify_step,
 )
+from printgen.trace import span
 from printgen.workers import (
     Helper,
     check_deadline,
@@ -69,7 +70,6 @@ from printgen.workers import (
     helper,
     preload,
     signals_deferred,
-    span,
 )
 
 log = logging.getLogger(__name__)

@@ -23,7 +23,8 @@ from printgen.errors import TimeLimitError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
 from printgen.report.parts_report import assembly_section, gcode_section, meshes_section
-from printgen.workers import seconds_left, span
+from printgen.trace import span
+from printgen.workers import seconds_left
 
 HELPER_SWEEPS = "helper: verification sweeps"  # timings_s keys of work done in the helper
 WAIT_SWEEPS = "waiting for the verification sweeps"  # in this process, within a step

@@ -39,11 +39,12 @@ from printgen.design.section import area_m2
 from printgen.errors import GeometryError
 from printgen.inputs.materials import load_material
 from printgen.inputs.prototype import Prototype
+from printgen.trace import span
 from printgen.units import MM
 from printgen.verification.compare import METRICS
 from printgen.verification.scenes import BarrierScene, model_scene
 from printgen.verification.verify import Run, load_keywords, run_jobs, sweep
-from printgen.workers import collect, span
+from printgen.workers import collect
 
 SLACK_MAX = 0.01  # initial slack of the printed net, upper end of the range (issue 10: 0-1 %)
 COARSENINGS = (2, 3)  # mesh multipliers tried in turn for the variant sweeps

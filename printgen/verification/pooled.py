@@ -19,6 +19,7 @@ from collections.abc import Callable
 from printgen.barrier.loads import LoadCase
 from printgen.design.record import Design
 from printgen.inputs.prototype import Prototype
+from printgen.trace import span
 from printgen.verification.bands import (
     COARSENINGS,
     Band,
@@ -28,7 +29,7 @@ from printgen.verification.bands import (
     run_variant,
 )
 from printgen.verification.verify import Verification, steel_counterexample, verify_plan
-from printgen.workers import collect, shared_pool, span
+from printgen.workers import collect, shared_pool
 
 
 def verify_with_band(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
