@@ -10,6 +10,7 @@ node coordinates (lambda = 100, stiff strands).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -30,6 +31,18 @@ class Bars:
     law_index: np.ndarray
     laws: list[Law]
 
+    @cached_property
+    def groups(self) -> tuple[tuple[Law, slice | np.ndarray], ...]:
+        """Each law that has strands, with them: a slice when they are consecutive (the usual
+        case: a view, no copy), else their indices; in the order of `laws`."""
+        out = []
+        for k, law in enumerate(self.laws):
+            idx = np.flatnonzero(self.law_index == k)
+            if idx.size:
+                whole = idx[-1] - idx[0] + 1 == idx.size
+                out.append((law, slice(int(idx[0]), int(idx[-1]) + 1) if whole else idx))
+        return tuple(out)
+
 
 @dataclass(frozen=True)
 class Cable:
@@ -44,7 +57,7 @@ class Cable:
 
 def make_bars(x0: np.ndarray, elements: np.ndarray, rest: np.ndarray, law_index: np.ndarray,
               laws: list[Law]) -> Bars:
-    i, j = elements[:, 0], elements[:, 1]
+    i, j = np.ascontiguousarray(elements[:, 0]), np.ascontiguousarray(elements[:, 1])
     d0 = x0[j] - x0[i]
     return Bars(i, j, d0, rest, np.einsum("ij,ij->i", d0, d0) - rest**2, law_index, laws)
 
@@ -54,13 +67,15 @@ def make_cable(x0: np.ndarray, nodes: np.ndarray, rest: float, law: Law) -> Cabl
     return Cable(nodes, d0, np.linalg.norm(d0, axis=1), rest, law)
 
 
-def _law_eval(laws: list[Law], index: np.ndarray, eps: np.ndarray):
+def strand_laws(b: Bars, eps: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """(force, tangent, strain energy) of the strands at strains `eps`: one law evaluation
+    per law, on its strands."""
     force, tangent = np.zeros_like(eps), np.zeros_like(eps)
-    for k, law in enumerate(laws):
-        sel = index == k
-        if sel.any():
-            force[sel], tangent[sel] = law.force_and_tangent(eps[sel])
-    return force, tangent
+    energy = 0.0
+    for law, sel in b.groups:
+        force[sel], tangent[sel], e = law.evaluate(eps[sel])
+        energy += float((b.rest[sel] * e).sum())
+    return force, tangent, energy
 
 
 def bar_state(b: Bars, u: np.ndarray):
@@ -70,7 +85,7 @@ def bar_state(b: Bars, u: np.ndarray):
     l = np.linalg.norm(d, axis=1)
     dl2 = b.c + 2 * np.einsum("ij,ij->i", b.d0, du) + np.einsum("ij,ij->i", du, du)
     eps = dl2 / (b.rest * (l + b.rest))
-    force, tangent = _law_eval(b.laws, b.law_index, eps)
+    force, tangent, _ = strand_laws(b, eps)
     return eps, force, tangent, d, l
 
 
@@ -153,13 +168,9 @@ def internal(bars: Bars, cables: list[Cable], u: np.ndarray, n_nodes: int, *,
 
 def bar_energy(bars: Bars, eps: np.ndarray) -> float:
     """Strain energy of the strands at strains `eps` (nondimensional)."""
-    if len(bars.laws) == 1:
-        return float((bars.rest * bars.laws[0].energy(eps)).sum())
     total = 0.0
-    for k, law in enumerate(bars.laws):
-        sel = bars.law_index == k
-        if sel.any():
-            total += float((bars.rest[sel] * law.energy(eps[sel])).sum())
+    for law, sel in bars.groups:
+        total += float((bars.rest[sel] * law.energy(eps[sel])).sum())
     return total
 
 

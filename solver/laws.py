@@ -58,6 +58,24 @@ class Law:
         tangent = self._slopes[np.searchsorted(self._knees, e, side="right")]
         return force, np.where(eps > 0, tangent, 0.0)
 
+    def evaluate(self, eps: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(force N, tangent N, energy per unit rest length N) at each strain: the values of
+        `force_and_tangent` and `energy`, segment by segment on 1-d arrays (the strain on
+        segment i is clip(e - lo_i, 0, width_i); the first starts at 0, the last is open)."""
+        e = np.maximum(eps, 0.0)
+        s = self._slopes
+        if not self.knees:
+            return s[0] * e, np.where(eps > 0, s[0], 0.0), 0.5 * s[0] * e * e
+        force = energy = None
+        for i, (lo, width, before) in enumerate(zip(self._lo, self._width, self._before)):
+            seg = e if i == 0 else np.maximum(e - lo, 0.0)
+            if i < len(self.knees):
+                seg = np.minimum(seg, width)
+            f, w = seg * s[i], (s[i] * 0.5) * (seg * seg) + before * seg
+            force, energy = (f, w) if force is None else (force + f, energy + w)
+        tangent = s[np.searchsorted(self._knees, e, side="right")]
+        return force, np.where(eps > 0, tangent, 0.0), energy
+
     def energy(self, eps: np.ndarray) -> np.ndarray:
         """Strain energy per unit rest length, integral of the force from 0 to eps (N)."""
         e = np.maximum(eps, 0.0)

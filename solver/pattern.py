@@ -15,6 +15,11 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+# the upper triangle of a symmetric 3 x 3 block, entry by entry, and where each of its nine
+# entries (a, b) finds its value among those six
+SYM_PAIRS = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
+SYM_INDEX = np.array([[0, 1, 2], [1, 3, 4], [2, 4, 5]])
+
 
 def block_rows_cols(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Dof rows and columns (k, 3, 3) of the 3 x 3 blocks at node pairs (a, b)."""
@@ -76,6 +81,7 @@ class Pattern:
                                (self.rows[upper], self.cols[upper])),
                               shape=(self.size, self.size))
         self.upper = upper[order.data.astype(np.int64) - 1]
+        self.upper_transpose = self.transpose[self.upper]  # each upper entry's mirror
         self.upper_indices, self.upper_indptr = order.indices, order.indptr
         self.upper_rows = np.flatnonzero(self.rows <= self.cols)  # CSR order: row, then column
         self.upper_cols = self.cols[self.upper_rows]
@@ -83,23 +89,36 @@ class Pattern:
         self.upper_rows_indptr = np.concatenate(
             [[0], np.cumsum(np.bincount(self.rows[self.upper_rows], minlength=self.size))])
 
-        # the same scatter as sparse operators: strand blocks k (m, 3, 3) -> CSR data in one
-        # product (each strand's four blocks +k, +k, -k, -k), and the other slots (cables,
-        # node diagonals) -> CSR data
-        m = len(bar_i)
-        n_slot = len(rows)
+        # the same scatter as sparse operators: the upper triangles (m, 6) of the strands'
+        # symmetric blocks k -> CSR data in one product (each strand's four blocks +k, +k,
+        # -k, -k), the cables' slots -> CSR data; and the CSR positions of the node diagonal
+        # blocks' z columns (the hydrostatic load's z-derivative)
+        m, n_cable = len(bar_i), len(rows) - 36 * len(bar_i) - 9 * n_nodes
         kept = np.flatnonzero(self.keep)
-        full = sp.csr_matrix((np.ones(len(kept)), (self.slot, kept)), shape=(self.nnz, n_slot))
+        full = sp.csr_matrix((np.ones(len(kept)), (self.slot, kept)), shape=(self.nnz, len(rows)))
         sign = np.repeat([1.0, 1.0, -1.0, -1.0], 9)  # slot (e, block, a, b) of strand e
-        src = (np.arange(m)[:, None] * 9 + np.tile(np.arange(9), 4)[None, :]).ravel()
-        expand = sp.csr_matrix((np.tile(sign, m), (np.arange(36 * m), src)), shape=(36 * m, 9 * m))
+        src = (np.arange(m)[:, None] * 6 + np.tile(SYM_INDEX.ravel(), 4)[None, :]).ravel()
+        expand = sp.csr_matrix((np.tile(sign, m), (np.arange(36 * m), src)), shape=(36 * m, 6 * m))
         self.strand_map = (full[:, :36 * m] @ expand).tocsr()
-        self.other_map = full[:, 36 * m:].tocsr()
+        self.cable_map = full[:, 36 * m:36 * m + n_cable].tocsr()
+        dof = 3 * every[:, None] + np.arange(3)  # (node, a): row 3 node + a, column 3 node + 2
+        z_row, z_col = index[dof].ravel(), index[3 * every + 2].repeat(3)
+        self.z_take = np.flatnonzero((z_row >= 0) & (z_col >= 0))
+        self.z_slots = np.searchsorted(uniq, z_row[self.z_take].astype(np.int64) * self.size
+                                       + z_col[self.z_take])
 
-    def assemble(self, strand_blocks: np.ndarray, others: np.ndarray) -> np.ndarray:
-        """CSR data of strand blocks k (m, 3, 3) and the other slots' values (cables, node
-        diagonals, in slot order): the same sum as `scatter`, without the (m, 4, 3, 3) copy."""
-        return self.strand_map @ strand_blocks.ravel() + self.other_map @ others
+    def assemble(self, strand_upper: np.ndarray, cables: np.ndarray, dz: np.ndarray
+                 ) -> np.ndarray:
+        """CSR data of the strands' symmetric blocks, given by their upper triangles (m, 6)
+        in SYM_PAIRS order, the cables' slot values (in slot order) and the node blocks' z
+        columns -dz (n, 3): the same sum as `scatter`, without the (m, 4, 3, 3) copy."""
+        data = self.strand_map @ strand_upper.ravel()
+        other = self.cable_map @ cables if cables.size else np.zeros(0)
+        if other.size:
+            other[self.z_slots] -= dz.ravel()[self.z_take]
+            return data + other
+        data[self.z_slots] -= dz.ravel()[self.z_take]
+        return data
 
     def scatter(self, values: np.ndarray) -> np.ndarray:
         """CSR data (nnz,) of all slot values (in slot order; summed where they coincide)."""
@@ -110,8 +129,8 @@ class Pattern:
 
     def symmetric_upper(self, data: np.ndarray) -> sp.csc_matrix:
         """Upper triangle (CSC) of the symmetric part (A + A^T) / 2 of the matrix `data`."""
-        sym = 0.5 * (data + data[self.transpose])
-        return sp.csc_matrix((sym[self.upper], self.upper_indices, self.upper_indptr),
+        sym = 0.5 * (data[self.upper] + data[self.upper_transpose])
+        return sp.csc_matrix((sym, self.upper_indices, self.upper_indptr),
                              shape=(self.size, self.size))
 
     def symmetric_upper_csr(self, data: np.ndarray) -> sp.csr_matrix:

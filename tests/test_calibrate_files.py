@@ -108,6 +108,16 @@ def test_unit_suffix_header_zip_and_footer(tmp_path):
     assert_allclose(rec.channels["time"], [0.01, 0.02, 0.03], rtol=ROUNDTRIP_RTOL)
 
 
+def test_a_quote_left_open_ends_with_its_line(tmp_path):
+    """Every line is read on its own: an open quote in a metadata line does not swallow the
+    table under it (the reader's one-pass split falls back to line by line)."""
+    p = tmp_path / "x.csv"
+    p.write_text('Operator: "A. Smith\ntime_s,force_N\n1,10\n2,20\n3,30\n')
+    rec = read_export(p)
+    assert_allclose(rec.channels["force"], [10.0, 20.0, 30.0], rtol=ROUNDTRIP_RTOL)
+    assert rec.first_data_line == 3
+
+
 def test_columns_chosen_by_option_and_unit_override(tmp_path):
     p = tmp_path / "x.csv"
     p.write_text("a,b,c\n1,2,3\n4,5,6\n7,8,9\n")

@@ -234,3 +234,32 @@ def test_gmres_reaches_its_target_on_a_nonsymmetric_system():
         assert np.linalg.norm(b - A @ x) <= rel * np.linalg.norm(b) * (1 + 1e-6)
     x = gmres(A, lambda v: v / 4, b, np.zeros(n), GMRES_TOL * np.linalg.norm(b), 60)
     assert np.allclose(x, np.linalg.solve(A.toarray(), b), rtol=1e-9, atol=1e-12)
+
+
+ROUND = 1e-12  # relative round-off of one strand's tension
+
+
+def test_predicted_tensions_follow_the_linearised_law_and_stay_tension_only():
+    """Mixed-integration-point Newton (solver.fast._predicted_tensions): along the strand the
+    linearised law is exact for a linear law; a transverse step predicts no change (the exact
+    tension grows by the second-order stretch it leaves out); a step past the rest length
+    predicts zero, never compression; half a step moves the prediction half-way."""
+    from solver.fast import _predicted_tensions
+
+    net = Net(np.array([[0.0, 0, 0], [1.0, 0, 0]]), np.array([True, False]),
+              np.array([[0, 1]]), [linear(100.0)])
+    ns = NetSystem(net)
+    u = np.zeros((2, 3))
+    u[1, 0] = 0.01 / ns.L
+    st = evaluate(ns, u)
+    t0 = st.bar[1][0]
+    along = np.array([0.005, 0.0, 0.0]) / ns.L
+    exact = evaluate(ns, u + np.vstack([np.zeros(3), along])).bar[1][0]
+    assert abs(_predicted_tensions(ns, st, None, along, 1.0, None)[0] - exact) <= ROUND * exact
+    half = _predicted_tensions(ns, st, None, along, 0.5, None)[0]
+    assert abs(half - (t0 + exact) / 2) <= ROUND * exact
+    across = np.array([0.0, 0.1, 0.0]) / ns.L
+    assert abs(_predicted_tensions(ns, st, None, across, 1.0, None)[0] - t0) <= ROUND * t0
+    assert evaluate(ns, u + np.vstack([np.zeros(3), across])).bar[1][0] > 1.4 * t0  # +0.1^2 / 2 of strain
+    back = np.array([-0.05, 0.0, 0.0]) / ns.L
+    assert _predicted_tensions(ns, st, None, back, 1.0, None)[0] == 0.0

@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 import io
 import logging
+import math
 import zipfile
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -142,7 +143,7 @@ def read_export(path: str | Path, *, columns: Mapping[str, str] | None = None,
         raise CalibrationError(f"{where}: {len(lines):,} lines, more than {MAX_ROWS:,} (a 1 kHz "
                                "test of 16 minutes); thin the rows (every 10th) or split the file")
     delim = delimiter or _sniff_delimiter(lines, where)
-    rows = [(i + 1, next(csv.reader([ln], delimiter=delim), [])) for i, ln in enumerate(lines)]
+    rows = list(enumerate(_split(lines, delim), start=1))
     rows = [(n, [c.strip() for c in r]) for n, r in rows if any(c.strip() for c in r)]
     tail = [c for _, r in rows[-SNIFF_ROWS:] for c in r]
     dec = decimal or decimal_of(tail)
@@ -216,7 +217,7 @@ def _sniff_delimiter(lines: list[str], where: str) -> str:
     """The first of DELIMITERS that splits most lines into the same number (>= 2) of fields."""
     body = [ln for ln in lines if ln.strip()]
     for d in DELIMITERS:
-        counts = np.array([len(next(csv.reader([ln], delimiter=d))) for ln in body])
+        counts = np.array([len(r) for r in _split(body, d)])
         if counts.size == 0:
             break
         values, freq = np.unique(counts, return_counts=True)
@@ -229,12 +230,28 @@ def _sniff_delimiter(lines: list[str], where: str) -> str:
     )
 
 
+def _split(lines: list[str], delim: str) -> list[list[str]]:
+    """Each line's fields, every line read on its own (a quote left open ends with its line);
+    one reader over all lines when that gives the same, a line per row."""
+    rows = list(csv.reader(lines, delimiter=delim))
+    if len(rows) == len(lines):
+        return rows
+    return [next(csv.reader([ln], delimiter=delim), []) for ln in lines]
+
+
 def _numeric(cells: list[str], dec: str) -> bool:
     return all(_value(c, dec) is not None for c in cells)
 
 
 def _value(cell: str, dec: str) -> float | None:
     """A cell's number, or 1/0 for true/false (flag columns)."""
+    if dec == "." or "." not in cell:  # a plain number reads alike either way: the fast path
+        try:
+            v = float(cell)
+        except ValueError:
+            pass
+        else:
+            return v if math.isfinite(v) else None
     v = parse_number(cell, dec)
     return _BOOLEAN.get(cell.strip().strip('"').lower()) if v is None else v
 
