@@ -116,7 +116,7 @@ class MakeContext:
     files: list[str] = field(default_factory=list)
     progress: Callable[[str], None] | None = None  # a step's finer progress (STEP per part)
     background: dict[str, Future] = field(default_factory=dict)  # jobs running in `helper`
-    helper: Helper | None = None  # the helper process of a short run (`verification_ahead`)
+    helper: Helper | None = None  # the helper process of the run (`verification_ahead`)
     toolpaths: dict[str, Any] = field(default_factory=dict)  # per part, built once per run
     volumes_mm3: dict[str, float] = field(default_factory=dict)  # per part's mesh (parts step)
 
