@@ -47,6 +47,10 @@ from printgen.verification.measured import (
 from printgen.verification.pooled import verify_with_band
 from printgen.verification.readings import design_units
 from printgen.verification.verify import Verification, free_section
+from printgen.workers import preload
+
+# what the workers' jobs import (the sweeps, the figures): a fork server imports them once
+JOB_MODULES = ("printgen.verification.pooled", "printgen.report.plots")
 
 
 @dataclass
@@ -77,6 +81,7 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     """
     say = progress or (lambda _label: None)
     t0 = time.perf_counter()
+    preload(JOB_MODULES)  # a fork server's imports, while the inputs are read
     inputs = [prototype, design_path, measured, *search_dirs()]
     check_destination(Path(out), force=force, inputs=inputs)  # before any work
     p = load_prototype(prototype)
