@@ -4,8 +4,8 @@ border cables), run as a user runs it, with PRINTGEN_TRACE set: every process ap
 per span (printgen.trace.span: make's steps, the helper's sweeps and band, each job of a
 worker pool, each pool's life in its parent). From them: a Gantt chart per process, the time
 before make's first span (interpreter start-up and imports), the wall time when 0, 1 or 2+
-worker jobs ran, and the idle core-seconds (cores x wall - the CPU of every process of the run,
-getrusage of the waited children).
+worker jobs ran, and the idle core-seconds (cores x wall - the CPU inside the spans:
+getrusage of the waited children misses the processes a fork server started).
 
     python -m benchmarks.bench_timeline --out DIR [--repeat 1]
 
@@ -104,12 +104,24 @@ def phases(run: dict) -> dict[str, float]:
     return out
 
 
+def span_cpu(run: dict) -> float:
+    """CPU seconds inside the spans: per process, its outermost spans' (getrusage of the
+    children misses the processes of a fork server, which make does not wait for)."""
+    total = 0.0
+    for pid in {s["pid"] for s in run["spans"]}:
+        mine = [s for s in run["spans"] if s["pid"] == pid]
+        total += sum(s["cpu"] for s in mine if not any(
+            o is not s and o["start"] <= s["start"] and s["end"] <= o["end"] for o in mine))
+    return total
+
+
 def summary(run: dict, cores: int) -> dict:
     rows = [{"process": lanes(run)[s["pid"]], "what": s["what"],
              "start_s": s["start"] - run["launch"], "end_s": s["end"] - run["launch"],
              "cpu_s": s["cpu"]} for s in sorted(run["spans"], key=lambda s: s["start"])]
-    return {"wall_s": run["wall_s"], "cpu_s": run["cpu_s"], "cores": cores,
-            "idle_core_s": cores * run["wall_s"] - run["cpu_s"],
+    cpu = max(run["cpu_s"], span_cpu(run))
+    return {"wall_s": run["wall_s"], "cpu_s": cpu, "cores": cores,
+            "idle_core_s": cores * run["wall_s"] - cpu,
             "load_average": run["load_average"], "exit": run["exit"],
             "phases_s": phases(run), "worker_jobs_running_s": concurrency(run), "spans": rows}
 
