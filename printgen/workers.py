@@ -332,6 +332,18 @@ def run_jobs(jobs: list[tuple]) -> list:
         return _in_pool(jobs, workers)
 
 
+def submit_jobs(jobs: list[tuple]) -> list[Future]:
+    """Start each (fn, args, kwargs) and return their futures (`collect` waits for them):
+    within `shared_pool` on its workers, without waiting; else `run_jobs` runs them now."""
+    if _shared is not None:
+        return [_shared.submit(fn, *args, **kw) for fn, args, kw in jobs]
+    out = []
+    for result in run_jobs(jobs):
+        out.append(Future())
+        out[-1].set_result(result)
+    return out
+
+
 def _in_pool(jobs: list[tuple], workers: int) -> list:
     plat = platform()
     ctx = multiprocessing.get_context(start_method(plat))

@@ -327,12 +327,12 @@ def verification_sweeps(prototype: Prototype, design: Design, *, load: str | Non
     """
     from printgen.report.plots import load_pyplot
     from printgen.verification.pooled import verify_with_band
-    from printgen.verification.verify import free_section, with_cases
+    from printgen.verification.verify import free_section
 
     # matplotlib is imported while the sweeps run: the figures' workers start with it
-    v, band = verify_with_band(prototype, design, load=load, counterexample=True,
-                               free_section=free_section(prototype), meanwhile=load_pyplot)
-    return with_cases(v, prototype, design, loads), band
+    return verify_with_band(prototype, design, load=load, counterexample=True,
+                            free_section=free_section(prototype), meanwhile=load_pyplot,
+                            loads=tuple(loads))
 
 
 def solver_work(v: Verification, band: Band) -> dict[str, Any]:

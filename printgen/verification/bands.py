@@ -25,6 +25,7 @@ from __future__ import annotations
 import dataclasses
 import inspect
 import time
+from collections.abc import Callable
 from concurrent.futures import Future
 from dataclasses import dataclass, field
 from typing import Any
@@ -43,8 +44,8 @@ from printgen.trace import span
 from printgen.units import MM
 from printgen.verification.compare import METRICS
 from printgen.verification.scenes import BarrierScene, model_scene
-from printgen.verification.verify import Run, load_keywords, run_jobs, sweep
-from printgen.workers import collect
+from printgen.verification.verify import Run, load_keywords, sweep
+from printgen.workers import collect, submit_jobs
 
 SLACK_MAX = 0.01  # initial slack of the printed net, upper end of the range (issue 10: 0-1 %)
 COARSENINGS = (2, 3)  # mesh multipliers tried in turn for the variant sweeps
@@ -321,14 +322,15 @@ def _largest_change(c: dict[str, np.ndarray], ref: dict[str, np.ndarray]) -> flo
 
 def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
                variants: list[Variant] | None = None, notes: list[str] | None = None,
-               free_section: float | None = None, ahead: dict[int, Future] | None = None
-               ) -> Band:
+               free_section: float | None = None, ahead: dict[int, Future] | None = None,
+               then: Callable[[], object] | None = None) -> Band:
     """Sweep every variant of design `d` and collect them around the `nominal` run (the
     model's sweep on the design's own net, as `verify` ran it), at the same levels.
 
     The variants run on the coarsest net that passes the refinement test (`ahead`: its
     sweeps already started, `refinement_test`); there a variant's curve is the nominal plus
-    the variant's change on the coarse net.
+    the variant's change on the coarse net. `then` is called once the variants are started
+    (within printgen.workers.shared_pool: to queue more jobs behind them).
     """
     t0 = time.perf_counter()
     lv = nominal.deformation.levels
@@ -348,7 +350,10 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
     jobs: list[tuple] = [(run_variant, (d, variants[i], lv, k, load_kw), {}) for i in order]
     if k > 1:
         jobs.append((run_variant, (d, Variant(mounting=mounting), lv, k, load_kw), {}))
-    done = run_jobs(jobs)
+    started = submit_jobs(jobs)
+    if then is not None:
+        then()
+    done = collect(started)
     extra = done[len(variants):]  # the nominal on the coarse net, when k > 1
     base = curves(extra[0]) if extra else None
     runs = [done[order.index(i)] for i in range(len(variants))]

@@ -352,20 +352,36 @@ class CaseRuns:
                                   "model": self.model.failed}}
 
 
-def case_runs(p: Prototype, d: Design, load: str, mounting: str | None = None) -> CaseRuns:
-    """The nominal prototype and model of load case `load` at its own levels (no band)."""
+def case_plan(p: Prototype, d: Design, load: str, mounting: str | None = None) -> VerifyPlan:
+    """The nominal sweeps of load case `load` at its own levels (the usual ones when it has
+    none)."""
     case, kw_p, kw_m, ps, ms = _barriers(p, d, load, mounting)
     own = case.levels_for(ms, kw_m["site"])
     lv = levels() if own is None else np.asarray(own, dtype=float)
-    model, proto = run_jobs([(sweep, (ms, lv), kw_m), (sweep, (ps, lv), kw_p)])
-    (proto, model), rec = stated(case, (proto, model), (kw_p["site"], kw_m["site"]))
-    return CaseRuns(case.spec, proto, model, rec)
+    return VerifyPlan(case, kw_p, kw_m, ps, ms, lv)
 
 
-def with_cases(v: Verification, p: Prototype, d: Design, loads: tuple[str, ...] | list[str]
-               ) -> Verification:
+def case_runs(p: Prototype, d: Design, load: str, mounting: str | None = None,
+              runs: tuple[Run, Run] | None = None) -> CaseRuns:
+    """The nominal prototype and model of load case `load` at its own levels (no band);
+    `runs`: its (model, prototype) sweeps already run (`case_plan(...).jobs()`)."""
+    plan = case_plan(p, d, load, mounting)
+    model, proto = runs if runs is not None else run_jobs(plan.jobs())
+    (proto, model), rec = stated(plan.case, (proto, model),
+                                 (plan.kw_p["site"], plan.kw_m["site"]))
+    return CaseRuns(plan.case.spec, proto, model, rec)
+
+
+def other_cases(loads: tuple[str, ...] | list[str], own: str) -> list[str]:
+    """The specs of `loads` (`make --loads`) but `own`, the verification's, once each."""
+    return [s for s in dict.fromkeys(get_load(x).spec for x in loads) if s != own]
+
+
+def with_cases(v: Verification, p: Prototype, d: Design, loads: tuple[str, ...] | list[str],
+               runs: dict[str, tuple[Run, Run]] | None = None) -> Verification:
     """`v` with the sweeps of each load case of `loads` (`make --loads`): the verification's
-    own case reuses its runs, every other one sweeps its nominal barriers (`case_runs`)."""
+    own case reuses its runs, every other one sweeps its nominal barriers (`case_runs`;
+    `runs`: spec -> its sweeps, already run)."""
     if not loads:
         return v
     mounting = v.model.scene.mounting
@@ -374,7 +390,7 @@ def with_cases(v: Verification, p: Prototype, d: Design, loads: tuple[str, ...] 
         if spec == v.load.get("spec"):
             out[get_load(spec).name] = CaseRuns(spec, v.prototype, v.model, v.load)
         else:
-            out[get_load(spec).name] = case_runs(p, d, spec, mounting)
+            out[get_load(spec).name] = case_runs(p, d, spec, mounting, (runs or {}).get(spec))
     return dataclasses.replace(v, by_load=out)
 
 
