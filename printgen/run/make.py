@@ -70,6 +70,7 @@ from printgen.workers import (
     helper,
     preload,
     signals_deferred,
+    start_method,
 )
 
 log = logging.getLogger(__name__)
@@ -157,7 +158,7 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     only file that differs between runs).
     """
     t0 = time.perf_counter()
-    preload(JOB_MODULES)  # a fork server's imports, beside the planning and the parts
+    warm_up()
     options = options or MakeOptions()
     inputs = [prototype_path, options.design_file, *search_dirs()]
     check_destination(Path(out), force=options.force, inputs=inputs)  # fail fast
@@ -252,6 +253,15 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]]) -> Itera
         finally:
             ctx.background.clear()
             ctx.helper = None
+
+
+def warm_up() -> None:
+    """Where workers start by `forkserver`, start the fork server now with the jobs' modules
+    (printgen.workers.preload: it imports them beside the planning and the parts), the
+    resource tracker quietened first (`quiet_tracker`: the fork server starts it)."""
+    if not os.environ.get("PRINTGEN_SERIAL") and cores() > 1 and start_method() == "forkserver":
+        quiet_tracker()
+        preload(JOB_MODULES)
 
 
 TRACKER_WARNING = "ignore:resource_tracker:UserWarning"  # a -W option (sys.warnoptions)
