@@ -31,14 +31,8 @@ from printgen.verification.bands import (
     model_band,
     run_variant,
 )
-from printgen.verification.verify import (
-    Verification,
-    case_plan,
-    other_cases,
-    steel_counterexample,
-    verify_plan,
-    with_cases,
-)
+from printgen.verification.cases import case_plan, other_cases, with_cases
+from printgen.verification.verify import Verification, steel_counterexample, verify_plan
 from printgen.workers import collect, shared_pool
 
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -43,6 +43,9 @@ from printgen.workers import (  # worker lifecycle: ground floor
     run_jobs,
 )
 from solver.loads import total_forces
+
+if TYPE_CHECKING:  # pragma: no cover
+    from printgen.verification.cases import CaseRuns
 
 LEVEL_STEP = 0.05  # relative loading step of the sweep (issue: at most 0.05)
 PATH_CUTS = 2  # halvings tried before a load level is reported as not converged
@@ -245,7 +248,7 @@ class Verification:
         }
 
 
-def _barriers(p: Prototype, d: Design, load: str | LoadCase | None, mounting: str | None
+def barriers(p: Prototype, d: Design, load: str | LoadCase | None, mounting: str | None
               ) -> tuple[LoadCase, dict[str, Any], dict[str, Any], BarrierScene, BarrierScene]:
     """(the load case, the prototype's and the model's sweep keywords, their scenes), both
     mounted by `mounting` (default: the prototype file's [flume] lateral)."""
@@ -292,7 +295,7 @@ class VerifyPlan:
 def verify_plan(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
                 lv: np.ndarray | None = None, mounting: str | None = None) -> VerifyPlan:
     """The sweeps of `verify` (default levels: the usual ones and the case's own)."""
-    case, kw_p, kw_m, ps, ms = _barriers(p, d, load, mounting)
+    case, kw_p, kw_m, ps, ms = barriers(p, d, load, mounting)
     if lv is None:  # the usual levels and the case's own (the jam's discharge steps)
         own = case.levels_for(ms, kw_m["site"])
         lv = levels() if own is None else np.unique(np.concatenate([levels(), own]))
@@ -330,68 +333,6 @@ def stated(case: LoadCase, runs: tuple[Run, Run], sites: tuple[Site, Site]
                 run.scene, assumptions=(*run.scene.assumptions, row)))
         out.append(run)
     return (out[0], out[1]), rec
-
-
-@dataclass(frozen=True)
-class CaseRuns:
-    """One more load case's nominal sweeps (`make --loads`): the prototype and the model at
-    the case's own levels (the usual ones when it has none), and what it used at each."""
-
-    spec: str
-    prototype: Run
-    model: Run
-    load: dict[str, Any]
-
-    def to_record(self) -> dict[str, Any]:
-        return {"spec": self.spec, "load": self.load,
-                "assumptions": [dict(zip(("what", "value", "source"), a, strict=True))
-                                for a in self.model.scene.assumptions
-                                if a[0].startswith("loading")],
-                "model_levels": self.model.deformation.levels,
-                "not_converged": {"prototype": self.prototype.failed,
-                                  "model": self.model.failed}}
-
-
-def case_plan(p: Prototype, d: Design, load: str, mounting: str | None = None) -> VerifyPlan:
-    """The nominal sweeps of load case `load` at its own levels (the usual ones when it has
-    none)."""
-    case, kw_p, kw_m, ps, ms = _barriers(p, d, load, mounting)
-    own = case.levels_for(ms, kw_m["site"])
-    lv = levels() if own is None else np.asarray(own, dtype=float)
-    return VerifyPlan(case, kw_p, kw_m, ps, ms, lv)
-
-
-def case_runs(p: Prototype, d: Design, load: str, mounting: str | None = None,
-              runs: tuple[Run, Run] | None = None) -> CaseRuns:
-    """The nominal prototype and model of load case `load` at its own levels (no band);
-    `runs`: its (model, prototype) sweeps already run (`case_plan(...).jobs()`)."""
-    plan = case_plan(p, d, load, mounting)
-    model, proto = runs if runs is not None else run_jobs(plan.jobs())
-    (proto, model), rec = stated(plan.case, (proto, model),
-                                 (plan.kw_p["site"], plan.kw_m["site"]))
-    return CaseRuns(plan.case.spec, proto, model, rec)
-
-
-def other_cases(loads: tuple[str, ...] | list[str], own: str) -> list[str]:
-    """The specs of `loads` (`make --loads`) but `own`, the verification's, once each."""
-    return [s for s in dict.fromkeys(get_load(x).spec for x in loads) if s != own]
-
-
-def with_cases(v: Verification, p: Prototype, d: Design, loads: tuple[str, ...] | list[str],
-               runs: dict[str, tuple[Run, Run]] | None = None) -> Verification:
-    """`v` with the sweeps of each load case of `loads` (`make --loads`): the verification's
-    own case reuses its runs, every other one sweeps its nominal barriers (`case_runs`;
-    `runs`: spec -> its sweeps, already run)."""
-    if not loads:
-        return v
-    mounting = v.model.scene.mounting
-    out = {}
-    for spec in dict.fromkeys(get_load(x).spec for x in loads):
-        if spec == v.load.get("spec"):
-            out[get_load(spec).name] = CaseRuns(spec, v.prototype, v.model, v.load)
-        else:
-            out[get_load(spec).name] = case_runs(p, d, spec, mounting, (runs or {}).get(spec))
-    return dataclasses.replace(v, by_load=out)
 
 
 def _only(run: Run, keep: np.ndarray) -> Run:
