@@ -26,11 +26,28 @@ def pair_values(k: np.ndarray) -> np.ndarray:
     return np.stack([k, k, -k, -k], axis=1)
 
 
-def _block_slots(blocks: np.ndarray) -> np.ndarray:
+def _block_slots(blocks: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(block, p, q) of every entry of the 3 x 3 blocks `blocks`, block by block, row-major."""
     pq = np.arange(9)
-    return np.column_stack([np.repeat(blocks, 9), np.tile(pq // 3, len(blocks)),
-                            np.tile(pq % 3, len(blocks))])
+    return (np.repeat(blocks, 9), np.tile(pq // 3, len(blocks)), np.tile(pq % 3, len(blocks)))
+
+
+def _strand_map(position: np.ndarray, m: int, nnz: int) -> sp.csc_matrix:
+    """The (nnz, 6 m) operator: strands' upper triangles (in reverse, last strand's last value
+    first: `assemble` reverses its input) -> CSR data, given each strand slot's CSR position
+    (-1: not kept). Built as the CSR of its transpose, one row per strand value, so no sort:
+    its product sums each CSR entry's strands last strand first, as the product of the slot
+    matrix with the expansion did before (the same tangent bit for bit)."""
+    sym = np.tile(SYM_INDEX.ravel(), 4)  # slot (block, a, b) of a strand -> its upper value
+    sign = np.repeat([1.0, 1.0, -1.0, -1.0], 9)
+    local = np.argsort(-sym, kind="stable")  # a strand's 36 slots, its last value's first
+    strands = np.arange(m)[::-1, None]
+    at = position[(36 * strands + local[None, :]).ravel()]
+    kept = at >= 0
+    value = (6 * m - 1 - 6 * strands - sym[local][None, :]).ravel()[kept]  # ascending
+    transpose = sp.csr_matrix((np.tile(sign[local], m)[kept], at[kept], np.concatenate(
+        [[0], np.cumsum(np.bincount(value, minlength=6 * m))])), shape=(6 * m, nnz))
+    return transpose.T
 
 
 class Pattern:
@@ -56,18 +73,16 @@ class Pattern:
             count += 4 * (k - 1)
             dof = np.arange(3 * k)  # the dense block, row-major over the cable's dofs
             block = count + (dof[:, None] // 3) * k + dof[None, :] // 3
-            slot_parts.append(np.stack([block, np.broadcast_to(dof[:, None] % 3, block.shape),
-                                        np.broadcast_to(dof[None, :] % 3, block.shape)],
-                                       axis=-1).reshape(-1, 3))
+            slot_parts.append((block.ravel(), np.repeat(dof % 3, 3 * k), np.tile(dof % 3, 3 * k)))
             count += k * k
         a_parts.append(every)
         b_parts.append(every)
         slot_parts.append(_block_slots(count + every))
-        self._build(n_nodes, free, np.concatenate(a_parts), np.concatenate(b_parts),
-                    np.concatenate(slot_parts), m)
+        slots = tuple(np.concatenate(x) for x in zip(*slot_parts))
+        self._build(n_nodes, free, np.concatenate(a_parts), np.concatenate(b_parts), slots, m)
 
     def _build(self, n_nodes: int, free: np.ndarray, block_a: np.ndarray, block_b: np.ndarray,
-               slots: np.ndarray, m: int) -> None:
+               slots: tuple, m: int) -> None:
         """The CSR structure from the node blocks: node a's free rows all have the columns
         of a's block partners b (in node order), so an entry's CSR position is its row's
         start + the free dofs of a's partners before b + its column's rank within b. No
@@ -84,7 +99,7 @@ class Pattern:
         row_width = np.bincount(pa, width, n_nodes).astype(np.int64)
         before = np.cumsum(width) - width  # the partners' columns before b, in a's rows
         offset = before - (np.cumsum(row_width) - row_width)[pa]
-        node, p, q = inverse[slots[:, 0]], slots[:, 1], slots[:, 2]
+        node, p, q = inverse[slots[0]], slots[1], slots[2]
         fr, fc = index[3 * pa[node] + p], index[3 * pb[node] + q]
         self.keep = (fr >= 0) & (fc >= 0)
         self.indptr = np.concatenate([[0], np.cumsum(row_width[np.flatnonzero(free) // 3])])
@@ -98,7 +113,7 @@ class Pattern:
         mirror = np.searchsorted(pairs, pb * n_nodes + pa)  # the node pattern is symmetric
         self.transpose = (self.indptr[self.cols] + offset[mirror[at]] + self.rows
                           - first[pa[at]])
-        self._derived(n_nodes, index, m, len(slots))
+        self._derived(n_nodes, index, m, len(p))
 
     def _derived(self, n_nodes: int, index: np.ndarray, m: int, n_slots: int) -> None:
         """The diagonal, the upper triangle's orders (CSC: the lower triangle's mirrors in
@@ -121,14 +136,10 @@ class Pattern:
         # blocks' z columns (the hydrostatic load's z-derivative)
         n_cable = n_slots - 36 * m - 9 * n_nodes
         kept = np.flatnonzero(self.keep)
+        position = np.full(n_slots, -1)
+        position[kept] = self.slot
+        self.strand_map = _strand_map(position[:36 * m], m, self.nnz)
         strand = kept < 36 * m
-        sign = np.repeat([1.0, 1.0, -1.0, -1.0], 9)  # slot (e, block, a, b) of strand e
-        src = (np.arange(m)[:, None] * 6 + np.tile(SYM_INDEX.ravel(), 4)[None, :]).ravel()
-        # columns numbered from the last strand value down (`assemble` reverses its input):
-        # each CSR entry then sums its strands' values last strand first, as the product of
-        # the slot matrix with the expansion did before (same tangent bit for bit)
-        self.strand_map = sp.csr_matrix((np.tile(sign, m)[kept[strand]], (
-            self.slot[strand], 6 * m - 1 - src[kept[strand]])), shape=(self.nnz, 6 * m))
         cable = strand ^ (kept < 36 * m + n_cable)
         self.cable_map = sp.csr_matrix((np.ones(int(cable.sum())), (
             self.slot[cable], kept[cable] - 36 * m)), shape=(self.nnz, n_cable))
@@ -136,8 +147,6 @@ class Pattern:
         dof = 3 * every[:, None] + np.arange(3)  # (node, a): row 3 node + a, column 3 node + 2
         z_row, z_col = index[dof].ravel(), index[3 * every + 2].repeat(3)
         self.z_take = np.flatnonzero((z_row >= 0) & (z_col >= 0))
-        position = np.full(n_slots, -1)
-        position[kept] = self.slot
         self.z_slots = position[n_slots - 9 * n_nodes + 3 * self.z_take + 2]
 
     def assemble(self, strand_upper: np.ndarray, cables: np.ndarray, dz: np.ndarray
