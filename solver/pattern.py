@@ -139,9 +139,8 @@ class Pattern:
         position = np.full(n_slots, -1)
         position[kept] = self.slot
         self.strand_map = _strand_map(position[:36 * m], m, self.nnz)
-        strand = kept < 36 * m
-        cable = strand ^ (kept < 36 * m + n_cable)
-        self.cable_map = sp.csr_matrix((np.ones(int(cable.sum())), (
+        cable = slice(*np.searchsorted(kept, [36 * m, 36 * m + n_cable]))  # kept is sorted
+        self.cable_map = sp.csr_matrix((np.ones(cable.stop - cable.start), (
             self.slot[cable], kept[cable] - 36 * m)), shape=(self.nnz, n_cable))
         every = np.arange(n_nodes)
         dof = 3 * every[:, None] + np.arange(3)  # (node, a): row 3 node + a, column 3 node + 2
