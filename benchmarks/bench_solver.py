@@ -4,15 +4,19 @@ section 7) at 61 x 21, 121 x 41, 241 x 81 and 481 x 161 nodes, with OpenSeesPy s
 the load paths of the 1:40 verification; the robustness table of the hard cases.
 
     python -m benchmarks.bench_solver --out DIR [--sizes 1 2 4 8] [--no-paths]
+        [--threads N] [--compare-threads 1 2]
 
 Errors are the mid-height centre deflection against a tight-tolerance solve of the same size
 (relative). Loads at the initial node height (the variant OpenSees can model); printgen's
 current-height variant is timed too. Times are wall-clock (perf_counter) and CPU
 (process_time), each the best of REPEAT at GOAL_TOL, with BLAS/MKL pinned to --threads
 threads (threadpoolctl; default 1); `size_table` lists them per size with the backend and
-the microseconds per unknown. The ratio to OpenSeesPy at 61 x 21 is also measured pair by
-pair (`paired_ratio`: PAIRS pairs, alternating, one thread each; wall and CPU time of each
-whole call, median and range, with the load average).
+the microseconds per unknown, and for PARDISO its CPU by phase (analysis, numeric
+factorizations, solves); --compare-threads 1 2 adds the same solves per thread count
+(`threads_table`). The ratio to OpenSeesPy at 61 x 21 is also measured pair by pair
+(`paired_ratio`: PAIRS pairs, alternating, one thread each; wall and CPU time of each whole
+call, median and range, with the load average; in a fresh process and in this one, see
+`paired_both`).
 Writes bench_solver.json and bench_solver.png.
 """
 
@@ -28,7 +32,10 @@ from pathlib import Path
 import numpy as np
 
 from solver import solve, solve_path
+from solver.driver import FastSolver
+from solver.linsolve import Pardiso
 from solver.loads import total_forces
+from solver.newton import MAX_ITER
 from solver.scenes import simple_scene
 
 REFERENCE_TOL = 1e-13  # the reference solve: round-off level
@@ -183,20 +190,39 @@ def robustness() -> list[dict]:
     return out
 
 
+def _solve_once(sc, tol: float, method: str):
+    """(result, CPU s, PARDISO's CPU by phase or None): what `solver.solve` does, with the
+    fast path's solver kept to read its PARDISO instance's counters."""
+    c0 = time.process_time()
+    if method != "fast":
+        return solve(sc.net, sc.loads_at(1.0), tol=tol, method=method), \
+            time.process_time() - c0, None
+    fs = FastSolver(sc.net)
+    r = fs.solve(sc.loads_at(1.0), [], tol, MAX_ITER)
+    cpu = time.process_time() - c0
+    handle = fs.stepper.handle
+    work = None
+    if isinstance(handle, Pardiso):
+        work = {f"{name}_cpu_s": handle.cpu[name] for name in handle.cpu}
+        work |= {f"{name}_calls": handle.calls[name] for name in handle.calls}
+    return r, cpu, work
+
+
 def _run(sc, tol: float, d_ref: float, *, method: str = "fast", repeat: int = 1) -> dict:
-    """One printgen solve at `tol` (best wall time and best CPU time of `repeat`)."""
-    best, cpu = None, float("inf")
+    """One printgen solve at `tol` (best wall time and best CPU time of `repeat`; PARDISO's
+    CPU by phase in the run of best CPU)."""
+    best, cpu, work = None, float("inf"), None
     for _ in range(repeat):
-        c0 = time.process_time()
-        r = solve(sc.net, sc.loads_at(1.0), tol=tol, method=method)
-        cpu = min(cpu, time.process_time() - c0)
+        r, c, w = _solve_once(sc, tol, method)
+        if c < cpu:
+            cpu, work = c, w
         best = r if best is None or r.seconds < best.seconds else best
     d = float(best.displacements[sc.centre, 1])
     return {"tool": "printgen" if method == "fast" else "printgen reference path (before)",
             "tol": tol, "converged": best.converged, "max_strain": float(best.strains.max()),
             "max_tension_n": float(best.tensions.max()), "iterations": best.iterations,
             "factorizations": best.factorizations, "backend": best.backend,
-            "time_s": best.seconds, "cpu_s": cpu, "deflection_m": d,
+            "time_s": best.seconds, "cpu_s": cpu, "pardiso": work, "deflection_m": d,
             "error": abs(d / d_ref - 1)}
 
 
@@ -236,7 +262,31 @@ def size_table(results: list[dict], threads: int) -> list[dict]:
                     "iterations": goal["iterations"], "factorizations": goal["factorizations"],
                     "wall_s": goal["time_s"], "cpu_s": goal["cpu_s"],
                     "us_per_unknown_wall": res["us_per_unknown_at_goal_tol"],
-                    "us_per_unknown_cpu": res["cpu_us_per_unknown_at_goal_tol"]})
+                    "us_per_unknown_cpu": res["cpu_us_per_unknown_at_goal_tol"],
+                    "pardiso": goal.get("pardiso")})
+    return out
+
+
+def thread_table(sizes: list[int], counts: list[int]) -> list[dict]:
+    """printgen at GOAL_TOL per size with BLAS/MKL pinned to each thread count in turn (best
+    of REPEAT, wall and CPU): PARDISO's factorizations are what a second thread speeds up."""
+    from threadpoolctl import threadpool_limits
+
+    out = []
+    for size in sizes:
+        sc = simple_scene(refine=size, current_z=False)
+        unknowns = int((~sc.net.fixed_dofs).sum())
+        for threads in counts:
+            with threadpool_limits(limits=threads):
+                runs = [_solve_once(sc, GOAL_TOL, "fast") for _ in range(REPEAT)]
+            r = runs[0][0]
+            out.append({"size": SIZES.get(size, f"refine {size}"), "unknowns": unknowns,
+                        "blas_threads": threads, "converged": r.converged,
+                        "iterations": r.iterations, "factorizations": r.factorizations,
+                        "wall_s": min(x[0].seconds for x in runs),
+                        "cpu_s": min(x[1] for x in runs),
+                        "load_average": list(os.getloadavg()) if hasattr(os, "getloadavg")
+                        else None})
     return out
 
 
@@ -404,7 +454,8 @@ def goals(results: list[dict], paths: list[dict], tent: dict | None,
     return out
 
 
-def run(out: Path, sizes: list[int], with_paths: bool = True, threads: int = THREADS) -> dict:
+def run(out: Path, sizes: list[int], with_paths: bool = True, threads: int = THREADS,
+        compare_threads: list[int] | None = None) -> dict:
     from threadpoolctl import threadpool_limits
 
     from solver.linsolve import pardiso_available
@@ -424,17 +475,29 @@ def run(out: Path, sizes: list[int], with_paths: bool = True, threads: int = THR
     paths = bench_paths(captured)
     tent = bench_tent(captured[0][0], captured[0][3].get("tol", GOAL_TOL)) if captured else None
     paired = paired_both() if 1 in sizes else None
+    by_threads = thread_table(sizes, compare_threads) if compare_threads else []
     report = {"benchmark": "bench_solver", "scene": "simple-pinned",
               "load": "hydrostatic at h = h_B + drag at 6 m/s, at the initial node height",
               "reference_tol": REFERENCE_TOL, "goal_tol": GOAL_TOL, "blas_threads": threads,
               "load_average": _load(),
-              "size_table": size_table(results, threads), "sizes": results,
+              "size_table": size_table(results, threads), "threads_table": by_threads,
+              "sizes": results,
               "verification_paths": paths, "tent": tent, "robustness": robustness(),
               "opensees_paired": paired, "goals": goals(results, paths, tent, paired),
               "total_s": time.perf_counter() - t0}
     (out / "bench_solver.json").write_text(json.dumps(report, indent=1) + "\n")
     figure(results, out / "bench_solver.png")
     return report
+
+
+def _pardiso_note(row: dict) -> str:
+    """PARDISO's share of a size-table row's CPU, by phase ("" for other backends)."""
+    w = row.get("pardiso")
+    if not w:
+        return ""
+    return (f"  (PARDISO: analysis {w['analysis_cpu_s']:.2f} s, {w['factorization_calls']} "
+            f"factorizations {w['factorization_cpu_s']:.2f} s, {w['solve_calls']} solves "
+            f"{w['solve_cpu_s']:.2f} s)")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -445,9 +508,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--no-paths", action="store_true", help="skip the verification load paths")
     ap.add_argument("--threads", type=int, default=THREADS,
                     help=f"BLAS/MKL threads of the size runs (default {THREADS})")
+    ap.add_argument("--compare-threads", type=int, nargs="+", metavar="N",
+                    help="also time each size at tol 1e-6 with each of these thread counts")
     ap.add_argument("--json", action="store_true", help="print the goals as JSON")
     a = ap.parse_args(argv)
-    report = run(a.out, a.sizes, not a.no_paths, a.threads)
+    report = run(a.out, a.sizes, not a.no_paths, a.threads, a.compare_threads)
     for res in report["sizes"]:
         for r in res["runs"]:
             err = r.get("error")
@@ -462,7 +527,10 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{row['size']:9s} {row['unknowns']:7d} unknowns  {row['backend']:8s} "
               f"{row['blas_threads']} thread(s)  wall {row['wall_s']:6.2f} s  cpu "
               f"{row['cpu_s']:6.2f} s  {row['us_per_unknown_cpu']:5.1f} us/unknown (cpu)  it "
-              f"{row['iterations']} fact {row['factorizations']}")
+              f"{row['iterations']} fact {row['factorizations']}{_pardiso_note(row)}")
+    for row in report["threads_table"]:
+        print(f"{row['size']:9s} {row['blas_threads']} thread(s): wall {row['wall_s']:6.2f} s  "
+              f"cpu {row['cpu_s']:6.2f} s  it {row['iterations']} fact {row['factorizations']}")
     for p in report["verification_paths"]:
         print(f"path {p['path']} ({p['nodes']} nodes, {p['levels']} levels): fast "
               f"{p['fast']['time_s']:.2f} s, {sum(p['fast']['iterations'])} it, "

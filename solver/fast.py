@@ -179,7 +179,8 @@ def _active_set_step(ns: NetSystem, st: State, stepper: Stepper, boost: float, f
         if fact is None or stepper.backend not in REPASS_BY_GMRES:
             trial = stepper.newton(at, boost)
         else:
-            trial = Updated(ns.pattern.csr(stepper.matrix(at, boost)), getattr(fact, "base", fact))
+            trial = Updated(ns.pattern.csr(stepper.matrix(at, boost)), getattr(fact, "base", fact),
+                            stepper)
         off = ns.incidence @ (np.where(active, ns.first_slope * eps, 0.0)[:, None] * nvec)
         new_rhs = -st.r - off.ravel()[ns.free]
         new_step = trial.solve(new_rhs, forcing)
@@ -218,8 +219,8 @@ class Updated:
     before's factorization (the matrices differ by the few strands whose state changed), and
     factorized afresh only when that misses the target."""
 
-    def __init__(self, A, base: Factorization) -> None:
-        self.A, self.base = A, base
+    def __init__(self, A, base: Factorization, stepper: Stepper) -> None:
+        self.A, self.base, self.stepper = A, base, stepper
 
     def solve(self, b: np.ndarray, forcing: float = 0.0) -> np.ndarray | None:
         base = self.base
@@ -231,6 +232,7 @@ class Updated:
                            row_sum_norm(self.A))
             if x is not None:
                 return x
+        self.stepper.factorizations += 1  # counted like the stepper's own
         fresh = Factorization(base.pattern, self.A.data, base.backend, None)
         return fresh.solve(b, forcing)
 

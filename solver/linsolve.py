@@ -22,6 +22,8 @@ SuperLU on A is the last resort. The answer is always that of A.
 from __future__ import annotations
 
 import contextlib
+import ctypes
+import time
 from collections.abc import Callable
 from typing import Any
 
@@ -34,13 +36,23 @@ from solver.pattern import Pattern
 LINEAR_RTOL = 1e-13  # backward error a solve must reach: |b - A x| <= tol (|A| |x| + |b|)
 GMRES_RTOL = 1e-14  # GMRES stops at this relative 2-norm residual at the latest
 GMRES_RESTART = 30  # GMRES iterations (one restart cycle) before falling back to SuperLU
-PARDISO_MIN_DOFS = 6_500  # from here on PARDISO's supernodal Cholesky of S beats qdldl's
-# LDL^T (simple-pinned, 1 thread, CPU per numeric factorization: 3.4k unknowns 4 / 5 ms, 14k
-# 21 / 64 ms, 57k 76 / 690 ms; whole solve at tol 1e-6: 5.3k 0.29 / 0.21 s, 7.7k 0.37 /
-# 0.48 s, 14k 0.87 / 1.26 s: PARDISO's solves and set-up cost more on small nets)
-PARDISO_IPARM = {1: 1, 2: 2, 8: 0, 10: 13, 11: 0, 13: 0, 21: 1}  # MKL's iparm (1-based):
-# own settings, METIS ordering, no refinement, pivot perturbation 1e-13, no scaling or
-# matching, Bunch-Kaufman pivots (mtype -2); everything else MKL's zero default
+PARDISO_MIN_DOFS = 5_000  # from here on PARDISO's Cholesky of S beats qdldl's LDL^T (simple
+# scene with 0.3 / 0.25 / 0.18 / 0.15 / 0.12 / 0.1 m meshes, 1 thread, whole solve at tol 1e-6,
+# CPU, best of 3, qdldl against PARDISO with its minimum-degree ordering: 1.4k unknowns 0.031-
+# 0.042 / 0.037-0.040 s, 2.1k 0.044 / 0.045 s, 4.2k 0.10-0.15 / 0.12-0.13 s, 6.2k 0.25 / 0.20 s,
+# 9.5k 0.48 / 0.36 s, 14k 0.77-0.86 / 0.48 s; was 6500 with METIS)
+PARDISO_IPARM = {1: 1, 2: 0, 8: 0, 10: 13, 11: 0, 13: 0, 21: 1}  # MKL's iparm (1-based):
+# own settings, minimum-degree ordering, no refinement, pivot perturbation 1e-13, no scaling
+# or matching, Bunch-Kaufman pivots (mtype -2); everything else MKL's zero default.
+# Minimum degree (iparm 2 = 0), not METIS nested dissection (2), on these grid nets, 1 thread:
+# fewer flops in the factor (14k / 57k / 228k unknowns: 72 / 729 / 6825 Mflop against 116 /
+# 900 / 7900), half the analysis (20 / 89 / 363 ms against 45 / 185 / 852 ms); whole solve
+# at tol 1e-6 (simple-pinned, CPU, best of 3): 0.47 / 2.59 / 20.6 s against 0.58 / 2.88 /
+# 21.5 s. Measured at 57k and not chosen: parallel METIS (3) and two-level factorization
+# (iparm 24) no faster on 1 thread, VBSR (37) 1.5x slower, MKL's low-rank update (39) no
+# faster for mtype 2, single precision (28) a 20 % faster factor but 5 digits (2 more solves)
+
+PHASES = {11: "analysis", 22: "factorization", 33: "solve"}  # MKL's phases, as Pardiso counts
 
 
 def ldl_available() -> bool:
@@ -84,13 +96,15 @@ def choose_backend(size: int) -> str:
 
 class Pardiso:
     """One MKL PARDISO instance per net, on the symmetric part S: its fill-reducing analysis
-    (METIS nested dissection) runs once, every later step only refactorizes numerically.
+    (minimum degree) runs once, every later step only refactorizes numerically.
 
     A Cholesky factorization (mtype 2) while S is positive definite; from the first
     non-positive pivot on, Bunch-Kaufman LDL^T (mtype -2, pivots perturbed at 1e-13 of the
     norm, analysed again once). No iterative refinement inside PARDISO (iparm 8 = 0) and no
     scaling or matching (iparm 11, 13 = 0: S is symmetric): `Factorization` checks every
-    result against A and repairs it with GMRES.
+    result against A and repairs it with GMRES. MKL is called directly with the pattern's
+    1-based int32 index arrays, converted once per net (pypardiso's call converts them at
+    every factorization and solve: 2.5 ms a call at 57k unknowns, ~30 calls a solve).
     """
 
     def __init__(self) -> None:
@@ -100,8 +114,11 @@ class Pardiso:
         self.error = pypardiso.pardiso_wrapper.PyPardisoError
         self.solver = self._solver(2)
         self.analysed = False
-        self.S = None
-        self.empty = sp.csr_matrix((0, 0))  # what MKL's release phase is called with
+        self.S: sp.csr_matrix | None = None  # the factorized matrix (MKL may read it at solves)
+        self.ia: np.ndarray | None = None  # S.indptr + 1 as int32
+        self.ja: np.ndarray | None = None  # S.indices + 1 as int32
+        self.cpu = dict.fromkeys(PHASES.values(), 0.0)  # CPU seconds (process_time) by phase
+        self.calls = dict.fromkeys(PHASES.values(), 0)
 
     @staticmethod
     def _solver(mtype: int):
@@ -112,12 +129,49 @@ class Pardiso:
             solver.iparm[k - 1] = value  # the 1-based numbering of MKL's documentation
         return solver
 
-    def _call(self, phase: int, rhs: np.ndarray) -> np.ndarray:
-        self.solver.set_phase(phase)
-        return self.solver._call_pardiso(self.S, rhs)  # the documented direct call (pypardiso)
+    def _index(self, S: sp.csr_matrix) -> None:
+        """The 1-based int32 index arrays of S, kept while the pattern stays the same (a new
+        pattern is analysed afresh)."""
+        ia, ja = self.ia, self.ja
+        if (ia is not None and ja is not None and len(ia) == len(S.indptr)
+                and len(ja) == len(S.indices) and np.array_equal(ia - 1, S.indptr)
+                and np.array_equal(ja - 1, S.indices)):
+            return
+        self.ia = (S.indptr + 1).astype(np.int32)
+        self.ja = (S.indices + 1).astype(np.int32)
+        self.analysed = False
+
+    def _call(self, phase: int, rhs: np.ndarray, nrhs: int = 1) -> np.ndarray:
+        """MKL's pardiso(...) at `phase` on the current S (pypardiso's library handle)."""
+        solver, S = self.solver, self.S
+        if S is None or self.ia is None or self.ja is None:
+            raise self.error(-1)
+        data = np.ascontiguousarray(S.data, dtype=np.float64)
+        x = np.zeros_like(rhs)
+        error = ctypes.c_int32(0)
+        t0 = time.process_time()
+        i32 = ctypes.POINTER(ctypes.c_int32)
+        solver._mkl_pardiso(
+            solver.pt.ctypes.data_as(ctypes.POINTER(solver._pt_type[0])),
+            ctypes.byref(ctypes.c_int32(1)), ctypes.byref(ctypes.c_int32(1)),  # maxfct, mnum
+            ctypes.byref(ctypes.c_int32(solver.mtype)), ctypes.byref(ctypes.c_int32(phase)),
+            ctypes.byref(ctypes.c_int32(S.shape[0])), data.ctypes.data_as(ctypes.c_void_p),
+            self.ia.ctypes.data_as(i32), self.ja.ctypes.data_as(i32),
+            solver.perm.ctypes.data_as(i32), ctypes.byref(ctypes.c_int32(nrhs)),
+            solver.iparm.ctypes.data_as(i32), ctypes.byref(ctypes.c_int32(0)),  # msglvl
+            rhs.ctypes.data_as(ctypes.c_void_p), x.ctypes.data_as(ctypes.c_void_p),
+            ctypes.byref(error))
+        name = PHASES.get(phase)
+        if name is not None:
+            self.cpu[name] += time.process_time() - t0
+            self.calls[name] += 1
+        if error.value != 0:
+            raise self.error(error.value)
+        return x
 
     def factor(self, S: sp.csr_matrix) -> None:
         """Factorize S, given as the CSR upper triangle of the same pattern at every call."""
+        self._index(S)
         self.S = S
         zero = np.zeros(S.shape[0])
         try:
@@ -130,17 +184,20 @@ class Pardiso:
                 raise
             self.free()
             self.solver, self.analysed = self._solver(-2), True
+            self.S = S
             self._call(11, zero)
             self._call(22, zero)
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        return self._call(33, np.asfortranarray(b))
+        return self._call(33, np.ascontiguousarray(b, dtype=np.float64))
 
     def free(self) -> None:
         """Release MKL's memory of this instance (factors and analysis)."""
-        with contextlib.suppress(self.error):  # nothing allocated yet
-            self.solver.set_phase(-1)
-            self.solver._call_pardiso(self.empty, np.zeros(0))
+        if self.S is None:
+            return  # nothing allocated yet
+        with contextlib.suppress(self.error):
+            self._call(-1, np.zeros(self.S.shape[0]))
+        self.S = None
 
     def __del__(self) -> None:
         with contextlib.suppress(Exception):  # at interpreter exit, modules may be gone
