@@ -98,25 +98,19 @@ def paired_ratio(pairs: int = PAIRS) -> dict:
 
     scale = solve(net, sc.loads_at(1.0), tol=GOAL_TOL).load_norm  # also: imports, caches
 
-    def opensees_s() -> tuple[float, float, float]:
+    def opensees_s() -> tuple[float, float]:
         _, seconds, ok, note, cpu = solve_opensees(net.nodes, net.fixed, net.elements,
                                                    net.laws[0].slopes[0], loads,
                                                    force_scale=scale, tol=GOAL_TOL)
         assert ok, note
-        return seconds, cpu, seconds
+        return seconds, cpu
 
-    times, load_before, threads = [], _load(), {"before": _threads()}
+    load_before, threads = _load(), {"before": _threads()}
     with threadpool_limits(limits=1):
         pinned = [{k: p[k] for k in ("user_api", "internal_api", "prefix", "num_threads")}
                   for p in threadpool_info()]
         printgen_s()
-        for k in range(pairs):
-            first, second = (printgen_s, opensees_s) if k % 2 == 0 else (opensees_s, printgen_s)
-            a, b = first(), second()
-            pg, os_ = (a, b) if k % 2 == 0 else (b, a)
-            times.append({"printgen_wall_s": pg[0], "printgen_cpu_s": pg[1],
-                          "printgen_result_s": pg[2], "opensees_wall_s": os_[0],
-                          "opensees_cpu_s": os_[1]})
+        times = _alternate(printgen_s, opensees_s, pairs)
     threads["after"] = _threads()
     return {"size": SIZES[1], **_summary(times),
             "opensees": f"{STEPS} load steps, BandSPD, NormUnbalance (max-norm) at {GOAL_TOL:g}"
@@ -124,6 +118,22 @@ def paired_ratio(pairs: int = PAIRS) -> dict:
             "force_scale_n": scale, "threads_per_library": pinned, "opensees_blas": opensees_blas(),
             "process_threads": threads, "load_average_before": load_before,
             "load_average_after": _load()}
+
+
+def _alternate(printgen_s, opensees_s, pairs: int) -> list[dict]:
+    """`pairs` pairs of timings, printgen first in the even pairs, OpenSees in the odd ones."""
+    times = []
+    for k in range(pairs):
+        if k % 2 == 0:
+            pg = printgen_s()
+            os_ = opensees_s()
+        else:
+            os_ = opensees_s()
+            pg = printgen_s()
+        times.append({"printgen_wall_s": pg[0], "printgen_cpu_s": pg[1],
+                      "printgen_result_s": pg[2], "opensees_wall_s": os_[0],
+                      "opensees_cpu_s": os_[1]})
+    return times
 
 
 def opensees_blas() -> str:
