@@ -57,7 +57,7 @@ from solver.newton import (
     POTENTIAL_ROUND_OFF,
     ROUND_OFF,
 )
-from solver.state import NetSystem, State, evaluate, potential, tangent_values
+from solver.state import NetSystem, State, evaluate, ray_potential, tangent_values
 
 FORCING = 0.1  # inexact Newton: linear solves to min(FORCING, |R| / force scale), relative
 MU_GROWTH = 10.0  # mu grows by this factor when no damped step descends
@@ -290,9 +290,10 @@ def membrane_start(ns: NetSystem, st: State, stepper: Stepper) -> State:
     if v is None or not np.any(v):
         return st
     v = v / float(np.abs(v).max())
+    along = ray_potential(ns, st.u, _moved(ns, np.zeros_like(st.u), v), st.f)
 
     def pot(log_s: float) -> float:
-        return potential(ns, _moved(ns, st.u, 10.0**log_s * v), st.f)
+        return along(10.0**log_s)
 
     grid = np.linspace(*START_SPAN, START_GRID)
     values = [pot(x) for x in grid]
