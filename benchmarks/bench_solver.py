@@ -13,8 +13,10 @@ current-height variant is timed too. Times are wall-clock (perf_counter) and CPU
 threads (threadpoolctl; default 1); `size_table` lists them per size with the backend and
 the microseconds per unknown, and for PARDISO its CPU by phase (analysis, numeric
 factorizations, solves); --compare-threads 1 2 adds the same solves per thread count
-(`threads_table`). The ratio to OpenSeesPy at 61 x 21 is also measured pair by
-pair (`paired_ratio`: PAIRS pairs, alternating, one BLAS thread each; median and range).
+(`threads_table`). The ratio to OpenSeesPy at 61 x 21 is also measured pair by pair
+(`paired_ratio`: PAIRS pairs, alternating, one thread each; wall and CPU time of each whole
+call, median and range, with the load average; in a fresh process and in this one, see
+`paired_both`).
 Writes bench_solver.json and bench_solver.png.
 """
 
@@ -49,46 +51,123 @@ EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "realistic_barrier.
 EXAMPLE_SCALE = 40.0  # the 1:40 verification whose load paths are timed
 
 
+def _load() -> list[float] | None:
+    """The 1, 5 and 15 min load averages (`uptime`'s), None where the OS has none."""
+    return list(os.getloadavg()) if hasattr(os, "getloadavg") else None
+
+
+def _threads() -> int | None:
+    """Threads of this process now (/proc/self/task; None off Linux)."""
+    try:
+        return len(os.listdir("/proc/self/task"))
+    except OSError:
+        return None
+
+
+def _spread(values: list[float]) -> dict:
+    return {"median": float(np.median(values)), "min": float(min(values)),
+            "max": float(max(values))}
+
+
 def paired_ratio(pairs: int = PAIRS) -> dict:
     """OpenSeesPy's time over printgen's at 61 x 21 (tol GOAL_TOL), measured pair by pair in
-    this process, alternating which of the two runs first, one BLAS thread each: on a shared
+    this process, alternating which of the two runs first, one thread each: on a shared
     machine the load changes between runs, and a pair taken back to back sees about the same
-    load. Median and range of the per-pair ratios."""
-    from threadpoolctl import threadpool_limits
+    load. Each side is timed around its whole call (printgen's `solve`, its NetSystem built
+    inside; OpenSees's model built inside), wall (perf_counter) and CPU (process_time: far
+    less sensitive to the other processes); OpenSees's test is printgen's (max-norm, tol of
+    printgen's force scale: `opensees_net`). Median and range of the per-pair ratios."""
+    from threadpoolctl import threadpool_info, threadpool_limits
 
     sc = simple_scene(refine=1, current_z=False)
     net = sc.net
     try:
         import openseespy.opensees  # noqa: F401
 
-        from benchmarks.opensees_net import solve_opensees
+        from benchmarks.opensees_net import STEPS, solve_opensees
     except (ImportError, RuntimeError) as exc:
         return {"skipped": f"OpenSeesPy not available: {exc}"}
     loads = total_forces(sc.loads_at(1.0), net.nodes)[0]
 
-    def printgen_s() -> float:
+    def printgen_s() -> tuple[float, float, float]:
+        w, c = time.perf_counter(), time.process_time()
         r = solve(net, sc.loads_at(1.0), tol=GOAL_TOL)
+        c, w = time.process_time() - c, time.perf_counter() - w
         assert r.converged, r.reason
-        return r.seconds
+        return w, c, r.seconds
 
-    def opensees_s() -> float:
-        _, seconds, ok, note = solve_opensees(net.nodes, net.fixed, net.elements,
-                                              net.laws[0].slopes[0], loads)
+    scale = solve(net, sc.loads_at(1.0), tol=GOAL_TOL).load_norm  # also: imports, caches
+
+    def opensees_s() -> tuple[float, float]:
+        _, seconds, ok, note, cpu = solve_opensees(net.nodes, net.fixed, net.elements,
+                                                   net.laws[0].slopes[0], loads,
+                                                   force_scale=scale, tol=GOAL_TOL)
         assert ok, note
-        return seconds
+        return seconds, cpu
 
-    ratios, times = [], []
+    load_before, threads = _load(), {"before": _threads()}
     with threadpool_limits(limits=1):
-        printgen_s()  # imports, caches: not timed
-        for k in range(pairs):
-            first, second = (printgen_s, opensees_s) if k % 2 == 0 else (opensees_s, printgen_s)
-            a, b = first(), second()
-            pg, os_ = (a, b) if k % 2 == 0 else (b, a)
-            ratios.append(os_ / pg)
-            times.append({"printgen_s": pg, "opensees_s": os_})
-    return {"size": SIZES[1], "pairs": times, "ratios": ratios,
-            "median": float(np.median(ratios)), "min": float(min(ratios)),
-            "max": float(max(ratios)), "blas_threads": 1}
+        pinned = [{k: p[k] for k in ("user_api", "internal_api", "prefix", "num_threads")}
+                  for p in threadpool_info()]
+        printgen_s()
+        times = _alternate(printgen_s, opensees_s, pairs)
+    threads["after"] = _threads()
+    return {"size": SIZES[1], **_summary(times),
+            "opensees": f"{STEPS} load steps, BandSPD, NormUnbalance (max-norm) at {GOAL_TOL:g}"
+                        " x printgen's force scale; each side timed around its whole call",
+            "force_scale_n": scale, "threads_per_library": pinned, "opensees_blas": opensees_blas(),
+            "process_threads": threads, "load_average_before": load_before,
+            "load_average_after": _load()}
+
+
+def _alternate(printgen_s, opensees_s, pairs: int) -> list[dict]:
+    """`pairs` pairs of timings, printgen first in the even pairs, OpenSees in the odd ones."""
+    times = []
+    for k in range(pairs):
+        if k % 2 == 0:
+            pg = printgen_s()
+            os_ = opensees_s()
+        else:
+            os_ = opensees_s()
+            pg = printgen_s()
+        times.append({"printgen_wall_s": pg[0], "printgen_cpu_s": pg[1],
+                      "printgen_result_s": pg[2], "opensees_wall_s": os_[0],
+                      "opensees_cpu_s": os_[1]})
+    return times
+
+
+def opensees_blas() -> str:
+    """What serves OpenSeesPy's LAPACK and BLAS calls in this process: its bundled LAPACK
+    binds them through the global symbol scope, so MKL, once loaded (pypardiso), takes them
+    over from the system's reference BLAS (seen with LD_DEBUG=bindings: dpbtrf_, dgemm_,
+    dtrsm_, dsyrk_ bound to libmkl_intel_lp64)."""
+    try:
+        with open("/proc/self/maps") as maps:
+            loaded = maps.read()
+    except OSError:
+        return "unknown"
+    return "MKL (1 thread)" if "libmkl_intel_lp64" in loaded else "reference BLAS (libblas3)"
+
+
+def paired_both() -> dict:
+    """`paired_ratio` twice: in a fresh process without MKL (OpenSeesPy as packaged, on the
+    reference BLAS), then in this one (MKL loaded by then, when installed: OpenSeesPy's
+    factorizations about twice as fast)."""
+    import multiprocessing
+
+    with multiprocessing.get_context("spawn").Pool(1) as pool:
+        fresh = pool.apply(paired_ratio)
+    here = paired_ratio()
+    return {"fresh_process": fresh, "this_process": here}
+
+
+def _summary(times: list[dict]) -> dict:
+    """The per-pair ratios (OpenSees / printgen), wall and CPU, and their median and range."""
+    wall = [t["opensees_wall_s"] / t["printgen_wall_s"] for t in times]
+    cpu = [t["opensees_cpu_s"] / t["printgen_cpu_s"] for t in times]
+    return {"pairs": times, "wall_ratios": wall, "cpu_ratios": cpu, "wall": _spread(wall),
+            "cpu": _spread(cpu), "printgen_cpu_s": _spread([t["printgen_cpu_s"] for t in times]),
+            "opensees_cpu_s": _spread([t["opensees_cpu_s"] for t in times])}
 
 
 def strand_state(net, disp: np.ndarray) -> tuple[float, float]:
@@ -174,7 +253,7 @@ def bench_size(refine: int) -> dict:
                  "factorizations": rc.factorizations, "time_s": rc.seconds,
                  "deflection_m": float(rc.displacements[cur.centre, 1]), "error": None})
     if refine in COMPARED:
-        runs.append(_opensees(sc, d_ref))
+        runs.append(_opensees(sc, d_ref, ref.load_norm))
     unknowns = int((~sc.net.fixed_dofs).sum())
     goal = next(r for r in runs if r["tool"] == "printgen" and r["tol"] == GOAL_TOL)
     return {"size": SIZES.get(refine, f"refine {refine}"), "nodes": len(sc.net.nodes),
@@ -288,7 +367,7 @@ def bench_paths(captured: list[tuple]) -> list[dict]:
     return out
 
 
-def _opensees(sc, d_ref: float) -> dict:
+def _opensees(sc, d_ref: float, scale: float) -> dict:
     try:
         import openseespy.opensees  # noqa: F401
 
@@ -298,11 +377,13 @@ def _opensees(sc, d_ref: float) -> dict:
                 "(pip install 'printgen[bench]'; Debian needs libblas3 liblapack3)"}
     net = sc.net
     loads = total_forces(sc.loads_at(1.0), net.nodes)[0]
-    disp, seconds, ok, note = solve_opensees(net.nodes, net.fixed, net.elements,
-                                             net.laws[0].slopes[0], loads)
+    disp, seconds, ok, note, cpu = solve_opensees(net.nodes, net.fixed, net.elements,
+                                                  net.laws[0].slopes[0], loads,
+                                                  force_scale=scale, tol=GOAL_TOL)
     d = float(disp[sc.centre, 1])
     strain, tension = strand_state(net, disp)
-    return {"tool": "OpenSeesPy", "converged": ok, "time_s": seconds, "note": note,
+    return {"tool": "OpenSeesPy", "converged": ok, "time_s": seconds, "cpu_s": cpu,
+            "note": f"{note}, {opensees_blas()}",
             "max_strain": strain, "max_tension_n": tension,
             "deflection_m": d, "error": abs(d / d_ref - 1) if ok else None}
 
@@ -363,8 +444,10 @@ def goals(results: list[dict], paths: list[dict], tent: dict | None,
     pg, os_ = at("61 x 21", "printgen"), at("61 x 21", "OpenSeesPy")
     if pg and os_:
         out["speedup_vs_opensees_61x21"] = os_["time_s"] / pg["time_s"]
-    if paired and "median" in paired:
-        out["opensees_ratio_61x21_paired"] = {k: paired[k] for k in ("median", "min", "max")}
+    for run in (paired or {}).values():
+        if "cpu" in run:
+            out[f"opensees_ratio_61x21_paired ({run['opensees_blas']})"] = {
+                "cpu": run["cpu"], "wall": run["wall"]}
     big = at("241 x 81", "printgen")
     if big:
         out["time_241x81_s"] = big["time_s"]
@@ -405,12 +488,12 @@ def run(out: Path, sizes: list[int], with_paths: bool = True, threads: int = THR
     captured = capture_verification_paths() if with_paths else []
     paths = bench_paths(captured)
     tent = bench_tent(captured[0][0], captured[0][3].get("tol", GOAL_TOL)) if captured else None
-    paired = paired_ratio() if 1 in sizes else None
+    paired = paired_both() if 1 in sizes else None
     by_threads = thread_table(sizes, compare_threads) if compare_threads else []
     report = {"benchmark": "bench_solver", "scene": "simple-pinned",
               "load": "hydrostatic at h = h_B + drag at 6 m/s, at the initial node height",
               "reference_tol": REFERENCE_TOL, "goal_tol": GOAL_TOL, "blas_threads": threads,
-              "load_average": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
+              "load_average": _load(),
               "size_table": size_table(results, threads), "threads_table": by_threads,
               "sizes": results,
               "verification_paths": paths, "tent": tent, "robustness": robustness(),
@@ -468,11 +551,13 @@ def main(argv: list[str] | None = None) -> int:
               f"{p['fast']['time_s']:.2f} s, {sum(p['fast']['iterations'])} it, "
               f"{p['fast']['factorizations_per_level']:.1f} fact/level; reference "
               f"{p['reference']['time_s']:.2f} s, {sum(p['reference']['iterations'])} it")
-    pair = report.get("opensees_paired") or {}
-    if "median" in pair:
-        print(f"OpenSeesPy / printgen at {pair['size']}, {len(pair['ratios'])} alternating pairs, "
-              f"1 BLAS thread: median {pair['median']:.1f}x (range {pair['min']:.1f}-"
-              f"{pair['max']:.1f}x)")
+    for pair in (report.get("opensees_paired") or {}).values():
+        if "cpu" in pair:
+            print(f"OpenSeesPy ({pair['opensees_blas']}) / printgen at {pair['size']}, "
+                  f"{len(pair['pairs'])} alternating pairs, 1 thread each, load "
+                  f"{pair['load_average_before'][0]:.1f}: " + ", ".join(
+                      f"{k} median {pair[k]['median']:.1f}x (range {pair[k]['min']:.1f}-"
+                      f"{pair[k]['max']:.1f}x)" for k in ("cpu", "wall")))
     if a.json:
         print(json.dumps(report["goals"], indent=1))
     else:

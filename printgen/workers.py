@@ -25,13 +25,14 @@ import sys
 import threading
 import time
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures import TimeoutError as FutureTimeout
 from dataclasses import dataclass
 from typing import Any
 
 from printgen.errors import TimeLimitError
+from printgen.trace import span, traced_job
 
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
 SIGNAL_NAMES = ("SIGINT", "SIGTERM", "SIGHUP")  # the stop signals; SIGHUP is POSIX only
@@ -85,6 +86,22 @@ def start_method(plat: Platform | None = None) -> str:
     if "forkserver" in plat.start_methods and plat.system != "darwin":
         return "forkserver"
     return "spawn"
+
+
+def preload(modules: Iterable[str]) -> None:
+    """Where workers start by `forkserver` (`start_method`: the process runs a thread, such as
+    the command line's spinner), have multiprocessing's fork server import `modules` (what the
+    run's jobs need) and start it now, so that it imports them while this process goes on: every
+    worker is then forked from it with them imported, a pool ready in ~0.05 s instead of the
+    3 to 5 s of importing numpy, scipy, printgen and matplotlib again in each worker (measured
+    on 2 shared cores). The first call's modules stay: the server lives as long as this
+    process. Under `fork` and `spawn` nothing is done."""
+    if start_method() != "forkserver":
+        return
+    from multiprocessing import forkserver
+
+    multiprocessing.get_context("forkserver").set_forkserver_preload(list(modules))
+    forkserver.ensure_running()
 
 
 def _one_thread() -> bool:
@@ -175,8 +192,9 @@ def _main_thread() -> bool:
 def init_worker(plat: Platform, sink: Any = None, at: float | None = None) -> None:
     """Pool initializer: die with the parent, leave signals to the parent, report progress to
     `sink` (the parent's queue, or None), keep the parent's deadline `at` (`deadline`)."""
-    global _inherited, _sink, _deadline
+    global _inherited, _sink, _deadline, _shared, _listener
     _inherited, _sink, _deadline = plat, sink, at
+    _shared, _listener = None, None  # a forked worker's copies of its parent's
     for s in plat.signals:
         signal.signal(s, signal.SIG_IGN)
     parent = multiprocessing.parent_process()
@@ -266,6 +284,11 @@ def _result(f: Future) -> Any:
         raise TimeLimitError("a worker's job: past the time limit") from exc
 
 
+def collect(futures: list[Future]) -> list:
+    """The futures' results, each waited for no longer than the deadline (`deadline`)."""
+    return [_result(f) for f in futures]
+
+
 def report_progress(task: str, done: float, total: float) -> None:
     """From inside a job: `task` has reached `done` of `total` (e.g. load level 0.35 of 1.1).
     A no-op unless the caller of `run_jobs` is listening."""
@@ -274,6 +297,12 @@ def report_progress(task: str, done: float, total: float) -> None:
         return
     with contextlib.suppress(Exception):  # progress must never break the work
         sink(task, done, total) if callable(sink) else sink.put((task, done, total))
+
+
+def _relay() -> Any:
+    """In a worker reporting to its parent's queue: that queue, for the workers it starts
+    (their reports go straight to the first process); else None."""
+    return _sink if _sink is not None and not callable(_sink) else None
 
 
 def _drain(queue: Any, listener: Callable[[str, float, float], None]) -> None:
@@ -290,21 +319,41 @@ def run_jobs(jobs: list[tuple]) -> list:
     On any exception or signal in the parent the workers are killed before it propagates.
     """
     global _sink
+    if _shared is not None:  # within `shared_pool`: its workers
+        return collect([_shared.submit(fn, *args, **kw) for fn, args, kw in jobs])
     workers = min(len(jobs), cores())
     if workers < 2 or os.environ.get("PRINTGEN_SERIAL"):
         previous, _sink = _sink, _listener or _sink  # in a worker: its parent's queue
         try:
-            return [fn(*args, **kw) for fn, args, kw in jobs]
+            return [fn(*args, **kw) for fn, args, kw in (traced_job(*j) for j in jobs)]
         finally:
             _sink = previous
+    with span(f"pool of {workers} for {len(jobs)} jobs"):
+        return _in_pool(jobs, workers)
+
+
+def submit_jobs(jobs: list[tuple]) -> list[Future]:
+    """Start each (fn, args, kwargs) and return their futures (`collect` waits for them):
+    within `shared_pool` on its workers, without waiting; else `run_jobs` runs them now."""
+    if _shared is not None:
+        return [_shared.submit(fn, *args, **kw) for fn, args, kw in jobs]
+    out = []
+    for result in run_jobs(jobs):
+        out.append(Future())
+        out[-1].set_result(result)
+    return out
+
+
+def _in_pool(jobs: list[tuple], workers: int) -> list:
     plat = platform()
     ctx = multiprocessing.get_context(start_method(plat))
     queue = ctx.SimpleQueue() if _listener else None
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=init_worker,
-                               initargs=(plat, queue, _deadline))
+                               initargs=(plat, queue or _relay(), _deadline))
     try:
         with _watch_is_safe():
-            futures = [pool.submit(fn, *args, **kw) for fn, args, kw in jobs]
+            futures = [pool.submit(fn, *args, **kw)
+                       for fn, args, kw in (traced_job(*j) for j in jobs)]
         if queue is not None:  # started once the workers are: fork only a one-thread process
             reader = threading.Thread(target=_drain, args=(queue, _listener), daemon=True)
             reader.start()
@@ -319,20 +368,110 @@ def run_jobs(jobs: list[tuple]) -> list:
     return results
 
 
+class Pool:
+    """Worker processes for the jobs of a block (`shared_pool`): `submit` starts a job now and
+    returns its Future (`collect` waits for futures within the deadline). With one core or
+    PRINTGEN_SERIAL=1, `submit` runs the job at once (its Future is done)."""
+
+    def __init__(self, workers: int) -> None:
+        self.pool: ProcessPoolExecutor | None = None
+        self.queue, self.reader = None, None
+        if workers < 2 or os.environ.get("PRINTGEN_SERIAL"):
+            return
+        plat = platform()
+        ctx = multiprocessing.get_context(start_method(plat))
+        self.queue = ctx.SimpleQueue() if _listener else None
+        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
+                                        initializer=init_worker,
+                                        initargs=(plat, self.queue or _relay(), _deadline))
+
+    def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> Future:
+        fn, args, kwargs = traced_job(fn, args, kwargs)
+        if self.pool is None:
+            return _done(fn, args, kwargs)
+        with _watch_is_safe():
+            f = self.pool.submit(fn, *args, **kwargs)
+        if self.queue is not None and self.reader is None:  # once the workers are forked
+            self.reader = threading.Thread(target=_drain, args=(self.queue, _listener),
+                                           daemon=True)
+            self.reader.start()
+        return f
+
+    def close(self) -> None:
+        if self.pool is not None:
+            self.pool.shutdown(wait=True)
+        if self.reader is not None:
+            self.queue.put(None)  # the workers are done: end the reader after the last report
+            self.reader.join(timeout=READER_JOIN_S)
+
+
+def _done(fn: Callable, args: tuple, kwargs: dict) -> Future:
+    """A Future holding fn(*args, **kwargs), run here (reporting progress as `run_jobs`
+    does when serial; its error raised here, as serial `run_jobs` raises it)."""
+    global _sink
+    f: Future = Future()
+    previous, _sink = _sink, _listener or _sink
+    try:
+        f.set_result(fn(*args, **kwargs))
+    finally:
+        _sink = previous
+    return f
+
+
+_shared: Pool | None = None  # set by `shared_pool` (None in every worker: `init_worker`)
+
+
+@contextlib.contextmanager
+def shared_pool(workers: int | None = None) -> Iterator[Pool]:
+    """One set of worker processes (`workers`, default: the cores) for the block: its jobs
+    submitted as their inputs are ready (`Pool.submit`), and every `run_jobs` of the block in
+    this process, start on them instead of on pools of their own, so that a core freed by one
+    sweep takes the next job at once. On any exception or signal the workers are killed
+    before it propagates."""
+    global _shared
+    previous = _shared
+    pool = Pool(cores() if workers is None else workers)
+    _shared = pool
+    try:
+        with span("shared pool"):
+            yield pool
+    except BaseException:
+        if pool.pool is not None:
+            stop(pool.pool)
+        raise
+    finally:
+        _shared = previous
+    pool.close()
+
+
 class Helper:
     """One worker process that runs the jobs submitted to it in order (see `helper`)."""
 
     def __init__(self) -> None:
         plat = platform()
-        self.pool = ProcessPoolExecutor(
-            max_workers=1, mp_context=multiprocessing.get_context(start_method(plat)),
-            initializer=init_worker, initargs=(plat, None, _deadline))
+        ctx = multiprocessing.get_context(start_method(plat))
+        self.queue = ctx.SimpleQueue() if _listener else None  # its workers' progress too
+        self.reader: threading.Thread | None = None
+        self.pool = ProcessPoolExecutor(max_workers=1, mp_context=ctx, initializer=init_worker,
+                                        initargs=(plat, self.queue or _relay(), _deadline))
         self.futures: list[Future] = []
 
     def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> Future:
         """Start `fn(*args, **kwargs)` there; `.result()` collects it (or raises its error)."""
-        self.futures.append(self.pool.submit(fn, *args, **kwargs))
+        fn, args, kwargs = traced_job(fn, args, kwargs)
+        with _watch_is_safe():
+            self.futures.append(self.pool.submit(fn, *args, **kwargs))
+        if self.queue is not None and self.reader is None:  # once the worker is forked
+            self.reader = threading.Thread(target=_drain, args=(self.queue, _listener),
+                                           daemon=True)
+            self.reader.start()
         return self.futures[-1]
+
+    def end_reports(self) -> None:
+        """The worker is gone: pass on the reports left, then end the reader."""
+        if self.reader is not None:
+            self.queue.put(None)
+            self.reader.join(timeout=READER_JOIN_S)
 
 
 @contextlib.contextmanager
@@ -352,6 +491,7 @@ def helper() -> Iterator[Helper]:
         h.pool.shutdown(wait=True)
     else:
         stop(h.pool)
+    h.end_reports()
 
 
 def stop(pool: ProcessPoolExecutor) -> None:

@@ -17,7 +17,7 @@ import scipy.sparse.linalg as spla
 from scipy.sparse import csgraph
 
 from solver.assemble import Bars, bar_energy, nondimensional, strand_laws
-from solver.linsolve import PARDISO_MIN_DOFS, Pardiso, choose_backend
+from solver.linsolve import ldl_available
 from solver.loads import total_forces
 from solver.model import Net
 from solver.pattern import SYM_PAIRS, Pattern, pair_values
@@ -64,39 +64,27 @@ class NetSystem:
     def membrane_shape(self, b: np.ndarray) -> np.ndarray | None:
         """D^-1 b on the free dofs, solved per direction on the node graph (D is the graph
         Laplacian times I3, so the three directions decouple and each system is a third of
-        the size); None when a direction's Laplacian is singular. Only a start shape: on
-        nets of PARDISO_MIN_DOFS unknowns and more a sparse Cholesky (`laplace_solve`),
-        below SuperLU as before (small nets' paths are kept bit for bit)."""
+        the size); None when a direction's Laplacian is singular (a part of the net reaches
+        no anchor)."""
         n, fixed = self.n, self.net.fixed_dofs
         edges = [(self.bars.i, self.bars.j, 1.0 / self.bars.rest)]
         edges += [(c.nodes[:-1], c.nodes[1:], 1.0 / c.l0) for c in self.cables]
         i, j, w = (np.concatenate(x) for x in zip(*edges))
-        lap = sp.coo_matrix((np.concatenate([w, w, -w, -w]), (np.concatenate([i, j, i, j]),
-                             np.concatenate([i, j, j, i]))), shape=(n, n)).tocsc()
         full = np.zeros(3 * n)
         full[self.free] = b
         rhs, out = full.reshape(n, 3), np.zeros((n, 3))
         masks: dict[bytes, list[int]] = {fixed[:, k].tobytes(): [] for k in range(3)}
         for k in range(3):
             masks[fixed[:, k].tobytes()].append(k)
-        large = self.pattern.size >= PARDISO_MIN_DOFS
-        backend = choose_backend(self.pattern.size) if large else "lu"
         for dirs in masks.values():  # one factorization per distinct set of free nodes
             nodes = np.flatnonzero(~fixed[:, dirs[0]])
             if not nodes.size:
                 continue
             at = np.ix_(nodes, np.asarray(dirs))
-            if backend != "lu":
-                if not anchored(lap, fixed[:, dirs[0]]):
-                    return None
-                out[at] = laplace_solve(lap[nodes][:, nodes], rhs[at], backend)
-                continue
-            try:
-                with np.errstate(all="ignore"):
-                    lu = spla.splu(lap[nodes][:, nodes].tocsc())
-                    out[at] = lu.solve(rhs[at])
-            except RuntimeError:  # singular: some nodes reach no anchor through D
+            x = _laplacian_solve(n, nodes, (i, j, w), rhs[at])
+            if x is None:
                 return None
+            out[at] = x
         v = out.ravel()[self.free]
         return v if np.all(np.isfinite(v)) else None
 
@@ -106,30 +94,47 @@ class NetSystem:
         return f / self.S, dz * self.L / self.S
 
 
-def anchored(lap: sp.csc_matrix, fixed: np.ndarray) -> bool:
-    """True when every free node reaches a fixed one through the graph of `lap` (then the
-    free nodes' Laplacian is positive definite)."""
-    _, label = csgraph.connected_components(lap, directed=False)
-    return bool(np.all(np.isin(label[~fixed], label[fixed])))
+def _laplacian_solve(n: int, nodes: np.ndarray, edges: tuple, rhs: np.ndarray
+                     ) -> np.ndarray | None:
+    """X with L X = rhs, L the weighted graph Laplacian (edges: i, j, weight) of the n nodes
+    restricted to `nodes` (the others held); None when L is singular (some nodes reach no
+    held one). By qdldl's LDL^T of L's upper triangle when installed (half of SuperLU's
+    time on the 61 x 21 net), else SuperLU."""
+    i, j, w = edges
+    if not anchored(n, nodes, i, j):
+        return None
+    index = np.full(n, -1)
+    index[nodes] = np.arange(len(nodes))
+    a, b = index[i], index[j]
+    inner = (a >= 0) & (b >= 0)
+    lo, hi = np.minimum(a[inner], b[inner]), np.maximum(a[inner], b[inner])
+    diag = (np.bincount(i, w, n) + np.bincount(j, w, n))[nodes]
+    k = np.arange(len(nodes))
+    upper = sp.coo_matrix((np.concatenate([diag, -w[inner]]), (np.concatenate([k, lo]),
+                           np.concatenate([k, hi]))), shape=(len(nodes),) * 2).tocsc()
+    try:
+        with np.errstate(all="ignore"):
+            if ldl_available():
+                import qdldl
+
+                ldl = qdldl.Solver(upper, upper=True)
+                return np.column_stack([ldl.solve(np.ascontiguousarray(c)) for c in rhs.T])
+            full = (upper + sp.triu(upper, 1, format="csc").T).tocsc()
+            return spla.splu(full).solve(rhs)
+    except (RuntimeError, ValueError):  # singular: some nodes reach no anchor through D
+        return None
 
 
-def laplace_solve(L: sp.csc_matrix, rhs: np.ndarray, backend: str) -> np.ndarray:
-    """L^-1 rhs (columns) for a positive definite L by a sparse Cholesky: MKL PARDISO's
-    (backend "pardiso") or qdldl's LDL^T. 241 x 81 / 481 x 161 nodes, 1 thread, CPU: 0.05-
-    0.1 / 0.33-0.40 s against SuperLU's 0.11 / 0.63 s."""
-    upper = sp.triu(L, format="csr")
-    upper.sort_indices()
-    if backend == "pardiso":
-        solver = Pardiso()
-        solver.factor(upper)
-        try:
-            return np.column_stack([solver.solve(np.ascontiguousarray(c)) for c in rhs.T])
-        finally:
-            solver.free()
-    import qdldl
-
-    ldl = qdldl.Solver(upper.tocsc(), upper=True)
-    return np.column_stack([ldl.solve(np.ascontiguousarray(c)) for c in rhs.T])
+def anchored(n: int, nodes: np.ndarray, i: np.ndarray, j: np.ndarray) -> bool:
+    """True when every node of `nodes` reaches a held node (one not in `nodes`) along the
+    edges (i, j): then their Laplacian is positive definite. Checked on the graph, since a
+    factorization of a singular Laplacian need not meet an exact zero pivot (a loose panel
+    of 667 nodes beside the 61 x 21 net: LDL^T returned a finite shape of 3e11)."""
+    held = np.ones(n, bool)
+    held[nodes] = False
+    graph = sp.coo_matrix((np.ones(len(i)), (i, j)), shape=(n, n))
+    _, label = csgraph.connected_components(graph, directed=False)
+    return bool(np.all(np.isin(label[nodes], label[held])))
 
 
 class CableSet:
@@ -235,36 +240,30 @@ def potential(ns: NetSystem, u: np.ndarray, f_frozen: np.ndarray) -> float:
     return energy - float((f_frozen * u).sum())
 
 
-def ray_potential(ns: NetSystem, u: np.ndarray, v: np.ndarray, f_frozen: np.ndarray
+def ray_potential(ns: NetSystem, u: np.ndarray, w: np.ndarray, f_frozen: np.ndarray
                   ) -> Callable[[float], float]:
-    """s -> potential(ns, u + s v, f_frozen), with each strand's and segment's
-    l^2 - L0^2 = q0 + q1 s + q2 s^2 computed once: an evaluation is a few operations per
-    strand instead of a strand pass with its gathers (the membrane start's scalar search)."""
-    b, cs = ns.bars, ns.cable_set
-    q = _ray_quadratic(b.d0, b.c, *(np.take(x, b.j, axis=0) - np.take(x, b.i, axis=0)
-                                    for x in (u, v)))
-    qc = _ray_quadratic(cs.d0, 0.0, *(x[cs.b] - x[cs.a] for x in (u, v))) if cs.count else ()
-    work = (float((f_frozen * u).sum()), float((f_frozen * v).sum()))
+    """`potential` at u + t w as a function of t, for scalar searches along one direction:
+    each strand's squared length and stretch are quadratics in t whose coefficients are
+    computed once, so a value costs a few operations per strand, not a pass over (m, 3)
+    arrays (the same numbers to round-off)."""
+    b = ns.bars
+    base = np.take(u, b.j, axis=0) - np.take(u, b.i, axis=0)
+    dw = np.take(w, b.j, axis=0) - np.take(w, b.i, axis=0)
+    d = b.d0 + base
+    sq0, lin, quad = (np.einsum("ij,ij->i", x, y) for x, y in ((d, d), (d, dw), (dw, dw)))
+    dl0 = b.c + 2 * np.einsum("ij,ij->i", b.d0, base) + np.einsum("ij,ij->i", base, base)
+    work0, work1 = float((f_frozen * u).sum()), float((f_frozen * w).sum())
+    cs = ns.cable_set
 
-    def at(s: float) -> float:
-        dl2 = q[0] + s * (q[1] + s * q[2])
-        energy = bar_energy(b, dl2 / (b.rest * (np.sqrt(np.maximum(b.rest**2 + dl2, 0.0))
-                                                + b.rest)))
+    def value(t: float) -> float:
+        sq = (2 * t) * lin + (t * t) * quad
+        eps = (dl0 + sq) / (b.rest * (np.sqrt(sq0 + sq) + b.rest))
+        energy = bar_energy(b, eps)
         if cs.count:
-            sq = qc[0] + s * (qc[1] + s * qc[2])
-            stretch = sq / (np.sqrt(np.maximum(cs.l0**2 + sq, 0.0)) + cs.l0)
-            eps = (np.bincount(cs.owner, stretch, cs.count) + cs.l0_sum - cs.rest) / cs.rest
-            energy += float((cs.rest * cs.laws_at(eps)[2]).sum())
-        return energy - (work[0] + s * work[1])
+            energy += float((cs.rest * cs.laws_at(cs.strains(u + t * w)[0])[2]).sum())
+        return energy - (work0 + t * work1)
 
-    return at
-
-
-def _ray_quadratic(d0: np.ndarray, c, du: np.ndarray, dv: np.ndarray) -> tuple:
-    """Coefficients of |d0 + du + s dv|^2 - |d0|^2 + c in s (rows)."""
-    d = d0 + du
-    return (c + np.einsum("ij,ij->i", 2 * d0 + du, du), 2 * np.einsum("ij,ij->i", d, dv),
-            np.einsum("ij,ij->i", dv, dv))
+    return value
 
 
 def tangent_values(ns: NetSystem, st: State) -> np.ndarray:

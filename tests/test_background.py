@@ -35,6 +35,18 @@ def nested(n: int) -> tuple[int, list[int]]:
     return os.getpid(), workers.run_jobs([(square, (k,), {}) for k in range(n)])
 
 
+def reporting_pool(names: list[str]) -> list[int]:
+    """Jobs on a shared pool and on a pool of run_jobs, each reporting its progress."""
+    with workers.shared_pool() as pool:
+        first = workers.collect([pool.submit(reported, n) for n in names[:1]])
+        return first + workers.run_jobs([(reported, (n,), {}) for n in names[1:]])
+
+
+def reported(name: str) -> int:
+    workers.report_progress(name, 1.0, 2.0)
+    return os.getpid()
+
+
 def failing() -> None:
     raise ValueError("from the worker")
 
@@ -48,6 +60,19 @@ def sleeper_tree(folder: str) -> None:
 def _sleep(pid_file: str) -> None:
     Path(pid_file).write_text(str(os.getpid()))
     time.sleep(SLEEP_S)
+
+
+@two_cores
+def test_progress_of_a_helpers_workers_reaches_the_listener(monkeypatch):
+    """A long make's per-level bars: the sweeps run in the helper's workers, their reports
+    reach the listener of the process that started the helper (issue 28: the helper in every
+    make)."""
+    monkeypatch.delenv("PRINTGEN_SERIAL", raising=False)
+    heard: list[tuple[str, float, float]] = []
+    with workers.reporting(lambda *item: heard.append(item)), workers.helper() as h:
+        pids = h.submit(reporting_pool, ["a", "b", "c"]).result()
+    assert os.getpid() not in pids
+    assert sorted(heard) == [("a", 1.0, 2.0), ("b", 1.0, 2.0), ("c", 1.0, 2.0)]
 
 
 @two_cores

@@ -44,7 +44,7 @@ def test_verify_design_is_estimated_before_any_solve(capsys, tmp_path, monkeypat
     def no_solve(*a, **k):
         raise AssertionError("verify solved a net the budget should have refused")
 
-    monkeypatch.setattr(verify_mod, "verify", no_solve)
+    monkeypatch.setattr(verify_mod, "verify_with_band", no_solve)
     d = dataclasses.replace(reference_design_1_40(), printer="generic-350")
     d = dataclasses.replace(d, net=dataclasses.replace(d.net, mesh_x_mm=1.0, mesh_y_mm=1.0))
     design = tmp_path / "design.json"

@@ -186,8 +186,8 @@ def test_case_readings_are_the_nominal_model_at_the_discharge_steps():
     report states the case's assumptions and readings."""
     from printgen.inputs.prototype import load_prototype
     from printgen.report.labfiles import _csv, case_file, case_readings
+    from printgen.verification.cases import case_runs
     from printgen.verification.readings import flume_units
-    from printgen.verification.verify import case_runs
 
     c = case_runs(load_prototype(REALISTIC), reference_design_1_40(), "jam:porosity=0.8")
     r = case_readings(c.model, c.load["model"], flume_units(c.model.scene).length_mm)

@@ -520,7 +520,7 @@ def test_verify_checks_out_before_computing(world, made, capsys, monkeypatch):
     def no_work(*_a, **_k):
         raise AssertionError("verify computed before checking --out")
 
-    monkeypatch.setattr(verify_mod, "verify", no_work)
+    monkeypatch.setattr(verify_mod, "verify_with_band", no_work)
     before = snapshot(world)
     code, err = cli(capsys, "verify", SIMPLE, "-s", 40, "--design", made / "design.json",
                     "--out", world / "app")

@@ -14,9 +14,10 @@ from solver import Hydrostatic, Net, SlidingCable, linear, piecewise
 from solver.assemble import internal, strain_energy
 from solver.linsolve import row_sum_norm
 from solver.scenes import square_net
-from solver.state import NetSystem, evaluate, potential, tangent_values
+from solver.state import NetSystem, evaluate, potential, ray_potential, tangent_values
 
 KERNEL = 1e-14  # relative: the same products and sums, only reassociated (BLAS, bincount)
+MEMBRANE = 1e-12  # relative residual of a direct sparse solve of the net's Laplacian
 LAWS = [linear(2.0), piecewise([0.01], [1.0, 0.3]), piecewise([0.002, 0.01, 0.05],
                                                                [0.5, 2.0, 1.0, 4.0])]
 
@@ -105,3 +106,107 @@ def test_row_sum_norm_with_empty_rows():
     assert np.diff(A.indptr).min() == 0  # some rows are empty
     assert row_sum_norm(A) == pytest.approx(float(abs(A).sum(axis=1).max()), rel=KERNEL)
     assert row_sum_norm(sp.csr_matrix((5, 5))) == 0.0
+
+
+def _partly_fixed_net() -> Net:
+    """`_net` with some nodes held in one or two directions only (rollers), so the pattern's
+    node blocks lose single rows and columns."""
+    net, _ = _net()
+    fixed = np.tile(np.asarray(net.fixed, dtype=bool)[:, None], (1, 3))
+    fixed[5::7, 1] = True
+    fixed[3::11, [0, 2]] = True
+    return Net(net.nodes, fixed, net.elements, net.laws, element_law=net.element_law,
+               cables=net.cables)
+
+
+def test_pattern_structure_equals_scipy_assembly():
+    """The pattern built from the node blocks, against scipy's COO -> CSR of the same slot
+    values: the CSR data, its transpose map, the symmetric part's upper triangle (CSC for
+    qdldl, CSR for PARDISO) and the z columns, on a net with a cable and rollers."""
+    ns = NetSystem(_partly_fixed_net())
+    p = ns.pattern
+    assert 0 < int((ns.net.fixed_dofs.sum(axis=1) % 3 != 0).sum())  # rollers present
+    rng = np.random.default_rng(3)
+    values = rng.normal(size=len(p.keep))
+    rows, cols = _slot_rows_cols(ns)
+    index = np.full(3 * ns.n, -1)
+    index[ns.free] = np.arange(p.size)
+    keep = (index[rows] >= 0) & (index[cols] >= 0)
+    np.testing.assert_array_equal(keep, p.keep)
+    ref = sp.coo_matrix((values[keep], (index[rows[keep]], index[cols[keep]])),
+                        shape=(p.size, p.size)).tocsr()
+    data = p.scatter(values)
+    assert np.abs(p.csr(data).toarray() - ref.toarray()).max() <= KERNEL * np.abs(values).max()
+    np.testing.assert_array_equal(p.rows[p.transpose], p.cols)
+    np.testing.assert_array_equal(p.cols[p.transpose], p.rows)
+    sym = 0.5 * (ref + ref.T)
+    for upper in (p.symmetric_upper(data), p.symmetric_upper_csr(data)):
+        assert np.abs(upper.toarray() - sp.triu(sym).toarray()).max() <= KERNEL * np.abs(
+            values).max()
+    dz = rng.normal(size=(ns.n, 3))
+    z = p.assemble(np.zeros((len(ns.bars.rest), 6)), np.zeros(p.cable_map.shape[1]), dz)
+    follower = np.zeros((ns.n, 3, ns.n, 3))
+    follower[np.arange(ns.n), :, np.arange(ns.n), 2] = dz
+    expect = -follower.reshape(3 * ns.n, 3 * ns.n)[ns.free][:, ns.free]
+    np.testing.assert_array_equal(p.csr(z).toarray(), expect)
+
+
+def _slot_rows_cols(ns: NetSystem) -> tuple[np.ndarray, np.ndarray]:
+    """Dof rows and columns of every slot, in the pattern's slot order, written out plainly:
+    per strand its blocks ii, jj, ij, ji; per cable its segments' blocks and its dense
+    block; each node's diagonal block."""
+    def blocks(a, b):
+        r = 3 * a[:, None, None] + np.arange(3)[None, :, None]
+        c = 3 * b[:, None, None] + np.arange(3)[None, None, :]
+        return np.broadcast_to(r, (len(a), 3, 3)), np.broadcast_to(c, (len(a), 3, 3))
+
+    def pairs(i, j):
+        rc = [blocks(a, b) for a, b in ((i, i), (j, j), (i, j), (j, i))]
+        return np.stack([r for r, _ in rc], 1).ravel(), np.stack([c for _, c in rc], 1).ravel()
+
+    parts = [pairs(ns.bars.i, ns.bars.j)]
+    for c in ns.cables:
+        parts.append(pairs(c.nodes[:-1], c.nodes[1:]))
+        dof = (3 * c.nodes[:, None] + np.arange(3)).ravel()
+        parts.append((np.repeat(dof, len(dof)), np.tile(dof, len(dof))))
+    every = np.arange(ns.n)
+    parts.append(tuple(x.ravel() for x in blocks(every, every)))
+    return tuple(np.concatenate(x) for x in zip(*parts))
+
+
+def test_ray_potential_equals_the_potential_along_the_ray():
+    net, loads = _net()
+    ns = NetSystem(net)
+    ns.loads = loads
+    u, w = _states(ns, 2)
+    f = evaluate(ns, u).f
+    along = ray_potential(ns, u, w, f)
+    for t in (0.0, 1e-3, 0.3, 1.0, 2.5):
+        assert along(t) == pytest.approx(potential(ns, u + t * w, f), rel=KERNEL, abs=KERNEL)
+
+
+def test_membrane_shape_solves_the_damping_system():
+    """D v = b / c on the free dofs (D: the net's Laplacian times I3, scaled in NetSystem to
+    a mean diagonal of 1; c > 0 that scale), per direction with the rollers' own free-node
+    sets."""
+    ns = NetSystem(_partly_fixed_net())
+    b = np.random.default_rng(4).normal(size=ns.pattern.size)
+    Dv = ns.pattern.csr(ns.damping) @ ns.membrane_shape(b)
+    c = float(b @ Dv) / float(Dv @ Dv)
+    assert c > 0
+    assert np.abs(c * Dv - b).max() <= MEMBRANE * np.abs(b).max()
+
+
+def test_membrane_shape_of_a_net_with_a_part_hanging_on_nothing_is_none():
+    """A loose panel beside the net, joined to no anchor: its Laplacian is singular, though a
+    factorization need not meet an exact zero pivot (LDL^T returned a finite shape of 3e11)."""
+    net, _ = _net()
+    n = len(net.nodes)
+    panel, el, _ = square_net(0.37, 0.29, 0.013)  # irregular spacing: no exact cancellation
+    fixed = np.concatenate([np.asarray(net.fixed_dofs), np.zeros((len(panel), 3), bool)])
+    ns = NetSystem(Net(np.vstack([net.nodes, panel + [0.0, 1.0, 0.0]]), fixed,
+                       np.vstack([net.elements, el + n]), LAWS,
+                       element_law=np.concatenate([net.element_law, np.zeros(len(el), int)]),
+                       cables=net.cables))
+    assert ns.membrane_shape(np.ones(ns.pattern.size)) is None
+    assert NetSystem(net).membrane_shape(np.ones(NetSystem(net).pattern.size)) is not None

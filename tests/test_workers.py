@@ -123,3 +123,33 @@ def test_a_helper_started_by_the_fork_server_forks_its_own_workers(monkeypatch):
         spinner.join()
     assert workers.WATCH_THREAD in threads and method == "fork"
     assert theirs == ["fork", "fork"]  # in the helper's workers: no watch, one thread
+
+
+def pid_of(_k: int) -> int:
+    return os.getpid()
+
+
+@pytest.mark.parametrize("serial", ["", "1"])
+def test_shared_pool_runs_every_job_of_the_block_on_its_workers(monkeypatch, serial):
+    """Within `shared_pool`, submitted jobs and those of `run_jobs` run on the same workers
+    (PRINTGEN_SERIAL=1 or one core: here, at once), results in order; the workers are gone
+    after the block."""
+    monkeypatch.setenv("PRINTGEN_SERIAL", serial)
+    with workers.shared_pool(2) as pool:
+        first = pool.submit(pid_of, 0)
+        later = workers.run_jobs([(pid_of, (k,), {}) for k in range(4)])
+        pids = {*workers.collect([first]), *later}
+    if serial or workers.cores() < 2:
+        assert first.done() and pids == {os.getpid()}
+    else:
+        assert os.getpid() not in pids and len(pids) <= 2
+    assert workers.run_jobs([(pid_of, (0,), {})])[0] not in pids - {os.getpid()}
+
+
+def test_preload_is_a_no_op_where_workers_fork(monkeypatch):
+    """Only a fork server imports ahead: under `fork` nothing is started."""
+    started = []
+    monkeypatch.setattr(workers, "start_method", lambda plat=None: "fork")
+    monkeypatch.setattr("multiprocessing.forkserver.ensure_running", lambda: started.append(1))
+    workers.preload(["json"])
+    assert started == []

@@ -48,6 +48,7 @@ class Drawing:
     fn: Callable[..., bytes]
     args: tuple = ()
     kwargs: dict[str, Any] = field(default_factory=dict)
+    cost: float = 1.0  # its drawing time relative to the others': the costliest go first
 
     def job(self) -> tuple:
         """(fn, args, kwargs), as printgen.workers.run_jobs takes it."""
@@ -124,11 +125,9 @@ class Report:
     def draw(self) -> None:
         """Draw the figures not drawn yet, side by side in worker processes when there are
         several and two cores (printgen.workers.run_jobs), and put them in."""
-        from printgen.workers import run_jobs
-
         todo = self.pending()
         if todo:
-            self.fill(run_jobs([d.job() for d in todo]))
+            self.fill(drawn(todo))
 
     def html(self) -> str:
         self.draw()
@@ -136,6 +135,17 @@ class Report:
         return (f"<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
                 f"<title>{html.escape(self.title)}</title><style>{CSS}</style></head>\n"
                 f"<body><h1>{html.escape(self.title)}</h1>\n{self.lead}\n{body}\n</body></html>\n")
+
+
+def drawn(drawings: list[Drawing]) -> list[bytes]:
+    """Each drawing's PNG, side by side in worker processes when there are several and two
+    cores (printgen.workers.run_jobs), the costliest started first (the worker that takes the
+    last one should not start a long one late); in the drawings' order."""
+    from printgen.workers import run_jobs
+
+    order = sorted(range(len(drawings)), key=lambda i: -drawings[i].cost)
+    pngs = run_jobs([drawings[i].job() for i in order])
+    return [pngs[order.index(i)] for i in range(len(drawings))]
 
 
 def _figure_file(png: bytes, caption: str, name: str, also: str) -> FigureFile | None:

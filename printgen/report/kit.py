@@ -142,19 +142,20 @@ def _overlaps(quads: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
 
 def kit_figures(a: Assembly, outline: Polygon, net_tp: Toolpath, cable_tp: Toolpath,
                 cable_name: str) -> list[tuple[str, Drawing, str]]:
-    """(file name, drawing, caption) of the assembly picture and the toolpath previews."""
+    """(file name, drawing, caption) of the assembly picture and the toolpath previews (their
+    Drawing.cost: CPU seconds, bench timeline on the 1:40 example)."""
     return [
-        ("assembly.png", Drawing(assembly_figure, (a, outline)),
+        ("assembly.png", Drawing(assembly_figure, (a, outline), cost=1.3),
          ("How the kit goes together: the net's corner eyelets and both cables' eyelets on "
           "each anchor pin, each cable threaded through the loops of its side.")),
         ("preview-net.png", Drawing(toolpath_preview, (net_tp, "net, lower-left corner"),
-                                    {"window_mm": NET_ZOOM_MM}),
+                                    {"window_mm": NET_ZOOM_MM}, cost=0.8),
          ("Direct net G-code per pass, beads at true width, one colour per path (pale: "
           "reduced flow over crossings and rings).")),
-        ("preview-net-whole.png", Drawing(toolpath_preview, (net_tp, "net, whole")),
+        ("preview-net-whole.png", Drawing(toolpath_preview, (net_tp, "net, whole"), cost=0.8),
          "Direct net G-code per pass, whole net."),
         (f"preview-cable-{cable_name}.png",
          Drawing(toolpath_preview, (cable_tp, f"cable {cable_name}, first eyelet"),
-                 {"window_mm": CABLE_ZOOM_MM}),
+                 {"window_mm": CABLE_ZOOM_MM}, cost=0.8),
          "Direct cable G-code per pass: the strip's beads run into the eyelet ring."),
     ]

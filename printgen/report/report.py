@@ -162,7 +162,8 @@ def _sweep_sections(rep: Report, v: Verification, scale: float, band: Band | Non
                 f"{to_prototype(m.max_cable_tension[-1], FORCE_EXPONENT, scale) / 1e3:.1f}",
                 f"{m.max_cable_tension[-1]:.3g}"]])
     title = "Normalised deformation against relative loading"
-    rep.figure(Drawing(verification_figure, (p, m, scale, title), {"band": band}),
+    # cost: CPU seconds of each drawing (bench timeline, simple barrier 1:40; Drawing.cost)
+    rep.figure(Drawing(verification_figure, (p, m, scale, title), {"band": band}, cost=2.0),
                "Prototype (black) and printed model (orange"
                + ("; shaded: the model's uncertainty band)." if band is not None else ")."),
                "verification")
@@ -189,7 +190,7 @@ def _deformed_section(rep: Report, v: Verification) -> None:
               for who, run in (("prototype", v.prototype), ("model", v.model))
               if SHOWN_LEVEL in run.shapes]
     if len(shapes) == 2:
-        rep.figure(Drawing(deformed_figure, (shapes, SHOWN_LEVEL)),
+        rep.figure(Drawing(deformed_figure, (shapes, SHOWN_LEVEL), cost=1.0),
                    "Both nets deformed at h/h_B = "
                    f"{SHOWN_LEVEL:g}, normalised by their own width (x, deflection) and height "
                    "(z); black: border cables. Model node positions at 0.5, 1.0 and 1.1 are in "

@@ -61,9 +61,23 @@ from printgen.run.steps import (
     verification_sweeps,
     verify_step,
 )
-from printgen.workers import Helper, check_deadline, cores, deadline, helper, signals_deferred
+from printgen.trace import span
+from printgen.workers import (
+    Helper,
+    check_deadline,
+    cores,
+    deadline,
+    helper,
+    preload,
+    signals_deferred,
+    start_method,
+)
 
 log = logging.getLogger(__name__)
+# what the workers' jobs import (the verification's sweeps, the report's figures): a fork
+# server imports them once (printgen.workers.preload); matplotlib's pyplot is imported by the
+# helper while its sweeps run (`verification_sweeps`), not here: the helper would wait for it
+JOB_MODULES = ("printgen.run.steps", "printgen.verification.pooled", "printgen.report.plots")
 
 
 @dataclass(frozen=True)
@@ -103,7 +117,7 @@ class MakeContext:
     files: list[str] = field(default_factory=list)
     progress: Callable[[str], None] | None = None  # a step's finer progress (STEP per part)
     background: dict[str, Future] = field(default_factory=dict)  # jobs running in `helper`
-    helper: Helper | None = None  # the helper process of a short run (`verification_ahead`)
+    helper: Helper | None = None  # the helper process of the run (`verification_ahead`)
     toolpaths: dict[str, Any] = field(default_factory=dict)  # per part, built once per run
     volumes_mm3: dict[str, float] = field(default_factory=dict)  # per part's mesh (parts step)
 
@@ -144,11 +158,13 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     only file that differs between runs).
     """
     t0 = time.perf_counter()
+    warm_up()
     options = options or MakeOptions()
     inputs = [prototype_path, options.design_file, *search_dirs()]
     check_destination(Path(out), force=options.force, inputs=inputs)  # fail fast
-    ctx = plan(prototype_path, scale, printer=printer, options=options)
-    est = size_check(ctx, steps is None or any(s is verify_step for _, s in steps))
+    with span("make: plan and estimate"):
+        ctx = plan(prototype_path, scale, printer=printer, options=options)
+        est = size_check(ctx, steps is None or any(s is verify_step for _, s in steps))
     if progress and est.seconds > LONG_RUN_S:
         progress(f"estimate: {est.summary()}")
     meta: dict[str, Any] = {}
@@ -159,26 +175,22 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     with deadline(None if bound is None else time.time() + bound - (time.perf_counter() - t0)), \
             staged_dir(out, force=ctx.options.force, meta=meta,
                        volatile=(TIMINGS,), inputs=inputs) as stage, level_bars(long_run), \
-            verification_ahead(ctx, steps, long_run is None):
+            verification_ahead(ctx, steps):
         for label, step in steps:
             if progress:
                 progress(label)
             t, cpu = time.perf_counter(), time.process_time()
             try:
-                ctx.record.update(step(ctx, stage))
+                with span(f"step: {label}"):
+                    ctx.record.update(step(ctx, stage))
                 check_deadline(label)
             except TimeLimitError as exc:
                 raise TimeLimitError(time_limit_line(label, exc, est, bound, t0)) from exc
             times = ctx.record.setdefault("timings_s", {})
             times[label] = time.perf_counter() - t
             times.setdefault("cpu_s", {})[label] = time.process_time() - cpu  # this process
-        meta.update(provenance(ctx))
-        provenance_section(ctx.report, meta)
-        for name, data in report_files(ctx.record, ctx.report).items():
-            (stage / name).parent.mkdir(exist_ok=True)
-            (stage / name).write_bytes(data)
-            ctx.files.append(name)
-        (stage / "report.html").write_text(ctx.report.html())
+        with span("make: report files"):
+            write_report(ctx, stage, meta)
         if ctx.options.pdf:
             report_pdf(ctx, stage, progress)
         ctx.record["files"] = sorted([*ctx.files, "report.html", "report.json", "design.json",
@@ -190,6 +202,17 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
         (stage / TIMINGS).write_text(dumps(timings))
     log.info("make finished in %.2f s", time.perf_counter() - t0)
     return ctx
+
+
+def write_report(ctx: MakeContext, stage: Path, meta: dict[str, Any]) -> None:
+    """The provenance section, the report's files (figures, lab files) and report.html."""
+    meta.update(provenance(ctx))
+    provenance_section(ctx.report, meta)
+    for name, data in report_files(ctx.record, ctx.report).items():
+        (stage / name).parent.mkdir(exist_ok=True)
+        (stage / name).write_bytes(data)
+        ctx.files.append(name)
+    (stage / "report.html").write_text(ctx.report.html())
 
 
 def report_pdf(ctx: MakeContext, stage: Path, progress: Callable[[str], None] | None) -> None:
@@ -208,14 +231,13 @@ def report_pdf(ctx: MakeContext, stage: Path, progress: Callable[[str], None] | 
 
 
 @contextlib.contextmanager
-def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]], short: bool
-                       ) -> Iterator[None]:
+def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]]) -> Iterator[None]:
     """Start the verification's sweeps (`verification_sweeps`) in a helper process now, so
     that they run while the parts are built here; `sweeps_done` and `verify_step` collect
-    them. Only for short runs on 2 cores or more: a long run's per-level progress bars come
-    from the sweeps' workers to this process, and on one core there is nothing to gain."""
+    them (a long run's per-level progress comes from the sweeps' workers straight to this
+    process: printgen.workers). Only on 2 cores or more: on one there is nothing to gain."""
     serial = os.environ.get("PRINTGEN_SERIAL") or cores() < 2
-    if serial or not short or not any(s is verify_step for _, s in steps):
+    if serial or not any(s is verify_step for _, s in steps):
         yield
         return
     quiet_tracker()
@@ -231,6 +253,15 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]], short: b
         finally:
             ctx.background.clear()
             ctx.helper = None
+
+
+def warm_up() -> None:
+    """Where workers start by `forkserver`, start the fork server now with the jobs' modules
+    (printgen.workers.preload: it imports them beside the planning and the parts), the
+    resource tracker quietened first (`quiet_tracker`: the fork server starts it)."""
+    if not os.environ.get("PRINTGEN_SERIAL") and cores() > 1 and start_method() == "forkserver":
+        quiet_tracker()
+        preload(JOB_MODULES)
 
 
 TRACKER_WARNING = "ignore:resource_tracker:UserWarning"  # a -W option (sys.warnoptions)

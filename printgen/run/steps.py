@@ -23,7 +23,8 @@ from printgen.errors import TimeLimitError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
 from printgen.report.parts_report import assembly_section, gcode_section, meshes_section
-from printgen.workers import run_jobs, seconds_left
+from printgen.trace import span
+from printgen.workers import seconds_left
 
 HELPER_SWEEPS = "helper: verification sweeps"  # timings_s keys of work done in the helper
 WAIT_SWEEPS = "waiting for the verification sweeps"  # in this process, within a step
@@ -246,7 +247,8 @@ def verify_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     if sweeps is None:
         sweeps = verification_sweeps(ctx.prototype, ctx.design, load=ctx.options.load,
                                      loads=ctx.options.loads)
-    blocks, figures, record = verification_report(*sweeps, ctx.targets.scale)
+    with span("verify: report"):
+        blocks, figures, record = verification_report(*sweeps, ctx.targets.scale)
     ctx.report.blocks.extend(blocks)
     ctx.report.figures.extend(figures)
     draw_figures(ctx)
@@ -273,23 +275,29 @@ def draw_figures(ctx: MakeContext) -> None:
     Their wall time goes to timings_s[FIGURES]."""
     t = time.perf_counter()
     todo = ctx.report.pending()
+    with span("figures"):
+        _draw(ctx, todo)
+    if todo:
+        ctx.record.setdefault("timings_s", {})[FIGURES] = time.perf_counter() - t
+
+
+def _draw(ctx: MakeContext, todo: list[Drawing]) -> None:
     if todo and ctx.helper is not None:
         pngs, _ = _collect(ctx.helper.submit(timed, draw_all, todo), "the report's figures")
         ctx.report.fill(pngs)
     else:
         ctx.report.draw()
-    if todo:
-        ctx.record.setdefault("timings_s", {})[FIGURES] = time.perf_counter() - t
 
 
 def draw_all(drawings: list[Drawing]) -> list[bytes]:
     """Each drawing's PNG (carrying its SVG), side by side in worker processes when there are
     several and two cores (printgen.workers.run_jobs); matplotlib is imported here first, so
     that forked workers start with it."""
+    from printgen.report.html import drawn
     from printgen.report.plots import load_pyplot
 
     load_pyplot()
-    return run_jobs([d.job() for d in drawings])
+    return drawn(drawings)
 
 
 def _collect(pending: Future, what: str) -> Any:
@@ -317,13 +325,14 @@ def verification_sweeps(prototype: Prototype, design: Design, *, load: str | Non
     (README: Pre-print verification); every load level is solved on both. Needs nothing from
     the other steps, so it can run in a worker process while they run.
     """
-    from printgen.verification.bands import model_band, model_load_kw
-    from printgen.verification.verify import free_section, verify, with_cases
+    from printgen.report.plots import load_pyplot
+    from printgen.verification.pooled import verify_with_band
+    from printgen.verification.verify import free_section
 
-    v = with_cases(verify(prototype, design, load=load, counterexample=True), prototype,
-                   design, loads)
-    return v, model_band(design, v.model, load_kw=model_load_kw(prototype, design, load),
-                         free_section=free_section(prototype))
+    # matplotlib is imported while the sweeps run: the figures' workers start with it
+    return verify_with_band(prototype, design, load=load, counterexample=True,
+                            free_section=free_section(prototype), meanwhile=load_pyplot,
+                            loads=tuple(loads))
 
 
 def solver_work(v: Verification, band: Band) -> dict[str, Any]:

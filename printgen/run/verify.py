@@ -33,12 +33,7 @@ from printgen.report.uncertainty import (
     measured_sections,
 )
 from printgen.run.budget import DEFAULT_LIMIT_S, Work, check_budget, sweep_cores
-from printgen.verification.bands import (
-    Band,
-    band_verdicts,
-    model_band,
-    model_load_kw,
-)
+from printgen.verification.bands import Band, band_verdicts, model_load_kw
 from printgen.verification.fit import MultiFit, fit_levels, fit_measured
 from printgen.verification.layout import flume_layout
 from printgen.verification.measured import (
@@ -49,8 +44,13 @@ from printgen.verification.measured import (
     model_predictor,
     read_measured,
 )
+from printgen.verification.pooled import verify_with_band
 from printgen.verification.readings import design_units
-from printgen.verification.verify import Verification, free_section, verify
+from printgen.verification.verify import Verification, free_section
+from printgen.workers import preload
+
+# what the workers' jobs import (the sweeps, the figures): a fork server imports them once
+JOB_MODULES = ("printgen.verification.pooled", "printgen.report.plots")
 
 
 @dataclass
@@ -81,6 +81,7 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     """
     say = progress or (lambda _label: None)
     t0 = time.perf_counter()
+    preload(JOB_MODULES)  # a fork server's imports, while the inputs are read
     inputs = [prototype, design_path, measured, *search_dirs()]
     check_destination(Path(out), force=force, inputs=inputs)  # before any work
     p = load_prototype(prototype)
@@ -90,10 +91,9 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     check_budget(p, d, limit_s=limit, cores=sweep_cores(),
                  work=Work(parts=False, fit=m is not None, model_follows=False))
     load_kw = model_load_kw(p, d, load)
-    say("verification (prototype and model load sweeps)")
-    v = verify(p, d, load=load)
-    say("uncertainty band (model variants)")
-    band = model_band(d, v.model, load_kw=load_kw, free_section=free_section(p))
+    say("verification (prototype and model load sweeps) and its uncertainty band (model "
+        "variants)")
+    v, band = verify_with_band(p, d, load=load, free_section=free_section(p))
     result, text = None, ""
     if m is not None and fit == "multi":
         say(f"multi-parameter fit of the printed net to {Path(measured).name}")

@@ -25,6 +25,8 @@ from __future__ import annotations
 import dataclasses
 import inspect
 import time
+from collections.abc import Callable
+from concurrent.futures import Future
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -38,10 +40,12 @@ from printgen.design.section import area_m2
 from printgen.errors import GeometryError
 from printgen.inputs.materials import load_material
 from printgen.inputs.prototype import Prototype
+from printgen.trace import span
 from printgen.units import MM
 from printgen.verification.compare import METRICS
 from printgen.verification.scenes import BarrierScene, model_scene
-from printgen.verification.verify import Run, load_keywords, run_jobs, sweep
+from printgen.verification.verify import Run, load_keywords, sweep
+from printgen.workers import collect, submit_jobs
 
 SLACK_MAX = 0.01  # initial slack of the printed net, upper end of the range (issue 10: 0-1 %)
 COARSENINGS = (2, 3)  # mesh multipliers tried in turn for the variant sweeps
@@ -209,6 +213,16 @@ def _scaled(law: tuple, factor: float) -> tuple:
     return tuple(knees), tuple(s * factor for s in slopes)
 
 
+def effort(v: Variant, mounting: str | None = None) -> tuple[bool, ...]:
+    """Sort key of variants (`mounting`: the nominal one), the longest sweep first (CPU measured by bench timeline at 1:40:
+    initial slack, a mechanism until its strands tighten, 24 s on the simple barrier and 2.4 s
+    on the 1:40 example; then the net mounted in the flume's free section, 4.0-4.5 s there;
+    another mounting 3.7 s; the virtual panel test's law 3.3-6.4 s; pressure normal to the
+    net 1.6-5.1 s; the rest 0.8-2.8 s)."""
+    return (v.slack == 0, v.span is None, v.mounting == mounting, v.net_law != "derived",
+            v.pressure != "normal")
+
+
 def run_variant(d: Design, v: Variant, lv: np.ndarray, coarsen: int = 1,
                 load_kw: dict | None = None) -> Run:
     """Sweep the model with variant `v` (a worker job: module-level, picklable)."""
@@ -265,16 +279,20 @@ def _nan_reduce(stack: np.ndarray, fn) -> np.ndarray:
 
 def refinement_test(d: Design, nominal: dict[str, np.ndarray], lv: np.ndarray,
                     load_kw: dict | None = None, base: Variant | None = None,
-                    work: list[dict[str, Any]] | None = None) -> tuple[int, dict[int, float]]:
+                    work: list[dict[str, Any]] | None = None,
+                    ahead: dict[int, Future] | None = None) -> tuple[int, dict[int, float]]:
     """Coarsest mesh multiplier whose nominal sweep stays within REFINE_TOL of `nominal` (the
     design's own net) on every metric, and each tried multiplier's largest change. The
     multipliers are tried from the finest: once one fails, coarser ones are not run. `work`
-    gets each sweep's Run.work()."""
+    gets each sweep's Run.work(). `ahead`: multiplier -> the sweep of `base` on it, started
+    before `lv` was known (used when it ran at `lv`, else run again)."""
     best, change = 1, {}
     for k in COARSENINGS:
-        if not _meshable(d, k):
+        if not meshable(d, k):
             break
-        run = run_variant(d, base or Variant(), lv, k, load_kw)
+        run = collect([ahead[k]])[0] if ahead and k in ahead else None
+        if run is None or not np.array_equal(run.deformation.levels, lv):
+            run = run_variant(d, base or Variant(), lv, k, load_kw)
         if work is not None:
             work.append(run.work())
         change[k] = _largest_change(curves(run), nominal)
@@ -284,7 +302,7 @@ def refinement_test(d: Design, nominal: dict[str, np.ndarray], lv: np.ndarray,
     return best, change
 
 
-def _meshable(d: Design, k: int) -> bool:
+def meshable(d: Design, k: int) -> bool:
     try:
         variant_scene(d, Variant(), k)
     except GeometryError:
@@ -304,12 +322,15 @@ def _largest_change(c: dict[str, np.ndarray], ref: dict[str, np.ndarray]) -> flo
 
 def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
                variants: list[Variant] | None = None, notes: list[str] | None = None,
-               free_section: float | None = None) -> Band:
+               free_section: float | None = None, ahead: dict[int, Future] | None = None,
+               then: Callable[[], object] | None = None) -> Band:
     """Sweep every variant of design `d` and collect them around the `nominal` run (the
     model's sweep on the design's own net, as `verify` ran it), at the same levels.
 
-    The variants run on the coarsest net that passes the refinement test; there a variant's
-    curve is the nominal plus the variant's change on the coarse net.
+    The variants run on the coarsest net that passes the refinement test (`ahead`: its
+    sweeps already started, `refinement_test`); there a variant's curve is the nominal plus
+    the variant's change on the coarse net. `then` is called once the variants are started
+    (within printgen.workers.shared_pool: to queue more jobs behind them).
     """
     t0 = time.perf_counter()
     lv = nominal.deformation.levels
@@ -321,17 +342,23 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
                 for v in variants]
     nom = curves(nominal)
     work: list[dict[str, Any]] = []
-    k, change = refinement_test(d, nom, lv, load_kw, Variant(mounting=mounting), work)
-    # longest first (the worker that takes the last job should not start a long one late):
-    # a slack variant is a mechanism until its strands tighten, the slowest sweep by far
-    order = sorted(range(len(variants)), key=lambda i: -variants[i].slack)
+    with span("band: refinement test"):
+        k, change = refinement_test(d, nom, lv, load_kw, Variant(mounting=mounting), work,
+                                    ahead)
+    # longest first (the worker that takes the last job should not start a long one late)
+    order = sorted(range(len(variants)), key=lambda i: effort(variants[i], mounting))
     jobs: list[tuple] = [(run_variant, (d, variants[i], lv, k, load_kw), {}) for i in order]
     if k > 1:
         jobs.append((run_variant, (d, Variant(mounting=mounting), lv, k, load_kw), {}))
-    done = run_jobs(jobs)
-    work += [r.work() for r in done]
-    base = curves(done.pop()) if k > 1 else None
+    started = submit_jobs(jobs)
+    if then is not None:
+        then()
+    done = collect(started)
+    extra = done[len(variants):]  # the nominal on the coarse net, when k > 1
+    base = curves(extra[0]) if extra else None
     runs = [done[order.index(i)] for i in range(len(variants))]
+    recorded = sorted(range(len(variants)), key=lambda i: -variants[i].slack)  # report.json's
+    work += [runs[i].work() for i in recorded] + [r.work() for r in extra]
     out, failed = {}, {}
     for v, r in zip(variants, runs, strict=True):
         c = curves(r)

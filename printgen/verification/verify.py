@@ -10,7 +10,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -43,6 +43,9 @@ from printgen.workers import (  # worker lifecycle: ground floor
     run_jobs,
 )
 from solver.loads import total_forces
+
+if TYPE_CHECKING:  # pragma: no cover
+    from printgen.verification.cases import CaseRuns
 
 LEVEL_STEP = 0.05  # relative loading step of the sweep (issue: at most 0.05)
 PATH_CUTS = 2  # halvings tried before a load level is reported as not converged
@@ -245,7 +248,7 @@ class Verification:
         }
 
 
-def _barriers(p: Prototype, d: Design, load: str | LoadCase | None, mounting: str | None
+def barriers(p: Prototype, d: Design, load: str | LoadCase | None, mounting: str | None
               ) -> tuple[LoadCase, dict[str, Any], dict[str, Any], BarrierScene, BarrierScene]:
     """(the load case, the prototype's and the model's sweep keywords, their scenes), both
     mounted by `mounting` (default: the prototype file's [flume] lateral)."""
@@ -256,31 +259,61 @@ def _barriers(p: Prototype, d: Design, load: str | LoadCase | None, mounting: st
             model_scene(d, mounting=mounting, load=case))
 
 
+@dataclass(frozen=True)
+class VerifyPlan:
+    """What `verify` sweeps: the load case, the prototype's and the model's sweep keywords and
+    scenes, the load levels; `jobs` starts the two sweeps (model first: the longer one),
+    `verified` compares what they gave."""
+
+    case: LoadCase
+    kw_p: dict[str, Any]
+    kw_m: dict[str, Any]
+    ps: BarrierScene
+    ms: BarrierScene
+    lv: np.ndarray
+
+    def jobs(self) -> list[tuple]:
+        """(sweep, args, kwargs) of the model, then of the prototype (run_jobs' form)."""
+        return [(sweep, (self.ms, self.lv), self.kw_m), (sweep, (self.ps, self.lv), self.kw_p)]
+
+    def verified(self, model: Run, proto: Run, ce: CounterExample | None = None
+                 ) -> Verification:
+        """The comparison of the two sweeps, at the levels where both converged."""
+        bad = set(proto.failed) | set(model.failed)
+        if bad:  # compare only where both barriers converged
+            keep = np.array([lvl not in bad for lvl in self.lv])
+            proto = _only(proto, keep)
+            model = _only(model, keep)
+        (proto, model), load_rec = stated(self.case, (proto, model),
+                                          (self.kw_p["site"], self.kw_m["site"]))
+        mm = compare(proto.deformation, model.deformation)
+        start = compare(increments(proto.deformation), increments(model.deformation))
+        return Verification(self.case.title, proto, model, mm, explain(mm), ce, start,
+                            len(self.lv), load_rec)
+
+
+def verify_plan(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
+                lv: np.ndarray | None = None, mounting: str | None = None) -> VerifyPlan:
+    """The sweeps of `verify` (default levels: the usual ones and the case's own)."""
+    case, kw_p, kw_m, ps, ms = barriers(p, d, load, mounting)
+    if lv is None:  # the usual levels and the case's own (the jam's discharge steps)
+        own = case.levels_for(ms, kw_m["site"])
+        lv = levels() if own is None else np.unique(np.concatenate([levels(), own]))
+    return VerifyPlan(case, kw_p, kw_m, ps, ms, np.asarray(lv, dtype=float))
+
+
 def verify(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
            lv: np.ndarray | None = None, counterexample: bool = False,
            mounting: str | None = None) -> Verification:
     """Sweep both barriers under the same relative loading of load case `load` (default
     hydrostatic) and compare them; both are mounted by `mounting` (default: the prototype
     file's [flume] lateral)."""
-    case, kw_p, kw_m, ps, ms = _barriers(p, d, load, mounting)
-    if lv is None:  # the usual levels and the case's own (the jam's discharge steps)
-        own = case.levels_for(ms, kw_m["site"])
-        lv = levels() if own is None else np.unique(np.concatenate([levels(), own]))
-    lv = np.asarray(lv, dtype=float)
-    jobs: list[tuple] = [(sweep, (ms, lv), kw_m), (sweep, (ps, lv), kw_p)]  # longest first
+    plan = verify_plan(p, d, load=load, lv=lv, mounting=mounting)
+    jobs = plan.jobs()  # longest first
     if counterexample:
         jobs.append((steel_counterexample, (d.scale,), {}))
     model, proto, *ce = run_jobs(jobs)
-    bad = set(proto.failed) | set(model.failed)
-    if bad:  # compare only where both barriers converged
-        keep = np.array([lvl not in bad for lvl in lv])
-        proto = _only(proto, keep)
-        model = _only(model, keep)
-    (proto, model), load_rec = stated(case, (proto, model), (kw_p["site"], kw_m["site"]))
-    mm = compare(proto.deformation, model.deformation)
-    start = compare(increments(proto.deformation), increments(model.deformation))
-    return Verification(case.title, proto, model, mm, explain(mm), ce[0] if ce else None,
-                        start, len(lv), load_rec)
+    return plan.verified(model, proto, ce[0] if ce else None)
 
 
 def stated(case: LoadCase, runs: tuple[Run, Run], sites: tuple[Site, Site]
@@ -300,52 +333,6 @@ def stated(case: LoadCase, runs: tuple[Run, Run], sites: tuple[Site, Site]
                 run.scene, assumptions=(*run.scene.assumptions, row)))
         out.append(run)
     return (out[0], out[1]), rec
-
-
-@dataclass(frozen=True)
-class CaseRuns:
-    """One more load case's nominal sweeps (`make --loads`): the prototype and the model at
-    the case's own levels (the usual ones when it has none), and what it used at each."""
-
-    spec: str
-    prototype: Run
-    model: Run
-    load: dict[str, Any]
-
-    def to_record(self) -> dict[str, Any]:
-        return {"spec": self.spec, "load": self.load,
-                "assumptions": [dict(zip(("what", "value", "source"), a, strict=True))
-                                for a in self.model.scene.assumptions
-                                if a[0].startswith("loading")],
-                "model_levels": self.model.deformation.levels,
-                "not_converged": {"prototype": self.prototype.failed,
-                                  "model": self.model.failed}}
-
-
-def case_runs(p: Prototype, d: Design, load: str, mounting: str | None = None) -> CaseRuns:
-    """The nominal prototype and model of load case `load` at its own levels (no band)."""
-    case, kw_p, kw_m, ps, ms = _barriers(p, d, load, mounting)
-    own = case.levels_for(ms, kw_m["site"])
-    lv = levels() if own is None else np.asarray(own, dtype=float)
-    model, proto = run_jobs([(sweep, (ms, lv), kw_m), (sweep, (ps, lv), kw_p)])
-    (proto, model), rec = stated(case, (proto, model), (kw_p["site"], kw_m["site"]))
-    return CaseRuns(case.spec, proto, model, rec)
-
-
-def with_cases(v: Verification, p: Prototype, d: Design, loads: tuple[str, ...] | list[str]
-               ) -> Verification:
-    """`v` with the sweeps of each load case of `loads` (`make --loads`): the verification's
-    own case reuses its runs, every other one sweeps its nominal barriers (`case_runs`)."""
-    if not loads:
-        return v
-    mounting = v.model.scene.mounting
-    out = {}
-    for spec in dict.fromkeys(get_load(x).spec for x in loads):
-        if spec == v.load.get("spec"):
-            out[get_load(spec).name] = CaseRuns(spec, v.prototype, v.model, v.load)
-        else:
-            out[get_load(spec).name] = case_runs(p, d, spec, mounting)
-    return dataclasses.replace(v, by_load=out)
 
 
 def _only(run: Run, keep: np.ndarray) -> Run:

@@ -1,0 +1,71 @@
+"""The verification's sweeps on one set of workers (printgen.workers.shared_pool): `verify`'s
+nominal pair, the band's refinement test and variants (printgen.verification.bands) and the
+steel counter-example, each started as soon as what it needs is known, so that no core waits
+for a pool to finish or for a serial step.
+
+Order of the jobs (the pool takes them first come, first served): the model and the prototype
+(longest first), the band's first refinement sweep (on the net COARSENINGS[0] times coarser,
+at the pair's levels: run again should a level fail on either barrier, since the band keeps
+only the levels both reached), the counter-example; the band's variants (longest first) once
+the pair and the refinement sweep are done; then the nominal pairs of the other load cases of
+`make --loads`, which fill the cores the band's last variants leave idle. The results are
+those of `verify`, `model_band` and `with_cases`, byte for byte: the same sweeps on the same
+nets at the same levels.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from concurrent.futures import Future
+
+from printgen.barrier.loads import LoadCase
+from printgen.design.record import Design
+from printgen.inputs.prototype import Prototype
+from printgen.trace import span
+from printgen.verification.bands import (
+    COARSENINGS,
+    Band,
+    Variant,
+    meshable,
+    model_band,
+    run_variant,
+)
+from printgen.verification.cases import case_plan, other_cases, with_cases
+from printgen.verification.verify import Verification, steel_counterexample, verify_plan
+from printgen.workers import collect, shared_pool
+
+
+def verify_with_band(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
+                     counterexample: bool = False, free_section: float | None = None,
+                     meanwhile: Callable[[], object] | None = None,
+                     loads: tuple[str, ...] = ()) -> tuple[Verification, Band]:
+    """`verify(p, d, load=load, counterexample=...)` and the model's uncertainty band around
+    its model run (`model_band`), on one pool, with the nominal sweeps of each other load
+    case of `loads` (`with_cases`; queued behind the band's variants); `meanwhile` is called
+    here once the first sweeps have started (this process then only waits)."""
+    plan = verify_plan(p, d, load=load)
+    base, first = Variant(mounting=plan.ms.mounting), COARSENINGS[0]
+    cases: dict[str, list[Future]] = {}
+    with shared_pool() as pool:
+
+        def queue_cases() -> None:
+            for spec in other_cases(loads, plan.case.spec):
+                cases[spec] = [pool.submit(fn, *args, **kw) for fn, args, kw
+                               in case_plan(p, d, spec, plan.ms.mounting).jobs()]
+
+        pair = [pool.submit(fn, *args, **kw) for fn, args, kw in plan.jobs()]
+        ahead = ({first: pool.submit(run_variant, d, base, plan.lv, first, plan.kw_m)}
+                 if meshable(d, first) else {})
+        ce = pool.submit(steel_counterexample, d.scale) if counterexample else None
+        if meanwhile is not None:
+            meanwhile()
+        with span("verify: nominal sweeps"):
+            v = plan.verified(*collect(pair))
+        with span("verify: band"):
+            band = model_band(d, v.model, load_kw=plan.kw_m, free_section=free_section,
+                              ahead=ahead, then=queue_cases)
+        if ce is not None:
+            v = dataclasses.replace(v, counterexample=collect([ce])[0])
+        runs = {spec: tuple(collect(f)) for spec, f in cases.items()}
+    return with_cases(v, p, d, loads, runs), band
