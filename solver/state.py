@@ -17,7 +17,7 @@ import scipy.sparse.linalg as spla
 from scipy.sparse import csgraph
 
 from solver.assemble import Bars, bar_energy, nondimensional, strand_laws
-from solver.linsolve import ldl_available
+from solver.linsolve import PARDISO_MIN_DOFS, Pardiso, ldl_available, pardiso_available
 from solver.loads import total_forces
 from solver.model import Net
 from solver.pattern import SYM_PAIRS, Pattern, pair_values
@@ -98,8 +98,9 @@ def _laplacian_solve(n: int, nodes: np.ndarray, edges: tuple, rhs: np.ndarray
                      ) -> np.ndarray | None:
     """X with L X = rhs, L the weighted graph Laplacian (edges: i, j, weight) of the n nodes
     restricted to `nodes` (the others held); None when L is singular (some nodes reach no
-    held one). By qdldl's LDL^T of L's upper triangle when installed (half of SuperLU's
-    time on the 61 x 21 net), else SuperLU."""
+    held one). From PARDISO_MIN_DOFS unknowns (3 per node) by PARDISO's Cholesky when
+    installed, else by qdldl's LDL^T of L's upper triangle when installed (half of
+    SuperLU's time on the 61 x 21 net), else SuperLU."""
     i, j, w = edges
     if not anchored(n, nodes, i, j):
         return None
@@ -111,7 +112,12 @@ def _laplacian_solve(n: int, nodes: np.ndarray, edges: tuple, rhs: np.ndarray
     diag = (np.bincount(i, w, n) + np.bincount(j, w, n))[nodes]
     k = np.arange(len(nodes))
     upper = sp.coo_matrix((np.concatenate([diag, -w[inner]]), (np.concatenate([k, lo]),
-                           np.concatenate([k, hi]))), shape=(len(nodes),) * 2).tocsc()
+                           np.concatenate([k, hi]))), shape=(len(nodes),) * 2)
+    if 3 * len(nodes) >= PARDISO_MIN_DOFS and pardiso_available():
+        x = _pardiso_solve(upper.tocsr(), rhs)
+        if x is not None:
+            return x
+    upper = upper.tocsc()
     try:
         with np.errstate(all="ignore"):
             if ldl_available():
@@ -123,6 +129,20 @@ def _laplacian_solve(n: int, nodes: np.ndarray, edges: tuple, rhs: np.ndarray
             return spla.splu(full).solve(rhs)
     except (RuntimeError, ValueError):  # singular: some nodes reach no anchor through D
         return None
+
+
+def _pardiso_solve(upper: sp.csr_matrix, rhs: np.ndarray) -> np.ndarray | None:
+    """X with L X = rhs by MKL PARDISO's Cholesky of L's upper triangle (CSR), None when it
+    fails. On large nets it beats qdldl's LDL^T (1 thread, CPU: 19k free nodes 0.038 against
+    0.054 s, 76k 0.13 against 0.29 s; a tie at 4.6k)."""
+    solver = Pardiso()
+    try:
+        solver.factor(upper)
+        return np.column_stack([solver.solve(np.ascontiguousarray(c)) for c in rhs.T])
+    except solver.error:
+        return None
+    finally:
+        solver.free()
 
 
 def anchored(n: int, nodes: np.ndarray, i: np.ndarray, j: np.ndarray) -> bool:

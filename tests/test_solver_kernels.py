@@ -12,8 +12,8 @@ import scipy.sparse as sp
 
 from solver import Hydrostatic, Net, SlidingCable, linear, piecewise
 from solver.assemble import internal, strain_energy
-from solver.linsolve import row_sum_norm
-from solver.scenes import square_net
+from solver.linsolve import PARDISO_MIN_DOFS, row_sum_norm
+from solver.scenes import simple_scene, square_net
 from solver.state import NetSystem, evaluate, potential, ray_potential, tangent_values
 
 KERNEL = 1e-14  # relative: the same products and sums, only reassociated (BLAS, bincount)
@@ -185,11 +185,13 @@ def test_ray_potential_equals_the_potential_along_the_ray():
         assert along(t) == pytest.approx(potential(ns, u + t * w, f), rel=KERNEL, abs=KERNEL)
 
 
-def test_membrane_shape_solves_the_damping_system():
+@pytest.mark.parametrize("large", [False, True])
+def test_membrane_shape_solves_the_damping_system(large):
     """D v = b / c on the free dofs (D: the net's Laplacian times I3, scaled in NetSystem to
     a mean diagonal of 1; c > 0 that scale), per direction with the rollers' own free-node
-    sets."""
-    ns = NetSystem(_partly_fixed_net())
+    sets; large: simple-pinned 121 x 41 (14k unknowns, PARDISO's Cholesky when installed)."""
+    ns = NetSystem(simple_scene(refine=2).net if large else _partly_fixed_net())
+    assert (ns.pattern.size >= PARDISO_MIN_DOFS) == large
     b = np.random.default_rng(4).normal(size=ns.pattern.size)
     Dv = ns.pattern.csr(ns.damping) @ ns.membrane_shape(b)
     c = float(b @ Dv) / float(Dv @ Dv)
