@@ -318,16 +318,11 @@ def run_jobs(jobs: list[tuple]) -> list:
 
     On any exception or signal in the parent the workers are killed before it propagates.
     """
-    global _sink
     if _shared is not None:  # within `shared_pool`: its workers
         return collect([_shared.submit(fn, *args, **kw) for fn, args, kw in jobs])
     workers = min(len(jobs), cores())
     if workers < 2 or os.environ.get("PRINTGEN_SERIAL"):
-        previous, _sink = _sink, _listener or _sink  # in a worker: its parent's queue
-        try:
-            return [fn(*args, **kw) for fn, args, kw in (traced_job(*j) for j in jobs)]
-        finally:
-            _sink = previous
+        return [_done(*traced_job(*j)).result() for j in jobs]
     with span(f"pool of {workers} for {len(jobs)} jobs"):
         return _in_pool(jobs, workers)
 
@@ -345,27 +340,50 @@ def submit_jobs(jobs: list[tuple]) -> list[Future]:
 
 
 def _in_pool(jobs: list[tuple], workers: int) -> list:
-    plat = platform()
-    ctx = multiprocessing.get_context(start_method(plat))
-    queue = ctx.SimpleQueue() if _listener else None
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=init_worker,
-                               initargs=(plat, queue or _relay(), _deadline))
+    w = _Workers(workers)
     try:
-        with _watch_is_safe():
-            futures = [pool.submit(fn, *args, **kw)
-                       for fn, args, kw in (traced_job(*j) for j in jobs)]
-        if queue is not None:  # started once the workers are: fork only a one-thread process
-            reader = threading.Thread(target=_drain, args=(queue, _listener), daemon=True)
-            reader.start()
+        futures = [w.submit(fn, *args, **kw) for fn, args, kw in jobs]
         results = [_result(f) for f in futures]
     except BaseException:
-        stop(pool)
+        stop(w.pool)
         raise
-    pool.shutdown(wait=True)
-    if queue is not None:
-        queue.put(None)  # the workers are done: end the helper thread after the last report
-        reader.join(timeout=READER_JOIN_S)
+    w.pool.shutdown(wait=True)
+    w.end_reports()
     return results
+
+
+class _Workers:
+    """`workers` processes started by `init_worker` (they die with this process and leave
+    signals to it), their jobs traced (`printgen.trace`) and their progress passed on to the
+    listener (`reporting`) by a reader thread, or straight to the first process's queue when
+    this process is itself a worker reporting there (`_relay`)."""
+
+    def __init__(self, workers: int) -> None:
+        plat = platform()
+        ctx = multiprocessing.get_context(start_method(plat))
+        self.queue = ctx.SimpleQueue() if _listener else None
+        self.reader: threading.Thread | None = None
+        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
+                                        initializer=init_worker,
+                                        initargs=(plat, self.queue or _relay(), _deadline))
+
+    def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> Future:
+        fn, args, kwargs = traced_job(fn, args, kwargs)
+        with _watch_is_safe():
+            f = self.pool.submit(fn, *args, **kwargs)
+        if self.queue is not None and self.reader is None:
+            # started once the workers are (a forking pool starts them all at its first job):
+            # fork only a one-thread process
+            self.reader = threading.Thread(target=_drain, args=(self.queue, _listener),
+                                           daemon=True)
+            self.reader.start()
+        return f
+
+    def end_reports(self) -> None:
+        """The workers are done: pass on the reports left, then end the reader."""
+        if self.reader is not None:
+            self.queue.put(None)
+            self.reader.join(timeout=READER_JOIN_S)
 
 
 class Pool:
@@ -374,43 +392,26 @@ class Pool:
     PRINTGEN_SERIAL=1, `submit` runs the job at once (its Future is done)."""
 
     def __init__(self, workers: int) -> None:
-        self.pool: ProcessPoolExecutor | None = None
-        self.queue, self.reader = None, None
-        if workers < 2 or os.environ.get("PRINTGEN_SERIAL"):
-            return
-        plat = platform()
-        ctx = multiprocessing.get_context(start_method(plat))
-        self.queue = ctx.SimpleQueue() if _listener else None
-        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
-                                        initializer=init_worker,
-                                        initargs=(plat, self.queue or _relay(), _deadline))
+        serial = workers < 2 or os.environ.get("PRINTGEN_SERIAL")
+        self.workers = None if serial else _Workers(workers)
 
     def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> Future:
-        fn, args, kwargs = traced_job(fn, args, kwargs)
-        if self.pool is None:
-            return _done(fn, args, kwargs)
-        with _watch_is_safe():
-            f = self.pool.submit(fn, *args, **kwargs)
-        if self.queue is not None and self.reader is None:  # once the workers are forked
-            self.reader = threading.Thread(target=_drain, args=(self.queue, _listener),
-                                           daemon=True)
-            self.reader.start()
-        return f
+        if self.workers is None:
+            return _done(*traced_job(fn, args, kwargs))
+        return self.workers.submit(fn, *args, **kwargs)
 
     def close(self) -> None:
-        if self.pool is not None:
-            self.pool.shutdown(wait=True)
-        if self.reader is not None:
-            self.queue.put(None)  # the workers are done: end the reader after the last report
-            self.reader.join(timeout=READER_JOIN_S)
+        if self.workers is not None:
+            self.workers.pool.shutdown(wait=True)
+            self.workers.end_reports()
 
 
 def _done(fn: Callable, args: tuple, kwargs: dict) -> Future:
-    """A Future holding fn(*args, **kwargs), run here (reporting progress as `run_jobs`
-    does when serial; its error raised here, as serial `run_jobs` raises it)."""
+    """A Future holding fn(*args, **kwargs), run here, its progress reported to this
+    process's listener or, in a worker, its parent's queue (its error raised here)."""
     global _sink
     f: Future = Future()
-    previous, _sink = _sink, _listener or _sink
+    previous, _sink = _sink, _listener or _sink  # in a worker: its parent's queue
     try:
         f.set_result(fn(*args, **kwargs))
     finally:
@@ -436,42 +437,25 @@ def shared_pool(workers: int | None = None) -> Iterator[Pool]:
         with span("shared pool"):
             yield pool
     except BaseException:
-        if pool.pool is not None:
-            stop(pool.pool)
+        if pool.workers is not None:
+            stop(pool.workers.pool)
         raise
     finally:
         _shared = previous
     pool.close()
 
 
-class Helper:
+class Helper(_Workers):
     """One worker process that runs the jobs submitted to it in order (see `helper`)."""
 
     def __init__(self) -> None:
-        plat = platform()
-        ctx = multiprocessing.get_context(start_method(plat))
-        self.queue = ctx.SimpleQueue() if _listener else None  # its workers' progress too
-        self.reader: threading.Thread | None = None
-        self.pool = ProcessPoolExecutor(max_workers=1, mp_context=ctx, initializer=init_worker,
-                                        initargs=(plat, self.queue or _relay(), _deadline))
+        super().__init__(1)
         self.futures: list[Future] = []
 
     def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> Future:
         """Start `fn(*args, **kwargs)` there; `.result()` collects it (or raises its error)."""
-        fn, args, kwargs = traced_job(fn, args, kwargs)
-        with _watch_is_safe():
-            self.futures.append(self.pool.submit(fn, *args, **kwargs))
-        if self.queue is not None and self.reader is None:  # once the worker is forked
-            self.reader = threading.Thread(target=_drain, args=(self.queue, _listener),
-                                           daemon=True)
-            self.reader.start()
+        self.futures.append(super().submit(fn, *args, **kwargs))
         return self.futures[-1]
-
-    def end_reports(self) -> None:
-        """The worker is gone: pass on the reports left, then end the reader."""
-        if self.reader is not None:
-            self.queue.put(None)
-            self.reader.join(timeout=READER_JOIN_S)
 
 
 @contextlib.contextmanager
