@@ -172,9 +172,9 @@ def _active_set_step(ns: NetSystem, st: State, stepper: Stepper, boost: float, f
         active = slack & stepper.active
     fact = step = rhs = None
     new = active
+    geometric = force if stepper.predicted is None else stepper.predicted
     for _ in range(PDAS_PASSES + 1):
         tan = np.where(active, ns.first_slope, tangent)
-        geometric = force if stepper.predicted is None else stepper.predicted
         at = dataclasses.replace(st, bar=(eps, geometric, tan, d, l))
         if fact is None or stepper.backend not in REPASS_BY_GMRES:
             trial = stepper.newton(at, boost)
@@ -198,16 +198,16 @@ def _active_set_step(ns: NetSystem, st: State, stepper: Stepper, boost: float, f
     return fact, step, rhs
 
 
-def _predicted_tensions(ns: NetSystem, st: State, active: np.ndarray | None, step: np.ndarray,
+def _predicted_tensions(ns: NetSystem, st: State, pulls: np.ndarray, step: np.ndarray,
                         alpha: float, last: np.ndarray | None) -> np.ndarray:
     """The strand tensions the step's own model predicts at its end (mixed integration
     point Newton, Magisano, Leonetti & Garcea 2017): the last prediction moved by alpha
-    towards the linearised law's tension at the full step, floored at zero (tension only)."""
+    towards the linearised law's tension at the full step, floored at zero (tension only);
+    `pulls`: the slack strands the step stretches (`Stepper.active`)."""
     eps, force, tangent, d, l = st.bar
     b = ns.bars
     du = _moved(ns, np.zeros_like(st.u), step)
     de = np.einsum("ij,ij->i", d / l[:, None], du[b.j] - du[b.i]) / b.rest
-    pulls = (force <= 0) & (active if active is not None else False)
     model = np.where(force > 0, force + tangent * de, np.where(pulls, ns.first_slope * (eps + de),
                                                                0.0))
     base = force if last is None else last

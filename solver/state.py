@@ -251,18 +251,10 @@ def evaluate(ns: NetSystem, u: np.ndarray) -> State:
                  energy, f, dz, (eps, force, tangent, d, l), cab)
 
 
-def potential(ns: NetSystem, u: np.ndarray, f_frozen: np.ndarray) -> float:
-    """Strain energy minus the work of frozen loads, without forces (for scalar searches)."""
-    energy = bar_energy(ns.bars, _strains(ns.bars, u)[0])
-    cs = ns.cable_set
-    if cs.count:
-        energy += float((cs.rest * cs.laws_at(cs.strains(u)[0])[2]).sum())
-    return energy - float((f_frozen * u).sum())
-
-
 def ray_potential(ns: NetSystem, u: np.ndarray, w: np.ndarray, f_frozen: np.ndarray
                   ) -> Callable[[float], float]:
-    """`potential` at u + t w as a function of t, for scalar searches along one direction:
+    """The total potential (strain energy minus the work of the frozen loads f_frozen) at
+    u + t w as a function of t, for scalar searches along one direction:
     each strand's squared length and stretch are quadratics in t whose coefficients are
     computed once, so a value costs a few operations per strand, not a pass over (m, 3)
     arrays (the same numbers to round-off)."""
