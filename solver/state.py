@@ -191,8 +191,7 @@ class CableSet:
         evaluation per distinct law)."""
         t, kt, e = np.zeros(self.count), np.zeros(self.count), np.zeros(self.count)
         for law, sel in self.groups:
-            t[sel], kt[sel] = law.force_and_tangent(eps[sel])
-            e[sel] = law.energy(eps[sel])
+            t[sel], kt[sel], e[sel] = law.evaluate(eps[sel])
         return t, kt, e
 
 
