@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from printgen.barrier.loads import DEFAULT as DEFAULT_LOAD
-from printgen.barrier.loads import get_load
+from printgen.barrier.loads import distinct_specs, get_load
 from printgen.design.design_file import load_design
 from printgen.design.plan import make_design
 from printgen.design.record import Design
@@ -298,7 +298,7 @@ def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
 def swept_cases(options: MakeOptions) -> int:
     """Load cases the verification sweeps: its own and each other one of --loads."""
     own = get_load(options.load).spec
-    return 1 + len({get_load(x).spec for x in options.loads} - {own})
+    return 1 + sum(spec != own for spec in distinct_specs(options.loads))
 
 
 def run_bound(options: MakeOptions) -> float | None:

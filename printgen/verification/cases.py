@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from printgen.barrier.loads import get_load
+from printgen.barrier.loads import distinct_specs, get_load
 from printgen.design.record import Design
 from printgen.inputs.prototype import Prototype
 from printgen.verification.verify import (
@@ -67,7 +67,7 @@ def case_runs(p: Prototype, d: Design, load: str, mounting: str | None = None,
 
 def other_cases(loads: tuple[str, ...] | list[str], own: str) -> list[str]:
     """The specs of `loads` (`make --loads`) but `own`, the verification's, once each."""
-    return [s for s in dict.fromkeys(get_load(x).spec for x in loads) if s != own]
+    return [s for s in distinct_specs(loads) if s != own]
 
 
 def with_cases(v: Verification, p: Prototype, d: Design, loads: tuple[str, ...] | list[str],
@@ -79,7 +79,7 @@ def with_cases(v: Verification, p: Prototype, d: Design, loads: tuple[str, ...] 
         return v
     mounting = v.model.scene.mounting
     out = {}
-    for spec in dict.fromkeys(get_load(x).spec for x in loads):
+    for spec in distinct_specs(loads):
         if spec == v.load.get("spec"):
             out[get_load(spec).name] = CaseRuns(spec, v.prototype, v.model, v.load)
         else:

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any
 
@@ -130,6 +130,11 @@ def get_load(name: str | LoadCase | None = None) -> LoadCase:
                          "printgen/barrier/loads/<name>.py or use a known one (--load)")
     values = parse_values(found, given)
     return dataclasses.replace(found, values=values) if values else found
+
+
+def distinct_specs(loads: Iterable[str | LoadCase]) -> list[str]:
+    """The full specs of `loads` (`make --loads`), once each, in their order."""
+    return list(dict.fromkeys(get_load(x).spec for x in loads))
 
 
 def parse_values(case: LoadCase, given: str) -> tuple[tuple[str, float], ...]:
