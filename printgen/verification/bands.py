@@ -216,10 +216,9 @@ def _scaled(law: tuple, factor: float) -> tuple:
 def effort(v: Variant, mounting: str | None = None) -> tuple[bool, ...]:
     """Sort key of variants (`mounting`: the nominal one), the longest sweep first (CPU
     measured by bench timeline at 1:40: initial slack, a mechanism until its strands tighten,
-    24 s on the simple barrier and 2.4 s
-    on the 1:40 example; then the net mounted in the flume's free section, 4.0-4.5 s there;
-    another mounting 3.7 s; the virtual panel test's law 3.3-6.4 s; pressure normal to the
-    net 1.6-5.1 s; the rest 0.8-2.8 s)."""
+    24 s on the simple barrier and 2.4 s on the 1:40 example; then the net mounted in the
+    flume's free section, 4.0-4.5 s there; another mounting 3.7 s; the virtual panel test's
+    law 3.3-6.4 s; pressure normal to the net 1.6-5.1 s; the rest 0.8-2.8 s)."""
     return (v.slack == 0, v.span is None, v.mounting == mounting, v.net_law != "derived",
             v.pressure != "normal")
 
