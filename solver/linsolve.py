@@ -131,6 +131,7 @@ class Pardiso:
         self.S: sp.csr_matrix | None = None  # the factorized matrix (MKL may read it at solves)
         self.ia: np.ndarray | None = None  # S.indptr + 1 as int32
         self.ja: np.ndarray | None = None  # S.indices + 1 as int32
+        self.source: tuple | None = None  # the (indptr, indices) arrays they were made from
         self.cpu = dict.fromkeys(PHASES.values(), 0.0)  # CPU seconds (process_time) by phase
         self.calls = dict.fromkeys(PHASES.values(), 0)
 
@@ -147,6 +148,9 @@ class Pardiso:
         """The 1-based int32 index arrays of S, kept while the pattern stays the same (a new
         pattern is analysed afresh)."""
         ia, ja = self.ia, self.ja
+        if self.source is not None and self.source[0] is S.indptr and self.source[1] is S.indices:
+            return  # the very arrays of the last call (the pattern's, shared by every step)
+        self.source = (S.indptr, S.indices)
         if (ia is not None and ja is not None and len(ia) == len(S.indptr)
                 and len(ja) == len(S.indices) and np.array_equal(ia - 1, S.indptr)
                 and np.array_equal(ja - 1, S.indices)):
