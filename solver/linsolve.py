@@ -8,7 +8,10 @@ lazily (the `fast` extra), in the order `choose_backend` prefers them:
   supernodal Cholesky (LDL^T once S proves indefinite) of the symmetric part
   S = (A + A^T) / 2; its fill-reducing analysis runs once per net, every later step only
   refactorizes numerically;
-- "ldl" (`qdldl`): a sparse LDL^T of S, ordering computed once per net;
+- "ldl" (`qdldl`): a sparse LDL^T of S, ordering computed once per net; on a net that is
+  factorized more than LDL_TO_PARDISO times (a load path) and has LDL_PARDISO_MIN_DOFS
+  unknowns or more, the later factorizations are PARDISO's when it is installed (one thread;
+  about half of qdldl's numeric factorization, an analysis costing about two of qdldl's);
 - "lu": scipy's SuperLU on A (always there; also the reference path's solver).
 
 With "pardiso" and "ldl", GMRES on A preconditioned by S^-1 takes care of the follower term
@@ -51,6 +54,16 @@ PARDISO_IPARM = {1: 1, 2: 0, 8: 0, 10: 13, 11: 0, 13: 0, 21: 1}  # MKL's iparm (
 # 21.5 s. Measured at 57k and not chosen: parallel METIS (3) and two-level factorization
 # (iparm 24) no faster on 1 thread, VBSR (37) 1.5x slower, MKL's low-rank update (39) no
 # faster for mtype 2, single precision (28) a 20 % faster factor but 5 digits (2 more solves)
+
+LDL_TO_PARDISO = 8  # a small net's first 8 factorizations are qdldl's, the later PARDISO's:
+# a single solve (61 x 21: 5 factorizations) keeps qdldl and loads no MKL, a load path (23
+# levels, 190-800 factorizations) pays PARDISO's import (0.45 s CPU once per process) and
+# analysis. CPU per factorization, 1 thread, qdldl / PARDISO: simple barrier's model net at
+# 1:40 (3540 unknowns) 3.2-5.7 / 1.9-3.0 ms, first 6-9 / 6-8 ms; 1:40 example's (1023)
+# 1.3-1.7 / 0.7-0.9 ms; triangular solves 0.23-0.38 / 0.19-0.38 ms
+LDL_PARDISO_MIN_DOFS = 500  # below, a factorization costs too little for the switch to pay
+LDL_PARDISO_THREADS = 1  # MKL threads of those factorizations and solves: on 3540 unknowns
+# MKL's default (one per core, 2 here) took 24-75 ms of CPU per factorization, not 2-3
 
 PHASES = {11: "analysis", 22: "factorization", 33: "solve"}  # MKL's phases, as Pardiso counts
 
@@ -107,16 +120,18 @@ class Pardiso:
     every factorization and solve: 2.5 ms a call at 57k unknowns, ~30 calls a solve).
     """
 
-    def __init__(self) -> None:
+    def __init__(self, threads: int | None = None) -> None:
         _mkl_hint()
         import pypardiso
 
         self.error = pypardiso.pardiso_wrapper.PyPardisoError
+        self.threads = threads  # MKL threads of this instance's calls (None: MKL's setting)
         self.solver = self._solver(2)
         self.analysed = False
         self.S: sp.csr_matrix | None = None  # the factorized matrix (MKL may read it at solves)
         self.ia: np.ndarray | None = None  # S.indptr + 1 as int32
         self.ja: np.ndarray | None = None  # S.indices + 1 as int32
+        self.source: tuple | None = None  # the (indptr, indices) arrays they were made from
         self.cpu = dict.fromkeys(PHASES.values(), 0.0)  # CPU seconds (process_time) by phase
         self.calls = dict.fromkeys(PHASES.values(), 0)
 
@@ -133,6 +148,9 @@ class Pardiso:
         """The 1-based int32 index arrays of S, kept while the pattern stays the same (a new
         pattern is analysed afresh)."""
         ia, ja = self.ia, self.ja
+        if self.source is not None and self.source[0] is S.indptr and self.source[1] is S.indices:
+            return  # the very arrays of the last call (the pattern's, shared by every step)
+        self.source = (S.indptr, S.indices)
         if (ia is not None and ja is not None and len(ia) == len(S.indptr)
                 and len(ja) == len(S.indices) and np.array_equal(ia - 1, S.indptr)
                 and np.array_equal(ja - 1, S.indices)):
@@ -151,6 +169,8 @@ class Pardiso:
         error = ctypes.c_int32(0)
         t0 = time.process_time()
         i32 = ctypes.POINTER(ctypes.c_int32)
+        local = solver.libmkl.MKL_Set_Num_Threads_Local
+        previous = local(self.threads) if self.threads is not None else None
         solver._mkl_pardiso(
             solver.pt.ctypes.data_as(ctypes.POINTER(solver._pt_type[0])),
             ctypes.byref(ctypes.c_int32(1)), ctypes.byref(ctypes.c_int32(1)),  # maxfct, mnum
@@ -161,6 +181,8 @@ class Pardiso:
             solver.iparm.ctypes.data_as(i32), ctypes.byref(ctypes.c_int32(0)),  # msglvl
             rhs.ctypes.data_as(ctypes.c_void_p), x.ctypes.data_as(ctypes.c_void_p),
             ctypes.byref(error))
+        if previous is not None:
+            local(previous)  # this thread's setting as it was (0: MKL's global one)
         name = PHASES.get(phase)
         if name is not None:
             self.cpu[name] += time.process_time() - t0
@@ -204,17 +226,49 @@ class Pardiso:
             self.free()
 
 
+class Ldl:
+    """The "ldl" backend's object of one net: LDL^T factorizations of S, qdldl's (its AMD
+    ordering computed once, later factorizations numeric only) and, once the net has been
+    factorized LDL_TO_PARDISO times and has LDL_PARDISO_MIN_DOFS unknowns or more, PARDISO's
+    on LDL_PARDISO_THREADS threads when it is installed (its analysis once, then numeric
+    factorizations at about half of qdldl's cost). `solve` is the latest factorization's."""
+
+    def __init__(self) -> None:
+        self.count = 0  # factorizations so far
+        self.qdldl: Any = None
+        self.pardiso: Pardiso | None = None
+        self.solve: Callable[[np.ndarray], np.ndarray] | None = None
+
+    def factor(self, pattern: Pattern, data: np.ndarray) -> None:
+        self.count += 1
+        if (self.pardiso is None and self.count > LDL_TO_PARDISO
+                and pattern.size >= LDL_PARDISO_MIN_DOFS and pardiso_available()):
+            self.pardiso, self.qdldl = Pardiso(threads=LDL_PARDISO_THREADS), None
+        if self.pardiso is not None:
+            self.pardiso.factor(pattern.symmetric_upper_csr(data))
+            self.solve = self.pardiso.solve
+            return
+        upper = pattern.symmetric_upper(data)
+        if self.qdldl is None:
+            import qdldl
+
+            self.qdldl = qdldl.Solver(upper, upper=True)
+        else:
+            self.qdldl.update(upper, upper=True)
+        self.solve = self.qdldl.solve
+
+
 class Factorization:
     """One factorization of A = J + mu D; `solve` returns None when A is singular.
 
     backend "pardiso", "ldl" or "lu" (see the module docstring); `handle`: the backend's
-    object from an earlier factorization of the same net (a qdldl solver, a Pardiso), reused
-    so the ordering is not computed again.
+    object from an earlier factorization of the same net (an Ldl, a Pardiso), reused so the
+    ordering is not computed again.
     """
 
     def __init__(self, pattern: Pattern, data: np.ndarray, backend: str, handle=None) -> None:
         self.pattern, self.A, self.backend = pattern, pattern.csr(data), backend
-        self.handle: Any = None  # the backend's object (qdldl.Solver, Pardiso)
+        self.handle: Any = None  # the backend's object (Ldl, Pardiso)
         self.direct: Callable[[np.ndarray], np.ndarray] | None = None  # its solve
         self.symmetric = False
         self.lu: Any = None  # scipy's SuperLU, when it is needed
@@ -233,14 +287,9 @@ class Factorization:
         if self.direct is None:
             self._factor_lu()
 
-    def _factor_ldl(self, data: np.ndarray, handle) -> None:
-        upper = self.pattern.symmetric_upper(data)
-        if handle is None:
-            import qdldl
-
-            handle = qdldl.Solver(upper, upper=True)
-        else:
-            handle.update(upper, upper=True)
+    def _factor_ldl(self, data: np.ndarray, handle: Ldl | None) -> None:
+        handle = handle if handle is not None else Ldl()
+        handle.factor(self.pattern, data)
         self.handle, self.direct, self.symmetric = handle, handle.solve, True
 
     def _factor_lu(self) -> None:

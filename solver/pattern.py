@@ -119,6 +119,12 @@ class Pattern:
                       index, fmask)
         self._triangles()
         self._maps(len(bar_i), len(self.keep), inverse[-n:], offset, rank, index)
+        # the index arrays of the matrices built at every step, in scipy's own index type:
+        # given int64, scipy checks their range and converts them at every construction (61 x
+        # 21 net: 60 against 17 us a CSR matrix, ~20 matrices a solve)
+        self._csr_index = (_index(self.cols), _index(self.indptr))
+        self._upper_index = (_index(self.upper_indices), _index(self.upper_indptr))
+        self._upper_csr_index = (_index(self.upper_cols), _index(self.upper_rows_indptr))
 
     def _entries(self, node_keys: np.ndarray, n: int, width: np.ndarray, offset: np.ndarray,
                  row_start: np.ndarray, row_len: np.ndarray, rank: np.ndarray,
@@ -201,16 +207,20 @@ class Pattern:
         return np.bincount(self.slot, weights=values[self.keep], minlength=self.nnz)
 
     def csr(self, data: np.ndarray) -> sp.csr_matrix:
-        return sp.csr_matrix((data, self.cols, self.indptr), shape=(self.size, self.size))
+        return sp.csr_matrix((data, *self._csr_index), shape=(self.size, self.size))
 
     def symmetric_upper(self, data: np.ndarray) -> sp.csc_matrix:
         """Upper triangle (CSC) of the symmetric part (A + A^T) / 2 of the matrix `data`."""
         sym = 0.5 * (data[self.upper] + data[self.upper_transpose])
-        return sp.csc_matrix((sym, self.upper_indices, self.upper_indptr),
-                             shape=(self.size, self.size))
+        return sp.csc_matrix((sym, *self._upper_index), shape=(self.size, self.size))
 
     def symmetric_upper_csr(self, data: np.ndarray) -> sp.csr_matrix:
         """The same upper triangle in CSR (what MKL PARDISO reads for a symmetric matrix)."""
         sym = 0.5 * (data[self.upper_rows] + data[self.upper_mirror])
-        return sp.csr_matrix((sym, self.upper_cols,
-                              self.upper_rows_indptr), shape=(self.size, self.size))
+        return sp.csr_matrix((sym, *self._upper_csr_index), shape=(self.size, self.size))
+
+
+def _index(a: np.ndarray) -> np.ndarray:
+    """`a` as scipy's index type for it: int32 when its values fit, else int64."""
+    small = a.size == 0 or int(a.max()) < np.iinfo(np.int32).max
+    return a.astype(np.int32 if small else np.int64)

@@ -191,6 +191,35 @@ def test_a_failing_pardiso_falls_back_to_superlu(monkeypatch):
     assert fast.converged and _agree(fast.displacements, ref.displacements) < AGREE
 
 
+@needs_pardiso
+@pytest.mark.skipif(not ldl_available(), reason="qdldl not installed")
+def test_ldl_turns_to_pardiso_on_a_net_factorized_often():
+    """The "ldl" backend's object of a net: qdldl for its first LDL_TO_PARDISO
+    factorizations, PARDISO (on LDL_PARDISO_THREADS threads) for the later ones; both solve
+    the same system (the follower term by GMRES), and a single solve of the 61 x 21 net
+    stays on qdldl (no MKL for it)."""
+    from solver import linsolve
+
+    sc = simple_scene(current_z=True)
+    ns, data = _tangent(sc.net, sc.loads_at(1.0))
+    assert ns.pattern.size >= linsolve.LDL_PARDISO_MIN_DOFS
+    A = ns.pattern.csr(data)
+    b = np.random.default_rng(5).normal(size=ns.pattern.size)
+    handle, kinds = None, []
+    for _ in range(linsolve.LDL_TO_PARDISO + 2):
+        fact = Factorization(ns.pattern, data, "ldl", handle)
+        handle = fact.handle
+        kinds.append("pardiso" if handle.pardiso is not None else "qdldl")
+        x = fact.solve(b)
+        assert np.linalg.norm(A @ x - b) <= LINEAR * np.linalg.norm(b)
+    assert kinds == ["qdldl"] * linsolve.LDL_TO_PARDISO + ["pardiso"] * 2
+    assert handle.pardiso.threads == linsolve.LDL_PARDISO_THREADS
+    single = FastSolver(sc.net)
+    single.solve(sc.loads_at(1.0), [], 1e-6, 400)
+    assert 0 < single.stepper.factorizations <= linsolve.LDL_TO_PARDISO
+    assert single.stepper.handle.pardiso is None
+
+
 def test_backend_by_size():
     expect_small = "ldl" if ldl_available() else "lu"
     assert choose_backend(PARDISO_MIN_DOFS - 1) == expect_small
