@@ -261,23 +261,32 @@ def _line_search(ns: NetSystem, st: State, step: np.ndarray, reference: float | 
     """(state, step length alpha) from backtracking as in `solver.newton._line_search`, but
     non-monotone: the Armijo test is against `reference`, the highest potential of the last
     NONMONOTONE states (Grippo et al. 1986), so a full Newton step may raise the potential a
-    little while strands settle slack or taut; the window still forces a decrease. The trial
-    potentials come from `ray_potential` (loads frozen at `st`, as before: the same numbers
-    to round-off, a few operations per strand each); only the accepted step is evaluated."""
+    little while strands settle slack or taut; the window still forces a decrease. The first
+    trial is evaluated whole (most steps end there); the shorter ones take their potentials
+    from `ray_potential` (loads frozen at `st`, as before: the same numbers to round-off, a
+    few operations per strand each) and only the accepted one is evaluated."""
     alpha = min(1.0, MAX_STEP / max(float(np.abs(step).max()), 1e-300))
     slope = float(st.r @ step)
     if slope >= 0:
         return None
     pi0 = st.potential(st.f)
-    along = ray_potential(ns, st.u, _moved(ns, np.zeros_like(st.u), step), st.f)
+    highest = max(pi0, reference if reference is not None else pi0)
+    along = None
     for _ in range(MAX_BACKTRACK):
-        pi = along(alpha)
-        if pi <= max(pi0, reference if reference is not None else pi0) + ARMIJO * alpha * slope:
-            return evaluate(ns, _moved(ns, st.u, alpha * step)), alpha
-        if abs(alpha * slope) < POTENTIAL_ROUND_OFF * max(abs(pi0), abs(pi), 1e-300):
+        trial = None
+        if along is None:
             trial = evaluate(ns, _moved(ns, st.u, alpha * step))
+            pi = trial.potential(st.f)
+        else:
+            pi = along(alpha)
+        if pi <= highest + ARMIJO * alpha * slope:
+            return trial or evaluate(ns, _moved(ns, st.u, alpha * step)), alpha
+        if abs(alpha * slope) < POTENTIAL_ROUND_OFF * max(abs(pi0), abs(pi), 1e-300):
+            trial = trial or evaluate(ns, _moved(ns, st.u, alpha * step))
             if trial.r_norm < st.r_norm:
                 return trial, alpha
+        if along is None:
+            along = ray_potential(ns, st.u, _moved(ns, np.zeros_like(st.u), step), st.f)
         alpha *= 0.5
     return None
 
