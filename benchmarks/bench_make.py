@@ -73,9 +73,10 @@ def predicted_cpu(example: Path) -> float:
     """The estimate's CPU of the verification's sweeps on one core (printgen.run.budget)."""
     from printgen.run.budget import sweeps
     from printgen.run.make import plan
+    from printgen.run.speed import speed_factor
 
     ctx = plan(example, SCALE)
-    return sum(s.seconds for s in sweeps(ctx.prototype, ctx.design))
+    return speed_factor() * sum(s.seconds for s in sweeps(ctx.prototype, ctx.design))
 
 
 def fitted_constants(runs: list[dict]) -> dict:

@@ -131,12 +131,14 @@ class Estimate:
     sweeps: tuple[SweepWork, ...] = ()
     verification_s: float = 0.0
     parts_s: float = 0.0
+    speed: float = 1.0  # this machine's time over the reference machine's (printgen.run.speed)
 
     def summary(self) -> str:
         nets = ", ".join(f"{n.name} {n.nodes:,} nodes / {n.unknowns:,} unknowns"
                          for n in self.nets) or "no solver sweep"
         return (f"{nets}; {self.mesh_segments:,} model strand segments; about "
-                f"{self.seconds:.0f} s and {self.memory_b / 1e9:.1f} GB on {self.cores} cores")
+                f"{self.seconds:.0f} s and {self.memory_b / 1e9:.1f} GB on {self.cores} cores "
+                f"(this machine takes {self.speed:.2g} x the reference machine's time)")
 
     def to_record(self) -> dict:
         return {"nets": {n.name: {"nodes": n.nodes, "unknowns": n.unknowns} for n in self.nets},
@@ -256,11 +258,14 @@ def _shared(jobs: list[float], cores: int) -> float:
 
 def estimate(p: Prototype, d: Design, *, cores: int, sweep: bool = True,
              proto_factor: float = 1.0, model_factor: float = 1.0,
-             work: Work | None = None, variants: int | None = None) -> Estimate:
+             work: Work | None = None, variants: int | None = None,
+             speed: float = 1.0) -> Estimate:
     """The run's size (`sweep`: the verification runs; `work`: what else, default make's);
     the factors coarsen the prototype's or the model's meshes; `variants`: as `sweeps`. On 2
     cores make runs its verification in a helper process beside the parts' steps: its wall
-    time is then the longer of the two, or their CPU shared out on the cores when more."""
+    time is then the longer of the two, or their CPU shared out on the cores when more.
+    `speed`: this machine's time over the reference machine's (`speed.speed_factor`); every
+    time of the estimate is the reference machine's times it (the solver work is not)."""
     work = work or Work(sweep=sweep)
     m_nodes = model_nodes(d, model_factor)
     nets: tuple[NetSize, ...] = ()
@@ -279,22 +284,30 @@ def estimate(p: Prototype, d: Design, *, cores: int, sweep: bool = True,
     if work.parts and work.sweep and cores > 1:  # the verification in make's helper
         seconds = max(verify, parts, (verify_cpu + parts) / min(cores, 2))
     memory = BASE_MEMORY_B + sum(n.memory_b for n in nets)
-    return Estimate(nets, segments, seconds, memory, cores, run, verify, parts)
+    return Estimate(nets, segments, speed * seconds, memory, cores, run, speed * verify,
+                    speed * parts, speed)
 
 
 def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
-                 sweep: bool = True, work: Work | None = None) -> Estimate:
+                 sweep: bool = True, work: Work | None = None,
+                 speed: float | None = None) -> Estimate:
     """Return the estimate; raise InputError with the estimate, the limit, the option that
     raises it and the least coarsening of the meshes that fits, when it is over the limit.
-    `work`: what the command runs (default make's, with the verification when `sweep`)."""
+    `work`: what the command runs (default make's, with the verification when `sweep`);
+    `speed`: as `estimate` (None: this machine's, measured once per process)."""
     if not (math.isfinite(limit_s) and limit_s > 0):
         raise InputError(f"--time-limit {limit_s:g} s must be a positive number of seconds")
     work = work or Work(sweep=sweep)
+    if speed is None:
+        from printgen.run.speed import speed_factor
+
+        speed = speed_factor()
     variants = band_variants(p, d) if work.sweep else 0  # read once: the profiles' files
-    est = estimate(p, d, cores=cores, work=work, variants=variants)
+    est = estimate(p, d, cores=cores, work=work, variants=variants, speed=speed)
     if est.seconds <= limit_s:
         return est
-    fix = coarsest_fix(p, d, limit_s=limit_s, cores=cores, work=work, variants=variants)
+    fix = coarsest_fix(p, d, limit_s=limit_s, cores=cores, work=work, variants=variants,
+                       speed=speed)
     which = ("the default, about a minute of make on 2 cores" if limit_s == DEFAULT_LIMIT_S
              else "from --time-limit")
     raise InputError(f"this run is too big: {est.summary()}; the limit is {limit_s:g} s "
@@ -303,9 +316,9 @@ def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
 
 
 def coarsest_fix(p: Prototype, d: Design, *, limit_s: float, cores: int,
-                 work: Work = MAKE, variants: int | None = None) -> str:
+                 work: Work = MAKE, variants: int | None = None, speed: float = 1.0) -> str:
     """The smallest uniform coarsening of the meshes that fits `limit_s`, as advice
-    (`variants`: the band's, as `sweeps`)."""
+    (`variants`: the band's, as `sweeps`; `speed`: as `estimate`)."""
     if variants is None and work.sweep:
         variants = band_variants(p, d)
     user_model = p.model.mesh_x_mm is not None or not work.model_follows
@@ -313,12 +326,13 @@ def coarsest_fix(p: Prototype, d: Design, *, limit_s: float, cores: int,
 
     def fits(f: float) -> bool:
         return estimate(p, d, cores=cores, work=work, proto_factor=f, variants=variants,
-                        model_factor=f if model_scales else 1.0).seconds <= limit_s
+                        model_factor=f if model_scales else 1.0, speed=speed).seconds <= limit_s
 
     lo, hi = 1.0, COARSEN_MAX
     if not fits(hi):
         if user_model and estimate(p, d, cores=cores, work=work, proto_factor=hi,
-                                   model_factor=hi, variants=variants).seconds <= limit_s:
+                                   model_factor=hi, variants=variants,
+                                   speed=speed).seconds <= limit_s:
             return ("coarsen [model] mesh_x_mm / mesh_y_mm (or the design's mesh) as well as "
                     "the prototype's net")
         return "no mesh coarsening alone fits; raise --time-limit"

@@ -291,7 +291,7 @@ def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
     ctx.record["size"] = est.to_record()
     ctx.record.setdefault("timings_s", {}).update(
         {"estimate": est.seconds, "estimate_verification": est.verification_s,
-         "estimate_parts": est.parts_s})
+         "estimate_parts": est.parts_s, "estimate_speed_factor": est.speed})
     return est
 
 
