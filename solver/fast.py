@@ -72,7 +72,10 @@ START_XTOL = 0.01  # log10 resolution of the membrane start's scale
 # backends whose re-passes are GMRES on the first pass's factorization: a triangular solve of
 # qdldl's LDL^T costs ~1/10 of its factorization; PARDISO refactorizes cheaper than the 5-10
 # preconditioned iterations (241 x 81 at tol 1e-6, 1 thread: 5.0-5.4 s wall by GMRES, 2.6 s
-# refactorizing)
+# refactorizing), and so does the "ldl" backend once it has switched to PARDISO along a load
+# path (`_repass_by_gmres`; simple barrier 1:40, the band's slack-1 % variant, its 529 re-
+# passes 9.4 preconditioned iterations each on average: CPU 4.54-5.50 -> 3.88-4.97 s back to
+# back, 764 -> 757 iterations; the nominal model sweep 1.16 -> 1.07 s, 187 -> 185)
 REPASS_BY_GMRES = ("ldl",)
 PDAS_PASSES = 1  # active-set re-solves per Newton step at most, each by GMRES on the first
 # pass's factorization (simple barrier 1:40, worst level of the model / prototype sweeps: 1 pass
@@ -176,7 +179,7 @@ def _active_set_step(ns: NetSystem, st: State, stepper: Stepper, boost: float, f
     for _ in range(PDAS_PASSES + 1):
         tan = np.where(active, ns.first_slope, tangent)
         at = dataclasses.replace(st, bar=(eps, geometric, tan, d, l))
-        if fact is None or stepper.backend not in REPASS_BY_GMRES:
+        if fact is None or not _repass_by_gmres(stepper):
             trial = stepper.newton(at, boost)
         else:
             trial = Updated(ns.pattern.csr(stepper.matrix(at, boost)), getattr(fact, "base", fact),
@@ -196,6 +199,13 @@ def _active_set_step(ns: NetSystem, st: State, stepper: Stepper, boost: float, f
         active = new
     stepper.active = new  # the set the last step predicts: the next step's first guess
     return fact, step, rhs
+
+
+def _repass_by_gmres(stepper: Stepper) -> bool:
+    """Whether an active-set re-pass solves by GMRES on the first pass's factorization (a
+    backend of REPASS_BY_GMRES whose factorizations are not PARDISO's) or factorizes afresh."""
+    return (stepper.backend in REPASS_BY_GMRES
+            and getattr(stepper.handle, "pardiso", None) is None)
 
 
 def _predicted_tensions(ns: NetSystem, st: State, pulls: np.ndarray, step: np.ndarray,
