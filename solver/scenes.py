@@ -46,7 +46,14 @@ def simple_scene(*, scale: float = 1.0, modulus: float | None = None, pinned_top
                  refine: int = 1, drag: bool = True, slack: float = 0.0,
                  current_z: bool = True) -> Scene:
     """simple-pinned (pinned_top) or simple-free-top at 1:scale; `refine` halves the mesh
-    that many times minus one (1 -> 61 x 21 nodes, 2 -> 121 x 41, 4 -> 241 x 81)."""
+    that many times minus one (1 -> 61 x 21 nodes, 2 -> 121 x 41, 4 -> 241 x 81).
+
+    `loads_at(r)`: hydrostatic to the water level r h plus (`drag`) the drag on the submerged
+    nodes, ramped in over one node row below the level, as printgen's drag load case does
+    (`solver.Drag` ramp): at full depth and in overflow (r >= 1: every free node a row or more
+    below the level) the same as the sharp switch, but a level that sits on a node row no
+    longer makes the node's load jump as it moves (the sharp switch made the load path 0 to
+    1.1 by 0.05 fail at r = 0.9 on 61 x 21 nodes: no equilibrium within 400 iterations)."""
     s = SIMPLE
     lam = float(scale)
     w, h, a = s["width"] / lam, s["height"] / lam, s["mesh"] / lam / refine
@@ -67,7 +74,7 @@ def simple_scene(*, scale: float = 1.0, modulus: float | None = None, pinned_top
     def loads_at(r: float) -> list[Hydrostatic | Drag]:
         out: list[Hydrostatic | Drag] = [Hydrostatic(free, a * a, r * h, initial_z=z0)]
         if drag:
-            out.append(Drag(free, 2 * a, d / refine, v, r * h))
+            out.append(Drag(free, 2 * a, d / refine, v, r * h, ramp=a))
         return out
 
     nx, nz = idx.shape

@@ -77,6 +77,18 @@ def test_paths_agree_level_by_level():
         assert _agree(f.displacements, r.displacements) < AGREE
 
 
+@pytest.mark.parametrize("refine", [0.5, 1])
+def test_a_drag_load_path_converges_where_the_level_sits_on_a_node_row(refine):
+    """simple-pinned with drag from h/h_B = 0 to 1.1 by 0.05: at 0.9 the water level sits on a
+    node row (both meshes), where a sharp drag switch made a node's load jump as it moved and
+    no level-0.9 equilibrium existed (400 iterations, 6 step cuts); the scene's drag ramps in
+    over one node row, as printgen's drag load case does."""
+    sc = simple_scene(refine=refine)
+    levels = np.round(np.arange(0.0, 1.1001, 0.05), 10)
+    results = solve_path(sc.net, sc.loads_at, levels, tol=1e-6)
+    assert [r.level for r in results if not r.converged] == []
+
+
 def test_without_the_optional_ldl_the_superlu_fallback_gives_the_same_answer(monkeypatch):
     """`qdldl` and `pypardiso` not importable (the `fast` extra absent): every solve goes
     through SuperLU."""
