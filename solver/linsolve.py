@@ -61,7 +61,12 @@ LDL_TO_PARDISO = 8  # a small net's first 8 factorizations are qdldl's, the late
 # analysis. CPU per factorization, 1 thread, qdldl / PARDISO: simple barrier's model net at
 # 1:40 (3540 unknowns) 3.2-5.7 / 1.9-3.0 ms, first 6-9 / 6-8 ms; 1:40 example's (1023)
 # 1.3-1.7 / 0.7-0.9 ms; triangular solves 0.23-0.38 / 0.19-0.38 ms
-LDL_PARDISO_MIN_DOFS = 500  # below, a factorization costs too little for the switch to pay
+LDL_PARDISO_MIN_DOFS = 2000  # below, a factorization costs too little for the switch to pay:
+# CPU with / without the switch (qdldl throughout), best of 3, load paths 0 to 1.1 by 0.05 on
+# simple-pinned: 783 unknowns 0.067 / 0.057 s, 1404 0.104 / 0.107-0.123 s, 2115 0.165 /
+# 0.159 s, 2703 0.319 / 0.359 s, 3363 0.224-0.243 / 0.257-0.264 s; the design search's
+# verification of the 1:40 example (978-1550 unknowns, sliding cables) 0.40-0.56 / 0.39-0.43 s
+# per design; and the switch's import of MKL costs 0.45 s of CPU once per process
 LDL_PARDISO_THREADS = 1  # MKL threads of those factorizations and solves: on 3540 unknowns
 # MKL's default (one per core, 2 here) took 24-75 ms of CPU per factorization, not 2-3
 
