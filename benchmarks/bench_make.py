@@ -82,10 +82,12 @@ def predicted_cpu(example: Path) -> float:
 def fitted_constants(runs: list[dict]) -> dict:
     """budget.py's constants from the runs: iterations per level by kind of net (its growth
     with the unknowns, ITERATION_GROWTH, kept), and the CPU per iteration (least squares of
-    every sweep's relative error)."""
+    every sweep's relative error), in the reference machine's seconds: this machine's over
+    its speed factor (printgen.run.speed), as budget.py keeps them."""
     import numpy as np
 
     from printgen.run import budget
+    from printgen.run.speed import speed_factor
 
     per_level = {}  # at budget.REFERENCE_UNKNOWNS: scaled by the counted / predicted totals
     for kind, rs in runs_by_kind(runs).items():
@@ -95,12 +97,13 @@ def fitted_constants(runs: list[dict]) -> dict:
     rows = [s for r in runs for s in r["sweeps"] if s["iterations"] and s["cpu_s"] > 0]
     it = np.array([s["iterations"] for s in rows], float)
     n = np.array([s["unknowns"] for s in rows], float)
-    cpu = np.array([s["cpu_s"] for s in rows])
+    factor = speed_factor()
+    cpu = np.array([s["cpu_s"] for s in rows]) / factor
     a = np.c_[it, it * n] / cpu[:, None]
     (per_it, per_unknown), *_ = np.linalg.lstsq(a, np.ones(len(rows)), rcond=None)
     ratio = a @ np.array([per_it, per_unknown])
     return {"ITERATIONS_PER_LEVEL": per_level, "ITERATION_S": per_it,
-            "ITERATION_S_PER_UNKNOWN": per_unknown,
+            "ITERATION_S_PER_UNKNOWN": per_unknown, "speed_factor": factor,
             "sweep_cpu_over_fit": [float(ratio.min()), float(ratio.max())], "sweeps": len(rows),
             "in_budget_py": {"ITERATIONS_PER_LEVEL": budget.ITERATIONS_PER_LEVEL,
                              "ITERATION_S": budget.ITERATION_S,
