@@ -134,11 +134,11 @@ def test_symlinked_lock_is_refused(world, capsys, command):
 
 @POSIX_ONLY
 @pytest.mark.parametrize("backend", ["flock", "exclusive"])
-@pytest.mark.parametrize("planted", ["link", "fifo", "folder"])
+@pytest.mark.parametrize("planted", ["link", "hard link", "fifo", "folder"])
 def test_lock_never_follows_a_planted_path(world, backend, planted):
     lock = world / "x" / ".out.lock"
     {"link": lambda: lock.symlink_to(world / "victim"), "fifo": lambda: os.mkfifo(lock),
-     "folder": lock.mkdir}[planted]()
+     "hard link": lambda: os.link(world / "victim", lock), "folder": lock.mkdir}[planted]()
     before = snapshot(world)
     with pytest.raises(LockError, match="lock file .* is"), \
             folder_lock(world / "x" / "out", backend=backend):

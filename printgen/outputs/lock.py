@@ -1,7 +1,8 @@
 """The lock beside an output folder (`.NAME.lock`, holding the pid): one run per folder.
 
 The lock file is opened without following symbolic links (O_NOFOLLOW) and must be a regular
-file: a link or a FIFO planted at its name is refused, never written through. Two ways to hold
+file with no other name: a symbolic or hard link, a folder or a FIFO planted at its name is
+refused, never written through (a hard link is a regular file to `fstat`; its link count tells). Two ways to hold
 it, chosen by what the platform has:
 
 - `flock`: where `fcntl` exists (Linux, macOS, BSD), an advisory lock on the open file; the
@@ -73,6 +74,8 @@ def check_lock_path(dest: Path) -> None:
         raise _not_plain(path, "a symbolic link")
     if not stat.S_ISREG(mode):
         raise _not_plain(path, kind_of(mode))
+    if os.lstat(path).st_nlink > 1:
+        raise _not_plain(path, "a hard link to another file")
 
 
 def _open(path: Path, flags: int) -> int:
@@ -87,10 +90,13 @@ def _open(path: Path, flags: int) -> int:
         if exc.errno == errno.EISDIR:
             raise _not_plain(path, "a folder") from None
         raise
-    mode = os.fstat(fd).st_mode
-    if not stat.S_ISREG(mode):
+    st = os.fstat(fd)
+    if not stat.S_ISREG(st.st_mode):
         os.close(fd)
         raise _not_plain(path, "not a regular file")
+    if st.st_nlink > 1:  # another name shares the file: writing the pid would change it
+        os.close(fd)
+        raise _not_plain(path, "a hard link to another file")
     return fd
 
 
