@@ -569,3 +569,27 @@ def test_realistic_example_is_untouched_by_refusals(capsys, tmp_path):
     code, err = cli(capsys, "make", REALISTIC, "-s", 40, "--out", REALISTIC.parent, "--force")
     assert code == 2 and "is inside the output folder" in err
     assert snapshot(REALISTIC.parent) == before
+
+
+# -- A design is checked against the prototype it is used with ------------------------------
+
+@pytest.mark.parametrize(("proto", "other"), [(SIMPLE, REALISTIC), (REALISTIC, SIMPLE)])
+def test_make_refuses_the_design_of_another_barrier(world, capsys, proto, other):
+    from printgen.run.api import plan
+
+    design = world / "other.json"
+    design.write_text(json.dumps(plan(other, 40).to_dict()))
+    before = snapshot(world)
+    code, err = cli(capsys, "make", proto, "-s", 40, "--design", design, "--out",
+                    world / "x" / "out")
+    assert code == 2 and "design of another barrier" in err and "other.json" in err, err
+    assert snapshot(world) == before
+
+
+def test_a_design_of_its_own_barrier_is_accepted():
+    from printgen.run.api import plan
+    from printgen.design.design_file import check_design_of
+    from printgen.inputs.prototype import load_prototype
+
+    for proto in (SIMPLE, REALISTIC):
+        check_design_of(plan(proto, 40), load_prototype(proto), where="design")

@@ -16,7 +16,7 @@ from printgen.barrier.patterns import get_pattern
 from printgen.design.record import CABLE_SIDES, CableDesign, Design, NetDesign, Section
 from printgen.errors import InputError
 from printgen.inputs.profiles import profile_name
-from printgen.inputs.prototype import MIN_MODEL_MESH_MM
+from printgen.inputs.prototype import MIN_MODEL_MESH_MM, Prototype
 from printgen.inputs.schema import Field, check_value, parse_data, positive, shown
 from printgen.outputs.files import read_input_text
 
@@ -102,9 +102,10 @@ def design_from_dict(data: Any, where: str = "design") -> Design:
                   net=NetDesign(**net), cables=tuple(cables))
 
 
-def load_design(path: str | Path, *, scale: float | None = None) -> Design:
+def load_design(path: str | Path, *, scale: float | None = None,
+                prototype: Prototype | None = None) -> Design:
     """Read a design.json file (or the report.json holding one); with `scale`, it must be a
-    design at that scale."""
+    design at that scale; with `prototype`, a design of that barrier (`check_design_of`)."""
     p = Path(path)
     text = read_input_text(p, "design file", limit=DESIGN_LIMIT_BYTES)
     data = parse_data(text, f"design file {p}", "JSON", json.loads)
@@ -114,4 +115,26 @@ def load_design(path: str | Path, *, scale: float | None = None) -> Design:
     if scale is not None and abs(d.scale - scale) > 1e-9 * scale:
         raise InputError(f"design file {p} is a 1:{d.scale:g} design, not 1:{scale:g}; pass "
                          f"--scale {d.scale:g} or search at 1:{scale:g} (printgen design)")
+    if prototype is not None:
+        check_design_of(d, prototype, where=f"design file {p}")
     return d
+
+
+def check_design_of(d: Design, p: Prototype, *, where: str) -> None:
+    """InputError unless `d` can be a design of the barrier `p` at its scale: border cables
+    exactly when the prototype has a [border], and the net's width and height the barrier's
+    over the scale, within one mesh (a design rounds them to its pattern's whole meshes)."""
+    fix = (f"make a design for {p.name} (printgen make or printgen design with its prototype "
+           "file), or pass the prototype the design was made for")
+    if bool(d.cables) != (p.border is not None):
+        has = f"{len(d.cables)} border cables" if d.cables else "no border cables"
+        need = "has a [border] table" if p.border is not None else "has no [border] table"
+        raise InputError(f"{where} has {has}, but the prototype {p.name!r} {need}: it is the "
+                         f"design of another barrier; {fix}")
+    for what, size, target, mesh in (("width", d.net.width_mm, p.width, d.net.mesh_x_mm),
+                                      ("height", d.net.height_mm, p.height, d.net.mesh_y_mm)):
+        model = target / d.scale * 1e3
+        if abs(size - model) > mesh + 1e-6 * model:
+            raise InputError(f"{where}: the net's {what} {size:g} mm is not the barrier's "
+                             f"{target:g} m at 1:{d.scale:g} ({model:g} mm, within one mesh "
+                             f"of {mesh:g} mm): it is the design of another barrier; {fix}")

@@ -110,7 +110,7 @@ def verify(prototype: PrototypeLike, scale: float, design_: Design | str | Path 
     if design_ is None:
         d = plan(p, scale, printer=printer)
     else:
-        d = design_ if isinstance(design_, Design) else load_design(design_, scale=scale)
+        d = design_ if isinstance(design_, Design) else load_design(design_, scale=scale, prototype=p)
     return _verify(p, d, load=load_name(load, drag))
 
 

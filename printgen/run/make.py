@@ -135,7 +135,7 @@ def plan(prototype_path: str | Path, scale: float, *, printer: str | None = None
     design = make_design(proto, t, sel)
     design_file, own = options.design_file, None
     if design_file:  # the net of `printgen design` (its design.json) instead of select's
-        design = load_design(design_file, scale=t.scale)
+        design = load_design(design_file, scale=t.scale, prototype=proto)
         own = design_net(proto, t, design.net, design.printer)
     rep = Report(f"printgen: {proto.name} at 1:{t.scale:g}")
     shown = Path(design_file).name if design_file else None

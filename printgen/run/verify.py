@@ -85,7 +85,7 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     inputs = [prototype, design_path, measured, *search_dirs()]
     check_destination(Path(out), force=force, inputs=inputs)  # before any work
     p = load_prototype(prototype)
-    d = load_design(design_path, scale=scale)
+    d = load_design(design_path, scale=scale, prototype=p)
     m = read_measured(measured, design_units(d)) if measured is not None else None
     limit = DEFAULT_LIMIT_S if time_limit_s is None else time_limit_s
     check_budget(p, d, limit_s=limit, cores=sweep_cores(),
