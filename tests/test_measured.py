@@ -90,6 +90,23 @@ def test_read_semicolon_decimal_comma_comments_and_blank_cells(tmp_path):
     assert mm["deflection"].rms == pytest.approx(np.sqrt(0.02**2 / 2), rel=1e-9)
 
 
+def test_a_raw_sensor_wired_backwards_is_refused(tmp_path):
+    from printgen.verification.readings import FlumeUnits
+
+    p = tmp_path / "raw.csv"
+    p.write_text("h_over_hb,mid_sensor_mm\n0.5,-0.4\n1.0,-3\n")
+    units = FlumeUnits(330.0, 100.0, {"bottom": 330.0, "top": 331.0, "mid": 335.0})
+    with pytest.raises(MeasurementError, match="'mid_sensor_mm': -3 is its largest reading"):
+        read_measured(p, units)
+
+
+def test_a_small_negative_reading_near_zero_is_kept(tmp_path):
+    p = tmp_path / "noise.csv"
+    p.write_text("h_over_hb,mid_height_elongation_pct\n0.2,-0.05\n1.0,4\n")
+    np.testing.assert_allclose(read_measured(p).values["strain_mid"], [-0.0005, 0.04],
+                               rtol=READ_TOL)
+
+
 BAD = {
     "unknown column": ("h_over_hb,mid_elongation\n0.5,1\n", "mid_elongation"),
     "missing level column": ("mid_height_elongation_pct\n1\n", "h_over_hb"),
@@ -100,6 +117,10 @@ BAD = {
     "percent as fraction": ("h_over_hb,deflection_over_width\n0.5,12\n",
                             "deflection_over_width"),
     "short row": ("h_over_hb,deflection_over_width\n0.5\n", "cells"),
+    "sensor wired backwards": ("h_over_hb,mid_height_elongation_pct\n0.5,-0.1\n1.0,-2.5\n",
+                               "line 3.*-2.5 is its largest reading and it is negative"),
+    "level twice": ("h_over_hb,mid_height_elongation_pct\n0.5,1\n1.0,2\n0.5,1.2\n",
+                    "lines 2 and 4: h_over_hb = 0.5 twice"),
 }
 
 

@@ -210,6 +210,7 @@ def _check_ranges(p: Path, data: dict[str, np.ndarray], line_numbers: list[int])
         i = int(bad[0])
         raise MeasurementError(f"{p}, line {line_numbers[i]}: {LEVEL_COLUMN} = {lv[i]:g} outside "
                                f"0 to {MAX_LEVEL:g} (the predicted range; h / h_B, not mm)")
+    _check_levels_once(p, lv, line_numbers)
     limits = {**LIMITS, **{c: (-RAW_LIMIT_MM, RAW_LIMIT_MM) for c in RAW_COLUMNS}}
     for col, (lo, hi) in limits.items():
         if col not in data:
@@ -228,6 +229,35 @@ def _check_ranges(p: Path, data: dict[str, np.ndarray], line_numbers: list[int])
     if not np.any(lv > 0):
         raise MeasurementError(f"{p}: every {LEVEL_COLUMN} is 0: the net was never loaded, so "
                                "there is nothing to compare or fit")
+    _check_stretching(p, data, line_numbers)
+
+
+def _check_levels_once(p: Path, lv: np.ndarray, line_numbers: list[int]) -> None:
+    """MeasurementError when a level is given twice: a test reads each level once, and two
+    lines at one level cannot both be compared with the one prediction there."""
+    order = np.argsort(lv, kind="stable")
+    same = np.flatnonzero(np.diff(lv[order]) == 0)
+    if same.size:
+        i, j = sorted((int(order[same[0]]), int(order[same[0] + 1])))
+        raise MeasurementError(f"{p}, lines {line_numbers[i]} and {line_numbers[j]}: "
+                               f"{LEVEL_COLUMN} = {lv[i]:g} twice; keep one line per level "
+                               "(average repeated readings)")
+
+
+def _check_stretching(p: Path, data: dict[str, np.ndarray], line_numbers: list[int]) -> None:
+    """MeasurementError when an elongation column's largest reading is negative: the water
+    stretches every sensor wire, so a column that reads mostly shortening comes from a sensor
+    wired or zeroed backwards (a small negative reading near zero is noise and is kept)."""
+    for col, key in {**{c: k for c, (k, _) in COLUMNS.items()}, **RAW_COLUMNS}.items():
+        if col not in data or not key.startswith("strain_"):
+            continue
+        v = data[col]
+        i = int(np.nanargmax(np.abs(v)))
+        if v[i] < 0:
+            raise MeasurementError(f"{p}, line {line_numbers[i]}, column {col!r}: {v[i]:g} is "
+                                   "its largest reading and it is negative, but the water "
+                                   "stretches every sensor wire; a sensor wired or zeroed "
+                                   "backwards? flip the column's sign")
 
 
 
