@@ -119,6 +119,18 @@ def test_cli_end_to_end(tmp_path, cable_files, capsys, monkeypatch):
     assert "modulus" in capsys.readouterr().out
 
 
+def test_forces_in_kilonewtons_read_as_newtons_write_nothing(tmp_path):
+    eps = np.linspace(0, STRAIN_MAX, N_POINTS)
+    files = [_write(tmp_path, f"kn_{i}", eps, e * eps / 1000, "semicolon_decimal_comma",
+                    seed=40 + i) for i, e in enumerate(MODULI)]  # kN values, labelled N
+    cal = calibrate(files, material="petg-lab", specimen=_spec())
+    out = tmp_path / "profiles"
+    with pytest.raises(CalibrationError, match=r"modulus 0\.00\d+ GPa is 0\.000\d+ x the "
+                                               r"datasheet's 2\.59 GPa.*--unit force=kN"):
+        write_profile(cal, name="petg-lab", out=out, inherits="petg")
+    assert not (out / "materials" / "petg-lab.toml").exists()
+
+
 @pytest.mark.parametrize("extra, message", [
     (["--window", "0.25"], "--window '0.25': expected 2 numbers"),
     (["--machine-stiffness", "-3"], "machine stiffness -3 N/mm must be > 0"),

@@ -27,6 +27,10 @@ from printgen.inputs.profiles import profile_name
 
 SOURCE = "printgen calibrate: tensile tests"
 SIG = 6  # significant digits written for measured values
+# A printed coupon's modulus and strength lie within this factor of its filament's datasheet
+# (voids, bead bonds and orientation lower them a few times at most); beyond it, a unit is
+# wrong (kN read as N is a factor 1000) or the profile inherits the wrong material.
+DATASHEET_SPREAD = 10.0
 
 
 def output_dir(out: str | Path | None) -> Path:
@@ -93,10 +97,33 @@ def write_profile(cal: Calibration, *, name: str, out: str | Path | None = None,
                                + (f", inheriting {inherits}" if inherits else ""))
     data.setdefault("measured", {}).update(measured_tables(cal, date=date))
     text, mat = validated_text(data, name=name, root=root, shown=path)
+    check_against_datasheet(mat, path)
     mode = _mode(path)
     outputs.write_text(path, text)
     os.chmod(path, mode)
     return path, mat
+
+
+def check_against_datasheet(mat: Material, shown: Path) -> None:
+    """CalibrationError when a measured modulus or strength is more than DATASHEET_SPREAD
+    times off the datasheet value the profile inherits: printing lowers a filament's values
+    by voids and bead bonds, never by orders of magnitude, so such a value comes from a wrong
+    unit (a force in kN read as N gives 1/1000) or the wrong parent material."""
+    for what, got, sheet, unit in (
+            ("modulus", mat.measured_modulus, mat.datasheet_modulus, 1e9),
+            ("failure stress", mat.measured_failure_stress, mat.datasheet_failure_stress, 1e6)):
+        if got is None or sheet <= 0:
+            continue
+        ratio = got.value / sheet
+        if 1 / DATASHEET_SPREAD <= ratio <= DATASHEET_SPREAD:
+            continue
+        u = "GPa" if unit == 1e9 else "MPa"
+        raise CalibrationError(
+            f"{shown}: measured {what} {got.value / unit:.4g} {u} is {ratio:.3g} x the datasheet's "
+            f"{sheet / unit:.4g} {u} ({mat.datasheet_source}); a printed part lies within "
+            f"{DATASHEET_SPREAD:g} x of its filament's datasheet. Nothing written: check the "
+            "force unit (--unit force=kN when the file's newtons are kilonewtons, or the "
+            "reverse), the section, or --inherits the material the coupons were printed from")
 
 
 def validated_text(data: dict[str, Any], *, name: str, root: Path | None = None,
