@@ -134,6 +134,8 @@ def test_columns_chosen_by_option_and_unit_override(tmp_path):
     ("Load (N),Extension (mm)\n1,2\n3,4\n5\n7,8\n", r"x\.csv:4: expected 2 values separated by"),
     ("Load (furlong),Extension (mm)\n1,2\n3,4\n", r"unit 'furlong' is not a force unit"),
     ("just a note\nanother note\n", r"no table found"),
+    ("Load (N),Extension (mm)\n1,2\n3," + "4" * 140_000 + "\n5,6\n",
+     r"x\.csv, line 3: 140,002 characters, more than the 65,536"),
 ])
 def test_bad_files_name_file_line_and_expectation(tmp_path, body, match):
     p = tmp_path / "x.csv"

@@ -42,6 +42,8 @@ TEXT_SUFFIXES = (".csv", ".txt", ".tsv", ".dat")
 # calibrate > 120 s; issue 20): a 1 kHz test of 16 minutes has 1 M rows, and the reader takes
 # about 10 s for them; real exports hold 10^3 to 10^5.
 MAX_ROWS = 1_000_000
+# A row of readings is tens of columns (< 1 KiB); Python's csv refuses a field over 128 KiB.
+MAX_LINE_CHARS = 64 << 10
 EXPORT_LIMIT_BYTES = INPUT_LIMIT_BYTES  # one export, or what a zip of one unpacks to (64 MiB)
 _BOOLEAN = {"true": 1.0, "false": 0.0}  # flag columns written as words
 
@@ -142,6 +144,12 @@ def read_export(path: str | Path, *, columns: Mapping[str, str] | None = None,
     if len(lines) > MAX_ROWS:
         raise CalibrationError(f"{where}: {len(lines):,} lines, more than {MAX_ROWS:,} (a 1 kHz "
                                "test of 16 minutes); thin the rows (every 10th) or split the file")
+    long = next((n for n, ln in enumerate(lines, start=1) if len(ln) > MAX_LINE_CHARS), None)
+    if long is not None:
+        raise CalibrationError(f"{where}, line {long}: {len(lines[long - 1]):,} characters, more "
+                               f"than the {MAX_LINE_CHARS:,} a tester's export line holds (one "
+                               "row of readings); is it the right file, or is it one line "
+                               "without line breaks?")
     delim = delimiter or _sniff_delimiter(lines, where)
     rows = list(enumerate(_split(lines, delim), start=1))
     rows = [(n, [c.strip() for c in r]) for n, r in rows if any(c.strip() for c in r)]
