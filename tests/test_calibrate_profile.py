@@ -135,6 +135,8 @@ def test_forces_in_kilonewtons_read_as_newtons_write_nothing(tmp_path):
     (["--window", "0.25"], "--window '0.25': expected 2 numbers"),
     (["--machine-stiffness", "-3"], "machine stiffness -3 N/mm must be > 0"),
     (["--window", "0.3,0.2"], "fit window"),
+    (["--date", "2025-13-45", "--save"], "--date '2025-13-45' is not a calendar day"),
+    (["--date", "2999-01-01", "--save"], "--date 2999-01-01 is after"),
     ([], "needs the grip distance"),
 ])
 def test_cli_bad_input_exits_2(tmp_path, cable_files, capsys, extra, message):

@@ -71,6 +71,7 @@ def write_profile(cal: Calibration, *, name: str, out: str | Path | None = None,
                   inherits: str | None = None, date: str | None = None) -> tuple[Path, Material]:
     """Write (or update) `<dir>/materials/<name>.toml`; return its path and the loaded material."""
     name = profile_name(name, "--material")
+    date = tested_on(date)
     if inherits is not None:
         inherits = profile_name(inherits, "--inherits")
     if cal.groups:
@@ -102,6 +103,23 @@ def write_profile(cal: Calibration, *, name: str, out: str | Path | None = None,
     outputs.write_text(path, text)
     os.chmod(path, mode)
     return path, mat
+
+
+def tested_on(date: str | None) -> str | None:
+    """`date` as an ISO day (YYYY-MM-DD), checked: a real calendar day, not after tomorrow
+    (a test not yet run; tomorrow allows for time zones); CalibrationError otherwise."""
+    if date is None:
+        return None
+    try:
+        day = dt.date.fromisoformat(date.strip())
+    except ValueError:
+        raise CalibrationError(f"--date {date!r} is not a calendar day in ISO format "
+                               "(YYYY-MM-DD, e.g. 2026-03-31)") from None
+    latest = dt.date.today() + dt.timedelta(days=1)
+    if day > latest:
+        raise CalibrationError(f"--date {day.isoformat()} is after {latest.isoformat()}: give the "
+                               "day the coupons were tested")
+    return day.isoformat()
 
 
 def check_against_datasheet(mat: Material, shown: Path) -> None:

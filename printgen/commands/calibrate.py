@@ -129,6 +129,10 @@ def run(args: argparse.Namespace) -> int:
     material = profile_name(args.material, "--material")  # names <material>.toml and .png
     if args.inherits is not None:
         profile_name(args.inherits, "--inherits")
+    if args.date is not None:  # before any work: a bad date must not cost the fit
+        from printgen.calibrate.profile_writer import tested_on
+
+        tested_on(args.date)
     spec = {name: getattr(args, opt) * f for opt, name, f in DIMENSION_OPTIONS
             if getattr(args, opt) is not None}
     if args.kind:
