@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
+from pathlib import Path
+
 import pytest
 from proto_files import REALISTIC, write_variant
 
@@ -43,6 +46,20 @@ def test_broken_toml_says_so(tmp_path):
     p.write_text("name = \n")
     with pytest.raises(InputError, match="not valid TOML"):
         load_prototype(p)
+
+
+def test_utf8_with_a_byte_order_mark_reads_and_utf16_is_named(tmp_path):
+    """Windows editors write UTF-8 with a BOM (read as UTF-8), PowerShell's `>` UTF-16
+    (refused, naming the encoding to save in)."""
+    text = Path(REALISTIC).read_text("utf-8")
+    bom = tmp_path / "bom.toml"
+    bom.write_bytes(b"\xef\xbb\xbf" + text.encode("utf-8"))
+    same = dataclasses.replace(load_prototype(REALISTIC), path=None)
+    assert dataclasses.replace(load_prototype(bom), path=None) == same
+    utf16 = tmp_path / "utf16.toml"
+    utf16.write_bytes(text.encode("utf-16"))
+    with pytest.raises(InputError, match="not utf-8 text.*save it as utf-8"):
+        load_prototype(utf16)
 
 
 def test_unknown_material_lists_the_known_ones():

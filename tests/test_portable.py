@@ -105,6 +105,8 @@ def simulate_windows(monkeypatch) -> list[Path]:
     monkeypatch.setattr(multiprocessing, "get_all_start_methods", lambda: ["spawn"])
     monkeypatch.delattr(os, "fork")
     monkeypatch.delattr(signal, "SIGHUP")
+    monkeypatch.delattr(os, "O_NOFOLLOW")
+    monkeypatch.setattr(lock, "NOFOLLOW", 0)
     monkeypatch.delenv("PRINTGEN_SERIAL", raising=False)
     return locked
 
@@ -194,3 +196,17 @@ def test_make_on_a_platform_without_fork_prctl_sighup_fcntl_gives_the_same_files
     one, two = make_mod.json_output(made.record), make_mod.json_output(again.record)
     assert one.pop("timings") != two.pop("timings")  # wall-clock times differ
     assert dumps(one) == dumps(two)
+
+
+def test_files_are_written_without_o_nofollow(tmp_path, monkeypatch, capsys):
+    """init, example --out and calibrate's profile write (each through outputs.write_bytes)
+    on a platform without os.O_NOFOLLOW."""
+    from printgen.cli import main
+
+    simulate_windows(monkeypatch)
+    assert main(["init", str(tmp_path / "proto.toml")]) == 0
+    assert main(["example", "paper_1_40", "--out", str(tmp_path / "ex")]) == 0
+    from printgen.outputs.files import write_text
+
+    assert write_text(tmp_path / "materials" / "x.toml", "a = 1\n").read_text() == "a = 1\n"
+    assert "internal error" not in capsys.readouterr().err

@@ -8,6 +8,7 @@ refused before it is read, so no input can hang a run or fill the memory.
 
 from __future__ import annotations
 
+import codecs
 import contextlib
 import errno
 import os
@@ -72,8 +73,9 @@ def read_input(path: str | Path, what: str = "input file", *,
         raise InputFileError(f"{what} {p} is {st.st_size:,} bytes, over the {limit:,}-byte "
                              "limit for this input; is it the right file?")
     with os.fdopen(fd, "rb") as fh:
-        if hasattr(os, "set_blocking"):
-            os.set_blocking(fd, True)
+        if hasattr(os, "set_blocking"):  # opened O_NONBLOCK so a FIFO cannot hang the open
+            with contextlib.suppress(OSError):  # Windows: not for every kind of file
+                os.set_blocking(fd, True)
         data = fh.read(limit + 1)
     if len(data) > limit:  # grew while being read
         raise InputFileError(f"{what} {p} holds more than {limit:,} bytes; is it the right file?")
@@ -84,6 +86,8 @@ def read_input_text(path: str | Path, what: str = "input file", *,
                     limit: int = INPUT_LIMIT_BYTES, encoding: str = "utf-8") -> str:
     """`read_input` decoded; InputFileError when it is not text in `encoding`."""
     data = read_input(path, what, limit=limit)
+    if encoding.replace("-", "").lower() == "utf8" and data.startswith(codecs.BOM_UTF8):
+        data = data[len(codecs.BOM_UTF8):]  # Windows editors mark UTF-8 so; TOML/JSON may not
     try:
         return data.decode(encoding)
     except UnicodeDecodeError as exc:
@@ -97,7 +101,8 @@ def write_bytes(path: str | Path, data: bytes) -> Path:
     p.parent.mkdir(parents=True, exist_ok=True)
     tmp = p.parent / f".{p.name}.{secrets.token_hex(4)}.tmp"
     # 0o666 less the umask, as any file the user writes (mkstemp would force 0600)
-    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o666)
+    # O_EXCL refuses any name already there, a link too; O_NOFOLLOW (absent on Windows) also
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0), 0o666)
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
