@@ -593,3 +593,15 @@ def test_a_design_of_its_own_barrier_is_accepted():
 
     for proto in (SIMPLE, REALISTIC):
         check_design_of(plan(proto, 40), load_prototype(proto), where="design")
+
+
+# -- A lab's readings typed into an output folder are never replaced silently ---------------
+
+def test_an_edited_measurement_sheet_stops_the_next_run(world, made_1_40, capsys):
+    out = earlier_output(made_1_40[1], world / "x" / "out")
+    sheet = out / "measurement-sheet.csv"
+    sheet.write_text(sheet.read_text() + "1.0,,,12.5\n")  # a lab's reading
+    before = snapshot(world)
+    code, err = cli(capsys, "make", REALISTIC, "-s", 40, "--out", out)
+    assert code == 2 and "measurement-sheet.csv, edited since printgen wrote it" in err, err
+    assert "--force" in err and snapshot(world) == before

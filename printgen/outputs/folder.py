@@ -7,10 +7,10 @@ every instant the output path holds one complete run or the previous one, never 
 run is killed between the fallback's two renames, the next run to start puts the old folder
 back before anything else, and no run removes an old folder before its own is in place.
 
-What may be replaced: an absent or empty folder, or a printgen output (its manifest reads, and
-the folder holds exactly the files it lists: `manifest.foreign_entry`); anything else needs
-`force`. Never replaced: a symbolic link, a mount point, a folder holding one of the run's
-inputs. An exclusive lock beside the output (`lock.folder_lock`) keeps a second run out of the
+What may be replaced: an absent or empty folder, or a printgen output (its manifest reads,
+and the folder holds exactly the files it lists, each as the run wrote it:
+`manifest.foreign_entry`, `manifest.edited_files`); anything else needs `force`. Never
+replaced: a symbolic link, a mount point, a folder holding one of the run's inputs. An exclusive lock beside the output (`lock.folder_lock`) keeps a second run out of the
 same folder; stale stages of the same output (a run killed with SIGKILL) are removed when the
 next run starts. Stage, aside and lock names are matched literally (an output named `*` is the
 folder `*`, not a pattern).
@@ -32,7 +32,7 @@ from typing import Any
 
 from printgen.outputs.files import FULL_ERRNOS, OutputError, named
 from printgen.outputs.lock import check_lock_path, folder_lock
-from printgen.outputs.manifest import foreign_entry, write_manifest
+from printgen.outputs.manifest import edited_files, foreign_entry, write_manifest
 from printgen.workers import signals_deferred
 
 log = logging.getLogger(__name__)
@@ -130,6 +130,12 @@ def check_destination(dest: Path, *, force: bool, inputs: Iterable[str | Path] =
             raise OutputError(f"output {dest} is not a printgen output folder: it holds "
                               f"{foreign}; choose a new or empty folder, or pass --force to "
                               "replace it whole")
+        edited = edited_files(dest)
+        if edited:  # a lab's own readings: a new run replaces the folder whole
+            raise OutputError(f"output {dest} holds {', '.join(edited)}, edited since printgen "
+                              "wrote it (a lab's readings?); a new run would replace it: copy "
+                              "it out of the folder first (or choose another --out), or pass "
+                              "--force to replace the folder whole")
     for parent in dest.parents:
         if parent.exists():
             if not parent.is_dir():

@@ -216,3 +216,16 @@ def foreign_entry(folder: Path) -> str | None:
     extra = [f"{rel} (not in its {MANIFEST})" for rel in files if rel not in allowed]
     extra += [f"{rel} ({what})" for rel, what in _foreign_others(m, others)]
     return min(extra, default=None)
+
+
+def edited_files(folder: Path) -> list[str]:
+    """The files of printgen's own output `folder` whose bytes differ from its manifest: a
+    lab's readings typed into the measurement sheet, notes added to a CSV. [] when none (or
+    when the folder has no manifest that reads: `foreign_entry` answers for it)."""
+    try:
+        m = read_manifest(Path(folder))
+    except InputError:
+        return []
+    return [rel for rel, want in sorted(m["files"].items())
+            if (Path(folder) / rel).is_file() and not (Path(folder) / rel).is_symlink()
+            and file_digest(Path(folder) / rel) != want]
