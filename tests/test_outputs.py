@@ -7,6 +7,7 @@ import os
 import subprocess
 import sys
 import textwrap
+from pathlib import Path
 
 import pytest
 
@@ -101,6 +102,28 @@ def test_stale_stages_are_removed_at_start(tmp_path):
     (tmp_path / ".other.stage.x").mkdir()  # another output's stage is not ours to remove
     run_into(tmp_path / "out", {"a.txt": "1"})
     assert sorted(p.name for p in tmp_path.iterdir()) == [".other.stage.x", "out"]
+
+
+def test_a_previous_run_that_cannot_be_removed_is_named(tmp_path, monkeypatch, caplog):
+    """A file of the previous run that cannot be removed (immutable, another user's): the new
+    run is in, and a warning names the folder left beside it and why."""
+    run_into(tmp_path / "out", {"a.txt": "1"})
+    real = outputs.shutil.rmtree
+
+    def stuck(path, onerror=None, **kw):
+        if ".out." in str(path) and (Path(path) / "a.txt").exists():
+            onerror(os.unlink, str(Path(path) / "a.txt"), (PermissionError,
+                    PermissionError(1, "Operation not permitted"), None))
+            return
+        real(path, onerror=onerror, **kw)
+
+    monkeypatch.setattr(outputs.shutil, "rmtree", stuck)
+    with caplog.at_level("WARNING", logger=outputs.log.name):
+        run_into(tmp_path / "out", {"b.txt": "2"})
+    assert (tmp_path / "out" / "b.txt").read_text() == "2"
+    left = [p for p in tmp_path.iterdir() if p.name != "out"]
+    assert len(left) == 1 and "could not remove the previous run in" in caplog.text
+    assert str(left[0]) in caplog.text and "Operation not permitted" in caplog.text
 
 
 def test_foreign_folder_needs_force(tmp_path):

@@ -77,10 +77,11 @@ def staged_dir(final: str | Path, *, force: bool = False,
                 swap_in(stage, dest)
                 for done in _trackers:
                     done.append(dest)
-                shutil.rmtree(stage, ignore_errors=True)
+                remove_tree(stage, "the previous run")
                 remove_stale(dest, "old")  # earlier runs' asides: the new run is in now
         finally:
-            shutil.rmtree(stage, ignore_errors=True)
+            if os.path.lexists(stage):
+                remove_tree(stage, "this run's unfinished stage")
 
 
 def write_folder(final: str | Path, files: dict[str, str | bytes], *, force: bool = False,
@@ -195,8 +196,21 @@ def remove_stale(dest: Path, kind: str = "stage") -> list[Path]:
     `restore_orphan`), or with kind "old" its aside folders (only once a new run is in)."""
     stale = _siblings(dest, kind)
     for p in stale:
-        shutil.rmtree(p, ignore_errors=True)
+        remove_tree(p, "a stopped run's stage" if kind == "stage" else "an earlier run")
     return stale
+
+
+def remove_tree(path: Path, what: str) -> bool:
+    """Remove the folder `path` (`what` it holds, for the message); True when it is gone. A
+    file that cannot be removed (immutable, another user's) leaves the folder beside the
+    output: a warning names it and the reason, never silence (the new run is in either way)."""
+    errors: list[str] = []
+    shutil.rmtree(path, onerror=lambda _fn, p, exc: errors.append(f"{p}: {exc[1]}"))
+    if not os.path.lexists(path):
+        return True
+    log.warning("could not remove %s in %s (%s); remove it by hand", what, path,
+                errors[0] if errors else "unknown reason")
+    return False
 
 
 def swap_in(stage: Path, dest: Path) -> None:
@@ -214,7 +228,7 @@ def swap_in(stage: Path, dest: Path) -> None:
     except BaseException:
         os.rename(aside, dest)
         raise
-    shutil.rmtree(aside, ignore_errors=True)
+    remove_tree(aside, "the previous run")
 
 
 def exchange(a: Path, b: Path) -> bool:
