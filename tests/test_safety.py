@@ -514,6 +514,27 @@ def test_disk_full_names_the_path(world, capsys):
     assert "free space" in err and not out.exists()
 
 
+def test_disk_already_full_names_the_lock_path(world, capsys, monkeypatch):
+    """The disk is full before the run: the first write is the lock's pid."""
+    out = world / "x" / "out"
+    real_write = os.write
+
+    def full(fd, data):
+        if data.strip().isdigit():  # the pid into the lock file
+            raise OSError(28, "No space left on device")
+        return real_write(fd, data)
+
+    def body():
+        monkeypatch.setattr(os, "write", full)
+        with staged_dir(out):
+            pass
+
+    code = run_command(_fake_command(body), "printgen make")
+    err = capsys.readouterr().err.strip()
+    assert code == 1 and ".out.lock" in err and "No space left on device" in err, err
+    assert "free space" in err and not out.exists()
+
+
 def test_verify_checks_out_before_computing(world, made, capsys, monkeypatch):
     import printgen.run.verify as verify_mod
 

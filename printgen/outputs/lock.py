@@ -25,7 +25,7 @@ import stat
 from collections.abc import Iterator
 from pathlib import Path
 
-from printgen.outputs.files import OutputError, kind_of
+from printgen.outputs.files import OutputError, kind_of, named
 
 NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)  # not on Windows: there a link is checked with lstat
 PID_BYTES = 32  # a pid and a newline, with room to spare
@@ -50,8 +50,11 @@ def folder_lock(dest: Path, backend: str | None = None) -> Iterator[None]:
         raise ValueError(f"lock backend {how!r}: flock or exclusive")
     fd = (_flock if how == "flock" else _exclusive)(dest, lock_path(dest))
     try:
-        os.ftruncate(fd, 0)
-        os.write(fd, f"{os.getpid()}\n".encode())
+        try:
+            os.ftruncate(fd, 0)
+            os.write(fd, f"{os.getpid()}\n".encode())
+        except OSError as exc:  # a full disk: write() names no file, the message must
+            raise named(exc, lock_path(dest)) from None
         yield
     finally:
         if how == "exclusive":  # closed first: Windows cannot remove an open file
