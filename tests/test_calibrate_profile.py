@@ -119,6 +119,17 @@ def test_cli_end_to_end(tmp_path, cable_files, capsys, monkeypatch):
     assert "modulus" in capsys.readouterr().out
 
 
+def test_a_materials_link_is_not_written_through(tmp_path, cable_files):
+    cal = calibrate(cable_files, material="petg-lab", specimen=_spec())
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    (tmp_path / "root").mkdir()
+    (tmp_path / "root" / "materials").symlink_to(elsewhere)
+    with pytest.raises(CalibrationError, match="materials is a symbolic link"):
+        write_profile(cal, name="petg-lab", out=tmp_path / "root", inherits="petg")
+    assert list(elsewhere.iterdir()) == []
+
+
 def test_forces_in_kilonewtons_read_as_newtons_write_nothing(tmp_path):
     eps = np.linspace(0, STRAIN_MAX, N_POINTS)
     files = [_write(tmp_path, f"kn_{i}", eps, e * eps / 1000, "semicolon_decimal_comma",

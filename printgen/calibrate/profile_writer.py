@@ -81,6 +81,11 @@ def write_profile(cal: Calibration, *, name: str, out: str | Path | None = None,
             + "); a profile holds one: calibrate and save one orientation at a time (name only "
             "its files, e.g. xy-*)")
     root = output_dir(out)
+    if (root / "materials").is_symlink():  # the profile would land wherever the link points
+        raise CalibrationError(f"{root / 'materials'} is a symbolic link (to "
+                               f"{os.readlink(root / 'materials')}); printgen writes profiles "
+                               "only into a real materials folder: give --out the folder the "
+                               "link points to, or remove the link")
     path = root / "materials" / f"{name.lower()}.toml"
     data = _existing(path)
     if inherits is not None:
