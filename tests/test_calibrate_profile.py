@@ -147,6 +147,8 @@ def test_forces_in_kilonewtons_read_as_newtons_write_nothing(tmp_path):
     (["--machine-stiffness", "-3"], "machine stiffness -3 N/mm must be > 0"),
     (["--window", "0.3,0.2"], "fit window"),
     (["--date", "2025-13-45", "--save"], "--date '2025-13-45' is not a calendar day"),
+    (["--width-mm", "0"], "--width-mm 0: a specimen dimension must be a positive number of mm"),
+    (["--area-mm2", "nan"], "--area-mm2 nan: a specimen dimension must be a positive"),
     (["--date", "2999-01-01", "--save"], "--date 2999-01-01 is after"),
     ([], "needs the grip distance"),
 ])
@@ -158,6 +160,7 @@ def test_cli_bad_input_exits_2(tmp_path, cable_files, capsys, extra, message):
     assert main([*args, *extra]) == 2
     err = capsys.readouterr().err
     assert message in err and "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1, err  # one line, no numpy warnings
 
 
 def test_sidecar_gives_dimensions_and_columns(tmp_path):

@@ -13,6 +13,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 from rich.console import Console
@@ -133,6 +134,13 @@ def run(args: argparse.Namespace) -> int:
         from printgen.calibrate.profile_writer import tested_on
 
         tested_on(args.date)
+    for opt, _, _ in DIMENSION_OPTIONS:  # a zero width would divide by zero deep in the fit
+        value = getattr(args, opt)
+        if value is not None and not (math.isfinite(value) and value > 0):
+            unit = opt.rsplit("_", 1)[1]
+            raise CalibrationError(f"--{opt.replace('_', '-')} {value:g}: a specimen dimension "
+                                   f"must be a positive number of {unit}; give the measured "
+                                   "value, or leave it out when the file gives it")
     spec = {name: getattr(args, opt) * f for opt, name, f in DIMENSION_OPTIONS
             if getattr(args, opt) is not None}
     if args.kind:
