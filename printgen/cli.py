@@ -11,6 +11,7 @@ import argparse
 import importlib
 import logging
 import os
+import re
 import sys
 from concurrent.futures.process import BrokenProcessPool
 from typing import NoReturn
@@ -89,10 +90,10 @@ def main(argv: list[str] | None = None) -> int:
         print("printgen: interrupted (Ctrl-C)", file=sys.stderr)
         return 130
     args.argv = ["printgen", *argv]
-    logging.basicConfig(
-        level=logging.INFO if args.verbose else logging.WARNING,
-        format="%(levelname)s: %(message)s",
-    )
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING)
+    for handler in logging.getLogger().handlers:
+        if type(handler) is logging.StreamHandler:  # basicConfig's own, not a test's capture
+            handler.setFormatter(_PrintableFormatter("%(levelname)s: %(message)s"))
     return run_command(args, f"printgen {args.command}")
 
 
@@ -136,5 +137,20 @@ def _stopped(name: str, signal_name: str, replaced: list) -> str:
 
 
 def _fail(line: str, code: int) -> int:
-    print(line, file=sys.stderr)
+    print(printable(line), file=sys.stderr)
     return code
+
+
+# C0 and C1 control characters but the newline: a path holding ESC sequences could otherwise
+# set the terminal's title or clear it when an error or a warning echoes it.
+_CONTROL = re.compile(r"[\x00-\x09\x0b-\x1f\x7f-\x9f]")
+
+
+def printable(text: str) -> str:
+    """`text` with control characters shown as escapes (`\x1b`), safe to print on a terminal."""
+    return _CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}", text)
+
+
+class _PrintableFormatter(logging.Formatter):
+    def format(self, record: logging.LogRecord) -> str:
+        return printable(super().format(record))

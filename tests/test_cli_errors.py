@@ -312,3 +312,14 @@ def test_time_limit_zero_is_refused_by_the_api_too(tmp_path):
     with pytest.raises(InputError, match="must be a positive number of seconds"):
         make_mod.make(REALISTIC, 40, tmp_path / "o", options=make_mod.MakeOptions(time_limit_s=0),
                       steps=[])
+
+
+def test_terminal_escapes_in_a_path_are_shown_not_sent(tmp_path, capsys):
+    """A path holding ESC sequences (set the title, clear the screen) is echoed escaped."""
+    from printgen.cli import main
+
+    bad = tmp_path / "x\x1b]0;pwned\x07\x1b[2J.toml"
+    assert main(["make", str(bad), "-s", "40"]) == 2
+    err = capsys.readouterr().err
+    assert "\x1b" not in err and "\x07" not in err
+    assert "x\\x1b]0;pwned\\x07\\x1b[2J.toml" in err
