@@ -136,3 +136,22 @@ def test_cli_exit_2_without_scale(capsys):
 
     assert main(["design", str(REALISTIC), "--serial"]) == 2
     assert "--scale" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("extra", "message"), [
+    (["--mesh-x-mm", "2:150", "--mesh-y-mm", "1:60"],
+     "the search space holds 10,275,520 nets .* over the 500,000"),
+    (["--level-step", "1e-6"], "--level-step 1e-06 is outside 0.005 to 1.1"),
+    (["--level-step", "nan"], "--level-step nan is outside"),
+])
+def test_a_search_too_large_is_refused_before_any_work(tmp_path, capsys, extra, message):
+    import re
+
+    from printgen.cli import main
+
+    out = tmp_path / "o"
+    assert main(["design", str(EXAMPLES / "realistic_barrier.toml"), "--scale", "40",
+                 "--serial", "--out", str(out), *extra]) == 2
+    err = capsys.readouterr().err
+    assert re.search(message, err) and len(err.strip().splitlines()) == 1, err
+    assert not out.exists() and list(tmp_path.iterdir()) == []

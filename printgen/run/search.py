@@ -37,7 +37,13 @@ from printgen.search.nets import (
 )
 from printgen.search.per_material import reachable
 from printgen.search.record import candidates_json, result_record
-from printgen.search.space import SearchSpace, default_space
+from printgen.search.space import (
+    SearchSpace,
+    check_level_step,
+    check_size,
+    default_space,
+    half_cell_counts,
+)
 from printgen.search.sweep import open_runner
 
 
@@ -100,7 +106,12 @@ def space_for(p: Prototype, scale: float, o: SearchOptions) -> SearchSpace:
     kw = {k: v for k, v in (("materials", o.materials), ("mesh_x_mm", o.mesh_x_mm),
                             ("mesh_y_mm", o.mesh_y_mm), ("tolerance", o.mesh_tolerance),
                             ("border_beads", o.border_beads)) if v is not None}
-    return default_space(p, scale_targets(p, scale), **kw)
+    t = scale_targets(p, scale)
+    space = default_space(p, t, **kw)
+    check_level_step(o.level_step)
+    check_size(space, len(half_cell_counts(t["width"] * 1e3, space.mesh_x_mm)),
+               len(half_cell_counts(t["height"] * 1e3, space.mesh_y_mm)))
+    return space
 
 
 def search_at_scales(prototype: str | Path | Prototype, scales: list[float], *,
@@ -109,12 +120,13 @@ def search_at_scales(prototype: str | Path | Prototype, scales: list[float], *,
                     progress: bool = False) -> DesignRun:
     """Search at every scale on one Dask runner (a LocalCluster unless `scheduler`/`serial`)."""
     p = prototype if isinstance(prototype, Prototype) else load_prototype(prototype)
+    spaces = {s: space_for(p, s, options) for s in scales}  # every bound checked before work
     results = []
     with open_runner(scheduler=scheduler, workers=workers, serial=serial,
                      progress=progress) as runner:
         for s in scales:
             results.append(search(p, s, runner, objective=options.objective,
-                                  space=space_for(p, s, options), printer=options.printer,
+                                  space=spaces[s], printer=options.printer,
                                   verifier=verify_task, verify_nets=options.verify_nets,
                                   level_step=options.level_step))
         where = runner.where

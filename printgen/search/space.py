@@ -32,6 +32,13 @@ BORDER_BEADS = (2, 4)  # border frame widths searched, in net beads (even: the f
 # around the net's corner loops in the parts stage)
 MIN_HALF_CELLS = 4  # fewer half-meshes than this across or up is not a net worth verifying
 MESH_DIGITS = 6  # mesh diagonals are rounded to 1e-6 mm in the records
+# Nets one search screens at most: screening keeps every net's record (~300 bytes in
+# candidates.json), about SCREEN_RATE nets per second on one core; the simple barrier's default
+# space at 1:40 holds ~230k, and unbounded mesh ranges reach tens of millions.
+MAX_CANDIDATES = 500_000
+SCREEN_RATE = 6_000  # nets screened per second, for the refusal's time estimate
+# The solver stage's load-level step (h / h_B): 1 to 220 levels per sweep of 0 to 1.1.
+LEVEL_STEP_RANGE = (0.005, 1.1)
 
 
 @dataclass(frozen=True)
@@ -160,6 +167,7 @@ def grid(ctx: SearchContext, space: SearchSpace) -> list[NetPoint]:
         raise InputError(f"mesh {which} bounds {space.mesh_x_mm if which == 'x' else space.mesh_y_mm}"
                          f" mm hold no whole number (>= {MIN_HALF_CELLS}) of half-meshes across "
                          f"the {length:.4g} mm panel; widen the bounds")
+    check_size(space, len(nxs), len(nys))
     out: list[NetPoint] = []
     for mat in space.materials:
         for beads in space.beads:
@@ -172,6 +180,30 @@ def grid(ctx: SearchContext, space: SearchSpace) -> list[NetPoint]:
                                 round(2 * ctx.width_mm / nx, MESH_DIGITS),
                                 round(2 * ctx.height_mm / ny, MESH_DIGITS), border))
     return out
+
+
+def check_size(space: SearchSpace, n_across: int, n_up: int) -> None:
+    """InputError before any work when the space holds more than MAX_CANDIDATES nets: each
+    screened net is kept (its record, candidates.json), so time and memory grow with it."""
+    factors = (len(space.materials), len(space.beads), len(space.layers), n_across, n_up,
+               len(space.border_beads))
+    n = math.prod(factors)
+    if n > MAX_CANDIDATES:
+        raise InputError(
+            f"the search space holds {n:,} nets (materials x beads x layers x meshes across x "
+            f"meshes up x borders = {' x '.join(map(str, factors))}), over the "
+            f"{MAX_CANDIDATES:,} one search screens (about {MAX_CANDIDATES // SCREEN_RATE} s "
+            "and a few hundred MB); narrow --mesh-x-mm / --mesh-y-mm (or --mesh-tolerance), "
+            "--materials or --border-beads")
+
+
+def check_level_step(step: float | None) -> None:
+    """InputError unless the solver stage's load-level step lies in LEVEL_STEP_RANGE."""
+    lo, hi = LEVEL_STEP_RANGE
+    if step is not None and not (math.isfinite(step) and lo <= step <= hi):
+        raise InputError(f"--level-step {step:g} is outside {lo:g} to {hi:g} (h / h_B per "
+                         f"level: {1.1 / lo:.0f} to {1.1 / hi:.0f} levels per sweep); the "
+                         "verification's own step is 0.05")
 
 
 def space_record(space: SearchSpace, n_points: int) -> dict:
