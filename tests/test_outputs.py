@@ -221,3 +221,17 @@ def test_check_folder_without_manifest_is_an_input_error(tmp_path):
         check_folder(tmp_path)
     with pytest.raises(InputError, match="not a folder"):
         check_folder(tmp_path / "missing")
+
+
+def test_a_failed_write_leaves_no_empty_folders(tmp_path, monkeypatch):
+    """A full disk while `calibrate --out/--plot` writes into new folders: none is left."""
+    from printgen.outputs import files
+
+    def full(p, data):
+        raise OSError(28, "No space left on device", str(p))
+
+    monkeypatch.setattr(files, "_write_new", full)
+    (tmp_path / "kept").mkdir()
+    with pytest.raises(OSError, match="No space"):
+        files.write_bytes(tmp_path / "kept" / "a" / "b" / "x.png", b"png")
+    assert [p.name for p in tmp_path.rglob("*")] == ["kept"]

@@ -98,7 +98,35 @@ def read_input_text(path: str | Path, what: str = "input file", *,
 def write_bytes(path: str | Path, data: bytes) -> Path:
     """Write `data` to `path` via a temp file in the same directory and `os.replace`."""
     p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
+    created: list[Path] = []
+    try:
+        make_parents(p.parent, created)
+        return _write_new(p, data)
+    except BaseException:
+        for folder in reversed(created):  # a failed write leaves no empty folders behind
+            with contextlib.suppress(OSError):
+                os.rmdir(folder)
+        raise
+
+
+def make_parents(folder: Path, created: list[Path]) -> None:
+    """Create `folder` and its missing parents, appending each one created to `created`
+    (outermost first) as it is made."""
+    missing = []
+    here = Path(folder)
+    while not os.path.lexists(here) and here != here.parent:
+        missing.append(here)
+        here = here.parent
+    for f in reversed(missing):
+        try:
+            f.mkdir()
+        except FileExistsError:  # made meanwhile by someone else: theirs, not ours to remove
+            continue
+        created.append(f)
+
+
+def _write_new(p: Path, data: bytes) -> Path:
+    """Write `data` to a temp file beside `p`, then rename it to `p`."""
     tmp = p.parent / f".{p.name}.{secrets.token_hex(4)}.tmp"
     # 0o666 less the umask, as any file the user writes (mkstemp would force 0600)
     # O_EXCL refuses any name already there, a link too; O_NOFOLLOW (absent on Windows) also
