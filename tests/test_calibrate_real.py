@@ -172,3 +172,17 @@ def test_bluehill_elongation_at_break_after_the_peak(folder):
         assert s.elongation_at_break - at_strength < BREAK_AFTER_PEAK
         assert (s.flags, s.notes) == ((), ())
     assert cal.elongation.n == 10 and cal.excluded == ()
+
+
+def test_default_window_refuted_by_the_machine_writes_no_profile(tmp_path, capsys):
+    """Bluehill files: the ISO window misses the machine's modulus in 10 of 10 files, so
+    --save writes nothing unless the window is chosen."""
+    from printgen.cli import main
+
+    folder = require_shared(f"{BLUEHILL}/Tens_Yield")
+    args = ["calibrate", str(folder), "--material", "cf-lab", "--inherits", "petg", "--out",
+            str(tmp_path / "p")]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert "in 10 of 10 files with the default ISO window" in err and "--window auto" in err
+    assert not (tmp_path / "p").exists()

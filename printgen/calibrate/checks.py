@@ -135,6 +135,15 @@ def window_warnings(samples: list[SampleFit], window: str, unit: tuple[str, floa
     return warns, summary
 
 
+def machine_refutes(samples: tuple[SampleFit, ...] | list[SampleFit]) -> tuple[int, int] | None:
+    """(files, files with the machine's own modulus) when the fitted modulus differs from the
+    machine's by more than MACHINE_TOL in every file that carries one (at least two): the
+    window does not fit these curves, and a profile from it would be wrong; else None."""
+    with_m = [s for s in samples if s.machine_modulus]
+    far = [s for s in with_m if abs(s.modulus / s.machine_modulus - 1) > MACHINE_TOL]
+    return (len(far), len(with_m)) if len(with_m) >= 2 and len(far) == len(with_m) else None
+
+
 def machine_warning(samples: list[SampleFit], window: str, unit: tuple[str, float]
                     ) -> str | None:
     """One warning when the fitted modulus differs from the machine's own value by more than

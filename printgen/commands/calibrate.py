@@ -22,6 +22,7 @@ from rich.measure import Measurement
 from rich.table import Table
 
 from printgen.calibrate.aggregate import MIN_SAMPLES
+from printgen.calibrate.checks import MACHINE_TOL, machine_refutes
 from printgen.calibrate.compliance import from_curve, from_stiffness
 from printgen.calibrate.fit import DEFAULT_ZERO, ISO_WINDOW, ZERO_MODES
 from printgen.calibrate.pipeline import Calibration
@@ -155,6 +156,15 @@ def run(args: argparse.Namespace) -> int:
     written = {}
     if args.save or args.out:
         from printgen.calibrate.profile_writer import value_sources, write_profile
+
+        refuted = machine_refutes(cal.samples) if args.window is None else None
+        if refuted:  # the default window against the machine in every file: ask, not guess
+            raise CalibrationError(
+                f"the fitted modulus differs from the machine's own by more than "
+                f"{MACHINE_TOL:.0%} in {refuted[0]} of {refuted[1]} files with the default ISO "
+                "window (0.05-0.25 %): no profile written; choose the window: --window auto "
+                "(the steepest part, as the machine's software fits it) or --window 0.05,0.25 "
+                "to keep the ISO value")
 
         path, mat = write_profile(cal, name=args.material, out=args.out, inherits=args.inherits,
                                   date=args.date)
