@@ -15,7 +15,7 @@ from printgen.parts.assembly import CLOSE_TOL_MM, assemble
 from printgen.parts.geometry.attach import DEFAULT_CLEARANCE_MM, holes
 from printgen.run.make import plan
 from printgen.units import MM
-from printgen.verification.scenes import model_scene
+from printgen.scene.scenes import model_scene
 
 SCALES = (40, 60, 80, 100)  # issue 12: the kit closes at every one of these
 COORD_MM = 1e-6  # round-off of coordinates built from the graph (mm)

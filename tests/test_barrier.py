@@ -120,7 +120,7 @@ def test_drag_is_hydrostatic_plus_half_rho_v2_l_d_when_all_is_wet():
 
 
 def test_a_load_case_states_its_assumptions_in_the_scenes(design_1_40):
-    from printgen.verification.scenes import model_scene
+    from printgen.scene.scenes import model_scene
 
     plain = model_scene(design_1_40)
     dragged = model_scene(design_1_40, load="drag")

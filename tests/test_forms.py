@@ -1,4 +1,4 @@
-"""Model-form options of the printed model's scene (issue 25, printgen.verification.forms): the
+"""Model-form options of the printed model's scene (issue 25, printgen.scene.forms): the
 strand law derived from the virtual panel test, and the net's bottom row held on the bed."""
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ from proto_files import EXAMPLES
 from printgen.design.design_file import load_design
 from printgen.inputs.materials import load_material
 from printgen.verification.bands import Variant, curves, model_variants, variant_scene
-from printgen.verification.forms import DERIVE_POINTS, derived_net_law
-from printgen.verification.panel import PanelTest, law_strains, simulate
+from printgen.scene.forms import DERIVE_POINTS, derived_net_law
+from printgen.scene.panel import PanelTest, law_strains, simulate
 from printgen.verification.verify import sweep
 
 PAPER = EXAMPLES / "paper_1_40" / "design.json"

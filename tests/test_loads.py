@@ -127,7 +127,7 @@ def test_jam_levels_are_the_flumes_discharge_steps():
     """On the printed 1:40 model the jam's levels pass 2, 3, ... 8 L/s through the 300 mm
     free section; a step held above the overflow is read at h/h_B = 1.1."""
     from printgen.inputs.prototype import load_prototype
-    from printgen.verification.scenes import model_scene
+    from printgen.scene.scenes import model_scene
     from printgen.verification.verify import load_keywords
 
     p, d = load_prototype(REALISTIC), reference_design_1_40()
@@ -187,7 +187,7 @@ def test_case_readings_are_the_nominal_model_at_the_discharge_steps():
     from printgen.inputs.prototype import load_prototype
     from printgen.report.labfiles import _csv, case_file, case_readings
     from printgen.verification.cases import case_runs
-    from printgen.verification.readings import flume_units
+    from printgen.scene.readings import flume_units
 
     c = case_runs(load_prototype(REALISTIC), reference_design_1_40(), "jam:porosity=0.8")
     r = case_readings(c.model, c.load["model"], flume_units(c.model.scene).length_mm)

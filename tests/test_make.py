@@ -98,7 +98,7 @@ def test_fine_mesh_is_refused_with_its_estimate(tmp_path, capsys):
 
 def test_estimate_counts_the_nodes_the_solver_gets(made):
     from printgen.run.budget import model_nodes, prototype_nodes
-    from printgen.verification.scenes import model_scene, prototype_scene
+    from printgen.scene.scenes import model_scene, prototype_scene
 
     ctx, _ = made
     assert prototype_nodes(ctx.prototype) == len(prototype_scene(ctx.prototype).nodes)

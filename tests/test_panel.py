@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from printgen.verification.panel import (
+from printgen.scene.panel import (
     PanelTest,
     analytic_blocked,
     derive_law,
@@ -15,7 +15,7 @@ from printgen.verification.panel import (
     lockup_strain,
     simulate,
 )
-from printgen.verification.scenes import strand_law_from_membrane
+from printgen.scene.scenes import strand_law_from_membrane
 
 MM = 1e-3
 ANALYTIC_TOL = 0.01  # issue 25: a blocked, infinite panel matches the formula within 1 %

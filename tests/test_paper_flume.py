@@ -11,7 +11,7 @@ import pytest
 from printgen.design.design_file import load_design
 from printgen.errors import GeometryError
 from printgen.verification.measured import MeasurementError, mismatch, read_measured
-from printgen.verification.scenes import model_scene, panel_axes
+from printgen.scene.scenes import model_scene, panel_axes
 
 HERE = Path(__file__).resolve().parents[1] / "examples" / "paper_1_40"
 EXACT = 1e-12  # values read from the CSV: only round-off

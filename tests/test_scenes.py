@@ -16,14 +16,14 @@ from printgen.design.similitude import scale_targets
 from printgen.errors import InputError
 from printgen.inputs.prototype import load_prototype
 from printgen.verification.compare import wire_elongation
-from printgen.verification.scenes import (
+from printgen.scene.scenes import (
     SENSOR_FORCE_N,
     BarrierScene,
     Wire,
     model_scene,
     prototype_scene,
 )
-from printgen.verification.solvernet import WIRE_RATE, WIRE_STRAIN, build, wire_law
+from printgen.scene.solvernet import WIRE_RATE, WIRE_STRAIN, build, wire_law
 from printgen.verification.verify import sweep
 from solver.assemble import internal, make_bars, make_cable
 

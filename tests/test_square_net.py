@@ -25,7 +25,7 @@ from printgen.inputs.printers import load_print_style, load_printer
 from printgen.inputs.prototype import load_prototype
 from printgen.parts.gcode import net_toolpath, net_volume_budget, write_gcode
 from printgen.parts.gcode.toolpath import BORDER, STRAND_MINUS, STRAND_PLUS
-from printgen.verification.scenes import model_scene, prototype_scene
+from printgen.scene.scenes import model_scene, prototype_scene
 
 GEOM_TOL_MM = 1e-6  # float round-off on coordinates built from the graph
 MESH_VOLUME_REL = 1e-6  # manifold's mesh volume vs the analytic plan area x thickness
@@ -204,12 +204,12 @@ FREE_HOLD_REL = 0.01
 
 @pytest.mark.parametrize("mode", ["blocked", "free"])
 def test_virtual_panel_of_the_square_net_reads_its_membrane_law(simple, mode):
-    """The same panel machinery as the diamond (`verification.panel`): the designed square
+    """The same panel machinery as the diamond (`scene.panel`): the designed square
     strands, tested as a panel, give the membrane law the design priced (one strand per mesh
     across, `square.membrane_factor`), times (nx + 1) / nx for the panel's two edge strands
     on a width of nx meshes; free or blocked alike (a square net has no Poisson effect)."""
     from printgen.design.section import net_membrane_law
-    from printgen.verification.panel import PanelTest, lattice_size, simulate
+    from printgen.scene.panel import PanelTest, lattice_size, simulate
 
     _, d = simple
     n = d.net

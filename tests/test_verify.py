@@ -16,7 +16,7 @@ from printgen.design.similitude import scale_targets
 from printgen.inputs.prototype import load_prototype
 from printgen.report.jsonout import dumps
 from printgen.report.plots import deformed_figure
-from printgen.verification.scenes import model_scene, prototype_scene
+from printgen.scene.scenes import model_scene, prototype_scene
 from printgen.verification.verify import SHAPE_LEVELS, sweep, verify
 
 HOLD_SHARE_MAX = 0.01  # the hold may carry at most 1 % of the applied load (a regularisation)
@@ -96,7 +96,7 @@ def _reference_curves(s, lv: np.ndarray) -> dict[str, np.ndarray]:
     formulation of the same physics."""
     import solver
     from printgen.verification.compare import deformation
-    from printgen.verification.solvernet import WIRE_STRAIN, build, path_length, wire_law
+    from printgen.scene.solvernet import WIRE_STRAIN, build, path_length, wire_law
     from printgen.verification.verify import loads_function
 
     net, ex = build(s)

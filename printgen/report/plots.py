@@ -11,7 +11,7 @@ from printgen.errors import PrintgenError
 from printgen.verification.bands import Band
 from printgen.verification.compare import METRICS, Deformation
 from printgen.verification.measured import Fit, Measurement
-from printgen.verification.scenes import BarrierScene
+from printgen.scene.scenes import BarrierScene
 
 DPI = 110
 SVG_SALT = "printgen"  # matplotlib's svg.hashsalt: the same figure gives the same SVG ids

@@ -204,7 +204,7 @@ MAKE = Work()
 def band_variants(p: Prototype, d: Design) -> int:
     """The model variants the uncertainty band sweeps (as `verify` mounts the model)."""
     from printgen.verification.bands import model_variants
-    from printgen.verification.scenes import lateral_mounting
+    from printgen.scene.scenes import lateral_mounting
     from printgen.verification.verify import free_section
 
     return len(model_variants(d, lateral_mounting(p), free_section(p))[0])

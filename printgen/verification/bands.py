@@ -43,7 +43,7 @@ from printgen.inputs.prototype import Prototype
 from printgen.trace import span
 from printgen.units import MM
 from printgen.verification.compare import METRICS
-from printgen.verification.scenes import BarrierScene, model_scene
+from printgen.scene.scenes import BarrierScene, model_scene
 from printgen.verification.verify import Run, load_keywords, sweep
 from printgen.workers import collect, submit_jobs
 
@@ -122,7 +122,7 @@ def model_variants(d: Design, mounting: str | None = None, free_section: float |
         notes.append("mounting: the model scene has one mounting only; no mounting variant")
     out.append(Variant(f"initial slack {SLACK_MAX:.0%}", slack=SLACK_MAX,
                        source="printed net hung with 0 to 1 % slack (printgen; README: Uncertainty band)"))
-    from printgen.verification.forms import model_form_variants
+    from printgen.scene.forms import model_form_variants
 
     out += model_form_variants(d, free_section, notes, nominal)
     return out, notes
@@ -161,7 +161,7 @@ def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
 def _orientation_variants(d: Design) -> list[Variant]:
     """The panel law read along each mesh diagonal its profile does not record (issue 25:
     the paper does not say which diagonal its printed panels were loaded along)."""
-    from printgen.verification.scenes import ORIENTATIONS, recorded_orientation
+    from printgen.scene.scenes import ORIENTATIONS, recorded_orientation
 
     law = load_material(d.net.material).panel_law
     recorded = recorded_orientation(law)
@@ -187,7 +187,7 @@ def variant_scene(d: Design, v: Variant, coarsen: int = 1) -> BarrierScene:
                     orientation=v.orientation)
     laws = list(s.laws)
     if v.net_law == "derived":  # issue 25: the virtual panel test's strand law
-        from printgen.verification.forms import derived_net_law
+        from printgen.scene.forms import derived_net_law
 
         laws[0], how = derived_net_law(load_material(d.net.material), d.net, v.orientation)
         s = dataclasses.replace(s, assumptions=tuple(
@@ -199,10 +199,10 @@ def variant_scene(d: Design, v: Variant, coarsen: int = 1) -> BarrierScene:
     cables = {k: (nodes, _scaled(law, v.cable_factor)) for k, (nodes, law) in s.cables.items()}
     s = dataclasses.replace(s, laws=laws, cables=cables, pressure=v.pressure)
     if v.span is not None:  # issue 25: the printed net mounted in the flume's free section
-        from printgen.verification.mount import in_free_section
+        from printgen.scene.mount import in_free_section
 
         s = in_free_section(s, v.span)
-    from printgen.verification.forms import held_on_bed, routed
+    from printgen.scene.forms import held_on_bed, routed
 
     s = held_on_bed(s) if v.bed == "held" else s
     return routed(s, v.routing)

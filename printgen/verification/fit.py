@@ -6,9 +6,9 @@ Parameters, each bounded by what a lab would see or measure (`BOUNDS`):
 - net_slack: initial slack of the net's strands (a zero-force strain before they pull);
 - cable_slack: initial slack of the border cables (the same, on the cables);
 and, as discrete choices tried in turn, the flume mounting and the panel-test orientation
-(`printgen.verification.scenes`), the net's span (printed width or the flume's free section,
-`printgen.verification.mount`) and its bottom row free or held on the bed
-(`printgen.verification.forms`). Slack is a law with a first, (nearly) flat segment (`slackened`):
+(`printgen.scene.scenes`), the net's span (printed width or the flume's free section,
+`printgen.scene.mount`) and its bottom row free or held on the bed
+(`printgen.scene.forms`). Slack is a law with a first, (nearly) flat segment (`slackened`):
 the same to first order as a rest length (1 + slack) times longer.
 
 For every discrete choice the continuous parameters are searched (scipy's bounded
@@ -34,9 +34,9 @@ import numpy as np
 
 from printgen.design.record import Design
 from printgen.verification.bands import Variant, curves, variant_scene
-from printgen.verification.forms import BEDS
+from printgen.scene.forms import BEDS
 from printgen.verification.measured import Measurement, mismatch, objective
-from printgen.verification.scenes import MOUNTINGS, ORIENTATIONS, BarrierScene
+from printgen.scene.scenes import MOUNTINGS, ORIENTATIONS, BarrierScene
 from printgen.verification.verify import sweep
 
 # (low, high, nominal) of each continuous parameter

@@ -1,5 +1,5 @@
 """The virtual scale series (Lambert et al. 2023, doi:10.1061/JHEND8.HYENG-13070, Fig. 2): the
-prototype's scene (`printgen.verification.scenes.prototype_scene`) rebuilt at 1:lambda for
+prototype's scene (`printgen.scene.scenes.prototype_scene`) rebuilt at 1:lambda for
 several stiffness rows, each solved under a load case of `printgen.barrier.loads` up to one
 relative loading, and read as normalised deformations (deflection / width, lowering / height,
 mid-height elongation).
@@ -33,7 +33,7 @@ from printgen.inputs.materials import load_material
 from printgen.inputs.profiles import profile_name
 from printgen.inputs.prototype import Prototype
 from printgen.units import RHO_WATER, G
-from printgen.verification.scenes import (
+from printgen.scene.scenes import (
     MOUNTINGS,
     ORIENTATIONS,
     PRESSURES,

@@ -1,5 +1,5 @@
 """Pre-print verification: the prototype and the printed model, each as a tension-only net
-(`printgen.verification.scenes`), loaded hydrostatically from h / h_B = 0 to 1.1 (the reference's loading
+(`printgen.scene.scenes`), loaded hydrostatically from h / h_B = 0 to 1.1 (the reference's loading
 test: water raised behind a folded film), or another load case of `printgen.barrier.loads`
 (flow, drag, jam: a case may bring its own levels and states what it used at each), and compared by their normalised deformations over the whole range (printgen.verification.compare).
 Also the counter-example the report warns about: the simple barrier with steel at every scale.
@@ -30,13 +30,13 @@ from printgen.verification.compare import (
     headline,
     increments,
 )
-from printgen.verification.scenes import (
+from printgen.scene.scenes import (
     BarrierScene,
     lateral_mounting,
     model_scene,
     prototype_scene,
 )
-from printgen.verification.solvernet import build, hold_share, wire_slack
+from printgen.scene.solvernet import build, hold_share, wire_slack
 from printgen.workers import (  # worker lifecycle: ground floor
     check_deadline,
     report_progress,
@@ -62,7 +62,7 @@ def levels(step: float = LEVEL_STEP, top: float = OVERFLOW) -> np.ndarray:
 
 
 def solver_net(s: BarrierScene, *, slack: float = 0.0) -> solver.Net:
-    """The scene as a solver net (`printgen.verification.solvernet`): its sensor wires pulling at
+    """The scene as a solver net (`printgen.scene.solvernet`): its sensor wires pulling at
     constant tension (one element per wire segment), its unloaded nodes held when the scene says so; `slack` is the
     relative initial slack of every strand and cable (0.01 = rest lengths 1 % longer than the
     printed ones)."""
@@ -78,7 +78,7 @@ def loads_function(s: BarrierScene, *, load: str | LoadCase | None = None,
     loads_at = get_load(load).loads_for(s, site)
     if s.pressure != "normal":
         return loads_at
-    from printgen.verification.pressure import normal_pressure
+    from printgen.scene.pressure import normal_pressure
 
     free = np.flatnonzero(~s.fixed)
     normal = normal_pressure(s.nodes, s.elements[s.element_law == 0], free, s.area_per_node,
@@ -169,7 +169,7 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw: Any
     if loose:  # a segment shorter than its knee would pull harder than the sensor
         raise SolverError(f"{s.name}: a sensor wire segment shortened below its spring's knee "
                           f"at h/h_B = {loose[0]:g}; raise WIRE_STRAIN in "
-                          "printgen/verification/solvernet.py")
+                          "printgen/scene/solvernet.py")
     n, m, c = ex.n_nodes, ex.n_elements, ex.n_cables
     d = deformation(s, lv, [r.positions[:n] for r in results],
                     [r.tensions[:m] for r in results], [r.cable_tensions[:c] for r in results])

@@ -2,7 +2,7 @@
 
 Each module here defines `CASE`, a `LoadCase`; `get_load(name)` finds it (a new load case
 is one module plus its test). A case reads the barrier's scene (nodes, anchors, strands,
-height and tributary area: a `printgen.verification.scenes.BarrierScene`) and its `Site` (the flow
+height and tributary area: a `printgen.scene.scenes.BarrierScene`) and its `Site` (the flow
 and strands at that barrier's scale), and gives the solver's loads at each relative loading
 r = h / h_B (the upstream water depth over the barrier's height).
 

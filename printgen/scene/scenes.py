@@ -12,7 +12,7 @@ held by the flume's side sheets along their whole height (`walls`, the default) 
 lateral cables' eyelets are anchored (`eyelets`). Without border cables the net is anchored
 on the bed and the banks and its top is free.
 
-Sensor wires (`Wire`; as solver cables in `printgen.verification.solvernet`): a string
+Sensor wires (`Wire`; as solver cables in `printgen.scene.solvernet`): a string
 potentiometer's wire is anchored at the barrier's left edge node of its row, runs along the
 row of nodes (the nodes are the points the wire bends over, frictionless), leaves the right
 edge node and runs on, in line with the row at rest, to the potentiometer `SENSOR_EXIT` x width
@@ -51,7 +51,7 @@ MOUNTINGS = LATERAL  # lateral mounting in the flume ([flume] lateral), the defa
 # short diagonal, whose strand modulus matches the datasheet (see `panel_strand_law`).
 ORIENTATIONS = ("short", "long")
 # Direction of the water's force on a node: along the flow (the reference's section 3), or
-# normal to the deformed net (the film lies on the net: `printgen.verification.pressure`).
+# normal to the deformed net (the film lies on the net: `printgen.scene.pressure`).
 PRESSURES = ("flow", "normal")
 PROTOTYPE_ORIENTATION = "long"
 # Stiffness holding each free node where it is when its strands carry no load (N/m), as a

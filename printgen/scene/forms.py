@@ -4,7 +4,7 @@ the test, never fitted to the flume curve (Lambert et al. 2023, doi:10.1061/JHEN
 - net law (`NET_LAWS`): "formula" (the nominal) turns the profile's panel law into a strand
   law by the analytic diamond mapping (every strand of an infinite, blocked panel stretched
   alike); "derived" uses the strand law whose simulated panel test, as the source ran it,
-  reproduces the panel law (`printgen.verification.panel.derive_law`): free between the clamps,
+  reproduces the panel law (`printgen.scene.panel.derive_law`): free between the clamps,
   or blocked where a free pin-jointed panel is a mechanism over the law's range (the printed
   net's rigid junctions, which the solver does not model, stop its meshes closing at no force;
   blocking is their stiff limit);
@@ -32,7 +32,7 @@ import numpy as np
 from printgen.design.record import Design
 from printgen.inputs.materials import load_material
 from printgen.units import MM
-from printgen.verification.scenes import BarrierScene, Law, panel_axes, recorded_orientation
+from printgen.scene.scenes import BarrierScene, Law, panel_axes, recorded_orientation
 
 if TYPE_CHECKING:
     from printgen.verification.bands import Variant
@@ -50,8 +50,8 @@ def _derived(knees: tuple[float, ...], slopes: tuple[float, ...], along: float, 
              length: float, width: float) -> tuple[Law, str, float]:
     """(strand law, test mode, derivation error) of a panel law n(eps) = piecewise(knees,
     slopes N/m) tested on a `length` x `width` panel loaded along the `along` diagonal."""
-    from printgen.verification.panel import PanelTest, derive_law, law_strains, simulate
-    from printgen.verification.scenes import strand_law_from_membrane
+    from printgen.scene.panel import PanelTest, derive_law, law_strains, simulate
+    from printgen.scene.scenes import strand_law_from_membrane
 
     free = PanelTest(along, across, length, width, "free")
     probe = simulate(strand_law_from_membrane(knees, slopes, along, across), free,
@@ -67,7 +67,7 @@ def derived_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
     strand section to the design's; and how it was found. GeometryError-free: a material
     without a panel law of recorded geometry keeps the formula (`model_net_law`)."""
     from printgen.design.section import area_m2
-    from printgen.verification.scenes import model_net_law
+    from printgen.scene.scenes import model_net_law
 
     law = mat.panel_law
     if law is None or not law.has_geometry:
@@ -126,8 +126,8 @@ def _routing_variants(d: Design, mounting: str | None, notes: list[str]) -> list
 def model_form_variants(d: Design, free_section: float | None, notes: list[str],
                         mounting: str | None = None) -> list[Variant]:
     """Issue 25: the water's force normal to the deformed net, the virtual panel test's strand
-    law and the bottom row held on the bed (printgen.verification.forms), and the net mounted
-    in a free section narrower than its printed width (printgen.verification.mount), alone and
+    law and the bottom row held on the bed (printgen.scene.forms), and the net mounted
+    in a free section narrower than its printed width (printgen.scene.mount), alone and
     with its slack bottom cable on the bed; the sensor routing where it matters."""
     from printgen.verification.bands import SAME, Variant
 

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 import solver
-from printgen.verification.scenes import BarrierScene
+from printgen.scene.scenes import BarrierScene
 
 WIRE_STRAIN = 3.0  # the spring's strain at rest (its rest length is a quarter of the segment's)
 WIRE_KNEE = 0.5  # below this strain the law is steep: a segment shorter than 3/8 of its length

@@ -14,7 +14,7 @@ boundary conditions, as the sources describe them:
 The reading is the clamp force per clamp width, n = F / w (N/m), against the elongation
 dl = eps L; the panel law kappa = n / dl (kN/m/m), or n against eps for the membrane law.
 
-The analytic diamond formula (`printgen.verification.scenes.strand_law_from_membrane`) is the
+The analytic diamond formula (`printgen.scene.scenes.strand_law_from_membrane`) is the
 blocked, infinite panel: every strand stretched alike. `analytic_blocked` gives it at finite
 strain too (the strands rotate toward the load), the test the blocked simulation must match.
 
@@ -328,7 +328,7 @@ def design_panel(d, orientation: str, mode: str = "free",
     """The simulated panel test of design `d`'s printed net, loaded along its `orientation`
     diagonal, of the size its material's panel law was tested at (else PRINTED_PANEL)."""
     from printgen.inputs.materials import load_material
-    from printgen.verification.scenes import model_net_law, panel_axes
+    from printgen.scene.scenes import model_net_law, panel_axes
 
     n = d.net
     mat = load_material(n.material)
