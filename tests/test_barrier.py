@@ -120,10 +120,10 @@ def test_drag_is_hydrostatic_plus_half_rho_v2_l_d_when_all_is_wet():
 
 
 def test_a_load_case_states_its_assumptions_in_the_scenes(design_1_40):
-    from printgen.scene.scenes import model_scene
+    from printgen.scene import SceneOptions, build_scene
 
-    plain = model_scene(design_1_40)
-    dragged = model_scene(design_1_40, load="drag")
+    plain = build_scene(design_1_40)
+    dragged = build_scene(design_1_40, SceneOptions(load="drag"))
     what = [a[0] for a in dragged.assumptions]
     assert "loading: drag" in what and "loading" in what
     assert "loading: drag" not in [a[0] for a in plain.assumptions]

@@ -9,14 +9,8 @@ import numpy as np
 import pytest
 from conftest import reference_design_1_40
 
-from printgen.verification.fit import (
-    BOUNDS,
-    Params,
-    at_bounds,
-    fit_measured,
-    predict,
-    slackened,
-)
+from printgen.scene.forms import slackened
+from printgen.verification.fit import BOUNDS, Params, at_bounds, fit_measured, predict
 from printgen.verification.measured import Measurement
 
 COARSE = 2  # the 1:40 net with a 2x coarser mesh (distinct top and mid rows): fast sweeps

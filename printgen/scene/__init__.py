@@ -9,3 +9,8 @@ Below it: the scene's arrays (`scenes`), its solver net (`solvernet`), the model
 transforms (`forms`, `mount`, `pressure`), the sensors' readings (`readings`), the flume
 drawing (`flume`) and the virtual panel test (`panel`).
 """
+
+from printgen.scene.options import SceneOptions, build_scene
+from printgen.scene.scenes import BarrierScene
+
+__all__ = ["BarrierScene", "SceneOptions", "build_scene"]

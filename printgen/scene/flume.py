@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from printgen.units import MM
 from printgen.scene.readings import SENSORS
 from printgen.scene.scenes import BarrierScene
+from printgen.units import MM
 
 DIGITS = 4  # decimals of mm kept in the record (0.1 um)
 SIDE_NAMES = {"left": "left side sheet", "right": "right side sheet", "bottom": "flume bed"}

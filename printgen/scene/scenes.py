@@ -287,6 +287,27 @@ def model_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
         "diagonal")
 
 
+def with_factors(s: BarrierScene, net: float, frame: float, cable: float) -> BarrierScene:
+    """Scene `s` with the force laws of its net's strands, its printed border frame (the
+    second law, when it has one) and its border cables multiplied by `net`, `frame`, `cable`."""
+    laws = list(s.laws)
+    laws[0] = _scaled(laws[0], net)
+    if len(laws) > 1:  # the printed border frame, of the net's material
+        laws[1] = _scaled(laws[1], frame)
+    cables = {k: (nodes, _scaled(law, cable)) for k, (nodes, law) in s.cables.items()}
+    return dataclasses.replace(s, laws=laws, cables=cables)
+
+
+def _scaled(law: Law, factor: float) -> Law:
+    knees, slopes = law
+    return tuple(knees), tuple(x * factor for x in slopes)
+
+
+def noted(s: BarrierScene, *rows: Assumption) -> BarrierScene:
+    """Scene `s` with assumption `rows` added after its own."""
+    return dataclasses.replace(s, assumptions=(*s.assumptions, *rows))
+
+
 def _finish(s: BarrierScene, rows: list[Assumption], *, sensors: bool,
             load: str | LoadCase | None) -> BarrierScene:
     """The scene with its sensor wires pulling (model) or only reading (prototype), and the

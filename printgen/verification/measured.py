@@ -29,8 +29,10 @@ from printgen.design.record import Design
 from printgen.errors import InputError
 from printgen.inputs.profiles import profile_name
 from printgen.outputs.files import read_input_text
-from printgen.verification.bands import Band, Variant, curves, run_variant
+from printgen.scene.options import SceneOptions
 from printgen.scene.readings import DEPTH_COLUMN, RAW_COLUMNS, FlumeUnits
+from printgen.verification.bands import Band, curves, run_variant
+from printgen.verification.variants import Variant
 
 LEVEL_COLUMN = "h_over_hb"
 # CSV column -> (METRICS key of printgen.verification.compare, factor from the CSV unit to the key's)
@@ -363,13 +365,15 @@ def model_predictor(d: Design, band: Band, m: Measurement, kind: str = "stiffnes
     above = np.flatnonzero(band.levels >= top - 1e-9)
     n = int(above[0]) + 1 if above.size else len(band.levels)
     lv, k = band.levels[:n], band.coarsen
-    nominal = Variant(mounting=band.mounting)
+    nominal = Variant(options=SceneOptions(mounting=band.mounting))
     base = curves(run_variant(d, nominal, lv, k, load_kw)) if k > 1 else None
 
     def predict(value: float) -> dict[str, np.ndarray]:
-        v = dataclasses.replace(nominal, label="fit", **(
-            {"net_factor": value, "frame_factor": value} if kind == "stiffness"
-            else {"slack": value}))
+        if kind == "stiffness":
+            v = Variant("fit", options=dataclasses.replace(nominal.options, net_factor=value,
+                                                           frame_factor=value))
+        else:
+            v = dataclasses.replace(nominal, label="fit", slack=value)
         c = curves(run_variant(d, v, lv, k, load_kw))
         out = {}
         for key in m.values:
