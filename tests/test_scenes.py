@@ -80,7 +80,7 @@ def test_wire_segments_pull_like_a_sliding_wire():
     strands = np.array([[4, 1], [5, 2]])
     exit_point = np.array([3.3, 0, 0])
     s = BarrierScene("wire", 1.0, 3.0, 1.0, x, fixed, strands, np.zeros(2, int),
-                     [((), (10.0,))], {}, {}, 0, 0, 1.0,
+                     [solver.linear(10.0)], {}, {}, 0, 0, 1.0,
                      {"w": Wire(np.arange(4), exit_point, SENSOR_FORCE_N)})
     net, ex = build(s)
     push = np.array([[0, 0.3, 0.5], [0, 0.4, 0.6]])

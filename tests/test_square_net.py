@@ -85,7 +85,7 @@ def test_square_membrane_law_is_one_strand_per_mesh(simple):
     _, d = simple
     s = build_scene(d)
     n = d.net
-    membrane = s.laws[0][1][0] * square_factor(n.mesh_x_mm * 1e-3)
+    membrane = s.laws[0].slopes[0] * square_factor(n.mesh_x_mm * 1e-3)
     from printgen.design.section import net_membrane_law
 
     want = net_membrane_law(load_material(n.material), n.strand, n.mesh_y_mm * 1e-3,

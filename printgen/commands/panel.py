@@ -35,7 +35,7 @@ def run(args: argparse.Namespace) -> int:
     panels = [design_panel(d, o, args.mode) for o in (args.orientation or ORIENTATIONS)]
     if args.json:
         emit_json([{"orientation": dp.orientation, "test": dp.test.describe(),
-                    "strand_law": {"knees": dp.law[0], "slopes_n": dp.law[1]},
+                    "strand_law": {"knees": dp.law.knees, "slopes_n": dp.law.slopes},
                     "strain": dp.curve.strains, "force_per_width_n_per_m":
                     dp.curve.force_per_width, "measured_n_per_m": dp.measured,
                     "hold_share": dp.curve.hold_share} for dp in panels])

@@ -28,19 +28,20 @@ from functools import lru_cache
 
 import numpy as np
 
-from printgen.barrier.patterns.diamond import strand_law as strand_law_from_membrane
+from printgen.barrier.patterns import get_pattern
 from printgen.design.record import Design
 from printgen.design.section import area_m2
 from printgen.inputs.materials import load_material
 from printgen.scene.panel import PanelTest, derive_law, law_strains, simulate
 from printgen.scene.scenes import (
+    TESTED_PATTERN,
     BarrierScene,
-    Law,
     model_net_law,
     panel_axes,
     recorded_orientation,
 )
 from printgen.units import MM
+from solver import Law
 
 NET_LAWS = ("formula", "derived")
 BEDS = ("free", "held")
@@ -56,9 +57,9 @@ def _derived(knees: tuple[float, ...], slopes: tuple[float, ...], along: float, 
              length: float, width: float) -> tuple[Law, str, float]:
     """(strand law, test mode, derivation error) of a panel law n(eps) = piecewise(knees,
     slopes N/m) tested on a `length` x `width` panel loaded along the `along` diagonal."""
-    free = PanelTest(along, across, length, width, "free")
-    probe = simulate(strand_law_from_membrane(knees, slopes, along, across), free,
-                     law_strains(knees)[:2])
+    free = PanelTest(along, across, length, width, "free", TESTED_PATTERN)
+    formula = get_pattern(TESTED_PATTERN).strand_law(knees, slopes, along, across)
+    probe = simulate(formula, free, law_strains(knees)[:2])
     t = free if probe.hold_share <= MECHANISM else dataclasses.replace(free, mode="blocked")
     d = derive_law(knees, slopes, t, law_strains(knees, DERIVE_POINTS))
     return d.law, t.mode, d.error
@@ -83,7 +84,7 @@ def derived_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
     how = (f"strand law derived from the virtual panel test ({law.panel_length / MM:g} mm "
            f"panel, {width / MM:g} mm clamps, {mode}, along the {along / MM:g} mm "
            f"({orientation}) diagonal; reproduces the panel law within {err:.1%})")
-    return (strand[0], tuple(s * ratio for s in strand[1])), how
+    return strand.scaled(ratio), how
 
 
 def with_derived_law(s: BarrierScene, d: Design, orientation: str | None) -> BarrierScene:
@@ -124,8 +125,8 @@ def slackened(law: Law, slack: float) -> Law:
     """The law with a nearly flat first segment of `slack` strain (SLACK_SLOPE of its slope)."""
     if slack <= 0:
         return law
-    knees, slopes = law
-    return (slack, *(k + slack for k in knees)), (SLACK_SLOPE * slopes[0], *slopes)
+    return Law((slack, *(k + slack for k in law.knees)),
+               (SLACK_SLOPE * law.slopes[0], *law.slopes))
 
 
 def slack_laws(s: BarrierScene, net: float, cable: float) -> BarrierScene:

@@ -7,7 +7,8 @@ from __future__ import annotations
 
 import dataclasses
 
-from printgen.scene.scenes import SENSOR_FORCE_N, BarrierScene, Law
+from printgen.scene.scenes import SENSOR_FORCE_N, BarrierScene
+from solver import Law
 
 
 def at_scale(base: BarrierScene, lam: float, name: str, *, sensors: bool = False,
@@ -17,16 +18,13 @@ def at_scale(base: BarrierScene, lam: float, name: str, *, sensors: bool = False
     net's strands of `net_law`, its other strand laws (the border frame) times lam^-2 and its
     cables of `cable_law`; the sensor wires pull SENSOR_FORCE_N when `sensors`, else only
     read."""
-    def scaled(law: Law, f: float) -> Law:
-        return law[0], tuple(k * f for k in law[1])
-
     if net_law is not None:
-        laws = [net_law] + [scaled(law, lam**-2) for law in base.laws[1:]]
+        laws = [net_law] + [law.scaled(lam**-2) for law in base.laws[1:]]
         cables = {k: (n, cable_law) for k, (n, _law) in base.cables.items()}
     else:
         f = 1.0 if factor is None else factor
-        laws = [scaled(law, f) for law in base.laws]
-        cables = {k: (n, scaled(law, f)) for k, (n, law) in base.cables.items()}
+        laws = [law.scaled(f) for law in base.laws]
+        cables = {k: (n, law.scaled(f)) for k, (n, law) in base.cables.items()}
     force = SENSOR_FORCE_N if sensors else 0.0
     wires = {k: dataclasses.replace(w, exit=w.exit / lam, force=force)
              for k, w in base.wires.items()}

@@ -40,10 +40,10 @@ from printgen.scene.scenes import (
     PRESSURES,
     PROTOTYPE_ORIENTATION,
     BarrierScene,
-    Law,
 )
 from printgen.units import RHO_WATER, G
 from printgen.verification.verify import levels, sweep
+from solver import linear
 
 SCALES = (1.0, 10.0, 30.0, 50.0, 100.0)  # the paper's series (Lambert et al. 2023, Fig. 2)
 OUTPUTS = {"deflection": "mid-height deflection / width",
@@ -187,8 +187,8 @@ def scaled_scene(base: BarrierScene, p: Prototype, row: Row, lam: float,
                  sensors: bool = False) -> BarrierScene:
     """`base` (the prototype's scene) at 1:`lam` with `row`'s stiffness (see the module)."""
     if row.kind == "material":
-        net_law: Law = ((), (row.modulus * math.pi / 4 * (p.net.strand_diameter / lam) ** 2,))
-        cable: Law | None = ((), (row.modulus * math.pi / 4 * (p.border.diameter / lam) ** 2,)) \
+        net_law = linear(row.modulus * math.pi / 4 * (p.net.strand_diameter / lam) ** 2)
+        cable = linear(row.modulus * math.pi / 4 * (p.border.diameter / lam) ** 2) \
             if p.border is not None else None
         return at_scale(base, lam, f"{base.name} 1:{lam:g} {row.key}",
                         sensors=sensors and lam > 1, net_law=net_law, cable_law=cable)
@@ -222,7 +222,7 @@ def solve_case(shared: SeriesShared, case: tuple[str, float]) -> CaseResult:
     values = {k: float(d.values[k][-1]) if d.levels[-1] == lv[-1] else math.nan
               for k in OUTPUTS}
     return CaseResult(key, lam, values, d.levels, {k: d.values[k] for k in OUTPUTS},
-                      float(s.laws[0][1][0]), RHO_WATER * G * s.height * s.area_per_node,
+                      float(s.laws[0].slopes[0]), RHO_WATER * G * s.height * s.area_per_node,
                       run.hold_share, int(sum(run.iterations)), dict(run.failed))
 
 
