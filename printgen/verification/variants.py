@@ -27,12 +27,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from printgen.barrier.patterns import get_pattern
-from printgen.barrier.patterns.diamond import diamond_factor
 from printgen.design.record import Design
 from printgen.design.section import area_m2
 from printgen.inputs.materials import load_material
 from printgen.scene.options import SceneOptions, build_scene
-from printgen.scene.scenes import MOUNTINGS, ORIENTATIONS, recorded_orientation
+from printgen.scene.scenes import MOUNTINGS, ORIENTATIONS, TESTED_PATTERN, recorded_orientation
 from printgen.units import MM
 
 SLACK_MAX = 0.01  # initial slack of the printed net, upper end of the range (0-1 %)
@@ -123,7 +122,8 @@ def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
     """The panel law used without the rescaling from its (assumed) tested net to the design's."""
     mat = load_material(d.net.material)
     law, n = mat.panel_law, d.net
-    tested = diamond_factor(law.mesh_along_load, law.mesh_across_load) * (
+    tested = get_pattern(TESTED_PATTERN).membrane_factor(law.mesh_along_load,
+                                                         law.mesh_across_load) * (
         law.strand_width * law.strand_thickness)
     design = get_pattern(n.pattern).membrane_factor(n.mesh_y_mm * MM, n.mesh_x_mm * MM) * \
         area_m2(n.strand)
