@@ -16,11 +16,12 @@ def at_scale(base: BarrierScene, lam: float, name: str, *, sensors: bool = False
              cable_law: Law | None = None) -> BarrierScene:
     """`base` at 1:`lam`, named `name`: every law times `factor`, or (`net_law` given) the
     net's strands of `net_law`, its other strand laws (the border frame) times lam^-2 and its
-    cables of `cable_law`; the sensor wires pull SENSOR_FORCE_N when `sensors`, else only
+    cables of `cable_law` (None: their own); the sensor wires pull SENSOR_FORCE_N when `sensors`, else only
     read."""
     if net_law is not None:
         laws = [net_law] + [law.scaled(lam**-2) for law in base.laws[1:]]
-        cables = {k: (n, cable_law) for k, (n, _law) in base.cables.items()}
+        cables = {k: (n, law if cable_law is None else cable_law)
+                  for k, (n, law) in base.cables.items()}
     else:
         f = 1.0 if factor is None else factor
         laws = [law.scaled(f) for law in base.laws]

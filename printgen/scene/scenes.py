@@ -196,7 +196,8 @@ def lateral_mounting(p: Prototype) -> str:
 def prototype_scene(p: Prototype, *, mounting: str | None = None,
                     orientation: str = PROTOTYPE_ORIENTATION,
                     load: str | LoadCase | None = None) -> BarrierScene:
-    """The prototype: net with its panel law (read along the mesh diagonal `orientation`) or
+    """The prototype's nominal scene (callers use `printgen.scene.build_scene`, which applies
+    the other options): net with its panel law (read along the mesh diagonal `orientation`) or
     linear strands, sliding border cables, mounted like the model (`mounting`, default the
     file's [flume] lateral); its sensor wires only read (a field barrier carries no sensors);
     `load`: the load case its assumptions state (default hydrostatic)."""
@@ -234,7 +235,8 @@ def prototype_scene(p: Prototype, *, mounting: str | None = None,
 def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
                 orientation: str | None = None,
                 load: str | LoadCase | None = None) -> BarrierScene:
-    """The printed model: its pattern's net with the material's (measured) law, printed
+    """The printed model's nominal scene (callers use `printgen.scene.build_scene`, which
+    applies the other options): its pattern's net with the material's (measured) law, printed
     border frame, cables of the measured modulus, mounted by `mounting`, and the three sensor
     wires pulling SENSOR_FORCE_N along themselves. `orientation` ("short", "long"): the mesh
     diagonal the material's panel test loaded (None: the one its profile records); `load`:
