@@ -14,8 +14,8 @@ from printgen.inputs.printers import load_printer
 from printgen.parts.assembly import CLOSE_TOL_MM, assemble
 from printgen.parts.geometry.attach import DEFAULT_CLEARANCE_MM, holes
 from printgen.run.make import plan
+from printgen.scene import build_scene
 from printgen.units import MM
-from printgen.verification.scenes import model_scene
 
 SCALES = (40, 60, 80, 100)  # issue 12: the kit closes at every one of these
 COORD_MM = 1e-6  # round-off of coordinates built from the graph (mm)
@@ -59,7 +59,7 @@ def test_every_edge_node_has_a_loop_threaded_by_its_cable(kit):
 def test_the_solver_slides_the_cables_through_the_loops(kit):
     """Sliding nodes of the model scene (x across, z up, m) = loop and eyelet centres (mm)."""
     d, a = kit
-    scene = model_scene(d)
+    scene = build_scene(d)
     for c in a.cables:
         nodes, _ = scene.cables[c.name]
         xz = scene.nodes[nodes][:, [0, 2]] / MM

@@ -10,17 +10,13 @@ import pytest
 from conftest import reference_design_1_40
 
 from printgen.design.record import Section
+from printgen.scene import SceneOptions, build_scene
+from printgen.scene.scenes import MOUNTINGS
 from printgen.verification import bands
-from printgen.verification.bands import (
-    Variant,
-    band_verdict,
-    model_band,
-    model_variants,
-    refinement_test,
-    run_variant,
-    variant_scene,
-)
+from printgen.verification import variants as variants_module
+from printgen.verification.bands import band_verdict, model_band, refinement_test, run_variant
 from printgen.verification.compare import METRICS
+from printgen.verification.variants import Variant, model_variants
 
 COARSE = 3  # the 1:40 net with a 3x coarser mesh (50 nodes): fast sweeps
 LEVELS = np.round(np.arange(0.0, 1.11, 0.1), 10)  # 0.1 steps keep the sweeps short
@@ -38,8 +34,8 @@ def coarse_design():
 def test_band_contains_the_nominal_and_every_variant():
     d = coarse_design()
     nominal = run_variant(d, Variant(), LEVELS)
-    variants = [Variant("softer net", net_factor=0.7, frame_factor=0.7),
-                Variant("stiffer cables", cable_factor=1.3)]
+    variants = [Variant("softer net", options=SceneOptions(net_factor=0.7, frame_factor=0.7)),
+                Variant("stiffer cables", options=SceneOptions(cable_factor=1.3))]
     b = model_band(d, nominal, variants=variants, notes=["a note"])
     assert b.notes == ["a note"] and set(b.variants) == {v.label for v in variants}
     for from_start in (False, True):
@@ -66,22 +62,22 @@ def test_refinement_test_keeps_the_design_net_when_coarsening_changes_the_answer
 
 def test_coarse_variant_scene_keeps_membrane_stiffness():
     d = coarse_design()
-    fine, coarse = variant_scene(d, Variant()), variant_scene(d, Variant(), 2)
+    fine, coarse = build_scene(d), build_scene(d, SceneOptions(coarsen=2))
     assert len(coarse.nodes) < len(fine.nodes)
-    assert coarse.laws[0][1][0] == pytest.approx(2 * fine.laws[0][1][0], rel=ROUND)
+    assert coarse.laws[0].slopes[0] == pytest.approx(2 * fine.laws[0].slopes[0], rel=ROUND)
     assert coarse.laws[1] == fine.laws[1]  # the border frame is not meshed: same law
 
 
 def test_variants_of_the_1_40_design_say_what_is_left_out():
     variants, notes = model_variants(reference_design_1_40())
-    assert [v.slack for v in variants if v.slack] == [bands.SLACK_MAX]
+    assert [v.slack for v in variants if v.slack] == [variants_module.SLACK_MAX]
     text = " ".join(notes)
     assert "TPE (net): no SD" in text and "PETG (cables): no SD" in text
     assert "tested net the profile assumes" in text
-    others = bands.mounting_options()[1:]  # every mounting but the nominal is a variant
-    assert [v.mounting for v in variants if v.mounting] == list(others)
-    variants, _ = model_variants(reference_design_1_40(), mounting=others[-1] if others else None)
-    assert all(v.mounting != (others[-1] if others else "") for v in variants)
+    others = MOUNTINGS[1:]  # every mounting but the nominal is a variant
+    assert [v.options.mounting for v in variants if v.options.mounting] == list(others)
+    variants, _ = model_variants(reference_design_1_40(), mounting=others[-1])
+    assert all(v.options.mounting != others[-1] for v in variants)
 
 
 def test_modulus_sd_and_panel_geometry_variants(tmp_path, monkeypatch):
@@ -94,11 +90,12 @@ def test_modulus_sd_and_panel_geometry_variants(tmp_path, monkeypatch):
         d, cables=tuple(dataclasses.replace(c, material="petg-sd") for c in d.cables),
         net=dataclasses.replace(d.net, strand=Section(0.6, 1, (0.35, 0.30))))
     variants = {v.label: v for v in model_variants(d)[0]}
-    assert sorted(v.cable_factor for v in variants.values() if v.cable_factor != 1) == \
+    factors = [v.options.cable_factor for v in variants.values()]
+    assert sorted(f for f in factors if f != 1) == \
         pytest.approx([0.9, 1.1], rel=ROUND)
     geometry = [v for label, v in variants.items() if "panel law" in label]
     assert len(geometry) == 1  # the tested net's strands were 0.95 mm thick, these 0.65 mm
-    assert geometry[0].net_factor == pytest.approx(0.95 / 0.65, rel=1e-9)
+    assert geometry[0].options.net_factor == pytest.approx(0.95 / 0.65, rel=1e-9)
 
 
 VERDICTS = {  # model band (lo, hi) as multiples of the prototype curve -> (kind, text)

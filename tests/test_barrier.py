@@ -69,7 +69,8 @@ def test_strand_law_inverts_the_membrane_factor(name):
     pat = get_pattern(name)
     along, across, ea, knee = 9.4e-3, 20.6e-3, 120.0, 0.1
     membrane = ea * pat.membrane_factor(along, across)
-    knees, slopes = pat.strand_law((knee,), (membrane, 2 * membrane), along, across)
+    law = pat.strand_law((knee,), (membrane, 2 * membrane), along, across)
+    knees, slopes = law.knees, law.slopes
     assert slopes == pytest.approx((ea, 2 * ea), rel=EXACT)
     sin2 = along**2 / (along**2 + across**2) if name == "diamond" else 1.0
     assert knees == pytest.approx((knee * sin2,), rel=EXACT)
@@ -120,10 +121,10 @@ def test_drag_is_hydrostatic_plus_half_rho_v2_l_d_when_all_is_wet():
 
 
 def test_a_load_case_states_its_assumptions_in_the_scenes(design_1_40):
-    from printgen.verification.scenes import model_scene
+    from printgen.scene import SceneOptions, build_scene
 
-    plain = model_scene(design_1_40)
-    dragged = model_scene(design_1_40, load="drag")
+    plain = build_scene(design_1_40)
+    dragged = build_scene(design_1_40, SceneOptions(load="drag"))
     what = [a[0] for a in dragged.assumptions]
     assert "loading: drag" in what and "loading" in what
     assert "loading: drag" not in [a[0] for a in plain.assumptions]

@@ -284,8 +284,8 @@ def test_csv_files_hold_the_numbers_of_report_json(made):
 
 def test_the_filled_measurement_sheet_reads_back(made, tmp_path):
     """The sheet filled with its own expected nominal readings reads as the model's curves."""
+    from printgen.scene.readings import FlumeUnits
     from printgen.verification.measured import read_measured
-    from printgen.verification.readings import FlumeUnits
 
     out, _ = made
     lab = json.loads((out / "report.json").read_text())["verification"]["lab"]

@@ -9,15 +9,10 @@ import numpy as np
 import pytest
 from conftest import reference_design_1_40
 
-from printgen.verification.fit import (
-    BOUNDS,
-    Params,
-    at_bounds,
-    fit_measured,
-    predict,
-    slackened,
-)
+from printgen.scene.forms import slackened
+from printgen.verification.fit import BOUNDS, Params, at_bounds, fit_measured, predict
 from printgen.verification.measured import Measurement
+from solver import Law
 
 COARSE = 2  # the 1:40 net with a 2x coarser mesh (distinct top and mid rows): fast sweeps
 LEVELS = np.array([0.0, 0.5, 0.8, 1.0])  # the load path of every evaluation
@@ -38,7 +33,8 @@ def measurement(values: dict[str, np.ndarray]) -> Measurement:
 
 
 def test_slack_is_a_flat_first_segment():
-    knees, slopes = slackened(((0.1,), (100.0, 10.0)), 0.02)
+    law = slackened(Law((0.1,), (100.0, 10.0)), 0.02)
+    knees, slopes = law.knees, law.slopes
     assert knees == pytest.approx((0.02, 0.12), abs=ROUND)
     assert slopes[1:] == (100.0, 10.0) and slopes[0] < 1e-3 * slopes[1]
 

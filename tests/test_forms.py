@@ -1,4 +1,4 @@
-"""Model-form options of the printed model's scene (issue 25, printgen.verification.forms): the
+"""Model-form options of the printed model's scene (issue 25, printgen.scene.forms): the
 strand law derived from the virtual panel test, and the net's bottom row held on the bed."""
 
 from __future__ import annotations
@@ -9,9 +9,11 @@ from proto_files import EXAMPLES
 
 from printgen.design.design_file import load_design
 from printgen.inputs.materials import load_material
-from printgen.verification.bands import Variant, curves, model_variants, variant_scene
-from printgen.verification.forms import DERIVE_POINTS, derived_net_law
-from printgen.verification.panel import PanelTest, law_strains, simulate
+from printgen.scene import SceneOptions, build_scene
+from printgen.scene.forms import DERIVE_POINTS, derived_net_law
+from printgen.scene.panel import PanelTest, law_strains, simulate
+from printgen.verification.bands import curves
+from printgen.verification.variants import model_variants
 from printgen.verification.verify import sweep
 
 PAPER = EXAMPLES / "paper_1_40" / "design.json"
@@ -45,7 +47,7 @@ def test_derived_law_along_the_short_diagonal_uses_the_blocked_test():
 
 def test_bed_holds_the_bottom_row_and_its_wire_reads_nothing():
     d = load_design(PAPER)
-    s = variant_scene(d, Variant(bed="held"))
+    s = build_scene(d, SceneOptions(bed="held"))
     assert s.fixed[s.rows["bottom"]].all()
     assert any(a[0] == "bed" for a in s.assumptions)
     c = curves(sweep(s, LEVELS))
@@ -56,20 +58,21 @@ def test_bed_holds_the_bottom_row_and_its_wire_reads_nothing():
 def test_model_form_variants_of_the_paper_design():
     d = load_design(PAPER)
     labels = {v.label: v for v in model_variants(d, "walls", 0.3)[0]}
-    assert labels["strand law from the virtual panel test"].net_law == "derived"
-    assert labels["bottom row held on the bed"].bed == "held"
-    both = labels["mounted in the 300 mm free section, bottom on the bed"]
+    assert labels["strand law from the virtual panel test"].options.net_law == "derived"
+    assert labels["bottom row held on the bed"].options.bed == "held"
+    both = labels["mounted in the 300 mm free section, bottom on the bed"].options
     assert both.span == pytest.approx(0.3) and both.bed == "held"
 
 
 def test_sensor_routing_is_a_variant_only_where_the_wire_ends_move():
     d = load_design(PAPER)
     walls, notes = model_variants(d, "walls", None)
-    assert not [v for v in walls if v.routing != "in-line"]
+    assert not [v for v in walls if v.options.routing != "in-line"]
     assert any("sensor routing" in n and "no routing variant" in n for n in notes)
-    eyelets = [v for v in model_variants(d, "eyelets", None)[0] if v.routing == "downstream"]
+    eyelets = [v for v in model_variants(d, "eyelets", None)[0]
+               if v.options.routing == "downstream"]
     assert len(eyelets) == 1
-    s = variant_scene(d, Variant(mounting="eyelets", routing="downstream"))
+    s = build_scene(d, SceneOptions(mounting="eyelets", routing="downstream"))
     for w in s.wires.values():
         step = w.exit - s.nodes[w.nodes[-1]]
         assert step[1] > 0 and step[0] == 0 and step[2] == 0  # downstream, out of the plane

@@ -14,8 +14,8 @@ from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_printer
 from printgen.parts.gcode.estimate import duration, print_estimate
 from printgen.parts.gcode.toolpath import BORDER, TRAVEL, Toolpath
+from printgen.scene.readings import RAW_COLUMNS, FlumeUnits, design_units
 from printgen.verification.measured import MeasurementError, read_measured
-from printgen.verification.readings import RAW_COLUMNS, FlumeUnits, design_units
 
 EXACT = 1e-12  # sums of a few floats
 READ_TOL = 1e-9  # numbers written with 10 significant digits and read back
@@ -142,11 +142,12 @@ def test_sensor_and_anchor_layout_is_the_scene_in_mm():
 
     from printgen.report.layout import layout_csv, layout_figure, layout_rows
     from printgen.report.plots import _png, axis_labels
-    from printgen.verification.layout import flume_layout
-    from printgen.verification.readings import flume_units
-    from printgen.verification.scenes import SENSOR_EXIT, model_scene
+    from printgen.scene import build_scene
+    from printgen.scene.flume import flume_layout
+    from printgen.scene.readings import flume_units
+    from printgen.scene.scenes import SENSOR_EXIT
 
-    s = model_scene(reference_design_1_40())
+    s = build_scene(reference_design_1_40())
     lay = flume_layout(s)
     w, h = lay.width_mm, lay.height_mm
     assert w == pytest.approx(s.width * 1e3, rel=EXACT) and h == pytest.approx(s.height * 1e3,

@@ -127,14 +127,14 @@ def test_jam_levels_are_the_flumes_discharge_steps():
     """On the printed 1:40 model the jam's levels pass 2, 3, ... 8 L/s through the 300 mm
     free section; a step held above the overflow is read at h/h_B = 1.1."""
     from printgen.inputs.prototype import load_prototype
-    from printgen.verification.scenes import model_scene
+    from printgen.scene import SceneOptions, build_scene
     from printgen.verification.verify import load_keywords
 
     p, d = load_prototype(REALISTIC), reference_design_1_40()
     for porosity in (0.6, 0.8):
         _, kw = load_keywords(p, d, f"jam:porosity={porosity}")
         case, site = kw["load"], kw["site"]
-        s = model_scene(d, load=case)
+        s = build_scene(d, SceneOptions(load=case))
         lv = case.levels_for(s, site)
         rec, _ = case.describe(s, site, lv)
         q = rec["discharge_l_per_s"]
@@ -186,8 +186,8 @@ def test_case_readings_are_the_nominal_model_at_the_discharge_steps():
     report states the case's assumptions and readings."""
     from printgen.inputs.prototype import load_prototype
     from printgen.report.labfiles import _csv, case_file, case_readings
+    from printgen.scene.readings import flume_units
     from printgen.verification.cases import case_runs
-    from printgen.verification.readings import flume_units
 
     c = case_runs(load_prototype(REALISTIC), reference_design_1_40(), "jam:porosity=0.8")
     r = case_readings(c.model, c.load["model"], flume_units(c.model.scene).length_mm)

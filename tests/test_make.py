@@ -98,11 +98,11 @@ def test_fine_mesh_is_refused_with_its_estimate(tmp_path, capsys):
 
 def test_estimate_counts_the_nodes_the_solver_gets(made):
     from printgen.run.budget import model_nodes, prototype_nodes
-    from printgen.verification.scenes import model_scene, prototype_scene
+    from printgen.scene import build_scene
 
     ctx, _ = made
-    assert prototype_nodes(ctx.prototype) == len(prototype_scene(ctx.prototype).nodes)
-    assert model_nodes(ctx.design) == len(model_scene(ctx.design).nodes)
+    assert prototype_nodes(ctx.prototype) == len(build_scene(ctx.prototype).nodes)
+    assert model_nodes(ctx.design) == len(build_scene(ctx.design).nodes)
     size = json.loads((made[1] / "report.json").read_text())["size"]
     assert size["nets"]["prototype"]["unknowns"] == 3 * prototype_nodes(ctx.prototype)
 

@@ -7,15 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from printgen.verification.panel import (
-    PanelTest,
-    analytic_blocked,
-    derive_law,
-    law_strains,
-    lockup_strain,
-    simulate,
-)
-from printgen.verification.scenes import strand_law_from_membrane
+from printgen.barrier.patterns.diamond import lockup_strain
+from printgen.barrier.patterns.diamond import strand_law as strand_law_from_membrane
+from printgen.scene.panel import PanelTest, analytic_blocked, derive_law, law_strains, simulate
+from solver import Law
 
 MM = 1e-3
 ANALYTIC_TOL = 0.01  # issue 25: a blocked, infinite panel matches the formula within 1 %
@@ -27,14 +22,14 @@ POINTS = 5  # strains per derivation (checked between them too): a cheap test
 
 
 def test_blocked_infinite_panel_matches_the_diamond_formula():
-    law = ((0.05,), (150.0, 40.0))  # strand law (N per unit strain), knee at 5 %
+    law = Law((0.05,), (150.0, 40.0))  # strand law (N per unit strain), knee at 5 %
     for along, across in ((9.4, 20.6), (20.6, 9.4)):
         t = PanelTest(along * MM, across * MM, 12 * along * MM, 12 * across * MM, "blocked")
         eps = np.array([SMALL, 0.05, 0.15, 0.3])
         sim = simulate(law, t, eps).force_per_width
         np.testing.assert_allclose(sim, analytic_blocked(law, t, eps), rtol=ANALYTIC_TOL)
         sin = (along / 2) / np.hypot(along / 2, across / 2)
-        linear = 2 * law[1][0] * sin**3 / (across * MM) * SMALL  # the diamond formula
+        linear = 2 * law.slopes[0] * sin**3 / (across * MM) * SMALL  # the diamond formula
         assert sim[0] == pytest.approx(linear, rel=ANALYTIC_TOL)
 
 
@@ -54,7 +49,7 @@ def test_printed_panel_along_the_long_diagonal_is_derived_within_tolerance():
     d = derive_law(knees, slopes, t, law_strains(knees, POINTS))
     assert d.error < DERIVED_TOL
     formula = strand_law_from_membrane(knees, slopes, t.mesh_along, t.mesh_across)
-    assert d.law[1][0] == pytest.approx(formula[1][0], rel=CLAMP_HOLD)
+    assert d.law.slopes[0] == pytest.approx(formula.slopes[0], rel=CLAMP_HOLD)
 
 
 def test_free_short_diagonal_panel_is_a_mechanism():

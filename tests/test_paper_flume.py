@@ -10,8 +10,9 @@ import pytest
 
 from printgen.design.design_file import load_design
 from printgen.errors import GeometryError
+from printgen.scene import SceneOptions, build_scene
+from printgen.scene.scenes import panel_axes
 from printgen.verification.measured import MeasurementError, mismatch, read_measured
-from printgen.verification.scenes import model_scene, panel_axes
 
 HERE = Path(__file__).resolve().parents[1] / "examples" / "paper_1_40"
 EXACT = 1e-12  # values read from the CSV: only round-off
@@ -47,12 +48,13 @@ def test_bounds_only_is_refused(tmp_path):
 
 def test_orientation_reads_the_panel_law_along_the_chosen_diagonal():
     d = load_design(HERE / "design.json", scale=40)
-    short, long_ = (model_scene(d, orientation=o).laws[0] for o in ("short", "long"))
-    assert model_scene(d).laws[0] == short  # the TPE profile records the short diagonal
+    short, long_ = (build_scene(d, SceneOptions(orientation=o)).laws[0]
+                    for o in ("short", "long"))
+    assert build_scene(d).laws[0] == short  # the TPE profile records the short diagonal
     sin_s, sin_l = 4.7 / np.hypot(4.7, 10.3), 10.3 / np.hypot(4.7, 10.3)
     # strand EA = kappa L a_across / (2 sin^3): the two readings differ by this ratio
     ratio = (9.4 / sin_l**3) / (20.6 / sin_s**3)
-    assert long_[1][0] / short[1][0] == pytest.approx(ratio, rel=1e-9)
+    assert long_.slopes[0] / short.slopes[0] == pytest.approx(ratio, rel=1e-9)
     assert panel_axes(20.6 * MM, 9.4 * MM, "long") == (20.6 * MM, 9.4 * MM)
     with pytest.raises(GeometryError, match="orientation"):
         panel_axes(1.0, 2.0, "diagonal")

@@ -15,15 +15,10 @@ from printgen.design.selection import select
 from printgen.design.similitude import scale_targets
 from printgen.errors import InputError
 from printgen.inputs.prototype import load_prototype
+from printgen.scene import SceneOptions, build_scene
+from printgen.scene.scenes import SENSOR_FORCE_N, BarrierScene, Wire
+from printgen.scene.solvernet import WIRE_RATE, WIRE_STRAIN, build, wire_law
 from printgen.verification.compare import wire_elongation
-from printgen.verification.scenes import (
-    SENSOR_FORCE_N,
-    BarrierScene,
-    Wire,
-    model_scene,
-    prototype_scene,
-)
-from printgen.verification.solvernet import WIRE_RATE, WIRE_STRAIN, build, wire_law
 from printgen.verification.verify import sweep
 from solver.assemble import internal, make_bars, make_cable
 
@@ -54,7 +49,7 @@ def test_taut_wire_on_a_flat_net_pushes_nothing_out_of_plane(design):
     """The model at rest: every wire pulls along itself only; the anchor node is pulled by the
     sensor force towards the potentiometer, the nodes it runs over feel nothing."""
     _, d = design
-    s = model_scene(d)
+    s = build_scene(d)
     net, ex = build(s)
     n = len(s.nodes)
     assert len(net.cables) == len(s.cables)  # the wires are segments, not sliding cables
@@ -85,7 +80,7 @@ def test_wire_segments_pull_like_a_sliding_wire():
     strands = np.array([[4, 1], [5, 2]])
     exit_point = np.array([3.3, 0, 0])
     s = BarrierScene("wire", 1.0, 3.0, 1.0, x, fixed, strands, np.zeros(2, int),
-                     [((), (10.0,))], {}, {}, 0, 0, 1.0,
+                     [solver.linear(10.0)], {}, {}, 0, 0, 1.0,
                      {"w": Wire(np.arange(4), exit_point, SENSOR_FORCE_N)})
     net, ex = build(s)
     push = np.array([[0, 0.3, 0.5], [0, 0.4, 0.6]])
@@ -147,7 +142,8 @@ def test_mountings_hold_or_free_the_lateral_edges(design, mounting):
     """walls: the side sheets hold the lateral edge nodes (they do not move); eyelets: only the
     corners are anchored and the lateral edges deflect with the net."""
     p, d = design
-    for s in (prototype_scene(p, mounting=mounting), model_scene(d, mounting=mounting)):
+    options = SceneOptions(mounting=mounting)
+    for s in (build_scene(p, options), build_scene(d, options)):
         run = sweep(s, LEVELS)
         assert not run.failed
         edge = _lateral(s)

@@ -25,7 +25,7 @@ from printgen.inputs.printers import load_print_style, load_printer
 from printgen.inputs.prototype import load_prototype
 from printgen.parts.gcode import net_toolpath, net_volume_budget, write_gcode
 from printgen.parts.gcode.toolpath import BORDER, STRAND_MINUS, STRAND_PLUS
-from printgen.verification.scenes import model_scene, prototype_scene
+from printgen.scene import build_scene
 
 GEOM_TOL_MM = 1e-6  # float round-off on coordinates built from the graph
 MESH_VOLUME_REL = 1e-6  # manifold's mesh volume vs the analytic plan area x thickness
@@ -60,7 +60,7 @@ def test_simple_barrier_is_printed_as_a_square_net(simple):
     assert (n.width_mm, n.height_mm) == (300.0, 100.0)
     assert n.border_width_mm == n.strand.width_mm  # the edge rows are strands, no cables
     g = n.graph()
-    assert len(g.nodes_mm) == len(prototype_scene(p).nodes) == 61 * 21
+    assert len(g.nodes_mm) == len(build_scene(p).nodes) == 61 * 21
     assert len(g.strands) == 59 + 19
     assert set(np.unique(g.family)) == {-1, 0, 1}
 
@@ -83,9 +83,9 @@ def test_square_membrane_law_is_one_strand_per_mesh(simple):
     """The printed net's law through the pattern's machinery: the model scene's strand law
     is the membrane law times the mesh across (`square.strand_law`)."""
     _, d = simple
-    s = model_scene(d)
+    s = build_scene(d)
     n = d.net
-    membrane = s.laws[0][1][0] * square_factor(n.mesh_x_mm * 1e-3)
+    membrane = s.laws[0].slopes[0] * square_factor(n.mesh_x_mm * 1e-3)
     from printgen.design.section import net_membrane_law
 
     want = net_membrane_law(load_material(n.material), n.strand, n.mesh_y_mm * 1e-3,
@@ -204,17 +204,17 @@ FREE_HOLD_REL = 0.01
 
 @pytest.mark.parametrize("mode", ["blocked", "free"])
 def test_virtual_panel_of_the_square_net_reads_its_membrane_law(simple, mode):
-    """The same panel machinery as the diamond (`verification.panel`): the designed square
+    """The same panel machinery as the diamond (`scene.panel`): the designed square
     strands, tested as a panel, give the membrane law the design priced (one strand per mesh
     across, `square.membrane_factor`), times (nx + 1) / nx for the panel's two edge strands
     on a width of nx meshes; free or blocked alike (a square net has no Poisson effect)."""
     from printgen.design.section import net_membrane_law
-    from printgen.verification.panel import PanelTest, lattice_size, simulate
+    from printgen.scene.panel import PanelTest, lattice_size, simulate
 
     _, d = simple
     n = d.net
     a = n.mesh_x_mm * 1e-3
-    law = model_scene(d).laws[0]
+    law = build_scene(d).laws[0]
     t = PanelTest(a, a, 10 * a, 8 * a, mode, "square")
     nx = round(lattice_size(t)[1] / a)
     strains = np.array([0.01, 0.05, 0.2])

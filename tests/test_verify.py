@@ -16,7 +16,7 @@ from printgen.design.similitude import scale_targets
 from printgen.inputs.prototype import load_prototype
 from printgen.report.jsonout import dumps
 from printgen.report.plots import deformed_figure
-from printgen.verification.scenes import model_scene, prototype_scene
+from printgen.scene import build_scene
 from printgen.verification.verify import SHAPE_LEVELS, sweep, verify
 
 HOLD_SHARE_MAX = 0.01  # the hold may carry at most 1 % of the applied load (a regularisation)
@@ -46,7 +46,7 @@ def test_free_top_barrier_solves_every_level(coarse_simple, who):
     """Without border cables the dry net above the water is a mechanism; with unloaded strands
     held where they are every level converges, and the hold carries almost nothing."""
     p, d = coarse_simple
-    s = prototype_scene(p) if who == "prototype" else model_scene(d)
+    s = build_scene(p) if who == "prototype" else build_scene(d)
     assert s.hold > 0 and not s.cables
     run = sweep(s, LOW_LEVELS)
     assert not run.failed
@@ -95,9 +95,9 @@ def _reference_curves(s, lv: np.ndarray) -> dict[str, np.ndarray]:
     constant tension (not per-segment elements), solved to TIGHT_TOL: an independent
     formulation of the same physics."""
     import solver
+    from printgen.scene.pressure import loads_function
+    from printgen.scene.solvernet import WIRE_STRAIN, build, path_length, wire_law
     from printgen.verification.compare import deformation
-    from printgen.verification.solvernet import WIRE_STRAIN, build, path_length, wire_law
-    from printgen.verification.verify import loads_function
 
     net, ex = build(s)
     keep = np.setdiff1d(np.arange(len(net.elements)), ex.wire_elements)
@@ -121,7 +121,7 @@ def test_free_top_curves_match_a_tight_sliding_wire_reference(coarse_simple):
     """The fast formulation (wires as segments, the sweep's tolerance) moves no nominal curve
     of the free-top model by more than CURVE_TOL of its peak at h/h_B = 0.5, 1.0, 1.1."""
     _, d = coarse_simple
-    s = model_scene(d)
+    s = build_scene(d)
     lv = np.round(np.arange(0.0, 1.1 + 1e-9, 0.1), 10)
     fast = sweep(s, lv)
     assert not fast.failed

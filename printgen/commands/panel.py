@@ -1,5 +1,5 @@
 """`printgen panel DESIGN [--orientation short|long] [--mode free|blocked] [--json]`: the
-simulated tensile test of a design's printed net panel (printgen.verification.panel), to compare
+simulated tensile test of a design's printed net panel (printgen.scene.panel), to compare
 with a printed test panel before printing the barrier."""
 
 from __future__ import annotations
@@ -11,8 +11,8 @@ from printgen.commands.common import add_json_arg, console, emit_json, table
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from printgen.verification.panel import MODES
-    from printgen.verification.scenes import ORIENTATIONS
+    from printgen.scene.panel import MODES
+    from printgen.scene.scenes import ORIENTATIONS
 
     p = sub.add_parser("panel", help="simulate a design's net panel tensile test (print a "
                                      "test panel and compare before printing the barrier)")
@@ -28,14 +28,14 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from printgen.design.design_file import load_design
-    from printgen.verification.panel import design_panel, panel_lockup
-    from printgen.verification.scenes import ORIENTATIONS
+    from printgen.scene.panel import design_panel, panel_lockup
+    from printgen.scene.scenes import ORIENTATIONS
 
     d = load_design(args.design)
     panels = [design_panel(d, o, args.mode) for o in (args.orientation or ORIENTATIONS)]
     if args.json:
         emit_json([{"orientation": dp.orientation, "test": dp.test.describe(),
-                    "strand_law": {"knees": dp.law[0], "slopes_n": dp.law[1]},
+                    "strand_law": {"knees": dp.law.knees, "slopes_n": dp.law.slopes},
                     "strain": dp.curve.strains, "force_per_width_n_per_m":
                     dp.curve.force_per_width, "measured_n_per_m": dp.measured,
                     "hold_share": dp.curve.hold_share} for dp in panels])

@@ -11,7 +11,7 @@ It is a `CableDesign` (the same strip-with-eyelets geometry, toolpath and slicer
 the border cables), printed with the print style `COUPON_STYLE`.
 
 Panel: the design's diamond mesh, loaded along one diagonal, sized as the virtual panel test
-(`printgen.verification.panel`): clamp edges on two node rows `length` apart and `width`
+(`printgen.scene.panel`): clamp edges on two node rows `length` apart and `width`
 across (whole half-meshes), with one more mesh row beyond each clamp edge for the clamp
 faces to hold and the net's border frame around it. The two side bars of the frame are cut
 before the test (the virtual panel's sides are free).

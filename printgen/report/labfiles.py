@@ -17,12 +17,12 @@ from typing import Any
 import numpy as np
 
 from printgen.report.layout import LAYOUT_CSV, layout_csv
+from printgen.scene.flume import flume_layout
+from printgen.scene.readings import DEPTH_COLUMN, RAW_COLUMNS, flume_units
 from printgen.units import MM
 from printgen.verification.bands import Band
 from printgen.verification.compare import METRICS
-from printgen.verification.layout import flume_layout
 from printgen.verification.measured import COLUMNS, LEVEL_COLUMN
-from printgen.verification.readings import DEPTH_COLUMN, RAW_COLUMNS, flume_units
 from printgen.verification.verify import Verification
 
 DIGITS = 8  # significant digits of every number in the CSV files

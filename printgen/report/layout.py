@@ -1,5 +1,5 @@
 """The sensor and anchor layout of the flume test (mm): a dimensioned drawing of the mounted
-model (`printgen.verification.layout`, from report.json's lab.layout record), its table in
+model (`printgen.scene.flume`, from report.json's lab.layout record), its table in
 the report, and sensor-layout.csv beside it."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from printgen.report.html import Drawing, Report
-from printgen.verification.layout import FlumeLayout
+from printgen.scene.flume import FlumeLayout
 
 LAYOUT_CSV = "sensor-layout.csv"
 WIRE_COLOURS = {"bottom": "C0", "top": "C2", "mid": "C3"}

@@ -8,10 +8,10 @@ import numpy as np
 
 from printgen.design.similitude import FORCE_EXPONENT, to_prototype
 from printgen.errors import PrintgenError
+from printgen.scene.scenes import BarrierScene
 from printgen.verification.bands import Band
 from printgen.verification.compare import METRICS, Deformation
 from printgen.verification.measured import Fit, Measurement
-from printgen.verification.scenes import BarrierScene
 
 DPI = 110
 SVG_SALT = "printgen"  # matplotlib's svg.hashsalt: the same figure gives the same SVG ids

@@ -5,7 +5,7 @@ The verification's solver work is predicted sweep by sweep (`sweeps`), from the 
 and the meshes alone (no net is built here): the prototype's and the model's nets over the load
 levels (23: h / h_B = 0 to 1.1 by 0.05, `printgen.verification.verify.levels`), each more load
 case of `make --loads` the same, the band's refinement test (the model on a net COARSENINGS[0]
-times coarser), then each band variant of the model (`printgen.verification.bands
+times coarser), then each band variant of the model (`printgen.verification.variants
 .model_variants`: 5 on the simple barrier, 9 on the 1:40 example) on the design's own net: the
 refinement test may pick a coarser one, which the estimate does not foresee (on both examples
 it keeps the design's net), so a run whose variants coarsen is estimated high. A sweep's work
@@ -203,8 +203,8 @@ MAKE = Work()
 
 def band_variants(p: Prototype, d: Design) -> int:
     """The model variants the uncertainty band sweeps (as `verify` mounts the model)."""
-    from printgen.verification.bands import model_variants
-    from printgen.verification.scenes import lateral_mounting
+    from printgen.scene.scenes import lateral_mounting
+    from printgen.verification.variants import model_variants
     from printgen.verification.verify import free_section
 
     return len(model_variants(d, lateral_mounting(p), free_section(p))[0])

@@ -22,8 +22,8 @@ from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import TIMINGS, check_destination, write_folder
 from printgen.report.jsonout import dumps
 from printgen.report.series import series_csv, series_figure, series_report
+from printgen.scene.scenes import SENSOR_FORCE_N
 from printgen.search.sweep import open_runner
-from printgen.verification.scenes import SENSOR_FORCE_N
 from printgen.verification.series import (
     LEVEL,
     LEVEL_STEP,

@@ -354,7 +354,7 @@ def verification_report(v: Verification, band: Band, scale: float
     from printgen.report.layout import layout_section
     from printgen.report.report import load_case_sections, verification_sections
     from printgen.report.uncertainty import band_record, band_sections
-    from printgen.verification.layout import flume_layout
+    from printgen.scene.flume import flume_layout
 
     rep = Report("")
     verification_sections(rep, v, v.counterexample, scale, band=band)

@@ -6,7 +6,7 @@ and passes, and a net test panel of its mesh, each as STL, 3MF, PrusaSlicer .ini
 G-code (read back against the toolpath), the sidecar each test's exports need in
 `printgen calibrate` (`<piece>.specimen.toml`, the keys of `printgen.calibrate.specimen`), and
 the panel's expected force-strain curve from the virtual panel test
-(`printgen.verification.panel`, free sides, as printed panels are tested). The loop:
+(`printgen.scene.panel`, free sides, as printed panels are tested). The loop:
 print pieces -> test -> calibrate -> verify -> print the barrier (LOOP).
 """
 
@@ -80,7 +80,7 @@ def material_source(mat) -> str:
 
 
 def _panel(d: Design, orientation: str):
-    from printgen.verification.panel import design_panel, lattice_size
+    from printgen.scene.panel import design_panel, lattice_size
 
     dp = design_panel(d, orientation, "free")
     blocked = design_panel(d, orientation, "blocked")
@@ -172,7 +172,7 @@ def _expected(stage: Path, dp, blocked) -> dict[str, Any]:
     """panel-expected.csv: the virtual panel test's force per width and clamp force against
     strain, free sides (as the printed panel is tested) and sides blocked (every strand
     stretched alike: the barrier's membrane law), with the profile's measured panel law."""
-    from printgen.verification.panel import lattice_size
+    from printgen.scene.panel import lattice_size
 
     width = lattice_size(dp.test)[1]
     buf = io.StringIO()

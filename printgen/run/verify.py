@@ -33,9 +33,10 @@ from printgen.report.uncertainty import (
     measured_sections,
 )
 from printgen.run.budget import DEFAULT_LIMIT_S, Work, check_budget, sweep_cores
+from printgen.scene.flume import flume_layout
+from printgen.scene.readings import design_units
 from printgen.verification.bands import Band, band_verdicts, model_load_kw
 from printgen.verification.fit import MultiFit, fit_levels, fit_measured
-from printgen.verification.layout import flume_layout
 from printgen.verification.measured import (
     Fit,
     Measurement,
@@ -45,7 +46,6 @@ from printgen.verification.measured import (
     read_measured,
 )
 from printgen.verification.pooled import verify_with_band
-from printgen.verification.readings import design_units
 from printgen.verification.verify import Verification, free_section
 from printgen.workers import preload
 

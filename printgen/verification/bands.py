@@ -2,15 +2,7 @@
 and for each uncertain input it depends on, one at a time, and the min/max envelope of the
 normalised deformations at every relative loading (issue 10).
 
-Variants of the printed model (`model_variants`):
-- measured modulus +- SD of each material whose profile records an SD (`sd_gpa`); the net's
-  strands follow it only when their law comes from the modulus (a panel law has no SD), the
-  printed border frame always does; the cables follow their material's SD;
-- the panel law's geometry assumption: the law's tested net (strand and mesh recorded in the
-  profile, an assumption when the source does not give it) against the alternative that the
-  tested panel had the design's own strands and mesh (the law used without rescaling);
-- the mounting in the flume, when the scene offers more than one (`mounting_options`);
-- initial slack of the printed net, 0 to `SLACK_MAX` (0 is the nominal).
+The variants of the printed model, as data, and their list: `printgen.verification.variants`.
 
 Cheap sweeps: the variants run on the coarsest solver net (the design's mesh times k, k in
 `COARSENINGS`, strands k times stiffer: the same membrane stiffness per unit width) whose
@@ -23,7 +15,6 @@ and the runs go to worker processes in parallel.
 from __future__ import annotations
 
 import dataclasses
-import inspect
 import time
 from collections.abc import Callable
 from concurrent.futures import Future
@@ -33,141 +24,18 @@ from typing import Any
 import numpy as np
 
 from printgen.barrier.loads import LoadCase
-from printgen.barrier.patterns import get_pattern
-from printgen.barrier.patterns.diamond import diamond_factor
 from printgen.design.record import Design
-from printgen.design.section import area_m2
 from printgen.errors import GeometryError
-from printgen.inputs.materials import load_material
 from printgen.inputs.prototype import Prototype
+from printgen.scene.options import SceneOptions, build_scene
 from printgen.trace import span
-from printgen.units import MM
 from printgen.verification.compare import METRICS
-from printgen.verification.scenes import BarrierScene, model_scene
+from printgen.verification.variants import Variant, model_variants
 from printgen.verification.verify import Run, load_keywords, sweep
 from printgen.workers import collect, submit_jobs
 
-SLACK_MAX = 0.01  # initial slack of the printed net, upper end of the range (issue 10: 0-1 %)
 COARSENINGS = (2, 3)  # mesh multipliers tried in turn for the variant sweeps
 REFINE_TOL = 0.01  # a coarser net is used when no nominal curve moves by more than 1 % of its peak
-SAME = 1e-9  # relative change below which an alternative equals the nominal (not run)
-
-
-@dataclass(frozen=True)
-class Variant:
-    """One uncertain input of the printed model moved from its nominal value.
-
-    net_factor, frame_factor, cable_factor : multipliers on the force laws of the net's
-    strands, the printed border frame and the border cables; slack : relative initial slack
-    of every strand and cable; mounting : the scene's mounting option (None: the default).
-    """
-
-    label: str = "nominal"
-    net_factor: float = 1.0
-    frame_factor: float = 1.0
-    cable_factor: float = 1.0
-    slack: float = 0.0
-    mounting: str | None = None
-    source: str = ""
-    orientation: str | None = None  # panel-test orientation of the net's law (None: profile's)
-    pressure: str = "flow"  # the water's force along the flow or normal to the net (scenes)
-    span: float | None = None  # lateral supports this far apart (m; None: the printed width)
-    net_law: str = "formula"  # strand law: diamond formula or the virtual panel test's (forms)
-    bed: str = "free"  # the net's bottom row free or held on the flume bed (forms)
-    routing: str = "in-line"  # the sensor wires beyond the right edge (forms.ROUTINGS)
-
-
-def mounting_options() -> tuple[str, ...]:
-    """Mounting variants the model scene offers (its `mounting` keyword), default first;
-    empty when the scene has a single mounting."""
-    param = inspect.signature(model_scene).parameters.get("mounting")
-    if param is None:
-        return ()
-    from printgen.verification import scenes
-
-    return tuple(getattr(scenes, "MOUNTINGS", ()))
-
-
-def model_variants(d: Design, mounting: str | None = None, free_section: float | None = None
-                   ) -> tuple[list[Variant], list[str]]:
-    """The variants of design `d` to sweep, and one note per uncertainty left out and why;
-    `mounting` is the nominal run's (the other mountings become variants); `free_section` m:
-    the flume's free section, when narrower than the net (a mounting-span variant)."""
-    out, notes = [], []
-    net = load_material(d.net.material)
-    panel = net.panel_law
-    law_from_modulus = panel is None or not panel.has_geometry
-    e, source = net.modulus()
-    sd = net.measured_modulus.sd if source == "measured" and net.measured_modulus else None
-    if sd:
-        f = sd / e
-        for sign, word in ((-1, "-"), (1, "+")):
-            k = 1 + sign * f
-            out.append(Variant(f"{net.name} modulus {word}1 SD", k if law_from_modulus else 1.0,
-                               k, source=f"{net.name} profile: E = {e / 1e9:.3g} +- "
-                                         f"{sd / 1e9:.2g} GPa (measured)"))
-    else:
-        notes.append(f"{net.name} (net): no SD of the {source} modulus in its profile; "
-                     "modulus spread not included (printgen calibrate writes sd_gpa)")
-    if d.cables:
-        out += _cable_variants(d, notes)
-    if panel is not None and panel.has_geometry:
-        out += _panel_geometry_variant(d, notes)
-        out += _orientation_variants(d)
-    opts = mounting_options() if d.cables else ()  # no border cables: bed and banks only
-    nominal = mounting or (opts[0] if opts else None)
-    out += [Variant(f"mounting: {m}", mounting=m, source="flume mounting option "
-                    f"(nominal: {nominal})") for m in opts if m != nominal]
-    if not opts:
-        notes.append("mounting: the model scene has one mounting only; no mounting variant")
-    out.append(Variant(f"initial slack {SLACK_MAX:.0%}", slack=SLACK_MAX,
-                       source="printed net hung with 0 to 1 % slack (printgen; README: Uncertainty band)"))
-    from printgen.verification.forms import model_form_variants
-
-    out += model_form_variants(d, free_section, notes, nominal)
-    return out, notes
-
-
-def _cable_variants(d: Design, notes: list[str]) -> list[Variant]:
-    mat = load_material(d.cables[0].material)
-    e, source = mat.modulus()
-    sd = mat.measured_modulus.sd if source == "measured" and mat.measured_modulus else None
-    if not sd:
-        notes.append(f"{mat.name} (cables): no SD of the {source} modulus in its profile; "
-                     "modulus spread not included (printgen calibrate writes sd_gpa)")
-        return []
-    return [Variant(f"{mat.name} cable modulus {word}1 SD", cable_factor=1 + sign * sd / e,
-                    source=f"{mat.name} profile: E = {e / 1e9:.3g} +- {sd / 1e9:.2g} GPa")
-            for sign, word in ((-1, "-"), (1, "+"))]
-
-
-def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
-    """The panel law used without the rescaling from its (assumed) tested net to the design's."""
-    mat = load_material(d.net.material)
-    law, n = mat.panel_law, d.net
-    tested = diamond_factor(law.mesh_along_load, law.mesh_across_load) * (
-        law.strand_width * law.strand_thickness)
-    design = get_pattern(n.pattern).membrane_factor(n.mesh_y_mm * MM, n.mesh_x_mm * MM) * \
-        area_m2(n.strand)
-    ratio = tested / design
-    if abs(ratio - 1) < SAME:
-        notes.append(f"{mat.name} panel law: the design's net is the tested net the profile "
-                     "assumes, so the geometry assumption does not change the law")
-        return []
-    return [Variant(f"{mat.name} panel law: tested net = the design's net", net_factor=ratio,
-                    source=f"{mat.name} profile [measured.panel_law] conditions")]
-
-
-def _orientation_variants(d: Design) -> list[Variant]:
-    """The panel law read along each mesh diagonal its profile does not record (issue 25:
-    the paper does not say which diagonal its printed panels were loaded along)."""
-    from printgen.verification.scenes import ORIENTATIONS, recorded_orientation
-
-    law = load_material(d.net.material).panel_law
-    recorded = recorded_orientation(law)
-    return [Variant(f"panel test along the {o} diagonal", orientation=o,
-                    source=f"panel-test orientation not stated (profile: {recorded})")
-            for o in ORIENTATIONS if o != recorded]
 
 
 def model_load_kw(p: Prototype, d: Design, load: str | LoadCase | None = None
@@ -176,57 +44,12 @@ def model_load_kw(p: Prototype, d: Design, load: str | LoadCase | None = None
     return load_keywords(p, d, load)[1]
 
 
-def variant_scene(d: Design, v: Variant, coarsen: int = 1) -> BarrierScene:
-    """The printed model's scene with variant `v`, on the design's mesh times `coarsen` (its
-    strands `coarsen` times stiffer, so the membrane stiffness per unit width is kept)."""
-    if coarsen != 1:
-        n = d.net
-        d = dataclasses.replace(d, net=dataclasses.replace(
-            n, mesh_x_mm=n.mesh_x_mm * coarsen, mesh_y_mm=n.mesh_y_mm * coarsen))
-    s = model_scene(d, **({"mounting": v.mounting} if v.mounting else {}),
-                    orientation=v.orientation)
-    laws = list(s.laws)
-    if v.net_law == "derived":  # issue 25: the virtual panel test's strand law
-        from printgen.verification.forms import derived_net_law
-
-        laws[0], how = derived_net_law(load_material(d.net.material), d.net, v.orientation)
-        s = dataclasses.replace(s, assumptions=tuple(
-            (w, f"{d.net.material}: {how}" if w == "net strands" else val, src)
-            for w, val, src in s.assumptions))
-    laws[0] = _scaled(laws[0], v.net_factor * coarsen)
-    if len(laws) > 1:  # the printed border frame, of the net's material
-        laws[1] = _scaled(laws[1], v.frame_factor)
-    cables = {k: (nodes, _scaled(law, v.cable_factor)) for k, (nodes, law) in s.cables.items()}
-    s = dataclasses.replace(s, laws=laws, cables=cables, pressure=v.pressure)
-    if v.span is not None:  # issue 25: the printed net mounted in the flume's free section
-        from printgen.verification.mount import in_free_section
-
-        s = in_free_section(s, v.span)
-    from printgen.verification.forms import held_on_bed, routed
-
-    s = held_on_bed(s) if v.bed == "held" else s
-    return routed(s, v.routing)
-
-
-def _scaled(law: tuple, factor: float) -> tuple:
-    knees, slopes = law
-    return tuple(knees), tuple(s * factor for s in slopes)
-
-
-def effort(v: Variant, mounting: str | None = None) -> tuple[bool, ...]:
-    """Sort key of variants (`mounting`: the nominal one), the longest sweep first (CPU
-    measured by bench timeline at 1:40: initial slack, a mechanism until its strands tighten,
-    24 s on the simple barrier and 2.4 s on the 1:40 example; then the net mounted in the
-    flume's free section, 4.0-4.5 s there; another mounting 3.7 s; the virtual panel test's
-    law 3.3-6.4 s; pressure normal to the net 1.6-5.1 s; the rest 0.8-2.8 s)."""
-    return (v.slack == 0, v.span is None, v.mounting == mounting, v.net_law != "derived",
-            v.pressure != "normal")
-
-
 def run_variant(d: Design, v: Variant, lv: np.ndarray, coarsen: int = 1,
                 load_kw: dict | None = None) -> Run:
-    """Sweep the model with variant `v` (a worker job: module-level, picklable)."""
-    return sweep(variant_scene(d, v, coarsen), lv, slack=v.slack, **(load_kw or {}))
+    """Sweep the model with variant `v` on the design's mesh times `coarsen` (a worker job:
+    module-level, picklable)."""
+    scene = build_scene(d, dataclasses.replace(v.options, coarsen=coarsen))
+    return sweep(scene, lv, slack=v.slack, **(load_kw or {}))
 
 
 def curves(run: Run) -> dict[str, np.ndarray]:
@@ -304,7 +127,7 @@ def refinement_test(d: Design, nominal: dict[str, np.ndarray], lv: np.ndarray,
 
 def meshable(d: Design, k: int) -> bool:
     try:
-        variant_scene(d, Variant(), k)
+        build_scene(d, SceneOptions(coarsen=k))
     except GeometryError:
         return False
     return True
@@ -338,18 +161,18 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
     if variants is None:
         variants, auto_notes = model_variants(d, mounting, free_section)
         notes = [*(notes or []), *auto_notes]
-    variants = [v if v.mounting else dataclasses.replace(v, mounting=mounting)
-                for v in variants]
+    variants = [v if v.options.mounting else dataclasses.replace(
+        v, options=dataclasses.replace(v.options, mounting=mounting)) for v in variants]
+    nominal_variant = Variant(options=SceneOptions(mounting=mounting))
     nom = curves(nominal)
     work: list[dict[str, Any]] = []
     with span("band: refinement test"):
-        k, change = refinement_test(d, nom, lv, load_kw, Variant(mounting=mounting), work,
-                                    ahead)
+        k, change = refinement_test(d, nom, lv, load_kw, nominal_variant, work, ahead)
     # longest first (the worker that takes the last job should not start a long one late)
-    order = sorted(range(len(variants)), key=lambda i: effort(variants[i], mounting))
+    order = sorted(range(len(variants)), key=lambda i: -variants[i].effort)
     jobs: list[tuple] = [(run_variant, (d, variants[i], lv, k, load_kw), {}) for i in order]
     if k > 1:
-        jobs.append((run_variant, (d, Variant(mounting=mounting), lv, k, load_kw), {}))
+        jobs.append((run_variant, (d, nominal_variant, lv, k, load_kw), {}))
     started = submit_jobs(jobs)
     if then is not None:
         then()
@@ -357,7 +180,8 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
     extra = done[len(variants):]  # the nominal on the coarse net, when k > 1
     base = curves(extra[0]) if extra else None
     runs = [done[order.index(i)] for i in range(len(variants))]
-    recorded = sorted(range(len(variants)), key=lambda i: -variants[i].slack)  # report.json's
+    # report.json's solver_work rows: the slack variant's first, then the list's order
+    recorded = sorted(range(len(variants)), key=lambda i: -variants[i].slack)
     work += [runs[i].work() for i in recorded] + [r.work() for r in extra]
     out, failed = {}, {}
     for v, r in zip(variants, runs, strict=True):

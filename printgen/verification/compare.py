@@ -8,8 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from printgen.verification.scenes import BarrierScene, Wire
-from printgen.verification.solvernet import path_length
+from printgen.scene.scenes import BarrierScene, Wire
+from printgen.scene.solvernet import path_length
 
 # Normalised quantities compared between prototype and model, with their labels.
 METRICS = {

@@ -6,9 +6,9 @@ Parameters, each bounded by what a lab would see or measure (`BOUNDS`):
 - net_slack: initial slack of the net's strands (a zero-force strain before they pull);
 - cable_slack: initial slack of the border cables (the same, on the cables);
 and, as discrete choices tried in turn, the flume mounting and the panel-test orientation
-(`printgen.verification.scenes`), the net's span (printed width or the flume's free section,
-`printgen.verification.mount`) and its bottom row free or held on the bed
-(`printgen.verification.forms`). Slack is a law with a first, (nearly) flat segment (`slackened`):
+(`printgen.scene.scenes`), the net's span (printed width or the flume's free section,
+`printgen.scene.mount`) and its bottom row free or held on the bed
+(`printgen.scene.forms`). Slack is a law with a first, (nearly) flat segment (`slackened`):
 the same to first order as a rest length (1 + slack) times longer.
 
 For every discrete choice the continuous parameters are searched (scipy's bounded
@@ -33,10 +33,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from printgen.design.record import Design
-from printgen.verification.bands import Variant, curves, variant_scene
-from printgen.verification.forms import BEDS
+from printgen.scene.forms import BEDS, slack_laws
+from printgen.scene.options import SceneOptions, build_scene
+from printgen.scene.scenes import MOUNTINGS, ORIENTATIONS, BarrierScene
+from printgen.verification.bands import curves
 from printgen.verification.measured import Measurement, mismatch, objective
-from printgen.verification.scenes import MOUNTINGS, ORIENTATIONS, BarrierScene
 from printgen.verification.verify import sweep
 
 # (low, high, nominal) of each continuous parameter
@@ -47,7 +48,6 @@ BOUNDS = {
 }
 Choice = tuple[str, "str | None", "float | None", str]  # mounting, orientation, span, bed
 EXPLAINS = 0.15  # issue 25: RMS mismatch below 15 % of the measured peak on every column
-SLACK_SLOPE = 1e-4  # slope of a slack segment / the law's first slope (keeps it solvable)
 MAX_EVALUATIONS = 15  # least-squares steps for a retained choice (each: 1 + free sweeps)
 SCREEN_EVALUATIONS = 3  # ... for every discrete choice first (a screen)
 SCREEN_KEEP = 2  # choices searched on after the screen
@@ -93,22 +93,11 @@ def _from_unit(key: str, u: float) -> float:
     return lo + u * (hi - lo)
 
 
-def slackened(law: tuple, slack: float) -> tuple:
-    """The law with a nearly flat first segment of `slack` strain (SLACK_SLOPE of its slope)."""
-    if slack <= 0:
-        return law
-    knees, slopes = law
-    return (slack, *(k + slack for k in knees)), (SLACK_SLOPE * slopes[0], *slopes)
-
-
 def fit_scene(d: Design, p: Params, coarsen: int = 1) -> BarrierScene:
     """The printed model's scene with parameter set `p` (on the design's mesh x coarsen)."""
-    v = Variant("fit", net_factor=p.net_factor, frame_factor=p.net_factor, mounting=p.mounting,
-                orientation=p.orientation, span=p.span, bed=p.bed)
-    s = variant_scene(d, v, coarsen)
-    laws = [slackened(law, p.net_slack) for law in s.laws]
-    cables = {k: (nodes, slackened(law, p.cable_slack)) for k, (nodes, law) in s.cables.items()}
-    return dataclasses.replace(s, laws=laws, cables=cables)
+    o = SceneOptions(mounting=p.mounting, orientation=p.orientation, bed=p.bed, span=p.span,
+                     net_factor=p.net_factor, frame_factor=p.net_factor, coarsen=coarsen)
+    return slack_laws(build_scene(d, o), p.net_slack, p.cable_slack)
 
 
 def predict(d: Design, p: Params, m: Measurement, lv: np.ndarray, coarsen: int = 1,

@@ -4,7 +4,7 @@ predicted curves, and fit the one factor of the printed net that best explains i
 The CSV (`,` or `;` separated; with `;`, decimal commas are accepted; lines starting with `#`
 are comments) has a column `h_over_hb` and any of the columns in `COLUMNS`; given the printed
 model's lengths, also the raw readings in mm (`water_depth_mm` for the level, the sensors'
-wire change, deflection and top lowering: printgen.verification.readings.RAW_COLUMNS). Columns
+wire change, deflection and top lowering: printgen.scene.readings.RAW_COLUMNS). Columns
 named `expected_*` (the model's readings on printgen's measurement sheet) are skipped, and so
 are columns left empty when others hold values. Elongations are
 read as what the extension sensors record: counted from h / h_B = 0 (sensors zeroed before
@@ -29,8 +29,10 @@ from printgen.design.record import Design
 from printgen.errors import InputError
 from printgen.inputs.profiles import profile_name
 from printgen.outputs.files import read_input_text
-from printgen.verification.bands import Band, Variant, curves, run_variant
-from printgen.verification.readings import DEPTH_COLUMN, RAW_COLUMNS, FlumeUnits
+from printgen.scene.options import SceneOptions
+from printgen.scene.readings import DEPTH_COLUMN, RAW_COLUMNS, FlumeUnits
+from printgen.verification.bands import Band, curves, run_variant
+from printgen.verification.variants import Variant
 
 LEVEL_COLUMN = "h_over_hb"
 # CSV column -> (METRICS key of printgen.verification.compare, factor from the CSV unit to the key's)
@@ -80,7 +82,7 @@ class Measurement:
 def read_measured(path: str | Path, units: FlumeUnits | None = None) -> Measurement:
     """Read and check a measured loading test (see the module docstring for the format).
 
-    With `units` (the printed model's lengths, printgen.verification.readings) the raw columns in mm
+    With `units` (the printed model's lengths, printgen.scene.readings) the raw columns in mm
     (RAW_COLUMNS, and DEPTH_COLUMN for the level) are read too; `expected_*` columns (the
     model's readings on the measurement sheet) are skipped.
     """
@@ -393,13 +395,15 @@ def model_predictor(d: Design, band: Band, m: Measurement, kind: str = "stiffnes
     above = np.flatnonzero(band.levels >= top - 1e-9)
     n = int(above[0]) + 1 if above.size else len(band.levels)
     lv, k = band.levels[:n], band.coarsen
-    nominal = Variant(mounting=band.mounting)
+    nominal = Variant(options=SceneOptions(mounting=band.mounting))
     base = curves(run_variant(d, nominal, lv, k, load_kw)) if k > 1 else None
 
     def predict(value: float) -> dict[str, np.ndarray]:
-        v = dataclasses.replace(nominal, label="fit", **(
-            {"net_factor": value, "frame_factor": value} if kind == "stiffness"
-            else {"slack": value}))
+        if kind == "stiffness":
+            v = Variant("fit", options=dataclasses.replace(nominal.options, net_factor=value,
+                                                           frame_factor=value))
+        else:
+            v = dataclasses.replace(nominal, label="fit", slack=value)
         c = curves(run_variant(d, v, lv, k, load_kw))
         out = {}
         for key in m.values:

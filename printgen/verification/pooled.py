@@ -22,16 +22,11 @@ from concurrent.futures import Future
 from printgen.barrier.loads import LoadCase
 from printgen.design.record import Design
 from printgen.inputs.prototype import Prototype
+from printgen.scene.options import SceneOptions
 from printgen.trace import span
-from printgen.verification.bands import (
-    COARSENINGS,
-    Band,
-    Variant,
-    meshable,
-    model_band,
-    run_variant,
-)
+from printgen.verification.bands import COARSENINGS, Band, meshable, model_band, run_variant
 from printgen.verification.cases import case_plan, other_cases, with_cases
+from printgen.verification.variants import Variant
 from printgen.verification.verify import Verification, steel_counterexample, verify_plan
 from printgen.workers import collect, shared_pool
 
@@ -45,7 +40,7 @@ def verify_with_band(p: Prototype, d: Design, *, load: str | LoadCase | None = N
     case of `loads` (`with_cases`; queued behind the band's variants); `meanwhile` is called
     here once the first sweeps have started (this process then only waits)."""
     plan = verify_plan(p, d, load=load)
-    base, first = Variant(mounting=plan.ms.mounting), COARSENINGS[0]
+    base, first = Variant(options=SceneOptions(mounting=plan.ms.mounting)), COARSENINGS[0]
     cases: dict[str, list[Future]] = {}
     with shared_pool() as pool:
 

@@ -1,8 +1,8 @@
 """The virtual scale series (Lambert et al. 2023, doi:10.1061/JHEND8.HYENG-13070, Fig. 2): the
-prototype's scene (`printgen.verification.scenes.prototype_scene`) rebuilt at 1:lambda for
-several stiffness rows, each solved under a load case of `printgen.barrier.loads` up to one
-relative loading, and read as normalised deformations (deflection / width, lowering / height,
-mid-height elongation).
+prototype's scene (`printgen.scene.build_scene`) rebuilt at 1:lambda
+(`printgen.scene.scaled`) for several stiffness rows, each solved under a load case of
+`printgen.barrier.loads` up to one relative loading, and read as normalised deformations
+(deflection / width, lowering / height, mid-height elongation).
 
 Rows (`Row`): how the strands' axial stiffness goes with lambda while every length is
 divided by lambda (nodes, mesh, strand diameter d, so the section A by lambda^2):
@@ -32,18 +32,18 @@ from printgen.errors import InputError
 from printgen.inputs.materials import load_material
 from printgen.inputs.profiles import profile_name
 from printgen.inputs.prototype import Prototype
-from printgen.units import RHO_WATER, G
-from printgen.verification.scenes import (
+from printgen.scene.options import SceneOptions, build_scene
+from printgen.scene.scaled import at_scale
+from printgen.scene.scenes import (
     MOUNTINGS,
     ORIENTATIONS,
     PRESSURES,
     PROTOTYPE_ORIENTATION,
-    SENSOR_FORCE_N,
     BarrierScene,
-    Law,
-    prototype_scene,
 )
+from printgen.units import RHO_WATER, G
 from printgen.verification.verify import levels, sweep
+from solver import linear
 
 SCALES = (1.0, 10.0, 30.0, 50.0, 100.0)  # the paper's series (Lambert et al. 2023, Fig. 2)
 OUTPUTS = {"deflection": "mid-height deflection / width",
@@ -186,34 +186,22 @@ class CaseResult:
 def scaled_scene(base: BarrierScene, p: Prototype, row: Row, lam: float,
                  sensors: bool = False) -> BarrierScene:
     """`base` (the prototype's scene) at 1:`lam` with `row`'s stiffness (see the module)."""
-    def scaled(law: Law, factor: float) -> Law:
-        return law[0], tuple(k * factor for k in law[1])
-
     if row.kind == "material":
-        net_law: Law = ((), (row.modulus * math.pi / 4 * (p.net.strand_diameter / lam) ** 2,))
-        laws = [net_law] + [scaled(law, lam**-2) for law in base.laws[1:]]
-        cable = ((), (row.modulus * math.pi / 4 * (p.border.diameter / lam) ** 2,)) \
+        net_law = linear(row.modulus * math.pi / 4 * (p.net.strand_diameter / lam) ** 2)
+        cable = linear(row.modulus * math.pi / 4 * (p.border.diameter / lam) ** 2) \
             if p.border is not None else None
-        cables = {k: (n, cable) for k, (n, _law) in base.cables.items()}
-    else:
-        f = lam**-2 if row.kind == "unscaled" else lam**-3
-        laws = [scaled(law, f) for law in base.laws]
-        cables = {k: (n, scaled(law, f)) for k, (n, law) in base.cables.items()}
-    force = SENSOR_FORCE_N if sensors and lam > 1 else 0.0
-    wires = {k: dataclasses.replace(w, exit=w.exit / lam, force=force)
-             for k, w in base.wires.items()}
-    return dataclasses.replace(
-        base, name=f"{base.name} 1:{lam:g} {row.key}", scale=lam, width=base.width / lam,
-        height=base.height / lam, nodes=base.nodes / lam, laws=laws, cables=cables,
-        area_per_node=base.area_per_node / lam**2, wires=wires, hold=base.hold / lam**2)
+        return at_scale(base, lam, f"{base.name} 1:{lam:g} {row.key}",
+                        sensors=sensors and lam > 1, net_law=net_law, cable_law=cable)
+    f = lam**-2 if row.kind == "unscaled" else lam**-3
+    return at_scale(base, lam, f"{base.name} 1:{lam:g} {row.key}",
+                    sensors=sensors and lam > 1, factor=f)
 
 
 def base_scene(shared: SeriesShared) -> BarrierScene:
     """The prototype's scene with the series' net options."""
     o = shared.net
-    s = prototype_scene(shared.prototype, mounting=o.mounting, orientation=o.orientation,
-                        load=shared.load)
-    return dataclasses.replace(s, pressure=o.pressure)
+    return build_scene(shared.prototype, SceneOptions(
+        mounting=o.mounting, orientation=o.orientation, load=shared.load, pressure=o.pressure))
 
 
 def solve_case(shared: SeriesShared, case: tuple[str, float]) -> CaseResult:
@@ -234,7 +222,7 @@ def solve_case(shared: SeriesShared, case: tuple[str, float]) -> CaseResult:
     values = {k: float(d.values[k][-1]) if d.levels[-1] == lv[-1] else math.nan
               for k in OUTPUTS}
     return CaseResult(key, lam, values, d.levels, {k: d.values[k] for k in OUTPUTS},
-                      float(s.laws[0][1][0]), RHO_WATER * G * s.height * s.area_per_node,
+                      float(s.laws[0].slopes[0]), RHO_WATER * G * s.height * s.area_per_node,
                       run.hold_share, int(sum(run.iterations)), dict(run.failed))
 
 

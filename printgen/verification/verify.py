@@ -1,5 +1,5 @@
 """Pre-print verification: the prototype and the printed model, each as a tension-only net
-(`printgen.verification.scenes`), loaded hydrostatically from h / h_B = 0 to 1.1 (the reference's loading
+(`printgen.scene.scenes`), loaded hydrostatically from h / h_B = 0 to 1.1 (the reference's loading
 test: water raised behind a folded film), or another load case of `printgen.barrier.loads`
 (flow, drag, jam: a case may bring its own levels and states what it used at each), and compared by their normalised deformations over the whole range (printgen.verification.compare).
 Also the counter-example the report warns about: the simple barrier with steel at every scale.
@@ -15,11 +15,15 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 import solver
-from printgen.barrier.loads import FLOW, OVERFLOW, LoadCase, LoadsAt, Site, get_load
+from printgen.barrier.loads import OVERFLOW, LoadCase, Site, get_load
 from printgen.design.record import Design
 from printgen.design.similitude import scale_targets
 from printgen.errors import SolverError
 from printgen.inputs.prototype import Prototype
+from printgen.scene.options import SceneOptions, build_scene
+from printgen.scene.pressure import loads_function
+from printgen.scene.scenes import BarrierScene, lateral_mounting, noted
+from printgen.scene.solvernet import build, hold_share, wire_slack
 from printgen.units import MM
 from printgen.verification.compare import (
     Deformation,
@@ -30,13 +34,6 @@ from printgen.verification.compare import (
     headline,
     increments,
 )
-from printgen.verification.scenes import (
-    BarrierScene,
-    lateral_mounting,
-    model_scene,
-    prototype_scene,
-)
-from printgen.verification.solvernet import build, hold_share, wire_slack
 from printgen.workers import (  # worker lifecycle: ground floor
     check_deadline,
     report_progress,
@@ -59,37 +56,6 @@ def levels(step: float = LEVEL_STEP, top: float = OVERFLOW) -> np.ndarray:
     """0, step, ..., top (inclusive)."""
     n = round(top / step)
     return np.round(np.linspace(0.0, top, n + 1), 10)
-
-
-def solver_net(s: BarrierScene, *, slack: float = 0.0) -> solver.Net:
-    """The scene as a solver net (`printgen.verification.solvernet`): its sensor wires pulling at
-    constant tension (one element per wire segment), its unloaded nodes held when the scene says so; `slack` is the
-    relative initial slack of every strand and cable (0.01 = rest lengths 1 % longer than the
-    printed ones)."""
-    return build(s, slack=slack)[0]
-
-
-def loads_function(s: BarrierScene, *, load: str | LoadCase | None = None,
-                   site: Site | None = None) -> LoadsAt:
-    """Loads at relative loading r of load case `load` (default hydrostatic) on the scene's
-    free nodes, at `site` (the sensor wires are part of the net: `solver_net`). With the
-    scene's pressure option "normal" the hydrostatic part presses normal to the deformed net
-    (issue 25: the folded film presses normal to the surface) instead of along the flow."""
-    loads_at = get_load(load).loads_for(s, site)
-    if s.pressure != "normal":
-        return loads_at
-    from printgen.verification.pressure import normal_pressure
-
-    free = np.flatnonzero(~s.fixed)
-    normal = normal_pressure(s.nodes, s.elements[s.element_law == 0], free, s.area_per_node,
-                             0.0)
-
-    def normal_at(r: float) -> list:
-        return [dataclasses.replace(normal, level=f.level)  # the water behind a jam stays along
-                if isinstance(f, solver.Hydrostatic) and f.direction == tuple(FLOW) else f
-                for f in loads_at(r)]
-
-    return normal_at
 
 
 def free_section(p: Prototype) -> float | None:
@@ -169,7 +135,7 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw: Any
     if loose:  # a segment shorter than its knee would pull harder than the sensor
         raise SolverError(f"{s.name}: a sensor wire segment shortened below its spring's knee "
                           f"at h/h_B = {loose[0]:g}; raise WIRE_STRAIN in "
-                          "printgen/verification/solvernet.py")
+                          "printgen/scene/solvernet.py")
     n, m, c = ex.n_nodes, ex.n_elements, ex.n_cables
     d = deformation(s, lv, [r.positions[:n] for r in results],
                     [r.tensions[:m] for r in results], [r.cable_tensions[:c] for r in results])
@@ -255,8 +221,8 @@ def barriers(p: Prototype, d: Design, load: str | LoadCase | None, mounting: str
     mounting = mounting or lateral_mounting(p)
     kw_p, kw_m = load_keywords(p, d, load)
     case = kw_m["load"]
-    return (case, kw_p, kw_m, prototype_scene(p, mounting=mounting, load=case),
-            model_scene(d, mounting=mounting, load=case))
+    options = SceneOptions(mounting=mounting, load=case)
+    return case, kw_p, kw_m, build_scene(p, options), build_scene(d, options)
 
 
 @dataclass(frozen=True)
@@ -329,8 +295,7 @@ def stated(case: LoadCase, runs: tuple[Run, Run], sites: tuple[Site, Site]
             row = (f"loading: {case.name} at each level", text,
                    ("printgen (report.json: verification.load, or verification.by_load.<case> "
                     "for make --loads)"))
-            run = dataclasses.replace(run, scene=dataclasses.replace(
-                run.scene, assumptions=(*run.scene.assumptions, row)))
+            run = dataclasses.replace(run, scene=noted(run.scene, row))
         out.append(run)
     return (out[0], out[1]), rec
 

@@ -1,8 +1,9 @@
 """Load cases of the pre-print check: what pushes on the net as the water rises.
 
 Each module here defines `CASE`, a `LoadCase`; `get_load(name)` finds it (a new load case
-is one module plus its test). A case reads the barrier's scene (nodes, anchors, strands,
-height and tributary area: a `printgen.verification.scenes.BarrierScene`) and its `Site` (the flow
+is one module plus its test). A case reads the barrier's scene through `SceneView` (nodes,
+anchors, strands, size and tributary area: `printgen.scene.BarrierScene` is one) and its
+`Site` (the flow
 and strands at that barrier's scale), and gives the solver's loads at each relative loading
 r = h / h_B (the upstream water depth over the barrier's height).
 
@@ -20,7 +21,7 @@ import dataclasses
 import math
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -31,6 +32,25 @@ OVERFLOW = 1.1  # last relative loading h / h_B of the loading test (the water o
 DEFAULT = "hydrostatic"  # the loading test of the reference (barrier-physics.md, section 4)
 Assumption = tuple[str, str, str]  # (what, value, source)
 LoadsAt = Callable[[float], list]  # relative loading r -> the solver's loads
+
+
+class SceneView(Protocol):
+    """What a load case reads of a barrier's solver scene (SI): nodes (n, 3) m at rest,
+    fixed (n,) bool anchors, elements (m, 2) int the net's strands, width and height m,
+    area_per_node m^2 (A*, the tributary area of a node)."""
+
+    @property
+    def nodes(self) -> np.ndarray: ...
+    @property
+    def fixed(self) -> np.ndarray: ...
+    @property
+    def elements(self) -> np.ndarray: ...
+    @property
+    def width(self) -> float: ...
+    @property
+    def height(self) -> float: ...
+    @property
+    def area_per_node(self) -> float: ...
 
 
 @dataclass(frozen=True)
@@ -75,7 +95,7 @@ class LoadCase:
     assumptions: tuple[Assumption, ...]
     params: tuple[Param, ...] = ()
     values: tuple[tuple[str, float], ...] = ()
-    levels: Callable[..., Any] | None = None
+    levels: Callable[..., np.ndarray] | None = None
     per_level: Callable[..., tuple[dict[str, Any], str]] | None = None
 
     @property
@@ -85,15 +105,16 @@ class LoadCase:
             return self.name
         return f"{self.name}:" + ",".join(f"{k}={v:g}" for k, v in self.values)
 
-    def loads_for(self, scene: Any, site: Site) -> LoadsAt:
+    def loads_for(self, scene: SceneView, site: Site) -> LoadsAt:
         """The loads at each relative loading, with this case's parameter values."""
         return self.loads(scene, site, **dict(self.values))
 
-    def levels_for(self, scene: Any, site: Site) -> Any:
+    def levels_for(self, scene: SceneView, site: Site) -> np.ndarray | None:
         """The case's own load levels (None: the sweep's usual ones)."""
         return None if self.levels is None else self.levels(scene, site, **dict(self.values))
 
-    def describe(self, scene: Any, site: Site, levels: Any) -> tuple[dict[str, Any], str]:
+    def describe(self, scene: SceneView, site: Site, levels: np.ndarray
+                 ) -> tuple[dict[str, Any], str]:
         """What the case used at each of `levels`, and a one-line text of it."""
         if self.per_level is None:
             return {}, ""

@@ -14,17 +14,17 @@ from typing import Any
 import numpy as np
 
 import solver
-from printgen.barrier.loads import FLOW, LoadCase, LoadsAt, Site, hydrostatic
+from printgen.barrier.loads import FLOW, LoadCase, LoadsAt, SceneView, Site, hydrostatic
 from printgen.units import RHO_WATER
 
 
-def strand_per_node(s: Any) -> float:
+def strand_per_node(s: SceneView) -> float:
     """l (m): the scene's strand length per node (the drag and the jam's net loss use it)."""
     d = s.nodes[s.elements[:, 1]] - s.nodes[s.elements[:, 0]]
     return float(np.linalg.norm(d, axis=1).sum()) / len(s.nodes)
 
 
-def strand_drag(s: Any, diameter: float) -> Callable[[float, float], solver.Drag]:
+def strand_drag(s: SceneView, diameter: float) -> Callable[[float, float], solver.Drag]:
     """(r, v) -> the drag 0.5 rho v^2 l d on the scene's free nodes wetted at level r h_B
     (l the strand length per node, d = `diameter`), ramped in over one node row."""
     free = np.flatnonzero(~s.fixed)
@@ -38,7 +38,7 @@ def strand_drag(s: Any, diameter: float) -> Callable[[float, float], solver.Drag
     return drag_at
 
 
-def loads(s: Any, site: Site) -> LoadsAt:
+def loads(s: SceneView, site: Site) -> LoadsAt:
     """The hydrostatic loads, and drag at `site.velocity` on the submerged free nodes."""
     still = hydrostatic.loads(s, site)
     drag_at = strand_drag(s, site.strand_diameter)
@@ -49,7 +49,8 @@ def loads(s: Any, site: Site) -> LoadsAt:
     return loads_at
 
 
-def per_level(s: Any, site: Site, levels: Any) -> tuple[dict[str, Any], str]:
+def per_level(s: SceneView, site: Site, levels: np.ndarray
+              ) -> tuple[dict[str, Any], str]:
     """The velocity at each level: the site's, whatever the depth."""
     v = np.full(len(levels), float(site.velocity))
     return {"velocity_m_per_s": v}, f"velocity {site.velocity:.4g} m/s at every level"

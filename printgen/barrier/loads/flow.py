@@ -14,18 +14,18 @@ from typing import Any
 
 import numpy as np
 
-from printgen.barrier.loads import LoadCase, LoadsAt, Site, hydrostatic
+from printgen.barrier.loads import LoadCase, LoadsAt, SceneView, Site, hydrostatic
 from printgen.barrier.loads.drag import strand_drag
 from printgen.units import G
 
 
-def velocity(s: Any, site: Site, r: float) -> float:
+def velocity(s: SceneView, site: Site, r: float) -> float:
     """The approach velocity (m/s) at relative loading r: constant Froude number."""
     depth = site.depth or s.height
     return float(site.velocity) * math.sqrt(max(r, 0.0) * s.height / depth)
 
 
-def loads(s: Any, site: Site) -> LoadsAt:
+def loads(s: SceneView, site: Site) -> LoadsAt:
     """Hydrostatic loads and drag at the level's velocity on the submerged free nodes."""
     still = hydrostatic.loads(s, site)
     drag_at = strand_drag(s, site.strand_diameter)
@@ -36,7 +36,8 @@ def loads(s: Any, site: Site) -> LoadsAt:
     return loads_at
 
 
-def per_level(s: Any, site: Site, levels: Any) -> tuple[dict[str, Any], str]:
+def per_level(s: SceneView, site: Site, levels: np.ndarray
+              ) -> tuple[dict[str, Any], str]:
     """The velocity and Froude number at each level."""
     v = np.array([velocity(s, site, float(r)) for r in levels])
     depth = np.asarray(levels, dtype=float) * s.height

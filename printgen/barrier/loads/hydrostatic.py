@@ -4,16 +4,14 @@ rho g (r h_B - z) A* on every free node at its current height (barrier-physics.m
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 import solver
-from printgen.barrier.loads import FLOW, LoadCase, LoadsAt, Site
+from printgen.barrier.loads import FLOW, LoadCase, LoadsAt, SceneView, Site
 from printgen.units import RHO_WATER, G
 
 
-def loads(s: Any, site: Site) -> LoadsAt:
+def loads(s: SceneView, site: Site) -> LoadsAt:
     """Hydrostatic rho g (r h_B - z) A* on the scene's free nodes at their current height."""
     free = np.flatnonzero(~s.fixed)
 

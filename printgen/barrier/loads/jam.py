@@ -36,7 +36,16 @@ import numpy as np
 from scipy.optimize import brentq
 
 import solver
-from printgen.barrier.loads import FLOW, OVERFLOW, LoadCase, LoadsAt, Param, Site, hydrostatic
+from printgen.barrier.loads import (
+    FLOW,
+    OVERFLOW,
+    LoadCase,
+    LoadsAt,
+    Param,
+    SceneView,
+    Site,
+    hydrostatic,
+)
 from printgen.barrier.loads.drag import strand_drag, strand_per_node
 from printgen.units import L_PER_S, NU_WATER, RHO_WATER, G
 
@@ -60,7 +69,7 @@ def ergun_gradient(u: float, porosity: float, log_d: float) -> float:
     return (lam + 1.75 * (1 - n) * u * u / (n**3 * dp)) / G
 
 
-def net_factor(s: Any) -> float:
+def net_factor(s: SceneView) -> float:
     """l / A* (1/m): strand length per unit net area; times d, the strands' frontal area
     per unit net area."""
     return strand_per_node(s) / s.area_per_node
@@ -95,14 +104,14 @@ def seepage(hu: float, k: float, porosity: float, thickness: float, log_d: float
     return (q, *behind_net(q, k, froude))
 
 
-def _jam(s: Any, site: Site, values: dict[str, float]) -> dict[str, float]:
+def _jam(s: SceneView, site: Site, values: dict[str, float]) -> dict[str, float]:
     """The jam at this barrier's scale (SI), its net factor and its flow width."""
     return {"k": net_factor(s) * site.strand_diameter, "porosity": values["porosity"],
             "thickness": values["thickness_m"] / site.scale,
             "log_d": values["log_diameter_m"] / site.scale, "froude": values["tailwater_froude"]}
 
 
-def loads(s: Any, site: Site, **values: float) -> LoadsAt:
+def loads(s: SceneView, site: Site, **values: float) -> LoadsAt:
     """The jam's head difference on the free nodes at their current height, and the drag of
     the seepage through the strands below h_m."""
     jam = _jam(s, site, values)
@@ -119,7 +128,7 @@ def loads(s: Any, site: Site, **values: float) -> LoadsAt:
     return loads_at
 
 
-def levels(s: Any, site: Site, **values: float) -> np.ndarray:
+def levels(s: SceneView, site: Site, **values: float) -> np.ndarray:
     """0 and the upstream depth / h_B of each discharge step on this barrier (the flume's
     printed model); steps held above the overflow are read at OVERFLOW."""
     jam = _jam(s, site, values)
@@ -138,7 +147,8 @@ def levels(s: Any, site: Site, **values: float) -> np.ndarray:
     return np.unique(np.round(out, 10))
 
 
-def per_level(s: Any, site: Site, lv: Any, **values: float) -> tuple[dict[str, Any], str]:
+def per_level(s: SceneView, site: Site, lv: np.ndarray, **values: float
+              ) -> tuple[dict[str, Any], str]:
     """Discharge (L/s through this barrier's flow width), depths and velocities at each level."""
     jam = _jam(s, site, values)
     width = site.flow_width or s.width

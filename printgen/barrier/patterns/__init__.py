@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 from printgen.barrier.graph import NetGraph
 from printgen.errors import InputError
+from solver import Law  # the one force-strain law type: strain knees, force slopes (N)
 
-Law = tuple[tuple[float, ...], tuple[float, ...]]  # (strain knees, force slopes)
 # Prototype patterns drawn as another (the prototype file's [net] pattern), said so in the
 # verification's assumptions.
 AS_DRAWN = {"water-drop": "diamond"}
@@ -33,6 +33,9 @@ class NetPattern:
     nodes(width, height, mesh_x, mesh_y) : nodes of `graph` (any length unit)
     edge_strands : the border loop's segments are strands of the prototype's net (the
       square's edge rows); False: the border is only the printed frame (the diamond's)
+    lockup(a_along, a_across) : the panel strain at which a free pin-jointed panel's strands
+      lie along the load (its meshes closed across it: a mechanism below); None: they lie
+      along it from the start (the square's strands up)
     """
 
     name: str
@@ -43,6 +46,7 @@ class NetPattern:
     span: Callable[[float, float], float]
     nodes: Callable[[float, float, float, float], int]
     edge_strands: bool = False
+    lockup: Callable[[float, float], float] | None = None
 
 
 def mesh_text(pattern: str, mesh_x_mm: float, mesh_y_mm: float) -> str:

@@ -46,13 +46,19 @@ def strand_law(knees: tuple[float, ...], slopes: tuple[float, ...], mesh_along: 
     """
     sin = diamond_sin(mesh_along, mesh_across)
     f = 1.0 / (diamond_factor(mesh_along, mesh_across))
-    return tuple(k * sin * sin for k in knees), tuple(s * f for s in slopes)
+    return Law(tuple(k * sin * sin for k in knees), tuple(s * f for s in slopes))
 
 
 def strand_force(n: float, mesh_along: float, mesh_across: float) -> float:
     """Strand tension (N) under a membrane force `n` N/m along the load: 2 / a_across
     strands per unit width carry it, each at sin(theta) to the cross direction."""
     return n * mesh_across / (2 * diamond_sin(mesh_along, mesh_across))
+
+
+def lockup_strain(mesh_along: float, mesh_across: float) -> float:
+    """Panel strain at which the diamonds' strands lie along the load (their meshes closed
+    across it): strand length over its along-load half-diagonal, minus 1."""
+    return math.hypot(mesh_along, mesh_across) / mesh_along - 1.0
 
 
 def span(length: float, diagonal: float) -> float:
@@ -132,4 +138,4 @@ def _border_loop(index: np.ndarray, nx: int, ny: int) -> np.ndarray:
 
 
 PATTERN = NetPattern("diamond", diamond_net, diamond_factor, strand_law, strand_force,
-                     span, diamond_nodes)
+                     span, diamond_nodes, lockup=lockup_strain)

@@ -42,7 +42,7 @@ def strand_law(knees: tuple[float, ...], slopes: tuple[float, ...], mesh_along: 
                mesh_across: float) -> Law:
     """Strand law of a square net with membrane law (knees, slopes N/m): the strands along
     the load strain as the net (same knees) and each carries a_across of its width."""
-    return tuple(knees), tuple(s * mesh_across for s in slopes)
+    return Law(tuple(knees), tuple(s * mesh_across for s in slopes))
 
 
 def span(length: float, mesh: float) -> float:

@@ -1,6 +1,6 @@
 """How the net meets the cables and the flume anchors (plan view, mm).
 
-The solver scene (`printgen.verification.scenes`) slides each border cable through the net's edge
+The solver scene (`printgen.scene.scenes`) slides each border cable through the net's edge
 nodes between four corner anchors. The printed net does the same: a **loop** (a hole in a
 ring) is centred on every edge node, and an **eyelet** on every corner node; the cable
 strip threads through the loops of its side and the cable's own eyelets go on the flume's

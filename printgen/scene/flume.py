@@ -4,7 +4,7 @@ eyelets go on one pin), the edges held along their length (the flume's side shee
 and the banks of a net without border cables), and each sensor wire: where it is anchored,
 the row it runs over and where its string potentiometer stands.
 
-Everything is read from the model's solver scene (`printgen.verification.scenes`, whose
+Everything is read from the model's solver scene (`printgen.scene.scenes`, whose
 docstring states the routing), so the drawing shows what the check solved. Coordinates:
 x across the flume from the net's left edge, z up from the flume bed (the net's bottom edge).
 """
@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from printgen.scene.readings import SENSORS
+from printgen.scene.scenes import BarrierScene
 from printgen.units import MM
-from printgen.verification.readings import SENSORS
-from printgen.verification.scenes import BarrierScene
 
 DIGITS = 4  # decimals of mm kept in the record (0.1 um)
 SIDE_NAMES = {"left": "left side sheet", "right": "right side sheet", "bottom": "flume bed"}

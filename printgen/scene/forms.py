@@ -4,7 +4,7 @@ the test, never fitted to the flume curve (Lambert et al. 2023, doi:10.1061/JHEN
 - net law (`NET_LAWS`): "formula" (the nominal) turns the profile's panel law into a strand
   law by the analytic diamond mapping (every strand of an infinite, blocked panel stretched
   alike); "derived" uses the strand law whose simulated panel test, as the source ran it,
-  reproduces the panel law (`printgen.verification.panel.derive_law`): free between the clamps,
+  reproduces the panel law (`printgen.scene.panel.derive_law`): free between the clamps,
   or blocked where a free pin-jointed panel is a mechanism over the law's range (the printed
   net's rigid junctions, which the solver does not model, stop its meshes closing at no force;
   blocking is their stiff limit);
@@ -25,23 +25,30 @@ from __future__ import annotations
 
 import dataclasses
 from functools import lru_cache
-from typing import TYPE_CHECKING
 
 import numpy as np
 
+from printgen.barrier.patterns import get_pattern
 from printgen.design.record import Design
+from printgen.design.section import area_m2
 from printgen.inputs.materials import load_material
+from printgen.scene.panel import PanelTest, derive_law, law_strains, simulate
+from printgen.scene.scenes import (
+    TESTED_PATTERN,
+    BarrierScene,
+    model_net_law,
+    panel_axes,
+    recorded_orientation,
+)
 from printgen.units import MM
-from printgen.verification.scenes import BarrierScene, Law, panel_axes, recorded_orientation
-
-if TYPE_CHECKING:
-    from printgen.verification.bands import Variant
+from solver import Law
 
 NET_LAWS = ("formula", "derived")
 BEDS = ("free", "held")
 ROUTINGS = ("in-line", "downstream")
 DERIVE_POINTS = 5  # strains the derivation fits (checked between them too): TPE long, free,
 # within 3.6 % of its panel law (12 points: 6.7 %, the same CPU time)
+SLACK_SLOPE = 1e-4  # slope of a slack segment / the law's first slope (keeps it solvable)
 MECHANISM = 0.5  # a free panel whose solver hold carries over half the clamp force is a mechanism
 
 
@@ -50,12 +57,9 @@ def _derived(knees: tuple[float, ...], slopes: tuple[float, ...], along: float, 
              length: float, width: float) -> tuple[Law, str, float]:
     """(strand law, test mode, derivation error) of a panel law n(eps) = piecewise(knees,
     slopes N/m) tested on a `length` x `width` panel loaded along the `along` diagonal."""
-    from printgen.verification.panel import PanelTest, derive_law, law_strains, simulate
-    from printgen.verification.scenes import strand_law_from_membrane
-
-    free = PanelTest(along, across, length, width, "free")
-    probe = simulate(strand_law_from_membrane(knees, slopes, along, across), free,
-                     law_strains(knees)[:2])
+    free = PanelTest(along, across, length, width, "free", TESTED_PATTERN)
+    formula = get_pattern(TESTED_PATTERN).strand_law(knees, slopes, along, across)
+    probe = simulate(formula, free, law_strains(knees)[:2])
     t = free if probe.hold_share <= MECHANISM else dataclasses.replace(free, mode="blocked")
     d = derive_law(knees, slopes, t, law_strains(knees, DERIVE_POINTS))
     return d.law, t.mode, d.error
@@ -66,9 +70,6 @@ def derived_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
     along `orientation` (None: the diagonal its profile records), rescaled from the tested
     strand section to the design's; and how it was found. GeometryError-free: a material
     without a panel law of recorded geometry keeps the formula (`model_net_law`)."""
-    from printgen.design.section import area_m2
-    from printgen.verification.scenes import model_net_law
-
     law = mat.panel_law
     if law is None or not law.has_geometry:
         return model_net_law(mat, n, orientation)
@@ -83,7 +84,17 @@ def derived_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
     how = (f"strand law derived from the virtual panel test ({law.panel_length / MM:g} mm "
            f"panel, {width / MM:g} mm clamps, {mode}, along the {along / MM:g} mm "
            f"({orientation}) diagonal; reproduces the panel law within {err:.1%})")
-    return (strand[0], tuple(s * ratio for s in strand[1])), how
+    return strand.scaled(ratio), how
+
+
+def with_derived_law(s: BarrierScene, d: Design, orientation: str | None) -> BarrierScene:
+    """Scene `s` of design `d` with its net's strand law from the virtual panel test
+    (`derived_net_law`), its "net strands" assumption saying so."""
+    laws = list(s.laws)
+    laws[0], how = derived_net_law(load_material(d.net.material), d.net, orientation)
+    rows = tuple((w, f"{d.net.material}: {how}" if w == "net strands" else val, src)
+                 for w, val, src in s.assumptions)
+    return dataclasses.replace(s, laws=laws, assumptions=rows)
 
 
 def held_on_bed(s: BarrierScene) -> BarrierScene:
@@ -110,49 +121,17 @@ def routed(s: BarrierScene, routing: str) -> BarrierScene:
     return dataclasses.replace(s, wires=wires, assumptions=(*s.assumptions, note))
 
 
-def _routing_variants(d: Design, mounting: str | None, notes: list[str]) -> list[Variant]:
-    from printgen.verification.bands import Variant, variant_scene
-
-    s = variant_scene(d, Variant(mounting=mounting))
-    if all(s.fixed[w.nodes[-1]] for w in s.wires.values()):
-        notes.append(f"sensor routing: the rows' end nodes are held ({s.mounting} mounting), "
-                     "so the wire beyond them changes neither the net nor the reading; no "
-                     "routing variant")
-        return []
-    return [Variant("sensor wires turn downstream at the edge", routing="downstream",
-                    source="potentiometers' position not stated (nominal: in line)")]
+def slackened(law: Law, slack: float) -> Law:
+    """The law with a nearly flat first segment of `slack` strain (SLACK_SLOPE of its slope)."""
+    if slack <= 0:
+        return law
+    return Law((slack, *(k + slack for k in law.knees)),
+               (SLACK_SLOPE * law.slopes[0], *law.slopes))
 
 
-def model_form_variants(d: Design, free_section: float | None, notes: list[str],
-                        mounting: str | None = None) -> list[Variant]:
-    """Issue 25: the water's force normal to the deformed net, the virtual panel test's strand
-    law and the bottom row held on the bed (printgen.verification.forms), and the net mounted
-    in a free section narrower than its printed width (printgen.verification.mount), alone and
-    with its slack bottom cable on the bed; the sensor routing where it matters."""
-    from printgen.verification.bands import SAME, Variant
-
-    out = [Variant("pressure normal to the deformed net", pressure="normal",
-                   source="the folded film presses normal to the net (nominal: along the "
-                          "flow, reference section 3)")]
-    out += _routing_variants(d, mounting, notes) if d.cables else []
-    law = load_material(d.net.material).panel_law
-    if law is not None and law.has_geometry:
-        out.append(Variant("strand law from the virtual panel test", net_law="derived",
-                           source="printgen panel: the strand law whose simulated panel test "
-                                  "reproduces the profile's (nominal: diamond formula)"))
-    if d.cables:
-        out.append(Variant("bottom row held on the bed", bed="held", source=(
-            "the film's foot seals on the bed under the full head (nominal: the bottom "
-            "cable free between its anchors)")))
-    width = d.net.width_mm * MM
-    if d.cables and free_section is not None and free_section < width * (1 - SAME):
-        fs = f"{free_section * 1e3:g} mm free section"
-        src = (f"net printed {width * 1e3:.4g} mm wide, side sheets {free_section * 1e3:g} mm "
-               "apart; how the excess is held is not stated (reference section 4)")
-        out += [Variant(f"mounted in the {fs}", span=free_section, source=src),
-                Variant(f"mounted in the {fs}, bottom on the bed", span=free_section,
-                        bed="held", source=src + "; its slack bottom cable lies on the bed")]
-    else:
-        notes.append("mounting span: no free section narrower than the net given "
-                     "([flume] free_section_m); no span variant")
-    return out
+def slack_laws(s: BarrierScene, net: float, cable: float) -> BarrierScene:
+    """Scene `s` with every strand law `slackened` by `net` and every cable law by `cable`
+    (relative slack as a law's first, nearly flat segment)."""
+    laws = [slackened(law, net) for law in s.laws]
+    cables = {k: (nodes, slackened(law, cable)) for k, (nodes, law) in s.cables.items()}
+    return dataclasses.replace(s, laws=laws, cables=cables)

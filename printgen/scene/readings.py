@@ -15,9 +15,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from printgen.design.record import Design
+from printgen.scene.options import build_scene
+from printgen.scene.scenes import BarrierScene
+from printgen.scene.solvernet import path_length
 from printgen.units import MM
-from printgen.verification.scenes import BarrierScene
-from printgen.verification.solvernet import path_length
 
 SENSORS = {"strain_bottom": "bottom", "strain_top": "top", "strain_mid": "mid"}
 # raw CSV column (mm) -> METRICS key; the water depth column stands for h_over_hb
@@ -56,8 +58,6 @@ def flume_units(scene: BarrierScene) -> FlumeUnits:
     return FlumeUnits(scene.width / MM, scene.height / MM, rows)
 
 
-def design_units(design) -> FlumeUnits:
-    """`flume_units` of the printed model of `design` (printgen.design.record.Design)."""
-    from printgen.verification.scenes import model_scene
-
-    return flume_units(model_scene(design))
+def design_units(design: Design) -> FlumeUnits:
+    """`flume_units` of the printed model of `design`."""
+    return flume_units(build_scene(design))

@@ -14,12 +14,12 @@ boundary conditions, as the sources describe them:
 The reading is the clamp force per clamp width, n = F / w (N/m), against the elongation
 dl = eps L; the panel law kappa = n / dl (kN/m/m), or n against eps for the membrane law.
 
-The analytic diamond formula (`printgen.verification.scenes.strand_law_from_membrane`) is the
+The analytic diamond formula (the diamond pattern's `strand_law`) is the
 blocked, infinite panel: every strand stretched alike. `analytic_blocked` gives it at finite
 strain too (the strands rotate toward the load), the test the blocked simulation must match.
 
 A pin-jointed, tension-only diamond net with free sides is a mechanism: its meshes close
-across the load at no force until the strands lie along it (`lockup_strain`). A free panel's
+across the load at no force until the strands lie along it (`NetPattern.lockup`). A free panel's
 stiffness below that strain comes only from the clamps' hold on the meshes next to them and,
 in a printed net, from its rigid junctions, which the solver does not model. So a strand law
 that makes the free simulated test match a measured law at low strain may not exist: the
@@ -36,9 +36,13 @@ import numpy as np
 
 import solver
 from printgen.barrier.patterns import get_pattern
+from printgen.design.record import Design
 from printgen.errors import SolverError
 from printgen.inputs.laws import piecewise_linear
+from printgen.inputs.materials import load_material
+from printgen.scene.scenes import TESTED_PATTERN, model_net_law, panel_axes
 from printgen.units import MM
+from solver import Law
 
 MODES = ("blocked", "free")
 PANEL_TOL = 1e-9  # out-of-balance force / strand force scale: exact for a 1 % comparison
@@ -48,8 +52,6 @@ STRAIN_STEP = 0.01  # largest strain step between two solves of the test
 STRAIN_POINTS = 12  # panel strains simulated over the law's range
 HOLD_RATIO = 1e-4  # free mode: each free node held at rest by this x the strand EA / length
 # (a vanishing stiffness that picks one state of the mechanism; its force share is reported)
-
-Law = tuple[tuple[float, ...], tuple[float, ...]]  # (strain knees, slopes: N per unit strain)
 
 
 @dataclass(frozen=True)
@@ -63,7 +65,7 @@ class PanelTest:
     length: float
     width: float
     mode: str = "free"
-    pattern: str = "diamond"
+    pattern: str = TESTED_PATTERN
 
     def describe(self) -> str:
         side = ("transverse displacement blocked" if self.mode == "blocked"
@@ -117,16 +119,11 @@ def lattice_size(t: PanelTest) -> tuple[float, float]:
     return float(xz[:, 1].max()), float(xz[:, 0].max())
 
 
-def lockup_strain(mesh_along: float, mesh_across: float) -> float:
-    """Panel strain at which the diamonds' strands lie along the load (their meshes closed
-    across it): strand length over its along-load half-diagonal, minus 1."""
-    return math.hypot(mesh_along, mesh_across) / mesh_along - 1.0
-
-
 def panel_lockup(t: PanelTest) -> float:
-    """Panel strain of test `t` at which its strands lie along the load: the diamond's
-    `lockup_strain`; 0 for a square net, whose strands up lie along it from the start."""
-    return 0.0 if t.pattern == "square" else lockup_strain(t.mesh_along, t.mesh_across)
+    """Panel strain of test `t` at which its strands lie along the load (its pattern's
+    `lockup`: the diamond's `lockup_strain`); 0 when they lie along it from the start."""
+    lockup = get_pattern(t.pattern).lockup
+    return 0.0 if lockup is None else lockup(t.mesh_along, t.mesh_across)
 
 
 def analytic_blocked(law: Law, t: PanelTest, strains: np.ndarray) -> np.ndarray:
@@ -136,7 +133,7 @@ def analytic_blocked(law: Law, t: PanelTest, strains: np.ndarray) -> np.ndarray:
     hx, hz = t.mesh_across / 2, t.mesh_along / 2
     e = np.asarray(strains, float)
     l0, l1 = math.hypot(hx, hz), np.hypot(hx, hz * (1 + e))
-    n = piecewise_linear(l1 / l0 - 1, *law)
+    n = piecewise_linear(l1 / l0 - 1, law.knees, law.slopes)
     return 2.0 / t.mesh_across * n * hz * (1 + e) / l1
 
 
@@ -164,10 +161,10 @@ def _solve_all(law: Law, t: PanelTest, strains: np.ndarray):
     fixed[np.concatenate([bottom, top])] = True
     if t.mode == "blocked":
         fixed[:, 0] = True
-    laws = [solver.piecewise(*law)]
+    laws = [law]
     free = np.flatnonzero(~fixed[:, 0])
     arm = float(rest.min())
-    hold_k = HOLD_RATIO * float(law[1][0]) / arm if t.mode == "free" else 0.0
+    hold_k = HOLD_RATIO * float(law.slopes[0]) / arm if t.mode == "free" else 0.0
     if hold_k:  # two ties per free node, out of the plane: in-plane stiffness hold_k
         anchors = np.vstack([nodes[free] - [0, arm, 0], nodes[free] + [0, arm, 0]])
         ties = np.column_stack([np.tile(free, 2), n + np.arange(2 * len(free))])
@@ -272,8 +269,8 @@ def derive_law(knees: tuple[float, ...], slopes: tuple[float, ...], t: PanelTest
         new, _ = nnls(shares, target * lattice_size(t)[1])
         new = np.maximum(new, 1e-9 * float(np.max(new)))
         k_new = tuple(float(np.interp(k, eps, strand_eps)) for k in fine)
-        moved = float(np.max(np.abs(new / np.asarray(law[1]) - 1)))
-        law = (k_new, tuple(float(s) for s in new))
+        moved = float(np.max(np.abs(new / np.asarray(law.slopes) - 1)))
+        law = Law(k_new, tuple(float(s) for s in new))
         if moved < DERIVE_TOL:
             break
     check = np.sort(np.concatenate([eps, (eps[1:] + eps[:-1]) / 2]))  # between the fitted too
@@ -291,7 +288,7 @@ def _segment_shares(law: Law, t: PanelTest, eps: np.ndarray) -> tuple[np.ndarray
     at_top = np.isin(elements, top)
     on_clamp = at_top.any(axis=1)
     sign = np.where(at_top[:, 1], 1.0, -1.0)[on_clamp]
-    lo = np.array([0.0, *law[0]])
+    lo = np.array([0.0, *law.knees])
     width = np.append(np.diff(lo), np.inf)
     rows, mean_eps = [], []
     for positions, _, _ in _solve_all(law, t, eps):
@@ -304,10 +301,7 @@ def _segment_shares(law: Law, t: PanelTest, eps: np.ndarray) -> tuple[np.ndarray
     return np.array(rows), np.array(mean_eps)
 
 
-
-
 PRINTED_PANEL = (43 * MM, 23 * MM)  # the paper's printed panels: length, clamp width (m)
-TESTED_PATTERN = "diamond"  # the pattern of the nets the material profiles' panel laws tested
 
 
 @dataclass(frozen=True)
@@ -323,13 +317,10 @@ class DesignPanel:
     measured: np.ndarray | None
 
 
-def design_panel(d, orientation: str, mode: str = "free",
+def design_panel(d: Design, orientation: str, mode: str = "free",
                  points: int = STRAIN_POINTS) -> DesignPanel:
     """The simulated panel test of design `d`'s printed net, loaded along its `orientation`
     diagonal, of the size its material's panel law was tested at (else PRINTED_PANEL)."""
-    from printgen.inputs.materials import load_material
-    from printgen.verification.scenes import model_net_law, panel_axes
-
     n = d.net
     mat = load_material(n.material)
     pl = mat.panel_law

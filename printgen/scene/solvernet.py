@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 import solver
-from printgen.verification.scenes import BarrierScene
+from printgen.scene.scenes import BarrierScene
 
 WIRE_STRAIN = 3.0  # the spring's strain at rest (its rest length is a quarter of the segment's)
 WIRE_KNEE = 0.5  # below this strain the law is steep: a segment shorter than 3/8 of its length
@@ -69,8 +69,8 @@ def build(s: BarrierScene, *, slack: float = 0.0) -> tuple[solver.Net, Extras]:
     printed = s.nodes if s.rest_nodes is None else s.rest_nodes  # strands' unstressed shape
     lengths = np.linalg.norm(printed[s.elements[:, 1]] - printed[s.elements[:, 0]], axis=1)
     rest = [lengths * (1.0 + slack)]
-    laws = [solver.piecewise(k, sl) for k, sl in s.laws]
-    cables = [solver.SlidingCable(c, solver.piecewise(*law), None if s.rest_nodes is None else
+    laws = list(s.laws)
+    cables = [solver.SlidingCable(c, law, None if s.rest_nodes is None else
                                   _polyline(printed[c]) * (1.0 + slack))
               for c, law in s.cables.values()]
     n, first = len(s.nodes), len(s.elements)

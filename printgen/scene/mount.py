@@ -17,7 +17,7 @@ import dataclasses
 import numpy as np
 
 from printgen.errors import GeometryError
-from printgen.verification.scenes import BarrierScene
+from printgen.scene.scenes import BarrierScene
 
 SPANS = ("printed", "free-section")
 

@@ -12,7 +12,7 @@ held by the flume's side sheets along their whole height (`walls`, the default) 
 lateral cables' eyelets are anchored (`eyelets`). Without border cables the net is anchored
 on the bed and the banks and its top is free.
 
-Sensor wires (`Wire`; as solver cables in `printgen.verification.solvernet`): a string
+Sensor wires (`Wire`; as solver cables in `printgen.scene.solvernet`): a string
 potentiometer's wire is anchored at the barrier's left edge node of its row, runs along the
 row of nodes (the nodes are the points the wire bends over, frictionless), leaves the right
 edge node and runs on, in line with the row at rest, to the potentiometer `SENSOR_EXIT` x width
@@ -33,13 +33,13 @@ import numpy as np
 from printgen.barrier.graph import NetGraph
 from printgen.barrier.loads import FLOW, LoadCase, get_load
 from printgen.barrier.patterns import AS_DRAWN, get_pattern, mesh_text
-from printgen.barrier.patterns.diamond import strand_law as strand_law_from_membrane
 from printgen.design.record import Design
 from printgen.design.section import area_m2, net_membrane_law
 from printgen.errors import GeometryError
 from printgen.inputs.materials import PanelLaw, load_material
 from printgen.inputs.prototype import LATERAL, Prototype
 from printgen.units import MM, RHO_WATER, G
+from solver import Law, linear
 
 SENSOR_FORCE_N = 1.0  # wire tension of each string potentiometer (reference, section 4)
 SENSOR_EXIT = 0.1  # the potentiometer stands this fraction of the width beyond the right edge
@@ -51,15 +51,15 @@ MOUNTINGS = LATERAL  # lateral mounting in the flume ([flume] lateral), the defa
 # short diagonal, whose strand modulus matches the datasheet (see `panel_strand_law`).
 ORIENTATIONS = ("short", "long")
 # Direction of the water's force on a node: along the flow (the reference's section 3), or
-# normal to the deformed net (the film lies on the net: `printgen.verification.pressure`).
+# normal to the deformed net (the film lies on the net: `printgen.scene.pressure`).
 PRESSURES = ("flow", "normal")
 PROTOTYPE_ORIENTATION = "long"
 # Stiffness holding each free node where it is when its strands carry no load (N/m), as a
 # fraction of rho g A* (the rate at which a node's hydrostatic load grows per metre of head):
 # it scales like every stiffness (lambda^-2), so prototype and model get the same share.
 HOLD_FRACTION = 1e-3
+TESTED_PATTERN = "diamond"  # the pattern of the nets the material profiles' panel laws tested
 
-Law = tuple[tuple[float, ...], tuple[float, ...]]  # (strain knees, force slopes N per strain)
 Assumption = tuple[str, str, str]  # (what, value, source)
 
 
@@ -196,7 +196,8 @@ def lateral_mounting(p: Prototype) -> str:
 def prototype_scene(p: Prototype, *, mounting: str | None = None,
                     orientation: str = PROTOTYPE_ORIENTATION,
                     load: str | LoadCase | None = None) -> BarrierScene:
-    """The prototype: net with its panel law (read along the mesh diagonal `orientation`) or
+    """The prototype's nominal scene (callers use `printgen.scene.build_scene`, which applies
+    the other options): net with its panel law (read along the mesh diagonal `orientation`) or
     linear strands, sliding border cables, mounted like the model (`mounting`, default the
     file's [flume] lateral); its sensor wires only read (a field barrier carries no sensors);
     `load`: the load case its assumptions state (default hydrostatic)."""
@@ -214,12 +215,12 @@ def prototype_scene(p: Prototype, *, mounting: str | None = None,
                     + f" of a panel loaded along the {along / MM:g} mm ({orientation}) "
                     "diagonal, transverse displacement blocked, turned into a strand law")
     else:
-        net_law = ((), (p.net.strand_modulus * math.pi / 4 * p.net.strand_diameter**2,))
+        net_law = linear(p.net.strand_modulus * math.pi / 4 * p.net.strand_diameter**2)
         law_text = (f"linear strands E = {p.net.strand_modulus / 1e9:g} GPa, "
                     f"d = {p.net.strand_diameter / MM:g} mm")
     cable_law = None
     if p.border is not None:
-        cable_law = ((), (p.border.modulus * math.pi / 4 * p.border.diameter**2,))
+        cable_law = linear(p.border.modulus * math.pi / 4 * p.border.diameter**2)
     s = _scene(f"{p.name}: prototype", 1.0, g, MM, net_law, cable_law, None, mounting)
     src = f"prototype file {p.path.name}" if p.path else "prototype file"
     drawn = f" (as {AS_DRAWN[p.net.pattern]}s)" if p.net.pattern in AS_DRAWN else ""
@@ -234,7 +235,8 @@ def prototype_scene(p: Prototype, *, mounting: str | None = None,
 def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
                 orientation: str | None = None,
                 load: str | LoadCase | None = None) -> BarrierScene:
-    """The printed model: its pattern's net with the material's (measured) law, printed
+    """The printed model's nominal scene (callers use `printgen.scene.build_scene`, which
+    applies the other options): its pattern's net with the material's (measured) law, printed
     border frame, cables of the measured modulus, mounted by `mounting`, and the three sensor
     wires pulling SENSOR_FORCE_N along themselves. `orientation` ("short", "long"): the mesh
     diagonal the material's panel test loaded (None: the one its profile records); `load`:
@@ -251,12 +253,12 @@ def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
         c = d.cables[0]
         cm = load_material(c.material)
         ce, ce_src = cm.modulus()
-        cable_law = ((), (ce * area_m2(c.section),))
+        cable_law = linear(ce * area_m2(c.section))
         rows.append(("border cables", (f"{cm.name}, E = {ce / 1e9:.3g} GPa ({ce_src}), "
                      f"{c.section.width_mm:g} x {c.section.thickness_mm:g} mm, sliding"),
                      f"profile materials/{c.material}"))
     s = _scene(f"printed model 1:{d.scale:g}", d.scale, g, MM, net_law, cable_law,
-               ((), (border_ea,)), mounting)
+               linear(border_ea), mounting)
     rows = [("net", (f"{mesh_text(pattern.name, n.mesh_x_mm, n.mesh_y_mm)}, "
              f"{len(s.nodes)} nodes, rigid junctions"), "design"),
             ("net strands", (f"{mat.name}: {how}, strand {n.strand.width_mm:g} x "
@@ -279,12 +281,28 @@ def model_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
         law_of = get_pattern(n.pattern).strand_law
         return law_of(knees, slopes, n.mesh_y_mm * MM, n.mesh_x_mm * MM), how
     along, across = panel_axes(law.mesh_along_load, law.mesh_across_load, orientation)
-    knees, slopes = strand_law_from_membrane(
+    tested = get_pattern(TESTED_PATTERN).strand_law(
         law.knee_strains, tuple(k * law.panel_length for k in law.kappas), along, across)
     ratio = area_m2(n.strand) / (law.strand_width * law.strand_thickness)
-    return (knees, tuple(s * ratio for s in slopes)), (
+    return tested.scaled(ratio), (
         f"measured panel law read along the tested net's {along / MM:g} mm ({orientation}) "
         "diagonal")
+
+
+def with_factors(s: BarrierScene, net: float, frame: float, cable: float) -> BarrierScene:
+    """Scene `s` with the force laws of its net's strands, its printed border frame (the
+    second law, when it has one) and its border cables multiplied by `net`, `frame`, `cable`."""
+    laws = list(s.laws)
+    laws[0] = laws[0].scaled(net)
+    if len(laws) > 1:  # the printed border frame, of the net's material
+        laws[1] = laws[1].scaled(frame)
+    cables = {k: (nodes, law.scaled(cable)) for k, (nodes, law) in s.cables.items()}
+    return dataclasses.replace(s, laws=laws, cables=cables)
+
+
+def noted(s: BarrierScene, *rows: Assumption) -> BarrierScene:
+    """Scene `s` with assumption `rows` added after its own."""
+    return dataclasses.replace(s, assumptions=(*s.assumptions, *rows))
 
 
 def _finish(s: BarrierScene, rows: list[Assumption], *, sensors: bool,

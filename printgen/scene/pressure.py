@@ -9,14 +9,21 @@ quarter (a third for an edge triangle) of each face it is a corner of, oriented 
 rest and scaled so that at rest its magnitude is the scene's A* (the same tributary area as the
 load along the flow): the two variants then differ only by the direction of the force and by
 the growth of the net's area as it stretches.
+
+`loads_function` gives a scene's loads at each relative loading: its load case's, with the
+hydrostatic part normal to the net when the scene's pressure option says so.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
+import solver
+from printgen.barrier.loads import FLOW, LoadCase, LoadsAt, Site, get_load
+from printgen.scene.scenes import BarrierScene
 from printgen.units import RHO_WATER, G
 
 
@@ -91,3 +98,25 @@ def normal_pressure(nodes: np.ndarray, elements: np.ndarray, free: np.ndarray,
     mag = np.linalg.norm(rest, axis=1)
     scale = np.divide(area_per_node, mag, out=np.zeros_like(mag), where=mag > 0)
     return NormalPressure(free, tuple(faces), scale, sign, level, len(nodes))
+
+
+def loads_function(s: BarrierScene, *, load: str | LoadCase | None = None,
+                   site: Site | None = None) -> LoadsAt:
+    """Loads at relative loading r of load case `load` (default hydrostatic) on the scene's
+    free nodes, at `site` (the sensor wires are part of the solver net,
+    `printgen.scene.solvernet.build`). With the scene's pressure option "normal" the
+    hydrostatic part presses normal to the deformed net (the folded film presses normal to
+    the surface) instead of along the flow."""
+    loads_at = get_load(load).loads_for(s, site)
+    if s.pressure != "normal":
+        return loads_at
+    free = np.flatnonzero(~s.fixed)
+    normal = normal_pressure(s.nodes, s.elements[s.element_law == 0], free, s.area_per_node,
+                             0.0)
+
+    def normal_at(r: float) -> list:
+        return [dataclasses.replace(normal, level=f.level)  # the water behind a jam stays along
+                if isinstance(f, solver.Hydrostatic) and f.direction == tuple(FLOW) else f
+                for f in loads_at(r)]
+
+    return normal_at
