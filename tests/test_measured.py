@@ -91,7 +91,7 @@ def test_read_semicolon_decimal_comma_comments_and_blank_cells(tmp_path):
 
 
 def test_a_raw_sensor_wired_backwards_is_refused(tmp_path):
-    from printgen.verification.readings import FlumeUnits
+    from printgen.scene.readings import FlumeUnits
 
     p = tmp_path / "raw.csv"
     p.write_text("h_over_hb,mid_sensor_mm\n0.5,-0.4\n1.0,-3\n")
