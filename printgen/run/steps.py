@@ -1,10 +1,11 @@
 """The steps of `printgen make`: plain functions `step(ctx, stage)` that add files under
-`stage` and return their records (report.json key -> record); their report sections are
-built in printgen/report from those records (the pipeline is `printgen.run.make`). The
-verification's sweeps (`verification_sweeps`) run in a helper process from the start of the
-run while the other steps run here. The report's figures are drawings
-(printgen.report.html.Drawing) until the sweeps are done; then the last step draws them all
-at once, side by side in the helper's worker processes (`draw_figures`).
+`stage` and return their records (report.json key -> record, printgen.report.records); the
+report is built once from them (printgen.report.build), their wall-clock times go to the
+run's timings (`ctx.timings`). The pipeline is `printgen.run.make`. The verification's
+sweeps (`verification_sweeps`) run in a helper process from the start of the run while the
+other steps run here. The report's figures are drawings (printgen.report.html.Drawing) until
+the report is built; then they are drawn all at once, side by side in the helper's worker
+processes (`draw_figures`).
 """
 
 from __future__ import annotations
@@ -22,20 +23,20 @@ import numpy as np
 from printgen.errors import TimeLimitError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
-from printgen.report.parts_report import assembly_section, gcode_section, meshes_section
 from printgen.trace import span
 from printgen.workers import seconds_left
 
 HELPER_SWEEPS = "helper: verification sweeps"  # timings_s keys of work done in the helper
 WAIT_SWEEPS = "waiting for the verification sweeps"  # in this process, within a step
-FIGURES = "figures (PNG and SVG, side by side)"  # within the verification step
+FIGURES = "figures (PNG and SVG, side by side)"  # within the report files, after the steps
 
 if TYPE_CHECKING:  # pragma: no cover
     from printgen.design.record import Design
     from printgen.inputs.printers import Printer
     from printgen.inputs.prototype import Prototype
     from printgen.parts.gcode.toolpath import Toolpath
-    from printgen.report.html import Drawing, FigureFile
+    from printgen.report.html import Drawing
+    from printgen.report.records import CheckRecords
     from printgen.run.make import MakeContext
     from printgen.verification.bands import Band
     from printgen.verification.verify import Verification
@@ -75,7 +76,7 @@ def gcode_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     d = ctx.design
     printer = load_printer(d.printer)
     parts = [("net", d.net)] + [(f"cable-{c.name}", c) for c in d.cables]
-    rec = {}
+    rec, times = {}, ctx.timings.setdefault("gcode", {})
     for name, part in parts:
         mat = load_material(part.material)
         t0 = time.perf_counter()
@@ -83,7 +84,7 @@ def gcode_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
         est = print_estimate(tp, printer, mat)
         text = gcode_text(tp, printer, mat, title=f"{name}, 1:{d.scale:g}", estimate=est)
         back = read_gcode_text(text, filament_diameter_mm=printer.filament_diameter_mm)
-        seconds = time.perf_counter() - t0
+        times[name] = {"seconds": time.perf_counter() - t0}
         path = stage / f"{name}.gcode"
         path.write_text(text)
         ctx.files.append(path.name)
@@ -94,9 +95,7 @@ def gcode_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
         rec[name] = {"file": path.name, "layers": len(back.layer_z_mm),
                      "volume_mm3": tp.volume_mm3, "readback_volume_mm3": back.volume_mm3,
                      "readback_error": err, "readback_vs_stl": vs_stl,
-                     "retractions": retractions, "seconds": seconds,
-                     "print": est.to_record()}
-    gcode_section(ctx.report, rec)
+                     "retractions": retractions, "print": est.to_record()}
     return {"gcode": rec}
 
 
@@ -106,6 +105,7 @@ def kit_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     from printgen.parts.assembly import assemble
     from printgen.parts.geometry.solid import net_outline
     from printgen.report.kit import kit_figures
+    from printgen.report.records import KitRecords
 
     d = ctx.design
     if not d.cables:
@@ -116,10 +116,9 @@ def kit_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     c = min(d.cables, key=lambda c: c.length_mm)
     cable_tp = part_toolpath(ctx, f"cable-{c.name}", c, printer)
     outline = net_outline(d.net, a.attachment)
-    # drawn with the verification's figures, side by side, once the sweeps are done (see
+    # drawn with the verification's figures, side by side, once the report is built (see
     # `draw_figures`); the pictures are also written beside the report (report_files)
-    assembly_section(ctx.report, a, kit_figures(a, outline, net_tp, cable_tp, c.name))
-    return {"assembly": a.to_record()}
+    return {"assembly": KitRecords(a, kit_figures(a, outline, net_tp, cable_tp, c.name))}
 
 
 def slicer_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
@@ -169,7 +168,6 @@ def parts_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
                              load_material(c.material))
         rec["cables-plate"] = _write_plate(stage, cables, printer, ini)
         ctx.files.append("cables-plate.3mf")
-    meshes_section(ctx.report, rec)
     return {"parts": rec}
 
 
@@ -240,19 +238,17 @@ def part_thickness(kind: str, part) -> float:
 
 def verify_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     """Prototype vs model over the loading sweep, the model's uncertainty band
-    (printgen.verification.bands), and the steel counter-example: the sections and record of
-    `verification_report` on the sweeps of the helper process `make` started them in, or
-    computed here; then every figure of the report, drawn (`draw_figures`)."""
+    (printgen.verification.bands), and the steel counter-example, from the sweeps of the
+    helper process `make` started them in, or computed here: their records
+    (`verification_records`), their times in the run's timings."""
     sweeps = sweeps_done(ctx)
     if sweeps is None:
         sweeps = verification_sweeps(ctx.prototype, ctx.design, load=ctx.options.load,
                                      loads=ctx.options.loads)
-    with span("verify: report"):
-        blocks, figures, record = verification_report(*sweeps, ctx.targets.scale)
-    ctx.report.blocks.extend(blocks)
-    ctx.report.figures.extend(figures)
-    draw_figures(ctx)
-    return {"verification": record}
+    with span("verify: records"):
+        check, times = verification_records(*sweeps, ctx.targets.scale)
+    ctx.timings["verification"] = times
+    return {"verification": check}
 
 
 def sweeps_done(ctx: MakeContext) -> tuple[Verification, Band] | None:
@@ -263,25 +259,28 @@ def sweeps_done(ctx: MakeContext) -> tuple[Verification, Band] | None:
         return None
     t = time.perf_counter()
     sweeps, seconds = _collect(pending, "the verification's sweeps")
-    times = ctx.record.setdefault("timings_s", {})
+    times = ctx.timings.setdefault("timings_s", {})
     times[HELPER_SWEEPS], times[WAIT_SWEEPS] = seconds, time.perf_counter() - t
     return sweeps
 
 
 def draw_figures(ctx: MakeContext) -> None:
-    """Draw the report's figures not drawn yet (the kit's and the verification's), side by
+    """Draw the built report's figures not drawn yet (the kit's and the verification's), side by
     side in worker processes: those of the helper process when there is one (forked from a
     process running one thread, they start with matplotlib imported), else `Report.draw`'s.
     Their wall time goes to timings_s[FIGURES]."""
+    if ctx.report is None:
+        return
     t = time.perf_counter()
     todo = ctx.report.pending()
     with span("figures"):
         _draw(ctx, todo)
     if todo:
-        ctx.record.setdefault("timings_s", {})[FIGURES] = time.perf_counter() - t
+        ctx.timings.setdefault("timings_s", {})[FIGURES] = time.perf_counter() - t
 
 
 def _draw(ctx: MakeContext, todo: list[Drawing]) -> None:
+    assert ctx.report is not None
     if todo and ctx.helper is not None:
         pngs, _ = _collect(ctx.helper.submit(timed, draw_all, todo), "the report's figures")
         ctx.report.fill(pngs)
@@ -345,24 +344,16 @@ def solver_work(v: Verification, band: Band) -> dict[str, Any]:
     return counted_work([*(r.work() for r in nominal), *band.work])
 
 
-def verification_report(v: Verification, band: Band, scale: float
-                        ) -> tuple[list[str], list[FigureFile], dict[str, Any]]:
-    """The verification's report blocks (figures included), its figures' files and its
-    record (with the lab's curves and expected readings, printgen.report.labfiles)."""
-    from printgen.report.html import Report
-    from printgen.report.labfiles import lab_record
-    from printgen.report.layout import layout_section
-    from printgen.report.report import load_case_sections, verification_sections
-    from printgen.report.uncertainty import band_record, band_sections
-    from printgen.verification.layout import flume_layout
+def verification_records(v: Verification, band: Band, scale: float
+                         ) -> tuple[CheckRecords, dict[str, Any]]:
+    """The verification's records (with the solver's work, the lab's curves and expected
+    readings: printgen.report.records.CheckRecords) and their wall-clock times, at the paths
+    timings.json holds them ("bands", "solver_work")."""
+    from printgen.report.records import CheckRecords
+    from printgen.run.provenance import split_timings
 
-    rep = Report("")
-    verification_sections(rep, v, v.counterexample, scale, band=band)
-    band_sections(rep, v, band)
-    load_case_sections(rep, v)
-    layout_section(rep, flume_layout(v.model.scene))
-    record = v.to_record()
-    record["solver_work"] = solver_work(v, band)
-    record["bands"] = band_record(v, band)
-    record["lab"] = lab_record(v, band, scale)
-    return rep.blocks, rep.figures, record
+    work, work_times = split_timings(solver_work(v, band))
+    times: dict[str, Any] = {"bands": {"seconds": band.seconds}}
+    if work_times:
+        times["solver_work"] = work_times
+    return CheckRecords(v, band, scale, solver_work=work, counterexample=True), times
