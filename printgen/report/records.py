@@ -10,11 +10,14 @@ from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # pragma: no cover
+    import numpy as np
+
     from printgen.design.record import Design
     from printgen.design.selection import Candidate, Selection
     from printgen.design.similitude import ScaledTargets
     from printgen.inputs.prototype import Prototype
     from printgen.parts.assembly import Assembly
+    from printgen.parts.gcode.estimate import PrintEstimate
     from printgen.report.html import Drawing
     from printgen.verification.bands import Band
     from printgen.verification.measured import Fit, Measurement
@@ -22,9 +25,14 @@ if TYPE_CHECKING:  # pragma: no cover
 
 
 def record_of(value: Any) -> Any:
-    """`value.to_record()` when it has one, else `value` (already a plain record)."""
+    """`value.to_record()` when it has one, a dict's values' records, else `value` (already
+    a plain record)."""
     to_record = getattr(value, "to_record", None)
-    return to_record() if callable(to_record) else value
+    if callable(to_record):
+        return to_record()
+    if isinstance(value, dict):
+        return {k: record_of(v) for k, v in value.items()}
+    return value
 
 
 @dataclass(frozen=True)
@@ -49,6 +57,68 @@ class PlanRecords:
             rec["design_file"] = self.design_file
             rec["design_net"] = self.own_net.to_record()  # its own stiffness error
         return rec
+
+
+@dataclass(frozen=True)
+class MeshRecord:
+    """One part's mesh as written: its files, its volume and the analytic one (mm^3), its
+    size on the bed (mm, x y z), its triangles, and the angle it was turned by on the bed."""
+
+    files: list[str]
+    volume_mm3: float
+    analytic_volume_mm3: float
+    size_mm: np.ndarray
+    triangles: int
+    watertight: bool
+    bed_angle_deg: float
+
+    @property
+    def volume_error(self) -> float:
+        """The mesh's volume against the analytic one, relative."""
+        return self.volume_mm3 / self.analytic_volume_mm3 - 1
+
+    def to_record(self) -> dict[str, Any]:
+        return {"files": self.files, "volume_mm3": self.volume_mm3,
+                "analytic_volume_mm3": self.analytic_volume_mm3,
+                "volume_error": self.volume_error, "size_mm": self.size_mm,
+                "triangles": self.triangles, "watertight": self.watertight,
+                "bed_angle_deg": self.bed_angle_deg}
+
+
+@dataclass(frozen=True)
+class PlateRecord:
+    """Parts laid out together on one bed: the file, and each part's angle on it (deg)."""
+
+    files: list[str]
+    parts: dict[str, float]
+
+    def to_record(self) -> dict[str, Any]:
+        return {"files": self.files, "parts": self.parts}
+
+
+@dataclass(frozen=True)
+class GcodeRecord:
+    """One part's direct G-code: its file, layers, the toolpath's volume (mm^3) and the one
+    read back from the G-code, relative to it and to the STL's (None: no STL), retractions,
+    and the print's estimate."""
+
+    file: str
+    layers: int
+    volume_mm3: float
+    readback_volume_mm3: float
+    readback_vs_stl: float | None
+    retractions: int
+    estimate: PrintEstimate
+
+    @property
+    def readback_error(self) -> float:
+        return self.readback_volume_mm3 / self.volume_mm3 - 1
+
+    def to_record(self) -> dict[str, Any]:
+        return {"file": self.file, "layers": self.layers, "volume_mm3": self.volume_mm3,
+                "readback_volume_mm3": self.readback_volume_mm3,
+                "readback_error": self.readback_error, "readback_vs_stl": self.readback_vs_stl,
+                "retractions": self.retractions, "print": self.estimate.to_record()}
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,7 @@ from printgen.verification.compare import METRICS
 if TYPE_CHECKING:  # pragma: no cover
     from printgen.design.record import Design, Section
     from printgen.design.selection import Candidate
-    from printgen.report.records import PlanRecords, RunRecords
+    from printgen.report.records import GcodeRecord, PlanRecords, RunRecords
 
 NEXT_PASS = ("Print the parts (the .gcode files, or slice the .3mf files), assemble them as the "
              "Assembly section below shows, and run the flume test with measurement-sheet.csv; "
@@ -29,13 +29,13 @@ NEXT_SOFT = ("Change the net before printing: the model is too soft. Try a stiff
 NEXT_NONE = "Run make with the verification step to get the verdict before printing."
 
 
-def print_rows(gcode: dict[str, Any]) -> tuple[list[str], list[list[str]]]:
+def print_rows(gcode: dict[str, GcodeRecord]) -> tuple[list[str], list[list[str]]]:
     """(columns, rows) of the print-time table: each part and the total."""
     from printgen.parts.gcode.estimate import NOT_COUNTED, duration
 
     rows, tot = [], {"print_time_s": 0.0, "filament_mm": 0.0, "mass_g": 0.0}
     for name, rec in gcode.items():
-        p = rec["print"]
+        p = rec.estimate.to_record()
         rows.append([name, duration(p["print_time_s"]), f"{p['filament_mm'] / 1e3:.3f}",
                      f"{p['mass_g']:.2f}"])
         for k in tot:
@@ -46,10 +46,11 @@ def print_rows(gcode: dict[str, Any]) -> tuple[list[str], list[list[str]]]:
             rows)
 
 
-def print_totals(gcode: dict[str, Any]) -> dict[str, float]:
+def print_totals(gcode: dict[str, GcodeRecord]) -> dict[str, float]:
     """Total print time (s), filament (mm) and mass (g) over every part's G-code."""
+    prints = [r.estimate.to_record() for r in gcode.values()]
     keys = ("print_time_s", "filament_mm", "mass_g")
-    return {k: float(sum(r["print"][k] for r in gcode.values())) for k in keys}
+    return {k: float(sum(p[k] for p in prints)) for k in keys}
 
 
 @dataclass(frozen=True)

@@ -36,7 +36,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from printgen.inputs.prototype import Prototype
     from printgen.parts.gcode.toolpath import Toolpath
     from printgen.report.html import Drawing
-    from printgen.report.records import CheckRecords
+    from printgen.report.records import CheckRecords, MeshRecord, PlateRecord
     from printgen.run.make import MakeContext
     from printgen.verification.bands import Band
     from printgen.verification.verify import Verification
@@ -72,6 +72,7 @@ def gcode_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     from printgen.parts.gcode.estimate import print_estimate
     from printgen.parts.gcode.readback import read_gcode_text
     from printgen.parts.gcode.writer import gcode_text
+    from printgen.report.records import GcodeRecord
 
     d = ctx.design
     printer = load_printer(d.printer)
@@ -88,14 +89,11 @@ def gcode_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
         path = stage / f"{name}.gcode"
         path.write_text(text)
         ctx.files.append(path.name)
-        err = back.volume_mm3 / tp.volume_mm3 - 1
         stl = ctx.volumes_mm3.get(name)
         vs_stl = back.volume_mm3 / stl - 1 if stl else None
         retractions = text.count(f"E-{mat.print.retract_length_mm:.5f}")
-        rec[name] = {"file": path.name, "layers": len(back.layer_z_mm),
-                     "volume_mm3": tp.volume_mm3, "readback_volume_mm3": back.volume_mm3,
-                     "readback_error": err, "readback_vs_stl": vs_stl,
-                     "retractions": retractions, "print": est.to_record()}
+        rec[name] = GcodeRecord(path.name, len(back.layer_z_mm), tp.volume_mm3,
+                                back.volume_mm3, vs_stl, retractions, est)
     return {"gcode": rec}
 
 
@@ -160,8 +158,8 @@ def parts_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
             ctx.progress(f"STEP {name} ({k} of {len(parts)})")
         rec[name] = _write_part(stage, name, kind, part, body, printer,
                                 outline if ctx.options.step else None, analytic(part))
-        ctx.files += rec[name]["files"]
-        ctx.volumes_mm3[name] = rec[name]["volume_mm3"]
+        ctx.files += rec[name].files
+        ctx.volumes_mm3[name] = rec[name].volume_mm3
     if cables:  # every cable on one plate: one print job, with the cables' settings
         c = d.cables[0]
         ini = prusa_ini_text("cable", c, printer, load_print_style(c.print_style),
@@ -193,11 +191,12 @@ def _mesh_parts(d: Design, comp: float) -> list[tuple]:
 
 
 def _write_part(stage: Path, name: str, kind: str, part, body, printer, outline,
-                expected: float) -> dict[str, Any]:
+                expected: float) -> MeshRecord:
     """Place `body` on the bed and write its STL, 3MF (and STEP from `outline` when given);
     its record."""
     from printgen.parts.export import place_mesh, prusa_config_from_ini, stl_bytes, threemf_bytes
     from printgen.parts.slicer.prusa import prusa_ini_text
+    from printgen.report.records import MeshRecord
 
     mat, style = load_material(part.material), load_print_style(part.print_style)
     mesh, angle = place_mesh(body, printer, name)
@@ -213,23 +212,20 @@ def _write_part(stage: Path, name: str, kind: str, part, body, printer, outline,
                                                         part_thickness(kind, part)))
         files.append(f"{name}.step")
     size = mesh.bounds[1] - mesh.bounds[0]
-    volume = float(mesh.volume)
-    rec = {"files": files, "volume_mm3": volume, "analytic_volume_mm3": expected,
-           "volume_error": volume / expected - 1, "size_mm": np.round(size, 4),
-           "triangles": len(mesh.faces), "watertight": bool(mesh.is_watertight),
-           "bed_angle_deg": angle}
-    return rec
+    return MeshRecord(files, float(mesh.volume), expected, np.round(size, 4), len(mesh.faces),
+                      bool(mesh.is_watertight), angle)
 
 
 def _write_plate(stage: Path, cables: list[tuple[str, Any]], printer, ini: str
-                 ) -> dict[str, Any]:
+                 ) -> PlateRecord:
     """cables-plate.3mf: the cables laid out together on one bed; its record."""
     from printgen.parts.export import layout_parts, prusa_config_from_ini, threemf_bytes
+    from printgen.report.records import PlateRecord
 
     placed = layout_parts(cables, printer)
     (stage / "cables-plate.3mf").write_bytes(threemf_bytes(
         [(p.name, p.mesh) for p in placed], prusa_config_from_ini(ini)))
-    return {"files": ["cables-plate.3mf"], "parts": {p.name: p.angle_deg for p in placed}}
+    return PlateRecord(["cables-plate.3mf"], {p.name: p.angle_deg for p in placed})
 
 
 def part_thickness(kind: str, part) -> float:
