@@ -130,11 +130,12 @@ def test_summary_of_a_verify_record_without_selection(monkeypatch):
     v = SimpleNamespace(ok=False, headline="model too stiff", mismatches=[],
                         prototype=SimpleNamespace(deformation=SimpleNamespace(values={})))
     run = RunRecords("t", d, steps={"verification": CheckRecords(v, None, 40.0, nested=False)})
-    s = summarize(run, "fitted: stiffness 0.8 x").to_record()
+    summary = summarize(run, "fitted: stiffness 0.8 x")
+    s = summary.to_record()
     assert s["verdict"] == "FAIL" and s["next"] == "fitted: stiffness 0.8 x"
     assert list(s["band"]) == ["deflection"]  # a quantity nothing deforms is not listed
     assert [p["stiffness_error"] for p in s["parts"]] == [None, None]
-    box = summary_html(s)
+    box = summary_html(summary)
     assert 'id="summary"' in box and "model stiffer by 20%" in box and "TPE" in box
 
 

@@ -47,7 +47,7 @@ def build_report(run: RunRecords) -> tuple[Report, Summary]:
     if run.provenance is not None:
         provenance_section(rep, run.provenance)
     summary = summarize(run, m.sentence() if m is not None else "")
-    rep.lead = summary_html(summary.to_record())
+    rep.lead = summary_html(summary)
     return rep, summary
 
 

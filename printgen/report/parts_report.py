@@ -4,6 +4,7 @@ provenance."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from printgen.outputs import MANIFEST
@@ -50,7 +51,7 @@ def gcode_section(rep: Report, gcode: dict[str, GcodeRecord]) -> None:
 
 
 def assembly_section(rep: Report, a: Assembly,
-                     figures: list[tuple[str, bytes | Drawing, str]]) -> None:
+                     figures: Sequence[tuple[str, bytes | Drawing, str]]) -> None:
     """The kit's verdict, its labelled picture with the checks after printing, and the
     toolpath previews (`figures`: file name, PNG or its drawing, caption)."""
     rep.heading("Assembly")

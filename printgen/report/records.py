@@ -5,6 +5,7 @@ back. Wall-clock times are not in them: they live in the run's timings (timings.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
@@ -78,7 +79,7 @@ class MeshRecord:
         return self.volume_mm3 / self.analytic_volume_mm3 - 1
 
     def to_record(self) -> dict[str, Any]:
-        return {"files": self.files, "volume_mm3": self.volume_mm3,
+        return {"files": list(self.files), "volume_mm3": self.volume_mm3,
                 "analytic_volume_mm3": self.analytic_volume_mm3,
                 "volume_error": self.volume_error, "size_mm": self.size_mm,
                 "triangles": self.triangles, "watertight": self.watertight,
@@ -93,7 +94,7 @@ class PlateRecord:
     parts: dict[str, float]
 
     def to_record(self) -> dict[str, Any]:
-        return {"files": self.files, "parts": self.parts}
+        return {"files": list(self.files), "parts": dict(self.parts)}
 
 
 @dataclass(frozen=True)
@@ -126,7 +127,7 @@ class KitRecords:
     """The kit's assembly and its figures (file name, PNG or its drawing, caption)."""
 
     assembly: Assembly
-    figures: list[tuple[str, bytes | Drawing, str]] = field(default_factory=list)
+    figures: Sequence[tuple[str, bytes | Drawing, str]] = ()
 
     def to_record(self) -> dict[str, Any]:
         return self.assembly.to_record()

@@ -97,14 +97,14 @@ def chosen_parts(design: Design, plan: PlanRecords | None = None) -> list[dict[s
     sel = None if plan is None else plan.selection
     net = design.net
     pick = plan.own_net if plan is not None and plan.own_net is not None else (
-        sel and _same_section(sel.net, net.material, net.strand))
+        None if sel is None else _same_section(sel.net, net.material, net.strand))
     out = [{"part": "net", "material": net.material.upper(),
             "section": (f"strand {_mm(net.strand)}, "
                         + mesh_text(net.pattern, net.mesh_x_mm, net.mesh_y_mm)),
             "stiffness_error": None if pick is None else pick.error}]
     if design.cables:
         c = design.cables[0]
-        pick = sel and _same_section(sel.cables, c.material, c.section)
+        pick = None if sel is None else _same_section(sel.cables, c.material, c.section)
         out.append({"part": f"border cables ({len(design.cables)})",
                     "material": c.material.upper(), "section": _mm(c.section),
                     "stiffness_error": None if pick is None else pick.error})
@@ -134,37 +134,38 @@ def _same_section(ranked: tuple[Candidate, ...], material: str, s: Section
     return None
 
 
-def summary_html(s: dict[str, Any]) -> str:
-    """The summary box (HTML) of a `Summary`'s record."""
+def summary_html(s: Summary) -> str:
+    """The summary box (HTML)."""
     from printgen.parts.gcode.estimate import duration
 
     e = html.escape
-    ok = s["verdict"] == "PASS"
-    tag = ("pass" if ok else "fail") if s["verdict"] != "not run" else "note"
-    lines = [(f'<p class="verdict"><span class="{tag}">{e(s["verdict"])}</span> '
-             f'{e(s["reason"] or "the verification was not run")}</p>')]
-    if s["band"]:
+    ok = s.verdict == "PASS"
+    tag = ("pass" if ok else "fail") if s.verdict != "not run" else "note"
+    lines = [(f'<p class="verdict"><span class="{tag}">{e(s.verdict)}</span> '
+             f'{e(s.reason or "the verification was not run")}</p>')]
+    if s.band:
         lines.append("<p><b>Uncertainty band</b> (where the prototype lies against the "
                      "model's band):</p><ul>" + "".join(
                          f"<li>{e(METRICS[k].split(' (')[0])}: {e(t)}</li>"
-                         for k, t in s["band"].items()) + "</ul>")
+                         for k, t in s.band.items()) + "</ul>")
     parts = "; ".join(
         f"{e(p['part'])}: {e(p['material'])}, {e(p['section'])}"
         + ("" if p["stiffness_error"] is None else
-           f", stiffness {p['stiffness_error']:+.0%} off target") for p in s["parts"])
+           f", stiffness {p['stiffness_error']:+.0%} off target") for p in s.parts)
     lines.append(f"<p><b>Chosen:</b> {parts}</p>")
-    if "print" in s:
-        t = s["print"]
+    if s.print is not None:
+        t = s.print
         lines.append(f"<p><b>Printing:</b> {e(duration(t['print_time_s']))}, "
                      f"{t['filament_mm'] / 1e3:.2f} m of filament, {t['mass_g']:.1f} g "
                      "(all parts; per part in Direct G-code)</p>")
-    lines.append(f"<p><b>Next:</b> {e(s['next'])}</p>")
+    lines.append(f"<p><b>Next:</b> {e(s.next)}</p>")
     return '<section class="summary" id="summary"><h2>Summary</h2>' + "".join(lines) \
         + "</section>"
 
 
 def summary_lines(s: dict[str, Any]) -> list[str]:
-    """The summary as plain lines for the terminal."""
+    """The summary as plain lines for the terminal, from its record (report.json's
+    "summary", which `make --json` prints too)."""
     from printgen.parts.gcode.estimate import duration
 
     if not s:

@@ -149,17 +149,19 @@ def parts_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     d = ctx.design
     printer = load_printer(d.printer)
     parts = _mesh_parts(d, printer.hole_compensation_mm)
-    rec, cables = {}, []
+    rec: dict[str, MeshRecord | PlateRecord] = {}
+    cables = []
     for k, (name, kind, part, solid, outline, analytic) in enumerate(parts, 1):
         body = solid(part)
         if kind == "cable":
             cables.append((name, body))
         if ctx.options.step and ctx.progress:
             ctx.progress(f"STEP {name} ({k} of {len(parts)})")
-        rec[name] = _write_part(stage, name, kind, part, body, printer,
-                                outline if ctx.options.step else None, analytic(part))
-        ctx.files += rec[name].files
-        ctx.volumes_mm3[name] = rec[name].volume_mm3
+        mesh = _write_part(stage, name, kind, part, body, printer,
+                           outline if ctx.options.step else None, analytic(part))
+        rec[name] = mesh
+        ctx.files += mesh.files
+        ctx.volumes_mm3[name] = mesh.volume_mm3
     if cables:  # every cable on one plate: one print job, with the cables' settings
         c = d.cables[0]
         ini = prusa_ini_text("cable", c, printer, load_print_style(c.print_style),
