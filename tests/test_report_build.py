@@ -54,6 +54,7 @@ def test_verify_is_the_same_builder_with_fewer_records(made_simple_drag):
         check, nested=False, counterexample=False, solver_work=None)})
     made, rec = ctx.record["verification"], run.to_record()
     assert set(rec) == {"design", "verification", "bands", "lab"}
+    assert _times(rec) == []  # the band's wall time is the run's timings', not report.json's
     assert dumps(rec["bands"]) == dumps(made["bands"]) and dumps(rec["lab"]) == dumps(made["lab"])
     assert dumps(rec["verification"]) == dumps(
         {k: v for k, v in made.items() if k not in ("bands", "lab", "solver_work")})
