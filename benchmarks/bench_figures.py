@@ -35,17 +35,17 @@ REPEAT = 3
 def drawings(example: Path) -> list:
     """(name, Drawing) of every figure `make` draws for `example` at 1:40 (its sweeps run here,
     in worker processes, untimed)."""
+    from printgen.report.build import build_report
     from printgen.run.make import plan
-    from printgen.run.steps import kit_step, verification_report, verification_sweeps
+    from printgen.run.steps import kit_step, verification_records, verification_sweeps
 
     ctx = plan(example, SCALE)
     with TemporaryDirectory() as tmp:
-        kit_step(ctx, Path(tmp))
+        ctx.records.steps.update(kit_step(ctx, Path(tmp)))
     v, band = verification_sweeps(ctx.prototype, ctx.design)
-    blocks, figures, _ = verification_report(v, band, SCALE)
-    ctx.report.blocks += blocks
-    ctx.report.figures += figures
-    return list(zip([f.name for f in ctx.report.figures], ctx.report.pending(), strict=True))
+    ctx.records.steps["verification"] = verification_records(v, band, SCALE)[0]
+    rep, _ = build_report(ctx.records)
+    return list(zip([f.name for f in rep.figures], rep.pending(), strict=True))
 
 
 def alone(named: list, repeat: int) -> dict[str, float]:

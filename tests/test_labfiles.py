@@ -114,22 +114,28 @@ def test_figures_give_the_same_png_and_svg_twice():
     assert a.labels == [("", ["relative loading h / h_B (-)", ""])]
 
 
-def test_summary_of_a_verify_record_without_selection():
+def test_summary_of_a_verify_record_without_selection(monkeypatch):
     """`verify` has the design but no selection: the box names the parts without an error."""
-    from printgen.report.summary import summary_html, summary_record
+    from types import SimpleNamespace
 
+    from printgen.report import summary
+    from printgen.report.records import CheckRecords, RunRecords
+    from printgen.report.summary import summarize, summary_html
+
+    verdicts = [SimpleNamespace(metric="deflection", text="model stiffer by 20%", levels=3),
+                SimpleNamespace(metric="strain_bottom", levels=0,
+                                text="no deformation to compare")]
+    monkeypatch.setattr(summary, "band_verdicts", lambda values, band: verdicts)
     d = reference_design_1_40()
-    rec = {"verification": {"verdict": "FAIL", "summary": "model too stiff", "ok": False,
-                            "mismatches": []},
-           "bands": {"verdicts": [{"metric": "deflection", "text": "model stiffer by 20%"},
-                                  {"metric": "strain_bottom", "levels": 0,
-                                   "text": "no deformation to compare"}]},
-           "design": d.to_dict()}
-    s = summary_record(rec, "fitted: stiffness 0.8 x")
+    v = SimpleNamespace(ok=False, headline="model too stiff", mismatches=[],
+                        prototype=SimpleNamespace(deformation=SimpleNamespace(values={})))
+    run = RunRecords("t", d, steps={"verification": CheckRecords(v, None, 40.0, nested=False)})
+    summary = summarize(run, "fitted: stiffness 0.8 x")
+    s = summary.to_record()
     assert s["verdict"] == "FAIL" and s["next"] == "fitted: stiffness 0.8 x"
     assert list(s["band"]) == ["deflection"]  # a quantity nothing deforms is not listed
     assert [p["stiffness_error"] for p in s["parts"]] == [None, None]
-    box = summary_html(s)
+    box = summary_html(summary)
     assert 'id="summary"' in box and "model stiffer by 20%" in box and "TPE" in box
 
 

@@ -148,7 +148,7 @@ def test_cli_make_json_and_exit_codes(made_simple_drag, tmp_path, capsys, monkey
                  "--drag"]) == 0
     assert [c["load"] for c in calls] == ["drag"]
     rec = json.loads(capsys.readouterr().out)
-    assert dumps(rec) == dumps(make_mod.json_output(ctx.record))
+    assert dumps(rec) == dumps(make_mod.json_output(ctx))
     assert rec["targets"]["scale"] == 40
     assert rec["timings"]["timings_s"]["total"] > 0
     assert times_outside_timings({k: v for k, v in rec.items() if k != "timings"}) == []

@@ -65,6 +65,7 @@ def test_make_with_the_paper_design_shows_its_own_net_error():
     the panel law's tested net, so its small-strain membrane stiffness is the measured
     kappa_0 x panel length with no geometric rescaling."""
     from printgen.inputs.materials import load_material
+    from printgen.report.build import build_report
     from printgen.report.summary import chosen_parts
     from printgen.run.make import MakeOptions, plan
 
@@ -75,5 +76,5 @@ def test_make_with_the_paper_design_shows_its_own_net_error():
     assert own["stiffness"] == pytest.approx(law.kappas[0] * law.panel_length, rel=EXACT)
     assert own["error"] == pytest.approx(own["stiffness"] / own["target"] - 1, rel=EXACT)
     assert abs(own["error"] - ctx.selection.net[0].error) > 0.5  # not select's pick
-    assert chosen_parts(ctx.record)[0]["stiffness_error"] == own["error"]
-    assert f"({own['error']:+.0%})" in ctx.report.html()
+    assert chosen_parts(ctx.design, ctx.records.plan)[0]["stiffness_error"] == own["error"]
+    assert f"({own['error']:+.0%})" in build_report(ctx.records)[0].html()

@@ -263,17 +263,13 @@ def test_profiles_show_and_inherits_do_not_read_outside(world, capsys, monkeypat
 
 def test_fitted_profile_is_written_inside_out_and_its_manifest(world, made, monkeypatch):
     from printgen.design.design_file import load_design
-    from printgen.report.html import Report
-    from printgen.run import verify
-    from printgen.run.verify import _write
-
-    monkeypatch.setattr(verify, "lab_files", lambda lab: {})  # the lab's CSVs: not this case
+    from printgen.run.verify import _write, fitted_name
 
     d = load_design(made / "design.json")
     out = world / "vout" / "x"
     before = snapshot(world, skip=world / "vout")
-    files = _write(out, Report("t"), {"timings_s": {}, "lab": None}, d, "inherits = 'x'\n", False, [])
-    name = f"{d.net.material}-fitted.toml"
+    name = fitted_name(d)
+    files = _write(out, {"report.html": "<html></html>\n", name: "inherits = 'x'\n"}, False, [])
     assert name in files and (out / name).is_file()
     assert name in json.loads((out / "manifest.json").read_text())["files"]
     assert snapshot(world, skip=world / "vout") == before

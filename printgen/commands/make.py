@@ -68,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
                                            time_limit_s=args.time_limit, pdf=args.pdf))
     seconds = time.perf_counter() - t0
     if args.json:
-        emit_json(json_output(ctx.record))
+        emit_json(json_output(ctx))
     else:
         show_summary(ctx, out, seconds)
     return incomplete_code(ctx.record, "make")

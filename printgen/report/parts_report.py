@@ -4,26 +4,30 @@ provenance."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from printgen.outputs import MANIFEST
 from printgen.report.html import Drawing, Report
+from printgen.report.records import MeshRecord
 from printgen.report.summary import print_rows
 
 if TYPE_CHECKING:
     from printgen.parts.assembly import Assembly
+    from printgen.report.records import GcodeRecord, PlateRecord
 
 
-def meshes_section(rep: Report, parts: dict[str, Any]) -> None:
-    """The meshes' table: size on the bed, volume against the analytic one, triangles."""
+def meshes_section(rep: Report, parts: dict[str, MeshRecord | PlateRecord]) -> None:
+    """The meshes' table: size on the bed, volume against the analytic one, triangles (a
+    plate of several parts is not a mesh of its own)."""
     rows = []
     for name, rec in parts.items():
-        if name == "cables-plate":
+        if not isinstance(rec, MeshRecord):
             continue
-        size = rec["size_mm"]
+        size = rec.size_mm
         rows.append([name, f"{size[0]:.1f} x {size[1]:.1f} x {size[2]:.2f}",
-                     f"{rec['volume_mm3']:.1f}", f"{rec['volume_error']:+.2%}",
-                     str(rec["triangles"]), f"{rec['bed_angle_deg']:g}"])
+                     f"{rec.volume_mm3:.1f}", f"{rec.volume_error:+.2%}",
+                     str(rec.triangles), f"{rec.bed_angle_deg:g}"])
     rep.heading("Meshes")
     rep.paragraph("One watertight body per part (STL, and a 3MF that opens in "
                   "PrusaSlicer with the part's settings), placed on the printer bed.")
@@ -31,13 +35,12 @@ def meshes_section(rep: Report, parts: dict[str, Any]) -> None:
                "turned (deg)"], rows)
 
 
-def gcode_section(rep: Report, gcode: dict[str, Any]) -> None:
+def gcode_section(rep: Report, gcode: dict[str, GcodeRecord]) -> None:
     """The G-code's table: layers, volume, read-back errors, retractions (times go to
     timings.json: the report is reproducible)."""
-    rows = [[name, r["file"], str(r["layers"]), f"{r['volume_mm3']:.1f}",
-             f"{r['readback_error']:+.2%}",
-             "-" if r["readback_vs_stl"] is None else f"{r['readback_vs_stl']:+.2%}",
-             str(r["retractions"])] for name, r in gcode.items()]
+    rows = [[name, r.file, str(r.layers), f"{r.volume_mm3:.1f}", f"{r.readback_error:+.2%}",
+             "-" if r.readback_vs_stl is None else f"{r.readback_vs_stl:+.2%}",
+             str(r.retractions)] for name, r in gcode.items()]
     rep.heading("Direct G-code")
     rep.paragraph("Every net strand is one straight extrusion through the crossings, the "
                   "strand families alternate per pass; the G-code is read back and its "
@@ -48,7 +51,7 @@ def gcode_section(rep: Report, gcode: dict[str, Any]) -> None:
 
 
 def assembly_section(rep: Report, a: Assembly,
-                     figures: list[tuple[str, bytes | Drawing, str]]) -> None:
+                     figures: Sequence[tuple[str, bytes | Drawing, str]]) -> None:
     """The kit's verdict, its labelled picture with the checks after printing, and the
     toolpath previews (`figures`: file name, PNG or its drawing, caption)."""
     rep.heading("Assembly")

@@ -1,9 +1,8 @@
-"""The `printgen make` report: targets, selection, parts and the pre-print verification, as
-HTML (with embedded plots) and as one JSON record of every number."""
+"""The report's sections of the plan (targets, selection, the printed parts) and of the
+pre-print verification, rendered from their objects (printgen.report.build puts them in
+order; report.json is the same objects' records)."""
 
 from __future__ import annotations
-
-from typing import Any
 
 import numpy as np
 
@@ -90,13 +89,6 @@ def _row(rank: int, c: Candidate) -> list[str]:
     return [str(rank), c.material_name, c.modulus_source, f"{s.width_mm:g} x {s.thickness_mm:g}",
             str(s.passes), f"{c.stiffness:.4g}", f"{c.target:.4g}", f"{c.error:+.1%}",
             f"{c.pi3_deviation:+.0%}", f"{c.safety_factor:.1f}"]
-
-
-def design_record(proto: Prototype, t: ScaledTargets, sel: Selection,
-                  design: Design) -> dict[str, Any]:
-    """The JSON part of the report for targets, selection and design."""
-    return {"targets": t.to_record(), "selection": sel.to_record(),
-            "design": design.to_dict()}
 
 
 def verification_sections(rep: Report, v: Verification | None, ce: CounterExample | None,

@@ -1,15 +1,22 @@
 """The report's summary box, first on the page: the verdict and its reason, the band verdict,
 the chosen materials and sections with their stiffness error, print time and mass, and what
-to do next. Built from the run's record (the numbers report.json holds), so the box, the
-JSON and the terminal say the same."""
+to do next. Built from the run's records (printgen.report.records); the box, report.json's
+"summary" and the terminal's lines are that one `Summary`, so they say the same."""
 
 from __future__ import annotations
 
 import html
-from typing import Any
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 from printgen.barrier.patterns import mesh_text
+from printgen.verification.bands import band_verdicts
 from printgen.verification.compare import METRICS
+
+if TYPE_CHECKING:  # pragma: no cover
+    from printgen.design.record import Design, Section
+    from printgen.design.selection import Candidate
+    from printgen.report.records import GcodeRecord, PlanRecords, RunRecords
 
 NEXT_PASS = ("Print the parts (the .gcode files, or slice the .3mf files), assemble them as the "
              "Assembly section below shows, and run the flume test with measurement-sheet.csv; "
@@ -22,13 +29,13 @@ NEXT_SOFT = ("Change the net before printing: the model is too soft. Try a stiff
 NEXT_NONE = "Run make with the verification step to get the verdict before printing."
 
 
-def print_rows(gcode: dict[str, Any]) -> tuple[list[str], list[list[str]]]:
+def print_rows(gcode: dict[str, GcodeRecord]) -> tuple[list[str], list[list[str]]]:
     """(columns, rows) of the print-time table: each part and the total."""
     from printgen.parts.gcode.estimate import NOT_COUNTED, duration
 
     rows, tot = [], {"print_time_s": 0.0, "filament_mm": 0.0, "mass_g": 0.0}
     for name, rec in gcode.items():
-        p = rec["print"]
+        p = rec.estimate.to_record()
         rows.append([name, duration(p["print_time_s"]), f"{p['filament_mm'] / 1e3:.3f}",
                      f"{p['mass_g']:.2f}"])
         for k in tot:
@@ -39,109 +46,126 @@ def print_rows(gcode: dict[str, Any]) -> tuple[list[str], list[list[str]]]:
             rows)
 
 
-def print_totals(gcode: dict[str, Any]) -> dict[str, float]:
+def print_totals(gcode: dict[str, GcodeRecord]) -> dict[str, float]:
     """Total print time (s), filament (mm) and mass (g) over every part's G-code."""
+    prints = [r.estimate.to_record() for r in gcode.values()]
     keys = ("print_time_s", "filament_mm", "mass_g")
-    return {k: float(sum(r["print"][k] for r in gcode.values())) for k in keys}
+    return {k: float(sum(p[k] for p in prints)) for k in keys}
 
 
-def summary_record(record: dict[str, Any], next_step: str = "") -> dict[str, Any]:
-    """The summary's numbers: verdict, reason, band verdicts, chosen parts, print totals,
-    next step (report.json "summary"; `next_step` replaces the one chosen from the verdict).
-    The band is record["verification"]["bands"] (make) or record["bands"] (verify)."""
-    v = record.get("verification") or {}
-    verdicts = (v.get("bands") or record.get("bands") or {}).get("verdicts", [])
-    ratios = [m.ratio_high for m in v.get("mismatches", []) if not m.ok]
-    if not v:
-        nxt = NEXT_NONE
-    elif v.get("ok"):
-        nxt = NEXT_PASS
+@dataclass(frozen=True)
+class Summary:
+    """The summary's numbers: verdict and reason, the band verdict of each metric, the chosen
+    parts, print totals (None: no G-code) and the next step (report.json "summary")."""
+
+    verdict: str
+    reason: str
+    band: dict[str, str]
+    parts: list[dict[str, Any]]
+    next: str
+    print: dict[str, float] | None = None
+
+    def to_record(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"verdict": self.verdict, "reason": self.reason,
+                               "band": self.band, "parts": self.parts, "next": self.next}
+        if self.print is not None:
+            out["print"] = self.print
+        return out
+
+
+def summarize(run: RunRecords, next_step: str = "") -> Summary:
+    """The run's summary, from its records (`next_step` replaces the one chosen from the
+    verdict)."""
+    check, gcode = run.check, run.steps.get("gcode")
+    if check is None:
+        verdict, reason, band, nxt = "not run", "", {}, NEXT_NONE
     else:
-        nxt = NEXT_STIFF if ratios and min(ratios) < 1 else NEXT_SOFT
-    out: dict[str, Any] = {
-        "verdict": v.get("verdict", "not run"), "reason": v.get("summary", ""),
-        "band": {b["metric"]: b["text"] for b in verdicts  # none where nothing deforms
-                 if b.get("levels", 1) > 0},
-        "parts": chosen_parts(record), "next": next_step or nxt}
-    if record.get("gcode"):
-        out["print"] = print_totals(record["gcode"])
+        v = check.verification
+        verdict, reason = ("PASS" if v.ok else "FAIL"), v.headline
+        band = {b.metric: b.text for b in band_verdicts(v.prototype.deformation.values,
+                                                        check.band)
+                if b.levels > 0}  # none where nothing deforms
+        ratios = [m.ratio_high for m in v.mismatches if not m.ok]
+        nxt = NEXT_PASS if v.ok else (NEXT_STIFF if ratios and min(ratios) < 1 else NEXT_SOFT)
+    return Summary(verdict, reason, band, chosen_parts(run.design, run.plan),
+                   next_step or nxt, print_totals(gcode) if gcode else None)
+
+
+def chosen_parts(design: Design, plan: PlanRecords | None = None) -> list[dict[str, Any]]:
+    """The net and the border cables as chosen: material, section, passes, stiffness error
+    (the selection's candidate of the same section; a design file's net: its own)."""
+    sel = None if plan is None else plan.selection
+    net = design.net
+    pick = plan.own_net if plan is not None and plan.own_net is not None else (
+        None if sel is None else _same_section(sel.net, net.material, net.strand))
+    out = [{"part": "net", "material": net.material.upper(),
+            "section": (f"strand {_mm(net.strand)}, "
+                        + mesh_text(net.pattern, net.mesh_x_mm, net.mesh_y_mm)),
+            "stiffness_error": None if pick is None else pick.error}]
+    if design.cables:
+        c = design.cables[0]
+        pick = None if sel is None else _same_section(sel.cables, c.material, c.section)
+        out.append({"part": f"border cables ({len(design.cables)})",
+                    "material": c.material.upper(), "section": _mm(c.section),
+                    "stiffness_error": None if pick is None else pick.error})
     return out
 
 
-def chosen_parts(record: dict[str, Any]) -> list[dict[str, Any]]:
-    """The net and the border cables as chosen: material, section, passes, stiffness error."""
-    sel, design = record.get("selection"), record["design"]
-    out = []
-    net = design["net"]
-    pick = record.get("design_net") or (  # a design.json's net: its own error, not select's
-        sel and _same_section(sel["net"]["ranked"], net["material"], net["strand"]))
-    out.append({"part": "net", "material": net["material"].upper(),
-                "section": (f"strand {_mm(net['strand'])}, "
-                            + mesh_text(net.get("pattern", "diamond"), net["mesh_x_mm"],
-                                        net["mesh_y_mm"])),
-                "stiffness_error": None if pick is None else pick["error"]})
-    if design["cables"]:
-        c = design["cables"][0]
-        pick = sel and _same_section(sel["cable"]["ranked"], c["material"], c["section"])
-        out.append({"part": f"border cables ({len(design['cables'])})",
-                    "material": c["material"].upper(), "section": _mm(c["section"]),
-                    "stiffness_error": None if pick is None else pick["error"]})
-    return out
-
-
-def _mm(s: dict[str, Any]) -> str:
+def _mm(s: Section) -> str:
     w, t, n = _dims(s)
     return f"{w:g} x {t:g} mm, {n} passes"
 
 
-def _dims(s: dict[str, Any]) -> tuple[float, float, int]:
-    """(width mm, thickness mm, passes) of a Section record (design.json's form)."""
-    layers = s["layer_heights_mm"]
-    return (round(s["bead_width_mm"] * s["beads_across"], 6), round(float(sum(layers)), 6),
-            s["beads_across"] * len(layers))
+def _dims(s: Section) -> tuple[float, float, int]:
+    """(width mm, thickness mm, passes) of a section, rounded as design.json states them."""
+    layers = s.layer_heights_mm
+    return (round(s.bead_width_mm * s.beads_across, 6), round(float(sum(layers)), 6),
+            s.beads_across * len(layers))
 
 
-def _same_section(ranked: list[dict], material: str, s: dict) -> dict | None:
+def _same_section(ranked: tuple[Candidate, ...], material: str, s: Section
+                  ) -> Candidate | None:
     w, t, n = _dims(s)
     for c in ranked:
-        cs = c["section"]
-        if (c["material"] == material and cs["passes"] == n
-                and abs(cs["width_mm"] - w) < 1e-9 and abs(cs["thickness_mm"] - t) < 1e-9):
+        cs = c.section
+        if (c.material == material and cs.passes == n
+                and abs(cs.width_mm - w) < 1e-9 and abs(cs.thickness_mm - t) < 1e-9):
             return c
     return None
 
 
-def summary_html(s: dict[str, Any]) -> str:
-    """The summary box (HTML) of `summary_record`'s output."""
+def summary_html(s: Summary) -> str:
+    """The summary box (HTML)."""
     from printgen.parts.gcode.estimate import duration
 
     e = html.escape
-    ok = s["verdict"] == "PASS"
-    tag = ("pass" if ok else "fail") if s["verdict"] != "not run" else "note"
-    lines = [(f'<p class="verdict"><span class="{tag}">{e(s["verdict"])}</span> '
-             f'{e(s["reason"] or "the verification was not run")}</p>')]
-    if s["band"]:
+    ok = s.verdict == "PASS"
+    tag = ("pass" if ok else "fail") if s.verdict != "not run" else "note"
+    lines = [(f'<p class="verdict"><span class="{tag}">{e(s.verdict)}</span> '
+             f'{e(s.reason or "the verification was not run")}</p>')]
+    if s.band:
         lines.append("<p><b>Uncertainty band</b> (where the prototype lies against the "
                      "model's band):</p><ul>" + "".join(
                          f"<li>{e(METRICS[k].split(' (')[0])}: {e(t)}</li>"
-                         for k, t in s["band"].items()) + "</ul>")
+                         for k, t in s.band.items()) + "</ul>")
     parts = "; ".join(
         f"{e(p['part'])}: {e(p['material'])}, {e(p['section'])}"
         + ("" if p["stiffness_error"] is None else
-           f", stiffness {p['stiffness_error']:+.0%} off target") for p in s["parts"])
+           f", stiffness {p['stiffness_error']:+.0%} off target") for p in s.parts)
     lines.append(f"<p><b>Chosen:</b> {parts}</p>")
-    if "print" in s:
-        t = s["print"]
+    if s.print is not None:
+        t = s.print
         lines.append(f"<p><b>Printing:</b> {e(duration(t['print_time_s']))}, "
                      f"{t['filament_mm'] / 1e3:.2f} m of filament, {t['mass_g']:.1f} g "
                      "(all parts; per part in Direct G-code)</p>")
-    lines.append(f"<p><b>Next:</b> {e(s['next'])}</p>")
+    lines.append(f"<p><b>Next:</b> {e(s.next)}</p>")
     return '<section class="summary" id="summary"><h2>Summary</h2>' + "".join(lines) \
         + "</section>"
 
 
 def summary_lines(s: dict[str, Any]) -> list[str]:
-    """The summary as plain lines for the terminal."""
+    """The summary as plain lines for the terminal, from its record (report.json's
+    "summary", which `make --json` prints too)."""
     from printgen.parts.gcode.estimate import duration
 
     if not s:

@@ -83,8 +83,7 @@ def band_record(v: Verification, band: Band) -> dict[str, Any]:
         "not_converged": band.failed,
         "verdicts": [_verdict(b) for b in band_verdicts(p, band)],
         "verdicts_from_start": [_verdict(b) for b in band_verdicts(p, band, from_start=True)],
-        "seconds": band.seconds,
-    }
+    }  # its wall time (band.seconds) goes to the run's timings
 
 
 def _verdict(b: BandVerdict) -> dict[str, Any]:
@@ -119,7 +118,7 @@ def measured_sections(rep: Report, m: Measurement, band: Band, fit: Fit | None,
         cols += [f"RMS, fitted {fit.kind}", "of measured peak"]
     rep.table(cols, rows)
     if fit:
-        rep.paragraph(_fit_sentence(fit))
+        rep.paragraph(fit_sentence(fit))
         if fit.kind == "multi":
             from printgen.report.fitreport import multi_fit_sections
 
@@ -140,7 +139,8 @@ def _fmt(mm) -> str:
     return f"{mm.rms * scale:.3g}{unit}"
 
 
-def _fit_sentence(fit: Fit) -> str:
+def fit_sentence(fit: Fit) -> str:
+    """What the fitted factor says, in one sentence."""
     if fit.kind == "multi":
         return fit.sentence()
     what = (f"net stiffness {fit.value:.3f} x its profile" if fit.kind == "stiffness"
@@ -165,5 +165,5 @@ def measured_record(m: Measurement, band: Band, fit: Fit | None, profile: str
         rec["fit"] = {"kind": fit.kind, "value": fit.value, "at_bound": fit.at_bound,
                       "evaluations": fit.evaluations, "mismatch_nominal": fit.before,
                       "mismatch_fitted": fit.after, "predicted": fit.predicted,
-                      "sentence": _fit_sentence(fit), "profile": profile}
+                      "sentence": fit_sentence(fit), "profile": profile}
     return rec

@@ -3,8 +3,11 @@ profiles, direct G-code, verification, report; every file staged and moved into 
 directory only when every step succeeded (a failed run leaves the previous outputs intact).
 
 Steps are plain functions `step(ctx, stage)` (printgen.run.steps) run in order; each adds
-files under `stage` and returns its records, which `make` puts into report.json. The verification, the longest and needing
-nothing from the others, starts in a worker process at the beginning and its step collects it.
+files under `stage` and returns its records (printgen.report.records), which `make` keeps
+with the plan's; the report is built once from them at the end (printgen.report.build), and
+report.json is their records. Wall-clock times go to the run's timings (timings.json) only.
+The verification, the longest and needing nothing from the others, starts in a worker process
+at the beginning and its step collects it.
 """
 
 from __future__ import annotations
@@ -31,11 +34,10 @@ from printgen.errors import TimeLimitError
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import MANIFEST, TIMINGS, check_destination, staged_dir
-from printgen.report.extras import report_files
+from printgen.report.build import build_report, report_files
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
-from printgen.report.parts_report import provenance_section
-from printgen.report.report import design_record, design_sections
+from printgen.report.records import PlanRecords, RunRecords
 from printgen.run.budget import (
     DEFAULT_LIMIT_S,
     LONG_RUN_S,
@@ -49,9 +51,9 @@ from printgen.run.provenance import (  # noqa: F401 (json_output, TIME_KEYS: use
     TIME_KEYS,
     json_output,
     provenance,
-    split_timings,
 )
 from printgen.run.steps import (
+    draw_figures,
     gcode_step,
     kit_step,
     parts_step,
@@ -104,16 +106,20 @@ class MakeOptions:
 
 @dataclass
 class MakeContext:
-    """What the steps share: inputs, the chosen design, the report being built; `record`
-    holds the steps' returned records (written by `make` only)."""
+    """What the steps share: inputs, the chosen design, the run's records (`records`: the
+    plan's and each step's, as objects) and `record`, their records as report.json holds
+    them (written by `make` only); `timings`, the run's wall-clock times (timings.json);
+    `report`, built from `records` once every step ran."""
 
     prototype: Prototype
     targets: ScaledTargets
     selection: Selection
     design: Design
-    report: Report
+    records: RunRecords
     options: MakeOptions = field(default_factory=MakeOptions)
     record: dict[str, Any] = field(default_factory=dict)
+    timings: dict[str, Any] = field(default_factory=dict)
+    report: Report | None = None
     files: list[str] = field(default_factory=list)
     progress: Callable[[str], None] | None = None  # a step's finer progress (STEP per part)
     background: dict[str, Future] = field(default_factory=dict)  # jobs running in `helper`
@@ -137,14 +143,11 @@ def plan(prototype_path: str | Path, scale: float, *, printer: str | None = None
     if design_file:  # the net of `printgen design` (its design.json) instead of select's
         design = load_design(design_file, scale=t.scale, prototype=proto)
         own = design_net(proto, t, design.net, design.printer)
-    rep = Report(f"printgen: {proto.name} at 1:{t.scale:g}")
     shown = Path(design_file).name if design_file else None
-    design_sections(rep, proto, t, sel, design, design_file=shown, own_net=own)
-    ctx = MakeContext(proto, t, sel, design, rep, options)
-    ctx.record.update(design_record(proto, t, sel, design))
-    if shown:
-        ctx.record["design_file"] = shown
-        ctx.record["design_net"] = own.to_record()  # its own stiffness error, not select's
+    planned = PlanRecords(proto, t, sel, design, design_file=shown, own_net=own)
+    run = RunRecords(f"printgen: {proto.name} at 1:{t.scale:g}", design, plan=planned)
+    ctx = MakeContext(proto, t, sel, design, run, options)
+    ctx.record.update(planned.to_record())
     return ctx
 
 
@@ -182,33 +185,48 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
             t, cpu = time.perf_counter(), time.process_time()
             try:
                 with span(f"step: {label}"):
-                    ctx.record.update(step(ctx, stage))
+                    keep(ctx, step(ctx, stage))
                 check_deadline(label)
             except TimeLimitError as exc:
                 raise TimeLimitError(time_limit_line(label, exc, est, bound, t0)) from exc
-            times = ctx.record.setdefault("timings_s", {})
+            times = ctx.timings.setdefault("timings_s", {})
             times[label] = time.perf_counter() - t
             times.setdefault("cpu_s", {})[label] = time.process_time() - cpu  # this process
-        with span("make: report files"):
-            write_report(ctx, stage, meta)
+        try:
+            with span("make: report files"):
+                write_report(ctx, stage, meta)  # the figures are drawn here
+        except TimeLimitError as exc:
+            raise TimeLimitError(time_limit_line(REPORT, exc, est, bound, t0)) from exc
         if ctx.options.pdf:
             report_pdf(ctx, stage, progress)
         ctx.record["files"] = sorted([*ctx.files, "report.html", "report.json", "design.json",
                                       MANIFEST, TIMINGS])
-        ctx.record.setdefault("timings_s", {})["total"] = time.perf_counter() - t0
-        stable, timings = split_timings(ctx.record)
+        ctx.timings.setdefault("timings_s", {})["total"] = time.perf_counter() - t0
         (stage / "design.json").write_text(dumps(ctx.design.to_dict()))
-        (stage / "report.json").write_text(dumps(stable))
-        (stage / TIMINGS).write_text(dumps(timings))
+        (stage / "report.json").write_text(dumps(ctx.record))
+        (stage / TIMINGS).write_text(dumps(ctx.timings))
     log.info("make finished in %.2f s", time.perf_counter() - t0)
     return ctx
 
 
+def keep(ctx: MakeContext, records: dict[str, Any]) -> None:
+    """Keep a step's records (by report.json key) with the run's, and their records in
+    `ctx.record`."""
+    ctx.records.steps.update(records)
+    ctx.record.update(ctx.records.records(records))
+
+
 def write_report(ctx: MakeContext, stage: Path, meta: dict[str, Any]) -> None:
-    """The provenance section, the report's files (figures, lab files) and report.html."""
+    """The report, built once from the run's records with their provenance (the manifest's),
+    its figures drawn (`draw_figures`), its files (figures, lab files) and report.html;
+    report.json's summary."""
     meta.update(provenance(ctx))
-    provenance_section(ctx.report, meta)
-    for name, data in report_files(ctx.record, ctx.report).items():
+    ctx.records.provenance = meta
+    with span("report: build"):
+        ctx.report, summary = build_report(ctx.records)
+    ctx.record["summary"] = summary.to_record()
+    draw_figures(ctx)
+    for name, data in report_files(ctx.records, ctx.report).items():
         (stage / name).parent.mkdir(exist_ok=True)
         (stage / name).write_bytes(data)
         ctx.files.append(name)
@@ -264,6 +282,7 @@ def warm_up() -> None:
         preload(JOB_MODULES)
 
 
+REPORT = "report (HTML, figures, lab files)"  # the last stage of a run, after its steps
 TRACKER_WARNING = "ignore:resource_tracker:UserWarning"  # a -W option (sys.warnoptions)
 
 
@@ -288,8 +307,8 @@ def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
     est = check_budget(ctx.prototype, ctx.design, cores=sweep_cores(),
                        limit_s=DEFAULT_LIMIT_S if limit is None else float(limit),
                        work=Work(sweep=verifies, cases=swept_cases(ctx.options)))
-    ctx.record["size"] = est.to_record()
-    ctx.record.setdefault("timings_s", {}).update(
+    keep(ctx, {"size": est})
+    ctx.timings.setdefault("timings_s", {}).update(
         {"estimate": est.seconds, "estimate_verification": est.verification_s,
          "estimate_parts": est.parts_s, "estimate_speed_factor": est.speed})
     return est

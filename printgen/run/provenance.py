@@ -1,8 +1,8 @@
 """What a `make` folder says about itself: the provenance (version, command line, sha256 of
 every input, the versions of Python and of the packages the numbers and bytes depend on, the
-solver's linear backend) that goes into manifest.json and the report, and the split of the
-run's record into its reproducible part (report.json) and its wall-clock times (timings.json, the one
-volatile file, and `make --json`'s "timings" key)."""
+solver's linear backend) that goes into manifest.json and the report, and `make --json`'s
+output: report.json's record with the run's wall-clock times (timings.json, the one volatile
+file) under "timings"."""
 
 from __future__ import annotations
 
@@ -14,6 +14,7 @@ import printgen
 from printgen.outputs import file_digest
 
 if TYPE_CHECKING:
+    from printgen.report.records import CheckRecords
     from printgen.run.make import MakeContext
 
 TIME_KEYS = ("timings_s", "seconds", "time_s")  # record keys that hold wall-clock times
@@ -24,9 +25,9 @@ PACKAGES = ("numpy", "scipy", "manifold3d", "trimesh", "shapely", "matplotlib", 
 
 
 def split_timings(record: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
-    """(the record without wall-clock times, the times at the same paths).
-
-    The first is byte-reproducible; the second is `timings.json` and `--json`'s "timings".
+    """(the record without wall-clock times, the times at the same paths): for a record made
+    outside the report's records that carries its times (the solver's counted work), so that
+    they go to the run's timings.
     """
     def split(v: Any) -> tuple[Any, Any]:
         if isinstance(v, dict):
@@ -48,10 +49,10 @@ def split_timings(record: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any
     return split(record)
 
 
-def json_output(record: dict[str, Any]) -> dict[str, Any]:
-    """What `make --json` prints: the reproducible record plus one top-level "timings" key."""
-    stable, timings = split_timings(record)
-    return {**stable, "timings": timings}
+def json_output(ctx: MakeContext) -> dict[str, Any]:
+    """What `make --json` prints: report.json's record plus one top-level "timings" key (the
+    run's timings, timings.json)."""
+    return {**ctx.record, "timings": ctx.timings}
 
 
 def provenance(ctx: MakeContext) -> dict[str, Any]:
@@ -73,12 +74,12 @@ def provenance(ctx: MakeContext) -> dict[str, Any]:
                      if path.is_relative_to(BUNDLED) else path)
             inputs[f"{kind}/{path.stem}"] = _digest(path, shown)
     return {"printgen_version": printgen.__version__, "command": ctx.options.command,
-            "inputs": inputs, "environment": environment(ctx.record)}
+            "inputs": inputs, "environment": environment(ctx.records.check)}
 
 
-def environment(record: dict[str, Any]) -> dict[str, Any]:
+def environment(check: CheckRecords | None = None) -> dict[str, Any]:
     """Python's version, each of PACKAGES' (None: not installed) and the solver backend the
-    verification's sweeps used (from the run's record; None when it did not verify)."""
+    verification's sweeps used (`check`'s; None when the run did not verify)."""
     from importlib.metadata import PackageNotFoundError, version
 
     def installed(name: str) -> str | None:
@@ -89,7 +90,9 @@ def environment(record: dict[str, Any]) -> dict[str, Any]:
 
     return {"python": platform.python_version(),
             "packages": {name: installed(name) for name in PACKAGES},
-            "solver_backend": record.get("verification", {}).get("solver_backend")}
+            "solver_backend": None if check is None else {
+                who: run.backend for who, run in (("prototype", check.verification.prototype),
+                                                  ("model", check.verification.model))}}
 
 
 def _digest(path: Path, shown: Path | None = None) -> dict[str, Any]:

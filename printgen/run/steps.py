@@ -1,10 +1,11 @@
 """The steps of `printgen make`: plain functions `step(ctx, stage)` that add files under
-`stage` and return their records (report.json key -> record); their report sections are
-built in printgen/report from those records (the pipeline is `printgen.run.make`). The
-verification's sweeps (`verification_sweeps`) run in a helper process from the start of the
-run while the other steps run here. The report's figures are drawings
-(printgen.report.html.Drawing) until the sweeps are done; then the last step draws them all
-at once, side by side in the helper's worker processes (`draw_figures`).
+`stage` and return their records (report.json key -> record, printgen.report.records); the
+report is built once from them (printgen.report.build), their wall-clock times go to the
+run's timings (`ctx.timings`). The pipeline is `printgen.run.make`. The verification's
+sweeps (`verification_sweeps`) run in a helper process from the start of the run while the
+other steps run here. The report's figures are drawings (printgen.report.html.Drawing) until
+the report is built; then they are drawn all at once, side by side in the helper's worker
+processes (`draw_figures`).
 """
 
 from __future__ import annotations
@@ -22,20 +23,20 @@ import numpy as np
 from printgen.errors import TimeLimitError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
-from printgen.report.parts_report import assembly_section, gcode_section, meshes_section
 from printgen.trace import span
 from printgen.workers import seconds_left
 
 HELPER_SWEEPS = "helper: verification sweeps"  # timings_s keys of work done in the helper
 WAIT_SWEEPS = "waiting for the verification sweeps"  # in this process, within a step
-FIGURES = "figures (PNG and SVG, side by side)"  # within the verification step
+FIGURES = "figures (PNG and SVG, side by side)"  # within the report files, after the steps
 
 if TYPE_CHECKING:  # pragma: no cover
     from printgen.design.record import Design
     from printgen.inputs.printers import Printer
     from printgen.inputs.prototype import Prototype
     from printgen.parts.gcode.toolpath import Toolpath
-    from printgen.report.html import Drawing, FigureFile
+    from printgen.report.html import Drawing
+    from printgen.report.records import CheckRecords, MeshRecord, PlateRecord
     from printgen.run.make import MakeContext
     from printgen.verification.bands import Band
     from printgen.verification.verify import Verification
@@ -71,11 +72,12 @@ def gcode_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     from printgen.parts.gcode.estimate import print_estimate
     from printgen.parts.gcode.readback import read_gcode_text
     from printgen.parts.gcode.writer import gcode_text
+    from printgen.report.records import GcodeRecord
 
     d = ctx.design
     printer = load_printer(d.printer)
     parts = [("net", d.net)] + [(f"cable-{c.name}", c) for c in d.cables]
-    rec = {}
+    rec, times = {}, ctx.timings.setdefault("gcode", {})
     for name, part in parts:
         mat = load_material(part.material)
         t0 = time.perf_counter()
@@ -83,20 +85,15 @@ def gcode_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
         est = print_estimate(tp, printer, mat)
         text = gcode_text(tp, printer, mat, title=f"{name}, 1:{d.scale:g}", estimate=est)
         back = read_gcode_text(text, filament_diameter_mm=printer.filament_diameter_mm)
-        seconds = time.perf_counter() - t0
+        times[name] = {"seconds": time.perf_counter() - t0}
         path = stage / f"{name}.gcode"
         path.write_text(text)
         ctx.files.append(path.name)
-        err = back.volume_mm3 / tp.volume_mm3 - 1
         stl = ctx.volumes_mm3.get(name)
         vs_stl = back.volume_mm3 / stl - 1 if stl else None
         retractions = text.count(f"E-{mat.print.retract_length_mm:.5f}")
-        rec[name] = {"file": path.name, "layers": len(back.layer_z_mm),
-                     "volume_mm3": tp.volume_mm3, "readback_volume_mm3": back.volume_mm3,
-                     "readback_error": err, "readback_vs_stl": vs_stl,
-                     "retractions": retractions, "seconds": seconds,
-                     "print": est.to_record()}
-    gcode_section(ctx.report, rec)
+        rec[name] = GcodeRecord(path.name, len(back.layer_z_mm), tp.volume_mm3,
+                                back.volume_mm3, vs_stl, retractions, est)
     return {"gcode": rec}
 
 
@@ -106,6 +103,7 @@ def kit_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     from printgen.parts.assembly import assemble
     from printgen.parts.geometry.solid import net_outline
     from printgen.report.kit import kit_figures
+    from printgen.report.records import KitRecords
 
     d = ctx.design
     if not d.cables:
@@ -116,10 +114,9 @@ def kit_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     c = min(d.cables, key=lambda c: c.length_mm)
     cable_tp = part_toolpath(ctx, f"cable-{c.name}", c, printer)
     outline = net_outline(d.net, a.attachment)
-    # drawn with the verification's figures, side by side, once the sweeps are done (see
+    # drawn with the verification's figures, side by side, once the report is built (see
     # `draw_figures`); the pictures are also written beside the report (report_files)
-    assembly_section(ctx.report, a, kit_figures(a, outline, net_tp, cable_tp, c.name))
-    return {"assembly": a.to_record()}
+    return {"assembly": KitRecords(a, kit_figures(a, outline, net_tp, cable_tp, c.name))}
 
 
 def slicer_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
@@ -152,24 +149,25 @@ def parts_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     d = ctx.design
     printer = load_printer(d.printer)
     parts = _mesh_parts(d, printer.hole_compensation_mm)
-    rec, cables = {}, []
+    rec: dict[str, MeshRecord | PlateRecord] = {}
+    cables = []
     for k, (name, kind, part, solid, outline, analytic) in enumerate(parts, 1):
         body = solid(part)
         if kind == "cable":
             cables.append((name, body))
         if ctx.options.step and ctx.progress:
             ctx.progress(f"STEP {name} ({k} of {len(parts)})")
-        rec[name] = _write_part(stage, name, kind, part, body, printer,
-                                outline if ctx.options.step else None, analytic(part))
-        ctx.files += rec[name]["files"]
-        ctx.volumes_mm3[name] = rec[name]["volume_mm3"]
+        mesh = _write_part(stage, name, kind, part, body, printer,
+                           outline if ctx.options.step else None, analytic(part))
+        rec[name] = mesh
+        ctx.files += mesh.files
+        ctx.volumes_mm3[name] = mesh.volume_mm3
     if cables:  # every cable on one plate: one print job, with the cables' settings
         c = d.cables[0]
         ini = prusa_ini_text("cable", c, printer, load_print_style(c.print_style),
                              load_material(c.material))
         rec["cables-plate"] = _write_plate(stage, cables, printer, ini)
         ctx.files.append("cables-plate.3mf")
-    meshes_section(ctx.report, rec)
     return {"parts": rec}
 
 
@@ -195,11 +193,12 @@ def _mesh_parts(d: Design, comp: float) -> list[tuple]:
 
 
 def _write_part(stage: Path, name: str, kind: str, part, body, printer, outline,
-                expected: float) -> dict[str, Any]:
+                expected: float) -> MeshRecord:
     """Place `body` on the bed and write its STL, 3MF (and STEP from `outline` when given);
     its record."""
     from printgen.parts.export import place_mesh, prusa_config_from_ini, stl_bytes, threemf_bytes
     from printgen.parts.slicer.prusa import prusa_ini_text
+    from printgen.report.records import MeshRecord
 
     mat, style = load_material(part.material), load_print_style(part.print_style)
     mesh, angle = place_mesh(body, printer, name)
@@ -215,23 +214,20 @@ def _write_part(stage: Path, name: str, kind: str, part, body, printer, outline,
                                                         part_thickness(kind, part)))
         files.append(f"{name}.step")
     size = mesh.bounds[1] - mesh.bounds[0]
-    volume = float(mesh.volume)
-    rec = {"files": files, "volume_mm3": volume, "analytic_volume_mm3": expected,
-           "volume_error": volume / expected - 1, "size_mm": np.round(size, 4),
-           "triangles": len(mesh.faces), "watertight": bool(mesh.is_watertight),
-           "bed_angle_deg": angle}
-    return rec
+    return MeshRecord(files, float(mesh.volume), expected, np.round(size, 4), len(mesh.faces),
+                      bool(mesh.is_watertight), angle)
 
 
 def _write_plate(stage: Path, cables: list[tuple[str, Any]], printer, ini: str
-                 ) -> dict[str, Any]:
+                 ) -> PlateRecord:
     """cables-plate.3mf: the cables laid out together on one bed; its record."""
     from printgen.parts.export import layout_parts, prusa_config_from_ini, threemf_bytes
+    from printgen.report.records import PlateRecord
 
     placed = layout_parts(cables, printer)
     (stage / "cables-plate.3mf").write_bytes(threemf_bytes(
         [(p.name, p.mesh) for p in placed], prusa_config_from_ini(ini)))
-    return {"files": ["cables-plate.3mf"], "parts": {p.name: p.angle_deg for p in placed}}
+    return PlateRecord(["cables-plate.3mf"], {p.name: p.angle_deg for p in placed})
 
 
 def part_thickness(kind: str, part) -> float:
@@ -240,19 +236,17 @@ def part_thickness(kind: str, part) -> float:
 
 def verify_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     """Prototype vs model over the loading sweep, the model's uncertainty band
-    (printgen.verification.bands), and the steel counter-example: the sections and record of
-    `verification_report` on the sweeps of the helper process `make` started them in, or
-    computed here; then every figure of the report, drawn (`draw_figures`)."""
+    (printgen.verification.bands), and the steel counter-example, from the sweeps of the
+    helper process `make` started them in, or computed here: their records
+    (`verification_records`), their times in the run's timings."""
     sweeps = sweeps_done(ctx)
     if sweeps is None:
         sweeps = verification_sweeps(ctx.prototype, ctx.design, load=ctx.options.load,
                                      loads=ctx.options.loads)
-    with span("verify: report"):
-        blocks, figures, record = verification_report(*sweeps, ctx.targets.scale)
-    ctx.report.blocks.extend(blocks)
-    ctx.report.figures.extend(figures)
-    draw_figures(ctx)
-    return {"verification": record}
+    with span("verify: records"):
+        check, times = verification_records(*sweeps, ctx.targets.scale)
+    ctx.timings["verification"] = times
+    return {"verification": check}
 
 
 def sweeps_done(ctx: MakeContext) -> tuple[Verification, Band] | None:
@@ -263,25 +257,28 @@ def sweeps_done(ctx: MakeContext) -> tuple[Verification, Band] | None:
         return None
     t = time.perf_counter()
     sweeps, seconds = _collect(pending, "the verification's sweeps")
-    times = ctx.record.setdefault("timings_s", {})
+    times = ctx.timings.setdefault("timings_s", {})
     times[HELPER_SWEEPS], times[WAIT_SWEEPS] = seconds, time.perf_counter() - t
     return sweeps
 
 
 def draw_figures(ctx: MakeContext) -> None:
-    """Draw the report's figures not drawn yet (the kit's and the verification's), side by
+    """Draw the built report's figures not drawn yet (the kit's and the verification's), side by
     side in worker processes: those of the helper process when there is one (forked from a
     process running one thread, they start with matplotlib imported), else `Report.draw`'s.
     Their wall time goes to timings_s[FIGURES]."""
+    if ctx.report is None:
+        return
     t = time.perf_counter()
     todo = ctx.report.pending()
     with span("figures"):
         _draw(ctx, todo)
     if todo:
-        ctx.record.setdefault("timings_s", {})[FIGURES] = time.perf_counter() - t
+        ctx.timings.setdefault("timings_s", {})[FIGURES] = time.perf_counter() - t
 
 
 def _draw(ctx: MakeContext, todo: list[Drawing]) -> None:
+    assert ctx.report is not None
     if todo and ctx.helper is not None:
         pngs, _ = _collect(ctx.helper.submit(timed, draw_all, todo), "the report's figures")
         ctx.report.fill(pngs)
@@ -345,24 +342,16 @@ def solver_work(v: Verification, band: Band) -> dict[str, Any]:
     return counted_work([*(r.work() for r in nominal), *band.work])
 
 
-def verification_report(v: Verification, band: Band, scale: float
-                        ) -> tuple[list[str], list[FigureFile], dict[str, Any]]:
-    """The verification's report blocks (figures included), its figures' files and its
-    record (with the lab's curves and expected readings, printgen.report.labfiles)."""
-    from printgen.report.html import Report
-    from printgen.report.labfiles import lab_record
-    from printgen.report.layout import layout_section
-    from printgen.report.report import load_case_sections, verification_sections
-    from printgen.report.uncertainty import band_record, band_sections
-    from printgen.scene.flume import flume_layout
+def verification_records(v: Verification, band: Band, scale: float
+                         ) -> tuple[CheckRecords, dict[str, Any]]:
+    """The verification's records (with the solver's work, the lab's curves and expected
+    readings: printgen.report.records.CheckRecords) and their wall-clock times, at the paths
+    timings.json holds them ("bands", "solver_work")."""
+    from printgen.report.records import CheckRecords
+    from printgen.run.provenance import split_timings
 
-    rep = Report("")
-    verification_sections(rep, v, v.counterexample, scale, band=band)
-    band_sections(rep, v, band)
-    load_case_sections(rep, v)
-    layout_section(rep, flume_layout(v.model.scene))
-    record = v.to_record()
-    record["solver_work"] = solver_work(v, band)
-    record["bands"] = band_record(v, band)
-    record["lab"] = lab_record(v, band, scale)
-    return rep.blocks, rep.figures, record
+    work, work_times = split_timings(solver_work(v, band))
+    times: dict[str, Any] = {"bands": {"seconds": band.seconds}}
+    if work_times:
+        times["solver_work"] = work_times
+    return CheckRecords(v, band, scale, solver_work=work, counterexample=True), times

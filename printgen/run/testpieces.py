@@ -131,7 +131,7 @@ def _piece_files(stage: Path, name: str, kind: str, part, solid: tuple, tp, prin
                  sidecar: dict[str, Any], note: str) -> dict[str, Any]:
     """One piece's files: mesh (`solid`: the mesh and its analytic volume), slicer profile,
     direct G-code and the specimen sidecar; their record."""
-    rec = _write_part(stage, name, kind, part, solid[0], printer, None, solid[1])
+    rec = _write_part(stage, name, kind, part, solid[0], printer, None, solid[1]).to_record()
     rec.update(_ini_and_gcode(stage, name, kind, part, printer, tp, rec["volume_mm3"]))
     rec["files"] += [_sidecar(stage, name, sidecar, note)]
     rec["sidecar"] = sidecar

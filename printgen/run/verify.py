@@ -20,18 +20,9 @@ from printgen.inputs.materials import load_material
 from printgen.inputs.profiles import profile_name, search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import TIMINGS, check_destination, staged_dir
-from printgen.report.html import Report
+from printgen.report.build import build_report, report_files
 from printgen.report.jsonout import dumps
-from printgen.report.labfiles import lab_files, lab_record
-from printgen.report.layout import layout_section
-from printgen.report.report import verification_sections
-from printgen.report.summary import summary_html, summary_record
-from printgen.report.uncertainty import (
-    band_record,
-    band_sections,
-    measured_record,
-    measured_sections,
-)
+from printgen.report.records import CheckRecords, MeasuredRecords, RunRecords
 from printgen.run.budget import DEFAULT_LIMIT_S, Work, check_budget, sweep_cores
 from printgen.scene.flume import flume_layout
 from printgen.scene.readings import design_units
@@ -55,7 +46,8 @@ JOB_MODULES = ("printgen.verification.pooled", "printgen.report.plots")
 
 @dataclass
 class VerifyRun:
-    """What `printgen verify` computed and wrote."""
+    """What `printgen verify` computed and wrote: `record` is report.json's with the run's
+    timings under "timings_s" (`--json`'s output); `records`, the objects it came from."""
 
     prototype: Prototype
     design: Design
@@ -66,6 +58,7 @@ class VerifyRun:
     profile_text: str
     record: dict[str, Any]
     files: list[str]
+    records: RunRecords | None = None
 
 
 def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
@@ -104,22 +97,22 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
         result = fit_factor(m, model_predictor(d, band, m, fit, load_kw=load_kw), fit)
         # a factor at the end of its range explains nothing: no profile to feed back
         text = "" if result.at_bound else _profile_text(d, result, Path(measured).name)
-    rep = Report(f"printgen verify: {p.name} at 1:{d.scale:g}")
-    verification_sections(rep, v, None, d.scale, band=band)
-    band_sections(rep, v, band)
-    layout_section(rep, flume_layout(v.model.scene))
-    record = {"design": d.to_dict(), "verification": v.to_record(),
-              "bands": band_record(v, band), "lab": lab_record(v, band, d.scale)}
+    run = RunRecords(f"printgen verify: {p.name} at 1:{d.scale:g}", d)
+    run.steps["verification"] = CheckRecords(v, band, d.scale, nested=False)
     if m is not None:
-        measured_sections(rep, m, band, result, text, prototype=v.prototype.deformation)
-        record["measured"] = measured_record(m, band, result, text)
-    record["summary"] = summary_record(record, record["measured"]["fit"]["sentence"]
-                                       if m is not None and result else "")
-    rep.lead = summary_html(record["summary"])
+        run.steps["measured"] = MeasuredRecords(m, band, result, text)
+    rep, summary = build_report(run)
     rep.draw()  # the figures, side by side in worker processes
-    record["timings_s"] = {"total": time.perf_counter() - t0, "band": band.seconds}
-    files = _write(out, rep, record, d, text, force, inputs)
-    return VerifyRun(p, d, v, band, m, result, text, record, files)
+    record = {**run.to_record(), "summary": summary.to_record()}
+    files = {"report.html": rep.html(), "report.json": dumps(record)}
+    files.update({k: b.decode("utf-8") for k, b in report_files(run, rep, figures=False).items()})
+    if text:
+        files[fitted_name(d)] = text
+    timings = {"total": time.perf_counter() - t0, "band": band.seconds}
+    files[TIMINGS] = dumps({"timings_s": timings})
+    written = _write(out, files, force, inputs)
+    return VerifyRun(p, d, v, band, m, result, text, {**record, "timings_s": timings}, written,
+                     run)
 
 
 def _multi_profile_text(d: Design, fit: MultiFit, source: str) -> str:
@@ -150,15 +143,8 @@ def fitted_name(d: Design) -> str:
     return f"{profile_name(d.net.material, 'design net.material')}-fitted.toml"
 
 
-def _write(out: str | Path, rep: Report, record: dict[str, Any], d: Design, profile: str,
-           force: bool, inputs: list) -> list[str]:
-    timings = record.pop("timings_s")
-    files = {"report.html": rep.html(), "report.json": dumps(record),
-             TIMINGS: dumps({"timings_s": timings})}
-    files.update(lab_files(record["lab"]))  # curves, expected readings, measurement sheet
-    if profile:
-        files[fitted_name(d)] = profile
-    record["timings_s"] = timings
+def _write(out: str | Path, files: dict[str, str], force: bool, inputs: list) -> list[str]:
+    """Write `files` (text by name) as the whole output folder; their names, sorted."""
     with staged_dir(out, force=force, volatile=(TIMINGS,), inputs=inputs) as stage:
         for name, text in files.items():
             (stage / name).write_text(text)
