@@ -413,7 +413,7 @@ def figure(results: list[dict], path: Path) -> None:
         pts = [(res["unknowns"], r["time_s"]) for res in results for r in res["runs"]
                if r["tool"] == tool and r.get("tol", GOAL_TOL) == GOAL_TOL and "time_s" in r]
         if pts:
-            bx.loglog(*zip(*pts), style, label=tool)
+            bx.loglog(*zip(*pts, strict=True), style, label=tool)
     if results:
         n0 = results[0]["unknowns"]
         t0 = next(r["time_s"] for r in results[0]["runs"]

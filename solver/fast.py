@@ -155,6 +155,7 @@ def _newton_step(ns: NetSystem, st: State, stepper: Stepper, reference: float):
         for step in (first, fact.symmetric_solve(rhs)):
             found = None if step is None else _line_search(ns, st, step, reference)
             if found is not None:
+                assert stepper.active is not None  # _active_set_step has just set it
                 stepper.predicted = _predicted_tensions(ns, st, stepper.active, step, found[1],
                                                         stepper.predicted)
                 return fact, found
@@ -166,24 +167,26 @@ def _active_set_step(ns: NetSystem, st: State, stepper: Stepper, boost: float, f
     quadratic model in which a slack strand pulls once the step's linearised strain
     eps + B s turns positive; the set of such strands is iterated to a fixed point
     (primal-dual active set), at most PDAS_PASSES times, from the last step's set."""
-    eps, force, tangent, d, l = st.bar
+    eps, force, tangent, d, length = st.bar
     b = ns.bars
     slack = force <= 0
-    nvec = d / l[:, None]
+    nvec = d / length[:, None]
     active = np.zeros_like(slack)
     if stepper.active is not None:
         active = slack & stepper.active
-    fact = step = rhs = None
+    fact: Factorization | Updated | None = None
+    step = rhs = None
     new = active
     geometric = force if stepper.predicted is None else stepper.predicted
     for _ in range(PDAS_PASSES + 1):
         tan = np.where(active, ns.first_slope, tangent)
-        at = dataclasses.replace(st, bar=(eps, geometric, tan, d, l))
+        at = dataclasses.replace(st, bar=(eps, geometric, tan, d, length))
+        trial: Factorization | Updated
         if fact is None or not _repass_by_gmres(stepper):
             trial = stepper.newton(at, boost)
         else:
-            trial = Updated(ns.pattern.csr(stepper.matrix(at, boost)), getattr(fact, "base", fact),
-                            stepper)
+            base = fact.base if isinstance(fact, Updated) else fact
+            trial = Updated(ns.pattern.csr(stepper.matrix(at, boost)), base, stepper)
         off = ns.incidence @ (np.where(active, ns.first_slope * eps, 0.0)[:, None] * nvec)
         new_rhs = -st.r - off.ravel()[ns.free]
         new_step = trial.solve(new_rhs, forcing)
@@ -214,10 +217,10 @@ def _predicted_tensions(ns: NetSystem, st: State, pulls: np.ndarray, step: np.nd
     point Newton, Magisano, Leonetti & Garcea 2017): the last prediction moved by alpha
     towards the linearised law's tension at the full step, floored at zero (tension only);
     `pulls`: the slack strands the step stretches (`Stepper.active`)."""
-    eps, force, tangent, d, l = st.bar
+    eps, force, tangent, d, length = st.bar
     b = ns.bars
     du = _moved(ns, np.zeros_like(st.u), step)
-    de = np.einsum("ij,ij->i", d / l[:, None], du[b.j] - du[b.i]) / b.rest
+    de = np.einsum("ij,ij->i", d / length[:, None], du[b.j] - du[b.i]) / b.rest
     model = np.where(force > 0, force + tangent * de, np.where(pulls, ns.first_slope * (eps + de),
                                                                0.0))
     base = force if last is None else last

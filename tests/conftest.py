@@ -1,4 +1,5 @@
-"""Shared fixtures: paths, and the slicer requirement (CI fails instead of skipping)."""
+"""Shared fixtures: paths, the slicer requirement (CI fails instead of skipping), the whole runs
+shared by the xdist workers, and the `slow` mark of the tests that read them."""
 
 from __future__ import annotations
 
@@ -168,6 +169,18 @@ def _make_simple_drag(tmp: Path):
         mp.setattr(make_mod, "default_steps", lambda: verify_only)
         ctx = api.make(path, 40, tmp / "out", drag=True)
     return ctx, tmp / "out", path
+
+
+# A test that reads one of these whole runs is a whole-pipeline test: `slow`, whatever its own
+# duration (the first to ask pays for the run).
+WHOLE_RUN_FIXTURES = {"made_1_40", "made_simple_drag"}
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Mark `slow` every test that uses a whole run (`pytest -m "not slow"`: CONTRIBUTING.md)."""
+    for item in items:
+        if WHOLE_RUN_FIXTURES & set(getattr(item, "fixturenames", ())):
+            item.add_marker(pytest.mark.slow)
 
 
 def alive(pid: int) -> bool:

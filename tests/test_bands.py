@@ -35,6 +35,7 @@ def coarse_design():
         n, mesh_x_mm=n.mesh_x_mm * COARSE, mesh_y_mm=n.mesh_y_mm * COARSE))
 
 
+@pytest.mark.slow
 def test_band_contains_the_nominal_and_every_variant():
     d = coarse_design()
     nominal = run_variant(d, Variant(), LEVELS)

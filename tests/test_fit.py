@@ -43,6 +43,7 @@ def test_slack_is_a_flat_first_segment():
     assert slopes[1:] == (100.0, 10.0) and slopes[0] < 1e-3 * slopes[1]
 
 
+@pytest.mark.slow
 def test_a_synthetic_measurement_is_recovered():
     d = coarse_design()
     known = Params(net_factor=0.5, net_slack=0.01)
@@ -58,6 +59,7 @@ def test_a_synthetic_measurement_is_recovered():
     assert max(mm.rms_rel for mm in fit.after) < max(mm.rms_rel for mm in fit.before)
 
 
+@pytest.mark.slow
 def test_an_impossible_curve_is_refused():
     """Mid-height 40 % at half loading while the top cable shortens: no net does that."""
     d = coarse_design()
@@ -68,6 +70,7 @@ def test_an_impossible_curve_is_refused():
     assert "NOT explained" in fit.sentence()
 
 
+@pytest.mark.slow
 def test_a_bed_choice_is_fitted_and_recorded():
     """The bed is a discrete choice (issue 25): a 3-tuple choice means the free bed."""
     d = coarse_design()

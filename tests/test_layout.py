@@ -1,7 +1,7 @@
 """The layout by stage (shared/design.md, README "Where things live"): data moves down the flow
-run -> report -> check -> parts -> design -> inputs and barrier -> ground floor; a lower stage never imports
-a higher one, and solver/ never imports printgen. Imports are read with `ast`, so a lazy import
-inside a function counts as much as one at the top of a module."""
+run -> report -> check -> parts -> design -> inputs and barrier -> ground floor; a lower stage never
+imports a higher one, and solver/ never imports printgen. Imports are read with `ast`, so a lazy
+import inside a function counts as much as one at the top of a module."""
 
 from __future__ import annotations
 
@@ -124,6 +124,7 @@ def test_top_level_stays_small():
     assert len(modules) <= TOP_LEVEL_MODULES_MAX, modules
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("victim", "line", "expected"), [
     ("printgen/inputs/schema.py", "from printgen.run.make import make\n", "inputs (rank 1)"),
     ("printgen/parts/geometry/cable.py", "    from printgen.verification import verify\n",

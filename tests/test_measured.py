@@ -53,6 +53,7 @@ def write_csv(path, levels, values: dict[str, np.ndarray], sep: str = ",") -> No
     path.write_text("\n".join(lines) + "\n")
 
 
+@pytest.mark.slow
 def test_fit_recovers_a_known_stiffness_factor(tmp_path):
     d = coarse_design()
     every = {key: np.zeros(len(MEASURED_LEVELS)) for key, _ in COLUMNS.values()}

@@ -142,6 +142,7 @@ def _lateral(s) -> np.ndarray:
 LEVELS = np.array([0.0, 0.5, 1.0])  # enough to load the edges
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("mounting", ["walls", "eyelets"])
 def test_mountings_hold_or_free_the_lateral_edges(design, mounting):
     """walls: the side sheets hold the lateral edge nodes (they do not move); eyelets: only the

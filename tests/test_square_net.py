@@ -93,6 +93,7 @@ def test_square_membrane_law_is_one_strand_per_mesh(simple):
     assert membrane == pytest.approx(want, rel=1e-12)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("size", ["reduced", "full"])
 def test_square_mesh_is_watertight_and_matches_its_analytic_volume(simple, size, tmp_path):
     pytest.importorskip("manifold3d")
@@ -202,6 +203,7 @@ PANEL_REL = 1e-6  # the solver's panel tolerance is 1e-9 of the strand force: fa
 FREE_HOLD_REL = 0.01
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("mode", ["blocked", "free"])
 def test_virtual_panel_of_the_square_net_reads_its_membrane_law(simple, mode):
     """The same panel machinery as the diamond (`verification.panel`): the designed square
@@ -239,6 +241,7 @@ def coarse_simple(tmp_path_factory):
     return _design(path)
 
 
+@pytest.mark.slow
 def test_verification_of_the_square_net_converges_at_every_level(coarse_simple):
     """Prototype and printed square net solved at every level of the sweep (h / h_B = 0 to
     1.1 by 0.05), the model with its printed edge frame and pulling sensor wires."""
@@ -255,6 +258,7 @@ def test_verification_of_the_square_net_converges_at_every_level(coarse_simple):
 RING_QUADRATURE = 1e-4  # the analytic area's polar-grid integral over each ring (1.3e-5 seen)
 
 
+@pytest.mark.slow
 def test_square_net_with_border_cables_has_loops_and_lays_its_volume(tmp_path):
     """The simple barrier with border cables: a two-bead frame with a loop on every edge node
     (the cables thread them), a watertight mesh, and a direct G-code laying the mesh's volume."""
@@ -283,5 +287,6 @@ def test_square_prototype_with_unequal_sides_is_refused(tmp_path):
     from printgen.errors import InputError
 
     bad = write_variant(tmp_path, {("net", "mesh_y_m"): 0.25}, base=SIMPLE)
-    with pytest.raises(InputError, match=r'pattern "square" needs mesh_x_m = mesh_y_m.*0\.2 x 0\.25'):
+    with pytest.raises(InputError,
+                       match=r'pattern "square" needs mesh_x_m = mesh_y_m.*0\.2 x 0\.25'):
         load_prototype(bad)

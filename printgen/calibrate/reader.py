@@ -301,7 +301,8 @@ def _body(rows, ncols: int, dec: str, where: str, headers: list[str], delim: str
 
 
 def _assign(headers: list[str], col_units: list[str | None], data: np.ndarray,
-            chosen: Mapping[str, str], where: str) -> tuple[dict[str, int], dict[str, tuple[str, ...]], list[str]]:
+            chosen: Mapping[str, str], where: str
+            ) -> tuple[dict[str, int], dict[str, tuple[str, ...]], list[str]]:
     """(role -> column index, role -> other candidate headers, notes): the options first, then
     the header names, preferring a column whose unit belongs to the role; raw counts are never
     taken and two unitless force columns are an error, not a guess."""
