@@ -7,12 +7,10 @@ import math
 
 import numpy as np
 import pytest
+from conftest import planned
 from proto_files import REALISTIC
 
 import solver
-from printgen.design.plan import make_design
-from printgen.design.selection import select
-from printgen.design.similitude import scale_targets
 from printgen.errors import InputError
 from printgen.inputs.prototype import load_prototype
 from printgen.verification.compare import wire_elongation
@@ -37,9 +35,7 @@ WIRE_SPRING = 10 * WIRE_RATE * SENSOR_FORCE_N
 
 @pytest.fixture(scope="module")
 def design():
-    p = load_prototype(REALISTIC)
-    t = scale_targets(p, 40)
-    return p, make_design(p, t, select(p, t))
+    return planned(REALISTIC)
 
 
 def _cable_forces(x: np.ndarray, nodes: np.ndarray, law, rest: float) -> np.ndarray:
