@@ -65,21 +65,18 @@ MU_RETRIES = 6  # ... at most this many times in one iteration
 NONMONOTONE = 5  # Armijo against the highest potential of the last 5 Newton states
 CHORD_RATE = 0.5  # a chord step is kept when it at least halves the out-of-balance force
 CHORD_MIN_DOFS = 10_000  # below, a factorization costs less than the trial state a chord step
-# needs (1:40 verification nets, ~1000 unknowns: 0.7 ms against 1-2 ms), so no chord steps
+# needs, so no chord steps (benchmarks/measurements.md#fast-chord-and-repass)
 START_SPAN = (-6.0, 0.0)  # log10 of the membrane start's largest displacement / net extent
 START_GRID = 13  # potentials sampled over START_SPAN before the scalar minimisation
 START_XTOL = 0.01  # log10 resolution of the membrane start's scale
 # backends whose re-passes are GMRES on the first pass's factorization: a triangular solve of
 # qdldl's LDL^T costs ~1/10 of its factorization; PARDISO refactorizes cheaper than the 5-10
-# preconditioned iterations (241 x 81 at tol 1e-6, 1 thread: 5.0-5.4 s wall by GMRES, 2.6 s
-# refactorizing), and so does the "ldl" backend once it has switched to PARDISO along a load
-# path (`_repass_by_gmres`; simple barrier 1:40, the band's slack-1 % variant, its 529 re-
-# passes 9.4 preconditioned iterations each on average: CPU 4.54-5.50 -> 3.88-4.97 s back to
-# back, 764 -> 757 iterations; the nominal model sweep 1.16 -> 1.07 s, 187 -> 185)
+# preconditioned iterations, and so does the "ldl" backend once it has switched to PARDISO
+# along a load path (`_repass_by_gmres`; benchmarks/measurements.md#fast-chord-and-repass)
 REPASS_BY_GMRES = ("ldl",)
 PDAS_PASSES = 1  # active-set re-solves per Newton step at most, each by GMRES on the first
-# pass's factorization (simple barrier 1:40, worst level of the model / prototype sweeps: 1 pass
-# 39 / 44 iterations, 3 passes 35 / 50, 6 passes 32 / 47 at 1.3-1.8 x the CPU of 1 pass)
+# pass's factorization: more passes save few Newton iterations for much more CPU
+# (benchmarks/measurements.md#fast-chord-and-repass)
 
 
 class Stepper:

@@ -133,7 +133,7 @@ def test_time_limit_stops_the_helper_process_run(tmp_path, monkeypatch):
     assert not out.exists() and list(tmp_path.iterdir()) == []
 
 
-PETG30 = ROOT / "tests" / "data" / "issue28"  # issue 28's file and its 500 mm bed printer
+PETG30 = ROOT / "tests" / "data" / "petg-1-30"  # a PETG barrier at 1:30, its 500 mm bed printer
 HELPER_LIMIT_S = 6.0  # the helper is well into its sweeps' worker pools by then
 
 

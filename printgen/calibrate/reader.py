@@ -38,9 +38,9 @@ log = logging.getLogger(__name__)
 DELIMITERS = (";", "\t", ",")  # preferred first: a decimal comma would split a ',' file
 SNIFF_ROWS = 40  # rows from the table's end used to choose the decimal separator
 TEXT_SUFFIXES = (".csv", ".txt", ".tsv", ".dat")
-# The most one export may hold, checked before it is parsed (a 175 KB zip of 20 M rows ran
-# calibrate > 120 s; issue 20): a 1 kHz test of 16 minutes has 1 M rows, and the reader takes
-# about 10 s for them; real exports hold 10^3 to 10^5.
+# The most one export may hold, checked before it is parsed (a small zip can unpack to tens of
+# millions of rows): a 1 kHz test of 16 minutes has 1 M rows; real exports hold 10^3 to 10^5
+# (benchmarks/measurements.md#calibrate-limits).
 MAX_ROWS = 1_000_000
 EXPORT_LIMIT_BYTES = INPUT_LIMIT_BYTES  # one export, or what a zip of one unpacks to (64 MiB)
 _BOOLEAN = {"true": 1.0, "false": 0.0}  # flag columns written as words

@@ -1,6 +1,6 @@
 """Uncertainty bands of the pre-print check: the printed model swept for its nominal design
 and for each uncertain input it depends on, one at a time, and the min/max envelope of the
-normalised deformations at every relative loading (issue 10).
+normalised deformations at every relative loading.
 
 Variants of the printed model (`model_variants`):
 - measured modulus +- SD of each material whose profile records an SD (`sd_gpa`); the net's
@@ -47,7 +47,7 @@ from printgen.verification.scenes import BarrierScene, model_scene
 from printgen.verification.verify import Run, load_keywords, sweep
 from printgen.workers import collect, submit_jobs
 
-SLACK_MAX = 0.01  # initial slack of the printed net, upper end of the range (issue 10: 0-1 %)
+SLACK_MAX = 0.01  # initial slack of the printed net, upper end of the range (0-1 %)
 COARSENINGS = (2, 3)  # mesh multipliers tried in turn for the variant sweeps
 REFINE_TOL = 0.01  # a coarser net is used when no nominal curve moves by more than 1 % of its peak
 SAME = 1e-9  # relative change below which an alternative equals the nominal (not run)
@@ -159,8 +159,8 @@ def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
 
 
 def _orientation_variants(d: Design) -> list[Variant]:
-    """The panel law read along each mesh diagonal its profile does not record (issue 25:
-    the paper does not say which diagonal its printed panels were loaded along)."""
+    """The panel law read along each mesh diagonal its profile does not record (the
+    paper does not say which diagonal its printed panels were loaded along)."""
     from printgen.verification.scenes import ORIENTATIONS, recorded_orientation
 
     law = load_material(d.net.material).panel_law
@@ -186,7 +186,7 @@ def variant_scene(d: Design, v: Variant, coarsen: int = 1) -> BarrierScene:
     s = model_scene(d, **({"mounting": v.mounting} if v.mounting else {}),
                     orientation=v.orientation)
     laws = list(s.laws)
-    if v.net_law == "derived":  # issue 25: the virtual panel test's strand law
+    if v.net_law == "derived":  # the virtual panel test's strand law
         from printgen.verification.forms import derived_net_law
 
         laws[0], how = derived_net_law(load_material(d.net.material), d.net, v.orientation)
@@ -198,7 +198,7 @@ def variant_scene(d: Design, v: Variant, coarsen: int = 1) -> BarrierScene:
         laws[1] = _scaled(laws[1], v.frame_factor)
     cables = {k: (nodes, _scaled(law, v.cable_factor)) for k, (nodes, law) in s.cables.items()}
     s = dataclasses.replace(s, laws=laws, cables=cables, pressure=v.pressure)
-    if v.span is not None:  # issue 25: the printed net mounted in the flume's free section
+    if v.span is not None:  # the printed net mounted in the flume's free section
         from printgen.verification.mount import in_free_section
 
         s = in_free_section(s, v.span)
@@ -214,11 +214,10 @@ def _scaled(law: tuple, factor: float) -> tuple:
 
 
 def effort(v: Variant, mounting: str | None = None) -> tuple[bool, ...]:
-    """Sort key of variants (`mounting`: the nominal one), the longest sweep first (CPU
-    measured by bench timeline at 1:40: initial slack, a mechanism until its strands tighten,
-    24 s on the simple barrier and 2.4 s on the 1:40 example; then the net mounted in the
-    flume's free section, 4.0-4.5 s there; another mounting 3.7 s; the virtual panel test's
-    law 3.3-6.4 s; pressure normal to the net 1.6-5.1 s; the rest 0.8-2.8 s)."""
+    """Sort key of variants (`mounting`: the nominal one), the longest sweep first: initial
+    slack (a mechanism until its strands tighten), the net mounted in the flume's free section,
+    another mounting, the virtual panel test's law, pressure normal to the net, the rest (CPU
+    by bench timeline at 1:40: benchmarks/measurements.md#band-variant-order)."""
     return (v.slack == 0, v.span is None, v.mounting == mounting, v.net_law != "derived",
             v.pressure != "normal")
 

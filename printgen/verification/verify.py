@@ -74,7 +74,7 @@ def loads_function(s: BarrierScene, *, load: str | LoadCase | None = None,
     """Loads at relative loading r of load case `load` (default hydrostatic) on the scene's
     free nodes, at `site` (the sensor wires are part of the net: `solver_net`). With the
     scene's pressure option "normal" the hydrostatic part presses normal to the deformed net
-    (issue 25: the folded film presses normal to the surface) instead of along the flow."""
+    (the folded film presses normal to the surface) instead of along the flow."""
     loads_at = get_load(load).loads_for(s, site)
     if s.pressure != "normal":
         return loads_at
