@@ -252,8 +252,8 @@ def _value(cell: str, dec: str) -> float | None:
             pass
         else:
             return v if math.isfinite(v) else None
-    v = parse_number(cell, dec)
-    return _BOOLEAN.get(cell.strip().strip('"').lower()) if v is None else v
+    parsed = parse_number(cell, dec)
+    return _BOOLEAN.get(cell.strip().strip('"').lower()) if parsed is None else parsed
 
 
 def _table_start(rows: list[tuple[int, list[str]]], dec: str, where: str, delim: str) -> int:
@@ -313,9 +313,9 @@ def _assign(headers: list[str], col_units: list[str | None], data: np.ndarray,
         roles[role] = _find_column(headers, key, where)
     cands: dict[str, list[int]] = {r: [] for r in ROLES}
     for j, h in enumerate(headers):
-        role = role_of(split_name_unit(h)[0])
-        if role is not None and role not in roles and j not in roles.values():
-            cands[role].append(j)
+        named = role_of(split_name_unit(h)[0])
+        if named is not None and named not in roles and j not in roles.values():
+            cands[named].append(j)
     alternatives: dict[str, tuple[str, ...]] = {}
     notes: list[str] = []
     for role, js in cands.items():
