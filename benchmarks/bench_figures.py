@@ -10,8 +10,8 @@ CPU time of the helper and its workers.
 The sweeps run once per example first (not timed). The machine may be shared: the CPU times
 (time.process_time, getrusage) are the numbers to compare; wall times are inflated by the
 other jobs' load (the load average is recorded). Writes bench_figures.json and
-bench_figures.png. Goal (issue 28 item 1, make of the simple barrier in under 15 s on 2
-cores): its figures drawn side by side in under GOAL_S of wall time.
+bench_figures.png. Goal (within make of the simple barrier in under 15 s on 2 cores): its
+figures drawn side by side in under GOAL_S of wall time.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = {"simple": ROOT / "examples" / "simple_barrier.toml",
             "realistic": ROOT / "examples" / "realistic_barrier.toml"}
 SCALE = 40.0
-GOAL_S = 3.0  # the simple barrier's figures, side by side, of make's 15 s (issue 28 item 1)
+GOAL_S = 3.0  # the simple barrier's figures, side by side, of make's 15 s
 REPEAT = 3
 
 

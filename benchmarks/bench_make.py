@@ -16,8 +16,8 @@ Each run is a fresh process (imports included) writing into its own folder; the 
 step comes from the run's own timings.json. The verification runs in make's helper process
 alongside the other steps ("helper: ..." bars, orange); a step that waits for it says how long
 ("waiting ...", grey, part of that step's time). Writes bench_make.json and bench_make.png.
-Goal (issue 11): median total < 3 s on this machine; issue 28: the estimate within x2 of the
-measured time on both examples (`estimate_within_x2`, on the wall time and on the CPU).
+Goals: median total < 3 s on this machine; the estimate within x2 of the measured time on both
+examples (`estimate_within_x2`, on the wall time and on the CPU).
 """
 
 from __future__ import annotations
@@ -34,8 +34,8 @@ ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "realistic_barrier.toml"
 SIMPLE = ROOT / "examples" / "simple_barrier.toml"  # free top: estimate checked, not timed x3
 SCALE = 40.0
-GOAL_S = 3.0  # issue 11: make at 1:40 in under 3 s
-ESTIMATE_FACTOR = 2.0  # issue 28: the estimate within x2 of the measured run
+GOAL_S = 3.0  # make at 1:40 in under 3 s
+ESTIMATE_FACTOR = 2.0  # the estimate within x2 of the measured run
 REPEAT = 3
 HELPER = "helper:"  # steps run in make's helper process, alongside the others (orange)
 WAITING = "waiting"  # time a step spent waiting for the helper (grey; inside that step's bar)

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from benchmarks.timing import best_of, goal_main
 
-GOAL_S = 5.0  # issue 5: the 330 mm net's mesh in under five seconds
+GOAL_S = 5.0  # the 330 mm net's mesh in under five seconds
 
 
 def _part_record(name, build, analytic, printer, repeat: int) -> tuple[dict, object]:

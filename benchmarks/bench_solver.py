@@ -1,6 +1,6 @@
 """Benchmark: the solver's speed against its error on scene simple-pinned (barrier-physics.md,
 section 7) at 61 x 21, 121 x 41, 241 x 81 and 481 x 161 nodes, with OpenSeesPy side by side
-(up to 241 x 81) and the reference path (method="reference", the solver before issue 11);
+(up to 241 x 81) and the reference path (method="reference", the solver before its fast path);
 the load paths of the 1:40 verification; the robustness table of the hard cases.
 
     python -m benchmarks.bench_solver --out DIR [--sizes 1 2 4 8] [--no-paths]
@@ -40,11 +40,11 @@ from solver.scenes import simple_scene
 
 REFERENCE_TOL = 1e-13  # the reference solve: round-off level
 TOLERANCES = (1e-4, 1e-6, 1e-8)  # printgen's runs: out-of-balance force / load
-GOAL_TOL = 1e-6  # issue 11's goals are stated at this tolerance
+GOAL_TOL = 1e-6  # the solver's speed goals are stated at this tolerance
 REPEAT = 3  # timing repeats at GOAL_TOL (best kept)
 PAIRS = 7  # printgen / OpenSeesPy timing pairs at 61 x 21, alternating which runs first
 SIZES = {1: "61 x 21", 2: "121 x 41", 4: "241 x 81", 8: "481 x 161"}
-LINEAR_FROM = 10_000  # issue 28: cost per unknown within 1.5x from here (14k) to 228k unknowns
+LINEAR_FROM = 10_000  # goal: cost per unknown within 1.5x from here (14k) to 228k unknowns
 THREADS = 1  # BLAS/MKL threads of the size runs (--threads)
 COMPARED = (1, 2, 4)  # sizes also run by OpenSeesPy and by the reference path
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "realistic_barrier.toml"
@@ -180,7 +180,7 @@ def strand_state(net, disp: np.ndarray) -> tuple[float, float]:
 
 
 def robustness() -> list[dict]:
-    """The hard cases of issue 4, each from the flat start with default settings."""
+    """The hard cases (robustness), each from the flat start with default settings."""
     cases = [("zero pretension, steel, 61 x 21", {}),
              ("very soft strands (0.5 GPa, ~40 % strain)", {"modulus": 5e8}),
              ("lambda = 100, E / lambda", {"scale": 100, "modulus": 1e9}),
@@ -266,7 +266,7 @@ def bench_size(refine: int) -> dict:
 
 
 def size_table(results: list[dict], threads: int) -> list[dict]:
-    """Issue 28's size table: printgen at GOAL_TOL per size, best of REPEAT."""
+    """The size table: printgen at GOAL_TOL per size, best of REPEAT."""
     out = []
     for res in results:
         goal = next(r for r in res["runs"] if r["tool"] == "printgen" and r["tol"] == GOAL_TOL)
@@ -413,7 +413,7 @@ def figure(results: list[dict], path: Path) -> None:
         pts = [(res["unknowns"], r["time_s"]) for res in results for r in res["runs"]
                if r["tool"] == tool and r.get("tol", GOAL_TOL) == GOAL_TOL and "time_s" in r]
         if pts:
-            bx.loglog(*zip(*pts), style, label=tool)
+            bx.loglog(*zip(*pts, strict=True), style, label=tool)
     if results:
         n0 = results[0]["unknowns"]
         t0 = next(r["time_s"] for r in results[0]["runs"]
@@ -431,7 +431,7 @@ def figure(results: list[dict], path: Path) -> None:
 
 def goals(results: list[dict], paths: list[dict], tent: dict | None,
           paired: dict | None = None) -> dict:
-    """Issue 11's targets, each with its measured figure."""
+    """The solver's speed targets, each with its measured figure."""
     def at(size: str, tool: str):
         for res in results:
             if res["size"] == size:
@@ -457,7 +457,7 @@ def goals(results: list[dict], paths: list[dict], tent: dict | None,
     cpu = {res["size"]: res["cpu_us_per_unknown_at_goal_tol"] for res in results
            if res["unknowns"] >= LINEAR_FROM}
     out["cpu_us_per_unknown"] = cpu
-    if len(cpu) > 1:  # issue 28: within 1.5x from 14k to 228k unknowns
+    if len(cpu) > 1:  # goal: within 1.5x from 14k to 228k unknowns
         out["cpu_us_per_unknown_spread"] = max(cpu.values()) / min(cpu.values())
     if tent:
         out["tent_iterations"] = {m: tent[m]["iterations"] for m in ("fast", "reference")}

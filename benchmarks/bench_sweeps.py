@@ -2,12 +2,12 @@
 barrier (scene simple-free-top, barrier-physics.md section 7; Lambert et al. 2023,
 doi 10.1061/JHEND8.HYENG-13070): the two sweeps `verify` solves for examples/simple_barrier.toml
 at 1:40 (printed model and prototype, h/h_B = 0 to 1.1 by 0.05), and with `--petg30` also
-issue 28's PETG barrier at 1:30 (tests/data/issue28, a 500 mm bed printer).
+a PETG barrier at 1:30 (tests/data/petg-1-30, a 500 mm bed printer).
 
     python -m benchmarks.bench_sweeps --out DIR [--petg30]     (or: printgen bench sweeps)
 
 The machine is shared: work is counted (iterations, factorizations per level) and timed by
-`time.process_time()` (CPU of this process), not wall time. Goal (issue 28): every level of
+`time.process_time()` (CPU of this process), not wall time. Goal: every level of
 every sweep converges in fewer than GOAL_ITERATIONS Newton iterations.
 Writes bench_sweeps.json.
 """
@@ -23,8 +23,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 SIMPLE = (ROOT / "examples" / "simple_barrier.toml", 40.0, None)
-PETG30 = (ROOT / "tests" / "data" / "issue28" / "simple_petg_1to30.toml", 30.0, "bed-500")
-GOAL_ITERATIONS = 50  # issue 28: Newton iterations per load level, at most
+PETG30 = (ROOT / "tests" / "data" / "petg-1-30" / "simple_petg_1to30.toml", 30.0, "bed-500")
+GOAL_ITERATIONS = 50  # Newton iterations per load level, at most
 SWEEPS = ("printed model", "prototype")  # the order `verify` solves them in (longest first)
 
 
@@ -74,7 +74,7 @@ def sweeps(example: Path, scale: float, printer: str | None) -> list[dict]:
 
 def run(out: Path, petg30: bool = False) -> dict:
     out.mkdir(parents=True, exist_ok=True)
-    cases = {"simple_barrier 1:40": SIMPLE, **({"issue 28 PETG 1:30": PETG30} if petg30 else {})}
+    cases = {"simple_barrier 1:40": SIMPLE, **({"PETG 1:30": PETG30} if petg30 else {})}
     report: dict = {"benchmark": "bench_sweeps", "scene": "simple-free-top",
                     "goal_iterations_per_level": GOAL_ITERATIONS, "cases": {}}
     for name, (example, scale, printer) in cases.items():
@@ -90,7 +90,8 @@ def run(out: Path, petg30: bool = False) -> dict:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", required=True, type=Path)
-    ap.add_argument("--petg30", action="store_true", help="also issue 28's PETG barrier at 1:30")
+    ap.add_argument("--petg30", action="store_true",
+                    help="also the PETG barrier at 1:30 (500 mm bed)")
     ap.add_argument("--json", action="store_true", help="print the whole report as JSON")
     a = ap.parse_args(argv)
     report = run(a.out, a.petg30)

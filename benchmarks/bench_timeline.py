@@ -10,8 +10,8 @@ getrusage of the waited children misses the processes a fork server started).
     python -m benchmarks.bench_timeline --out DIR [--repeat 1]
 
 The machine may be shared: the load average is recorded beside each run; a loaded machine
-stretches every span. Writes bench_timeline.json and timeline-<example>.png. Goal (issue 28
-item 1): the simple barrier's make in under GOAL_S on 2 cores.
+stretches every span. Writes bench_timeline.json and timeline-<example>.png. Goal: the
+simple barrier's make in under GOAL_S on 2 cores.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = {"simple": ROOT / "examples" / "simple_barrier.toml",
             "realistic": ROOT / "examples" / "realistic_barrier.toml"}
 SCALE = 40.0
-GOAL_S = 15.0  # issue 28 item 1: the simple barrier's make in under 15 s on 2 cores
+GOAL_S = 15.0  # the simple barrier's make in under 15 s on 2 cores
 TRACE = "PRINTGEN_TRACE"  # printgen.trace.TRACE
 POOL = "pool of"  # a pool's life in its parent (printgen.workers.run_jobs), not a job
 

@@ -35,7 +35,7 @@ def run() -> Verification:
     for key in ("strain_bottom", "strain_top", "deflection", "lowering"):
         assert np.all(np.diff(m.values[key][half]) > 0), key
     # the prototype's top centre lowers to ~0.12 of its height near h/h_B = 0.8, then rises a
-    # little as the net (panel law along the meshes' long axis, issue 25) bulges downstream
+    # little as the net (panel law along the meshes' long axis) bulges downstream
     assert 0.08 < p.values["lowering"].max() < 0.16
     # the 1 N sensor wires pull along themselves: no deflection before the water arrives
     assert abs(m.values["deflection"][0]) < 0.01 and p.values["deflection"][0] == 0.0

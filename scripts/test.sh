@@ -8,10 +8,20 @@ if ! .venv/bin/python -c "import cadquery" 2>/dev/null; then
   .venv/bin/python -m pip install -q -e ".[all,cad]" >.venv/setup-cad.log 2>&1 \
     || { cat .venv/setup-cad.log >&2; echo "test: installing the cad extra failed" >&2; exit 1; }
 fi
-# The wheel, installed outside the clone and used from an empty folder (issue 21; ~30 s).
+# The wheel, installed outside the clone and used from an empty folder: what a user installs.
 bash scripts/test_wheel.sh
 export PRINTGEN_REQUIRE_SLICERS=1   # slicer tests fail, not skip, when a slicer is missing
 # ../shared tests (G-code checker, tensile exports) fail, not skip, when ../shared sits beside the
 # clone or PRINTGEN_REQUIRE_SHARED=1 is given (.ci/run); a clone with nothing beside it skips them.
 export PRINTGEN_REQUIRE_SHARED="${PRINTGEN_REQUIRE_SHARED:-$([[ -d ../shared ]] && echo 1 || echo 0)}"
-exec .venv/bin/python -m pytest -n auto --dist loadfile "$@"
+# Lint and types, then every test (no marker filter: the `slow` ones too). Each step runs even
+# when one before it failed, so one run shows every problem; the script fails if any did.
+failed=()
+.venv/bin/ruff check . || failed+=("ruff check")
+.venv/bin/python -m mypy solver || failed+=("mypy solver")
+.venv/bin/python scripts/mypy_budget.py || failed+=("mypy printgen (scripts/mypy_budget.txt)")
+.venv/bin/python -m pytest -n auto --dist loadfile "$@" || failed+=("pytest")
+if ((${#failed[@]})); then
+  printf 'test: failed: %s\n' "${failed[@]}" >&2
+  exit 1
+fi

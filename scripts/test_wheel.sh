@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# printgen as a user installs it (issue 21): build the wheel from this clone, install it into a
+# printgen as a user installs it: build the wheel from this clone, install it into a
 # fresh venv outside the clone, and from an empty folder run profiles list, example, make,
 # check and calibrate --inherits petg on a generated export; then the same profile lookup
 # through the clone's editable install. scripts/test.sh runs it before the suite.

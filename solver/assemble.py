@@ -82,22 +82,23 @@ def bar_state(b: Bars, u: np.ndarray):
     """(strain, force, tangent, current vector d, length l) of every strand."""
     du = u[b.j] - u[b.i]
     d = b.d0 + du
-    l = np.linalg.norm(d, axis=1)
+    length = np.linalg.norm(d, axis=1)
     dl2 = b.c + 2 * np.einsum("ij,ij->i", b.d0, du) + np.einsum("ij,ij->i", du, du)
-    eps = dl2 / (b.rest * (l + b.rest))
+    eps = dl2 / (b.rest * (length + b.rest))
     force, tangent, _ = strand_laws(b, eps)
-    return eps, force, tangent, d, l
+    return eps, force, tangent, d, length
 
 
 def cable_state(c: Cable, u: np.ndarray):
     """(strain, tension, tangent, unit vectors (k-1, 3), segment lengths) of a sliding cable."""
     du = np.diff(u[c.nodes], axis=0)
     d = c.d0 + du
-    l = np.linalg.norm(d, axis=1)
-    stretch = (2 * np.einsum("ij,ij->i", c.d0, du) + np.einsum("ij,ij->i", du, du)) / (l + c.l0)
+    length = np.linalg.norm(d, axis=1)
+    stretch = ((2 * np.einsum("ij,ij->i", c.d0, du) + np.einsum("ij,ij->i", du, du))
+               / (length + c.l0))
     eps = (stretch.sum() + (c.l0.sum() - c.rest)) / c.rest
     t, kt = c.law.force_and_tangent(np.array([eps]))
-    return float(eps), float(t[0]), float(kt[0]), d / l[:, None], l
+    return float(eps), float(t[0]), float(kt[0]), d / length[:, None], length
 
 
 def _block_entries(rows, cols, blocks):
@@ -114,15 +115,15 @@ def internal(bars: Bars, cables: list[Cable], u: np.ndarray, n_nodes: int, *,
     rows: list[np.ndarray] = []
     cols: list[np.ndarray] = []
     vals: list[np.ndarray] = []
-    _, force, tangent, d, l = bar_state(bars, u)
+    _, force, tangent, d, length = bar_state(bars, u)
     taut = force > 0
-    n = d / l[:, None]
+    n = d / length[:, None]
     fn = force[:, None] * n
     np.add.at(g, bars.i, -fn)
     np.add.at(g, bars.j, fn)
     if with_tangent and taut.any():
         nn = np.einsum("ki,kj->kij", n[taut], n[taut])
-        geo = (force[taut] / l[taut])[:, None, None]
+        geo = (force[taut] / length[taut])[:, None, None]
         mat = (tangent[taut] / bars.rest[taut])[:, None, None]
         k = geo * (np.eye(3)[None] - nn) + mat * nn
         i, j = bars.i[taut], bars.j[taut]

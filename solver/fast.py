@@ -65,21 +65,18 @@ MU_RETRIES = 6  # ... at most this many times in one iteration
 NONMONOTONE = 5  # Armijo against the highest potential of the last 5 Newton states
 CHORD_RATE = 0.5  # a chord step is kept when it at least halves the out-of-balance force
 CHORD_MIN_DOFS = 10_000  # below, a factorization costs less than the trial state a chord step
-# needs (1:40 verification nets, ~1000 unknowns: 0.7 ms against 1-2 ms), so no chord steps
+# needs, so no chord steps (benchmarks/measurements.md#fast-chord-and-repass)
 START_SPAN = (-6.0, 0.0)  # log10 of the membrane start's largest displacement / net extent
 START_GRID = 13  # potentials sampled over START_SPAN before the scalar minimisation
 START_XTOL = 0.01  # log10 resolution of the membrane start's scale
 # backends whose re-passes are GMRES on the first pass's factorization: a triangular solve of
 # qdldl's LDL^T costs ~1/10 of its factorization; PARDISO refactorizes cheaper than the 5-10
-# preconditioned iterations (241 x 81 at tol 1e-6, 1 thread: 5.0-5.4 s wall by GMRES, 2.6 s
-# refactorizing), and so does the "ldl" backend once it has switched to PARDISO along a load
-# path (`_repass_by_gmres`; simple barrier 1:40, the band's slack-1 % variant, its 529 re-
-# passes 9.4 preconditioned iterations each on average: CPU 4.54-5.50 -> 3.88-4.97 s back to
-# back, 764 -> 757 iterations; the nominal model sweep 1.16 -> 1.07 s, 187 -> 185)
+# preconditioned iterations, and so does the "ldl" backend once it has switched to PARDISO
+# along a load path (`_repass_by_gmres`; benchmarks/measurements.md#fast-chord-and-repass)
 REPASS_BY_GMRES = ("ldl",)
 PDAS_PASSES = 1  # active-set re-solves per Newton step at most, each by GMRES on the first
-# pass's factorization (simple barrier 1:40, worst level of the model / prototype sweeps: 1 pass
-# 39 / 44 iterations, 3 passes 35 / 50, 6 passes 32 / 47 at 1.3-1.8 x the CPU of 1 pass)
+# pass's factorization: more passes save few Newton iterations for much more CPU
+# (benchmarks/measurements.md#fast-chord-and-repass)
 
 
 class Stepper:
@@ -155,6 +152,7 @@ def _newton_step(ns: NetSystem, st: State, stepper: Stepper, reference: float):
         for step in (first, fact.symmetric_solve(rhs)):
             found = None if step is None else _line_search(ns, st, step, reference)
             if found is not None:
+                assert stepper.active is not None  # _active_set_step has just set it
                 stepper.predicted = _predicted_tensions(ns, st, stepper.active, step, found[1],
                                                         stepper.predicted)
                 return fact, found
@@ -166,24 +164,26 @@ def _active_set_step(ns: NetSystem, st: State, stepper: Stepper, boost: float, f
     quadratic model in which a slack strand pulls once the step's linearised strain
     eps + B s turns positive; the set of such strands is iterated to a fixed point
     (primal-dual active set), at most PDAS_PASSES times, from the last step's set."""
-    eps, force, tangent, d, l = st.bar
+    eps, force, tangent, d, length = st.bar
     b = ns.bars
     slack = force <= 0
-    nvec = d / l[:, None]
+    nvec = d / length[:, None]
     active = np.zeros_like(slack)
     if stepper.active is not None:
         active = slack & stepper.active
-    fact = step = rhs = None
+    fact: Factorization | Updated | None = None
+    step = rhs = None
     new = active
     geometric = force if stepper.predicted is None else stepper.predicted
     for _ in range(PDAS_PASSES + 1):
         tan = np.where(active, ns.first_slope, tangent)
-        at = dataclasses.replace(st, bar=(eps, geometric, tan, d, l))
+        at = dataclasses.replace(st, bar=(eps, geometric, tan, d, length))
+        trial: Factorization | Updated
         if fact is None or not _repass_by_gmres(stepper):
             trial = stepper.newton(at, boost)
         else:
-            trial = Updated(ns.pattern.csr(stepper.matrix(at, boost)), getattr(fact, "base", fact),
-                            stepper)
+            base = fact.base if isinstance(fact, Updated) else fact
+            trial = Updated(ns.pattern.csr(stepper.matrix(at, boost)), base, stepper)
         off = ns.incidence @ (np.where(active, ns.first_slope * eps, 0.0)[:, None] * nvec)
         new_rhs = -st.r - off.ravel()[ns.free]
         new_step = trial.solve(new_rhs, forcing)
@@ -214,10 +214,10 @@ def _predicted_tensions(ns: NetSystem, st: State, pulls: np.ndarray, step: np.nd
     point Newton, Magisano, Leonetti & Garcea 2017): the last prediction moved by alpha
     towards the linearised law's tension at the full step, floored at zero (tension only);
     `pulls`: the slack strands the step stretches (`Stepper.active`)."""
-    eps, force, tangent, d, l = st.bar
+    eps, force, tangent, d, length = st.bar
     b = ns.bars
     du = _moved(ns, np.zeros_like(st.u), step)
-    de = np.einsum("ij,ij->i", d / l[:, None], du[b.j] - du[b.i]) / b.rest
+    de = np.einsum("ij,ij->i", d / length[:, None], du[b.j] - du[b.i]) / b.rest
     model = np.where(force > 0, force + tangent * de, np.where(pulls, ns.first_slope * (eps + de),
                                                                0.0))
     base = force if last is None else last

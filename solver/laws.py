@@ -67,12 +67,14 @@ class Law:
         if not self.knees:
             return s[0] * e, np.where(eps > 0, s[0], 0.0), 0.5 * s[0] * e * e
         force = energy = None
-        for i, (lo, width, before) in enumerate(zip(self._lo, self._width, self._before)):
+        segments = zip(self._lo, self._width, self._before, strict=True)
+        for i, (lo, width, before) in enumerate(segments):
             seg = e if i == 0 else np.maximum(e - lo, 0.0)
             if i < len(self.knees):
                 seg = np.minimum(seg, width)
             f, w = seg * s[i], (s[i] * 0.5) * (seg * seg) + before * seg
             force, energy = (f, w) if force is None else (force + f, energy + w)
+        assert force is not None and energy is not None  # knees: the loop ran at least once
         tangent = s[np.searchsorted(self._knees, e, side="right")]
         return force, np.where(eps > 0, tangent, 0.0), energy
 

@@ -39,36 +39,25 @@ from solver.pattern import Pattern
 LINEAR_RTOL = 1e-13  # backward error a solve must reach: |b - A x| <= tol (|A| |x| + |b|)
 GMRES_RTOL = 1e-14  # GMRES stops at this relative 2-norm residual at the latest
 GMRES_RESTART = 30  # GMRES iterations (one restart cycle) before falling back to SuperLU
-PARDISO_MIN_DOFS = 5_000  # from here on PARDISO's Cholesky of S beats qdldl's LDL^T (simple
-# scene with 0.3 / 0.25 / 0.18 / 0.15 / 0.12 / 0.1 m meshes, 1 thread, whole solve at tol 1e-6,
-# CPU, best of 3, qdldl against PARDISO with its minimum-degree ordering: 1.4k unknowns 0.031-
-# 0.042 / 0.037-0.040 s, 2.1k 0.044 / 0.045 s, 4.2k 0.10-0.15 / 0.12-0.13 s, 6.2k 0.25 / 0.20 s,
-# 9.5k 0.48 / 0.36 s, 14k 0.77-0.86 / 0.48 s; was 6500 with METIS)
+PARDISO_MIN_DOFS = 5_000  # from here on PARDISO's Cholesky of S beats qdldl's LDL^T (whole
+# solves of the simple scene, 1 thread: benchmarks/measurements.md#linsolve-pardiso-min-dofs)
 PARDISO_IPARM = {1: 1, 2: 0, 8: 0, 10: 13, 11: 0, 13: 0, 21: 1}  # MKL's iparm (1-based):
 # own settings, minimum-degree ordering, no refinement, pivot perturbation 1e-13, no scaling
 # or matching, Bunch-Kaufman pivots (mtype -2); everything else MKL's zero default.
 # Minimum degree (iparm 2 = 0), not METIS nested dissection (2), on these grid nets, 1 thread:
-# fewer flops in the factor (14k / 57k / 228k unknowns: 72 / 729 / 6825 Mflop against 116 /
-# 900 / 7900), half the analysis (20 / 89 / 363 ms against 45 / 185 / 852 ms); whole solve
-# at tol 1e-6 (simple-pinned, CPU, best of 3): 0.47 / 2.59 / 20.6 s against 0.58 / 2.88 /
-# 21.5 s. Measured at 57k and not chosen: parallel METIS (3) and two-level factorization
-# (iparm 24) no faster on 1 thread, VBSR (37) 1.5x slower, MKL's low-rank update (39) no
-# faster for mtype 2, single precision (28) a 20 % faster factor but 5 digits (2 more solves)
+# fewer flops in the factor and half the analysis; the other settings tried (parallel METIS,
+# two-level factorization, VBSR, low-rank update, single precision) were no faster or lost
+# digits (benchmarks/measurements.md#linsolve-pardiso-ordering)
 
 LDL_TO_PARDISO = 8  # a small net's first 8 factorizations are qdldl's, the later PARDISO's:
-# a single solve (61 x 21: 5 factorizations) keeps qdldl and loads no MKL, a load path (23
-# levels, 190-800 factorizations) pays PARDISO's import (0.45 s CPU once per process) and
-# analysis. CPU per factorization, 1 thread, qdldl / PARDISO: simple barrier's model net at
-# 1:40 (3540 unknowns) 3.2-5.7 / 1.9-3.0 ms, first 6-9 / 6-8 ms; 1:40 example's (1023)
-# 1.3-1.7 / 0.7-0.9 ms; triangular solves 0.23-0.38 / 0.19-0.38 ms
-LDL_PARDISO_MIN_DOFS = 2000  # below, a factorization costs too little for the switch to pay:
-# CPU with / without the switch (qdldl throughout), best of 3, load paths 0 to 1.1 by 0.05 on
-# simple-pinned: 783 unknowns 0.067 / 0.057 s, 1404 0.104 / 0.107-0.123 s, 2115 0.165 /
-# 0.159 s, 2703 0.319 / 0.359 s, 3363 0.224-0.243 / 0.257-0.264 s; the design search's
-# verification of the 1:40 example (978-1550 unknowns, sliding cables) 0.40-0.56 / 0.39-0.43 s
-# per design; and the switch's import of MKL costs 0.45 s of CPU once per process
-LDL_PARDISO_THREADS = 1  # MKL threads of those factorizations and solves: on 3540 unknowns
-# MKL's default (one per core, 2 here) took 24-75 ms of CPU per factorization, not 2-3
+# a single solve (a few factorizations) keeps qdldl and loads no MKL, a load path (hundreds)
+# pays PARDISO's import and analysis once and factorizes faster after
+# (benchmarks/measurements.md#linsolve-ldl-to-pardiso)
+LDL_PARDISO_MIN_DOFS = 2000  # below, a factorization costs too little for the switch to pay
+# back MKL's import (benchmarks/measurements.md#linsolve-ldl-pardiso-min-dofs)
+LDL_PARDISO_THREADS = 1  # MKL threads of those factorizations and solves: MKL's default (one
+# per core) costs ten times the CPU per factorization or more
+# (benchmarks/measurements.md#linsolve-threads)
 
 PHASES = {11: "analysis", 22: "factorization", 33: "solve"}  # MKL's phases, as Pardiso counts
 

@@ -86,7 +86,7 @@ class Pattern:
         n = n_nodes
         p_parts, q_parts, kinds = _node_slots(bar_i, bar_j, cable_nodes, n)
         keys = np.concatenate([p.ravel().astype(np.int64) * n + q.ravel()
-                               for p, q in zip(p_parts, q_parts)])
+                               for p, q in zip(p_parts, q_parts, strict=True)])
         node_keys, inverse = np.unique(keys, return_inverse=True)
         erow, ecol = node_keys // n, node_keys % n
         fmask = free.reshape(n, 3)
@@ -107,7 +107,7 @@ class Pattern:
         row_at = np.where(fmask, self.indptr[:-1][np.maximum(index, 0)].reshape(n, 3), 0)
         col_at, col_free = offset[:, None] + rank.reshape(n, 3)[ecol], fmask[ecol]
         keep, slot, at = [], [], 0
-        for p, kind in zip(p_parts, kinds):
+        for p, kind in zip(p_parts, kinds, strict=True):
             k, pos = _positions(kind, p, inverse[at:at + p.size].reshape(p.shape), row_at,
                                 fmask, col_at, col_free)
             keep.append(k)

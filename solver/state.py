@@ -22,7 +22,7 @@ from solver.loads import total_forces
 from solver.model import Net
 from solver.pattern import SYM_PAIRS, Pattern, pair_values
 
-_SYM_A, _SYM_B = (np.array(x) for x in zip(*SYM_PAIRS))
+_SYM_A, _SYM_B = (np.array(x) for x in zip(*SYM_PAIRS, strict=True))
 _SYM_DIAGONAL = np.flatnonzero(_SYM_A == _SYM_B)
 
 
@@ -69,7 +69,7 @@ class NetSystem:
         n, fixed = self.n, self.net.fixed_dofs
         edges = [(self.bars.i, self.bars.j, 1.0 / self.bars.rest)]
         edges += [(c.nodes[:-1], c.nodes[1:], 1.0 / c.l0) for c in self.cables]
-        i, j, w = (np.concatenate(x) for x in zip(*edges))
+        i, j, w = (np.concatenate(x) for x in zip(*edges, strict=True))
         full = np.zeros(3 * n)
         full[self.free] = b
         rhs, out = full.reshape(n, 3), np.zeros((n, 3))
@@ -180,11 +180,11 @@ class CableSet:
         """(cable strains (c,), unit vectors (s, 3), lengths (s,)) of every segment."""
         du = u[self.b] - u[self.a]
         d = self.d0 + du
-        l = np.sqrt(np.einsum("ij,ij->i", d, d))
+        length = np.sqrt(np.einsum("ij,ij->i", d, d))
         stretch = (2 * np.einsum("ij,ij->i", self.d0, du) + np.einsum("ij,ij->i", du, du)) / (
-            l + self.l0)
+            length + self.l0)
         eps = (np.bincount(self.owner, stretch, self.count) + self.l0_sum - self.rest) / self.rest
-        return eps, d / l[:, None], l
+        return eps, d / length[:, None], length
 
     def laws_at(self, eps: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(tension, tangent, energy per rest length) of each cable at its strain (one law
@@ -219,18 +219,18 @@ def _strains(b: Bars, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray
     times quicker than fancy indexing)."""
     du = np.take(u, b.j, axis=0) - np.take(u, b.i, axis=0)
     d = b.d0 + du
-    l = np.sqrt(np.einsum("ij,ij->i", d, d))
+    length = np.sqrt(np.einsum("ij,ij->i", d, d))
     d0_du = b.d0[:, 0] * du[:, 0] + b.d0[:, 1] * du[:, 1] + b.d0[:, 2] * du[:, 2]
     dl2 = b.c + 2 * d0_du + np.einsum("ij,ij->i", du, du)
-    return dl2 / (b.rest * (l + b.rest)), d, l
+    return dl2 / (b.rest * (length + b.rest)), d, length
 
 
 def evaluate(ns: NetSystem, u: np.ndarray) -> State:
     """Forces, energy and strand states at u, in one pass over the strands."""
     b = ns.bars
-    eps, d, l = _strains(b, u)
+    eps, d, length = _strains(b, u)
     force, tangent, energy = strand_laws(b, eps)
-    g = ns.incidence @ ((force / l)[:, None] * d)
+    g = ns.incidence @ ((force / length)[:, None] * d)
     scales = [float(force.max()) if force.size else 0.0]
     cab: tuple = ()
     cs = ns.cable_set
@@ -247,7 +247,7 @@ def evaluate(ns: NetSystem, u: np.ndarray) -> State:
     r = (g - f).ravel()[ns.free]
     scales.append(float(np.abs(f).max()) if f.size else 0.0)
     return State(u, r, float(np.abs(r).max()) if r.size else 0.0, max(max(scales), 1e-300),
-                 energy, f, dz, (eps, force, tangent, d, l), cab)
+                 energy, f, dz, (eps, force, tangent, d, length), cab)
 
 
 def ray_potential(ns: NetSystem, u: np.ndarray, w: np.ndarray, f_frozen: np.ndarray
@@ -279,9 +279,9 @@ def ray_potential(ns: NetSystem, u: np.ndarray, w: np.ndarray, f_frozen: np.ndar
 
 def tangent_values(ns: NetSystem, st: State) -> np.ndarray:
     """CSR data of the tangent K - dF_ext/du at a state (the pattern's slot order)."""
-    _, force, tangent, d, l = st.bar
-    n = d / l[:, None]
-    geo = np.where(force > 0, force / l, 0.0)
+    _, force, tangent, d, length = st.bar
+    n = d / length[:, None]
+    geo = np.where(force > 0, force / length, 0.0)
     # geo (I - n n^T) + mat n n^T, by the upper triangle of each strand's block
     upper = (tangent / ns.bars.rest - geo)[:, None] * (n[:, _SYM_A] * n[:, _SYM_B])
     upper[:, _SYM_DIAGONAL] += geo[:, None]

@@ -1,7 +1,9 @@
-"""Shared fixtures: paths, and the slicer requirement (CI fails instead of skipping)."""
+"""Shared fixtures: paths, the slicer requirement (CI fails instead of skipping), the whole runs
+shared by the xdist workers, and the `slow` mark of the tests that read them."""
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import pickle
 import shutil
@@ -81,6 +83,36 @@ def design_1_40():
     return reference_design_1_40()
 
 
+def coarse_design_1_40(coarser: float):
+    """The reference 1:40 design with its net's mesh `coarser` times coarser each way: the
+    same scene on fewer nodes, for fast sweeps."""
+    d = reference_design_1_40()
+    n = d.net
+    return dataclasses.replace(d, net=dataclasses.replace(
+        n, mesh_x_mm=n.mesh_x_mm * coarser, mesh_y_mm=n.mesh_y_mm * coarser))
+
+
+def planned(path: Path, scale: float = 40):
+    """(prototype, design) of a prototype file at 1:scale: similitude, selection and the
+    design, as `make` plans them."""
+    from printgen.design.plan import make_design
+    from printgen.design.selection import select
+    from printgen.design.similitude import scale_targets
+    from printgen.inputs.prototype import load_prototype
+
+    p = load_prototype(path)
+    t = scale_targets(p, scale)
+    return p, make_design(p, t, select(p, t))
+
+
+def coarse_simple_file(folder: Path) -> Path:
+    """examples/simple_barrier.toml on a mesh twice as coarse (COARSE_SIMPLE), written in
+    `folder`: the same scene on fewer nodes."""
+    from proto_files import SIMPLE, write_variant
+
+    return write_variant(folder, COARSE_SIMPLE, base=SIMPLE)
+
+
 SHARED_RUN_WAIT_S = 3600.0  # a whole make on a machine loaded many times over, with slack
 POLL_S = 0.2
 
@@ -155,12 +187,10 @@ def made_simple_drag(tmp_path_factory):
 
 
 def _make_simple_drag(tmp: Path):
-    from proto_files import SIMPLE, write_variant
-
     import printgen.run.make as make_mod
     from printgen.run import api
 
-    path = write_variant(tmp, COARSE_SIMPLE, base=SIMPLE)
+    path = coarse_simple_file(tmp)
     verify_only = [s for s in make_mod.default_steps() if s[1] is make_mod.verify_step]
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("PRINTGEN_SERIAL", "1")
@@ -168,6 +198,18 @@ def _make_simple_drag(tmp: Path):
         mp.setattr(make_mod, "default_steps", lambda: verify_only)
         ctx = api.make(path, 40, tmp / "out", drag=True)
     return ctx, tmp / "out", path
+
+
+# A test that reads one of these whole runs is a whole-pipeline test: `slow`, whatever its own
+# duration (the first to ask pays for the run).
+WHOLE_RUN_FIXTURES = {"made_1_40", "made_simple_drag"}
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Mark `slow` every test that uses a whole run (`pytest -m "not slow"`: CONTRIBUTING.md)."""
+    for item in items:
+        if WHOLE_RUN_FIXTURES & set(getattr(item, "fixturenames", ())):
+            item.add_marker(pytest.mark.slow)
 
 
 def alive(pid: int) -> bool:

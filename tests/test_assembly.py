@@ -84,6 +84,7 @@ def test_the_checklist_gives_the_kit_numbers(kit):
     assert f"{a.net_size_mm[0]:.1f} mm" in text
 
 
+@pytest.mark.slow
 def test_make_shows_the_kit_and_the_toolpath_previews(made_1_40):
     """The kit step (of the session's 1:40 run) writes the labelled assembly picture and
     per-pass previews into the output and the report, with the checklist and the closing

@@ -131,6 +131,7 @@ def _deferred_in_thread() -> bool:
         return True
 
 
+@pytest.mark.slow
 @two_cores
 def test_verification_in_the_helper_equals_the_verification_step(made_simple_drag, tmp_path,
                                                                   monkeypatch):

@@ -7,7 +7,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from conftest import reference_design_1_40
+from conftest import coarse_design_1_40, reference_design_1_40
 
 from printgen.design.record import Section
 from printgen.scene import SceneOptions, build_scene
@@ -24,15 +24,10 @@ ROUND = 1e-12  # round-off allowed between a curve and the band's edge
 LEVELS_V = np.linspace(0.0, 1.1, 12)
 
 
-def coarse_design():
-    d = reference_design_1_40()
-    n = d.net
-    return dataclasses.replace(d, net=dataclasses.replace(
-        n, mesh_x_mm=n.mesh_x_mm * COARSE, mesh_y_mm=n.mesh_y_mm * COARSE))
 
-
+@pytest.mark.slow
 def test_band_contains_the_nominal_and_every_variant():
-    d = coarse_design()
+    d = coarse_design_1_40(COARSE)
     nominal = run_variant(d, Variant(), LEVELS)
     variants = [Variant("softer net", options=SceneOptions(net_factor=0.7, frame_factor=0.7)),
                 Variant("stiffer cables", options=SceneOptions(cable_factor=1.3))]
@@ -50,7 +45,7 @@ def test_band_contains_the_nominal_and_every_variant():
 
 
 def test_refinement_test_keeps_the_design_net_when_coarsening_changes_the_answer(monkeypatch):
-    d = coarse_design()
+    d = coarse_design_1_40(COARSE)
     nominal = bands.curves(run_variant(d, Variant(), LEVELS))
     k, change = refinement_test(d, nominal, LEVELS)
     assert list(change) == [2]  # a failing x2 stops the test: x3 is not run
@@ -61,7 +56,7 @@ def test_refinement_test_keeps_the_design_net_when_coarsening_changes_the_answer
 
 
 def test_coarse_variant_scene_keeps_membrane_stiffness():
-    d = coarse_design()
+    d = coarse_design_1_40(COARSE)
     fine, coarse = build_scene(d), build_scene(d, SceneOptions(coarsen=2))
     assert len(coarse.nodes) < len(fine.nodes)
     assert coarse.laws[0].slopes[0] == pytest.approx(2 * fine.laws[0].slopes[0], rel=ROUND)

@@ -97,6 +97,7 @@ def probe_of(run: subprocess.CompletedProcess) -> dict:
     return json.loads(m.group(1).replace("&quot;", '"').replace("&amp;", "&"))
 
 
+@pytest.mark.slow
 def test_report_renders_with_every_image_and_no_errors(report, tmp_path):
     exe = require_tool("chromium")
     html = report.read_text()
@@ -111,6 +112,7 @@ def test_report_renders_with_every_image_and_no_errors(report, tmp_path):
     assert console == [], console
 
 
+@pytest.mark.slow
 def test_screenshot_is_kept_as_an_artifact(report, tmp_path):
     exe = require_tool("chromium")
     ARTIFACTS.mkdir(exist_ok=True)
@@ -123,6 +125,7 @@ def test_screenshot_is_kept_as_an_artifact(report, tmp_path):
     assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > MIN_SCREENSHOT_BYTES
 
 
+@pytest.mark.slow
 def test_the_probe_sees_a_broken_image_and_an_error(tmp_path):
     """The check above can fail: a missing image file and a script error are both caught."""
     exe = require_tool("chromium")
@@ -157,6 +160,7 @@ FILE_REF = re.compile(r"\b[\w.-]+\.(?:md|csv|json|gcode|toml|png|svg|ini|cfg|3mf
                       r"|html)\b")
 
 
+@pytest.mark.slow
 def test_summary_box_is_in_the_first_screen(report, tmp_path):
     exe = require_tool("chromium")
     probed = tmp_path / "box.html"
@@ -212,6 +216,7 @@ def test_no_reference_to_a_file_the_package_lacks(made):
         assert name in shipped, name
 
 
+@pytest.mark.slow
 def test_report_pdf_has_pages_and_text(printed):
     require_tool("chromium")
     pypdf = pytest.importorskip("pypdf")
@@ -223,6 +228,7 @@ def test_report_pdf_has_pages_and_text(printed):
     assert "Summary" in first and "FAIL" in first
 
 
+@pytest.mark.slow
 def test_make_pdf_writes_report_pdf_into_the_folder_and_its_manifest(tmp_path):
     """`make` with options.pdf runs that step and lists report.pdf (targets, selection and
     design only: the PDF step does not depend on the other steps' files)."""

@@ -36,7 +36,7 @@ def within(predicted: float, counted: float) -> bool:
 
 
 def test_the_estimate_sweeps_the_levels_verify_solves():
-    assert LEVELS == len(verify_mod.levels())
+    assert len(verify_mod.levels()) == LEVELS
 
 
 def test_predicted_work_of_the_1_40_example_is_the_counted_work(made_1_40):
@@ -84,6 +84,7 @@ def _verification_inline(monkeypatch):
     monkeypatch.setattr(make_mod, "default_steps", lambda: VERIFY_ONLY)
 
 
+@pytest.mark.slow
 def test_make_with_an_unconverged_level_writes_everything_and_exits_3(tmp_path, monkeypatch,
                                                                        capsys):
     """Through the command line: the level is listed in report.json and the report, left out
@@ -119,6 +120,7 @@ def test_time_limit_stops_the_verification_mid_sweep(tmp_path, monkeypatch, caps
     assert "Raise it with --time-limit" in err and not out.exists()
 
 
+@pytest.mark.slow
 def test_time_limit_stops_the_helper_process_run(tmp_path, monkeypatch):
     """The default make (parts here, the verification in a helper process beside them): past
     the limit it stops in the step it is in and the helper's work is dropped; nothing written."""
@@ -131,10 +133,11 @@ def test_time_limit_stops_the_helper_process_run(tmp_path, monkeypatch):
     assert not out.exists() and list(tmp_path.iterdir()) == []
 
 
-PETG30 = ROOT / "tests" / "data" / "issue28"  # issue 28's file and its 500 mm bed printer
+PETG30 = ROOT / "tests" / "data" / "petg-1-30"  # a PETG barrier at 1:30, its 500 mm bed printer
 HELPER_LIMIT_S = 6.0  # the helper is well into its sweeps' worker pools by then
 
 
+@pytest.mark.slow
 def test_time_limit_stop_is_one_line_on_stderr(tmp_path):
     """The whole process's stderr (the CLI in a subprocess, issue 28's PETG barrier at 1:30,
     estimated within the limit by a bypass, its verification step only): the helper, killed

@@ -94,6 +94,7 @@ def test_iso_window_past_the_knee_warns_with_both_values(stiff_set):
     assert cal.window_summary.endswith("in 0 of 3 files (see the warnings)")
 
 
+@pytest.mark.slow
 def test_auto_window_agrees_and_says_so(stiff_set, capsys):
     cal = calibrate(stiff_set, material="cf", options=FitOptions(window=None))
     assert_allclose([s.modulus for s in cal.samples], [E1 * f for f in SCATTER], rtol=AUTO_RTOL)

@@ -62,6 +62,7 @@ def _cal(paths, **kw):
     return calibrate(paths, material="synthetic", specimen=spec, **kw)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("variant", sorted(VARIANTS))
 def test_linear_law_every_variant(tmp_path, variant):
     eps = np.linspace(0, STRAIN_MAX, N_POINTS)
@@ -85,6 +86,7 @@ def test_bilinear_law_every_variant(tmp_path, variant):
     assert_allclose(cal.modulus.mean, e1, rtol=RECOVERY_RTOL)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("variant", sorted(VARIANTS))
 def test_toe_region_zeroed_at_preload(tmp_path, variant):
     """Slack toe: quadratic up to 2 e_t, then E (e - e_t); zeroing at a preload past the toe
@@ -100,6 +102,7 @@ def test_toe_region_zeroed_at_preload(tmp_path, variant):
     assert abs(no_preload / E - 1) > UNCORRECTED_MIN_ERROR  # the toe biases an unzeroed fit
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("variant", sorted(VARIANTS))
 def test_constant_machine_stiffness_corrected(tmp_path, variant):
     k = 2000e3  # N/m (2000 N/mm); the specimen's own E A / L is 80 N/mm
@@ -111,6 +114,7 @@ def test_constant_machine_stiffness_corrected(tmp_path, variant):
     assert _cal([p]).modulus.mean < E * (1 - UNCORRECTED_MIN_ERROR)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("variant", sorted(VARIANTS))
 def test_measured_compliance_curve_subtracted_point_by_point(tmp_path, variant):
     """Nonlinear system compliance (seating then stiffening), measured on a rigid bar."""
@@ -145,6 +149,7 @@ def test_tpe_panel_law_recovered(tmp_path, variant):
     assert_allclose(cal.samples[0].kappa, k1, rtol=RECOVERY_RTOL)
 
 
+@pytest.mark.slow
 def test_stats_over_samples_and_outlier_flag(tmp_path):
     """Five specimens: mean and sample SD of the fitted moduli; a sixth, 30 % stiffer, flagged."""
     moduli = E * np.array([0.97, 1.0, 1.02, 0.99, 1.01, 1.3])

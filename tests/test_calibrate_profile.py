@@ -100,6 +100,7 @@ def test_panel_law_profile_round_trip(tmp_path, monkeypatch):
                     rtol=FIT_RTOL)
 
 
+@pytest.mark.slow
 def test_cli_end_to_end(tmp_path, cable_files, capsys, monkeypatch):
     out = tmp_path / "prof"
     args = ["calibrate", *map(str, cable_files), "--material", "petg-lab", "--width-mm", "2",

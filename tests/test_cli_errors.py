@@ -51,6 +51,7 @@ def test_out_under_a_file(capsys, tmp_path):
     assert code == 2 and f"{f} is a file" in one_line(err)
 
 
+@pytest.mark.slow
 def test_out_under_proc(capsys):
     code, _, err = run(capsys, *make_args("/proc/printgen-test-out"))
     assert code in (1, 2) and "/proc/" in one_line(err)
@@ -62,6 +63,7 @@ def test_out_in_a_foreign_folder_needs_force(capsys, tmp_path):
     assert code == 2 and "--force" in one_line(err) and (tmp_path / "data.csv").exists()
 
 
+@pytest.mark.slow
 def test_second_make_into_a_busy_folder_names_the_pid(capsys, tmp_path):
     import subprocess
     import sys
@@ -167,6 +169,7 @@ def test_readme_documents_every_prototype_range():
     assert ranges_markdown() in readme, "README's ranges table differs from ranges_markdown()"
 
 
+@pytest.mark.slow
 def test_check_command(capsys, tmp_path):
     out = tmp_path / "out"
     make_mod.make(SIMPLE, 40, out, steps=[s for s in make_mod.default_steps()
@@ -208,8 +211,8 @@ TOML_CASES = {
                                "must be >= 0.5 mm"),
     "froude_min > froude_max": (BASE_TEXT.replace("froude_min = 0.5", "froude_min = 2.0"),
                                 "froude_min = 2 is above froude_max = 1.4"),
-    "control characters in the name": (BASE_TEXT.replace('name = "Realistic', 'name = "\\u001b[31m'),
-                                       "control character U+001B"),
+    "control characters in the name": (
+        BASE_TEXT.replace('name = "Realistic', 'name = "\\u001b[31m'), "control character U+001B"),
 }
 
 
@@ -241,6 +244,7 @@ DESIGN_CASES = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", sorted(DESIGN_CASES))
 def test_bad_design_files_are_one_line_exit_2(capsys, tmp_path, case):
     edit, message = DESIGN_CASES[case]

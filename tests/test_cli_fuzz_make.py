@@ -73,6 +73,7 @@ def quick_make(monkeypatch):
     monkeypatch.setattr(make_mod, "default_steps", fast_steps)
 
 
+@pytest.mark.slow
 @settings(max_examples=EXAMPLES, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 @given(case=PROTOTYPES)
@@ -96,6 +97,7 @@ def test_make_succeeds_or_says_why_in_one_line(quick_make, tmp_path_factory, cap
         assert check_folder(out) == []
 
 
+@pytest.mark.slow
 def test_one_small_make_with_gcode(monkeypatch, tmp_path, capsys):
     """After the fuzz's input stages, one small make through the command line with the
     G-code step too (the realistic barrier at 1:100, its smallest net)."""

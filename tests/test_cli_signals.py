@@ -4,6 +4,7 @@ next run removes what a SIGKILL left behind."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -11,6 +12,7 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
 from proto_files import REALISTIC, SIMPLE
 
 import printgen.run.make as make_mod
@@ -25,10 +27,8 @@ EXIT_S = 30.0  # the killed make returns well within this (it kills its workers 
 def children(pid: int) -> list[int]:
     out = []
     for task in Path(f"/proc/{pid}/task").glob("*"):
-        try:
+        with contextlib.suppress(OSError):
             out += [int(c) for c in (task / "children").read_text().split()]
-        except OSError:
-            pass
     return out
 
 
@@ -69,6 +69,7 @@ def start_and_wait_for_workers(out: Path) -> subprocess.Popen:
     return proc
 
 
+@pytest.mark.slow
 def test_kills_during_verification_leave_nothing_behind(tmp_path):
     if (os.cpu_count() or 1) < 2 or os.environ.get("PRINTGEN_SERIAL"):
         import pytest

@@ -10,6 +10,7 @@ from conftest import EXAMPLES
 SCRIPTS = sorted(p for p in EXAMPLES.glob("*.py"))
 
 
+@pytest.mark.slow  # each example runs its whole pipeline
 @pytest.mark.parametrize("path", SCRIPTS, ids=[p.stem for p in SCRIPTS])
 def test_example_runs(path):
     spec = importlib.util.spec_from_file_location(path.stem, path)

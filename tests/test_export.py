@@ -107,7 +107,8 @@ def test_a_part_larger_than_the_bed_is_rejected_before_writing(cables, printer, 
     long = dataclasses.replace(cables[0], length_mm=600.0)
     out = tmp_path / "long.3mf"
     with pytest.raises(PrintabilityError, match=r"part 606\.0 x 6\.0 mm does not fit the usable "
-                       r"340 x 340 mm .* not even turned diagonally .* larger bed .* larger lambda"):
+                       r"340 x 340 mm .* not even turned diagonally .* larger bed "
+                       r".* larger lambda"):
         write_plate(out, [("cable-long", cable_solid(long))], printer)
     assert not out.exists() and not list(tmp_path.iterdir())
 
@@ -224,6 +225,7 @@ def test_a_bad_net_fails_before_any_export(tmp_path):
     assert not list(tmp_path.iterdir())
 
 
+@pytest.mark.slow
 def test_prusaslicer_slices_the_cable_plate_alone_with_its_settings(plate, tmp_path):
     """slicers.md, section 8: the 3MF carries its settings (here PETG at 240/80 degC)."""
     exe = require_tool("prusa-slicer")
@@ -245,6 +247,7 @@ def test_prusaslicer_slices_the_cable_plate_alone_with_its_settings(plate, tmp_p
         assert f"; printing object {p.name}" in text, p.name
 
 
+@pytest.mark.slow
 def test_prusaslicer_slices_the_net_with_its_loops_and_eyelets_from_its_3mf(tmp_path):
     """The 1:40 net with its loops and corner eyelets (335.4 mm wide with its corner rings:
     turned on the 340 mm usable bed) slices alone with its TPE settings."""

@@ -3,11 +3,9 @@ from a known parameter set is recovered, and a curve no parameter set can produc
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import pytest
-from conftest import reference_design_1_40
+from conftest import coarse_design_1_40
 
 from printgen.scene.forms import slackened
 from printgen.verification.fit import BOUNDS, Params, at_bounds, fit_measured, predict
@@ -21,12 +19,6 @@ RECOVER = 0.05  # issue 25: known parameters recovered within 5 %
 ROUND = 1e-12
 
 
-def coarse_design():
-    d = reference_design_1_40()
-    n = d.net
-    return dataclasses.replace(d, net=dataclasses.replace(
-        n, mesh_x_mm=n.mesh_x_mm * COARSE, mesh_y_mm=n.mesh_y_mm * COARSE))
-
 
 def measurement(values: dict[str, np.ndarray]) -> Measurement:
     return Measurement("synthetic", MEASURED, values, {k: k for k in values})
@@ -39,8 +31,9 @@ def test_slack_is_a_flat_first_segment():
     assert slopes[1:] == (100.0, 10.0) and slopes[0] < 1e-3 * slopes[1]
 
 
+@pytest.mark.slow
 def test_a_synthetic_measurement_is_recovered():
-    d = coarse_design()
+    d = coarse_design_1_40(COARSE)
     known = Params(net_factor=0.5, net_slack=0.01)
     probe = Measurement("probe", MEASURED, {k: np.zeros(3) for k in
                                             ("strain_bottom", "strain_top", "strain_mid")},
@@ -54,9 +47,10 @@ def test_a_synthetic_measurement_is_recovered():
     assert max(mm.rms_rel for mm in fit.after) < max(mm.rms_rel for mm in fit.before)
 
 
+@pytest.mark.slow
 def test_an_impossible_curve_is_refused():
     """Mid-height 40 % at half loading while the top cable shortens: no net does that."""
-    d = coarse_design()
+    d = coarse_design_1_40(COARSE)
     m = measurement({"strain_mid": np.array([0.40, 0.41, 0.42]),
                      "strain_top": np.array([-0.05, -0.05, -0.05])})
     fit = fit_measured(d, m, LEVELS, choices=[("walls", None, None)])
@@ -64,9 +58,10 @@ def test_an_impossible_curve_is_refused():
     assert "NOT explained" in fit.sentence()
 
 
+@pytest.mark.slow
 def test_a_bed_choice_is_fitted_and_recorded():
     """The bed is a discrete choice (issue 25): a 3-tuple choice means the free bed."""
-    d = coarse_design()
+    d = coarse_design_1_40(COARSE)
     m = measurement({"strain_mid": np.array([0.001, 0.004, 0.008])})
     fit = fit_measured(d, m, LEVELS, choices=[("walls", None, None), ("walls", None, None,
                                                                        "held")],

@@ -23,6 +23,7 @@ STILL = 1e-12  # relative wire change of a row whose nodes are all held (round-o
 LEVELS = np.array([0.0, 0.5])
 
 
+@pytest.mark.slow
 def test_derived_law_reproduces_the_tpe_panel_law_along_the_long_diagonal():
     d = load_design(PAPER)
     mat = load_material("tpe")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from proto_files import write_variant
@@ -55,6 +56,7 @@ ALL_KEYS = [*KEYS, ("name",), ("description",), ("flume", "froude_min"),
             ("flow", "density_kg_per_m3"), ("net", "panel_law", "panel_length_m")]
 
 
+@pytest.mark.slow
 @settings(max_examples=80, deadline=None,
           suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 @given(edits=st.dictionaries(st.sampled_from(ALL_KEYS), HOSTILE, min_size=1, max_size=2))

@@ -260,12 +260,13 @@ def test_direct_cable_gcode_passes_the_checker(cable_setup, tmp_path):
     assert rep["e_mode_at_first_extrusion"] == "absolute"
 
 
+@pytest.mark.slow
 def test_benchmark_writes_json(tmp_path):
     """The G-code benchmark runs and writes its report; whether it meets its 1 s goal is the
     benchmark's verdict (exit 1 when missed), not the suite's: a loaded machine says nothing."""
     r = subprocess.run([sys.executable, "-m", "benchmarks.bench_gcode", "--out", str(tmp_path),
-                        "--repeat", "1", "--json"], cwd=ROOT, capture_output=True, text=True, check=False,
-                       timeout=120)
+                        "--repeat", "1", "--json"], cwd=ROOT, capture_output=True, text=True,
+                       check=False, timeout=120)
     assert r.returncode in (0, 1), r.stderr  # 1: goal missed, still a whole report
     report = json.loads(r.stdout)
     assert json.loads((tmp_path / "bench_gcode.json").read_text()) == report
@@ -331,6 +332,7 @@ def kit_net(request):
             load_material(d.net.material), float(net_solid(d.net, att).volume))
 
 
+@pytest.mark.slow
 def test_direct_net_with_loops_lays_the_stl_volume(kit_net, tmp_path):
     """Read back, the direct G-code of the net with its loops lays the STL's volume within
     2 %, and the independent checker passes it with the material's own flow limit."""
@@ -353,6 +355,7 @@ def test_direct_net_with_loops_lays_the_stl_volume(kit_net, tmp_path):
     assert rc == 0, summary
 
 
+@pytest.mark.slow
 def test_travel_between_strands_runs_over_the_border_unretracted(kit_net):
     d, att, printer, style, material, _ = kit_net
     tp = net_toolpath(d.net, printer, style, material, attachment=att)
@@ -364,6 +367,7 @@ def test_travel_between_strands_runs_over_the_border_unretracted(kit_net):
                                                      d.net.mesh_x_mm, d.net.mesh_y_mm).strands)
 
 
+@pytest.mark.slow
 def test_loops_ring_the_holes_in_the_border_beads(kit_net):
     """No bead reaches into a hole, and beads line every hole (the loop's ring)."""
     d, att, printer, style, material, _ = kit_net

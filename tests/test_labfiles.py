@@ -139,6 +139,7 @@ def test_summary_of_a_verify_record_without_selection(monkeypatch):
     assert 'id="summary"' in box and "model stiffer by 20%" in box and "TPE" in box
 
 
+@pytest.mark.slow
 def test_sensor_and_anchor_layout_is_the_scene_in_mm():
     """The layout drawing's positions: the pins on the net's corners, each wire anchored at the
     left end of its row with its potentiometer SENSOR_EXIT x width beyond the right edge in line

@@ -127,6 +127,7 @@ def test_top_level_stays_small():
     assert len(modules) <= TOP_LEVEL_MODULES_MAX, modules
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("victim", "line", "expected"), [
     ("printgen/inputs/schema.py", "from printgen.run.make import make\n", "inputs (rank 1)"),
     ("printgen/parts/geometry/cable.py", "    from printgen.verification import verify\n",

@@ -38,6 +38,7 @@ def run(capsys, *argv):
     return code, err.strip()
 
 
+@pytest.mark.slow
 def test_verify_design_is_estimated_before_any_solve(capsys, tmp_path, monkeypatch):
     """A 1 mm mesh over the 1:40 net (~60 000 nodes) is refused with the estimate, not solved
     for minutes (a 3 mm mesh ran > 100 s, 0.01 mm ran out of memory)."""

@@ -180,6 +180,7 @@ def test_cli_loads_and_load_params_make_specs():
         "porosity", 0.4)
 
 
+@pytest.mark.slow
 def test_case_readings_are_the_nominal_model_at_the_discharge_steps():
     """`make --loads ...,jam` writes expected-readings-jam.csv from these: the model's sweep
     at the jam's levels, the discharge beside each reading, sensors zeroed at h/h_B = 0; the

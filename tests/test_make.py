@@ -128,6 +128,7 @@ def test_failed_first_run_writes_nothing(tmp_path):
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow
 def test_cli_make_json_and_exit_codes(made_simple_drag, tmp_path, capsys, monkeypatch):
     """--json and --drag through the command line: the command passes the load case to
     `api.make` (a spy returns the shared drag run of the coarse simple barrier, made through
@@ -185,6 +186,7 @@ def test_barrier_without_cables_is_verified_at_every_level(made_simple_drag):
     assert not any("bottom cable" in t for t in panels)
 
 
+@pytest.mark.slow
 def test_time_limit_stops_the_run_in_its_step(tmp_path, monkeypatch):
     """Issue 28: past --time-limit, make stops with one line naming the step, the estimate,
     the time spent and the option; nothing is written (the refusal by estimate is

@@ -3,12 +3,11 @@ printed net's effective stiffness (issue 10)."""
 
 from __future__ import annotations
 
-import dataclasses
 import json
 
 import numpy as np
 import pytest
-from conftest import EXAMPLES, reference_design_1_40
+from conftest import EXAMPLES, coarse_design_1_40, reference_design_1_40
 
 from printgen.cli import main
 from printgen.design.record import Design
@@ -32,12 +31,6 @@ MEASURED_LEVELS = np.array([0.2, 0.4, 0.6, 0.8, 1.0])
 READ_TOL = 1e-12  # numbers read back from text written with repr()
 
 
-def coarse_design() -> Design:
-    d = reference_design_1_40()
-    n = d.net
-    return dataclasses.replace(d, net=dataclasses.replace(
-        n, mesh_x_mm=n.mesh_x_mm * COARSE, mesh_y_mm=n.mesh_y_mm * COARSE))
-
 
 def plain_band(levels: np.ndarray) -> Band:
     """A band with no variants on the design's own net: all the predictor needs."""
@@ -53,8 +46,9 @@ def write_csv(path, levels, values: dict[str, np.ndarray], sep: str = ",") -> No
     path.write_text("\n".join(lines) + "\n")
 
 
+@pytest.mark.slow
 def test_fit_recovers_a_known_stiffness_factor(tmp_path):
-    d = coarse_design()
+    d = coarse_design_1_40(COARSE)
     every = {key: np.zeros(len(MEASURED_LEVELS)) for key, _ in COLUMNS.values()}
     template = Measurement("synthetic", MEASURED_LEVELS, every,
                            {key: col for col, (key, _) in COLUMNS.items()})

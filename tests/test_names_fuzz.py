@@ -89,6 +89,7 @@ def accepted_or_refused(call, name: str) -> None:
     assert PLAIN.fullmatch(name), f"{name!r} was accepted"
 
 
+@pytest.mark.slow
 @fuzz_names
 def test_profile_lookup_of_every_kind(reads, name):
     root, seen = reads
@@ -98,6 +99,7 @@ def test_profile_lookup_of_every_kind(reads, name):
     assert inside_profile_folders(seen, root), seen
 
 
+@pytest.mark.slow
 @fuzz_names
 def test_inherits(reads, name):
     root, seen = reads
@@ -112,6 +114,7 @@ def test_inherits(reads, name):
     assert inside_profile_folders(seen, root), seen
 
 
+@pytest.mark.slow
 @fuzz_names
 def test_prototype_model_names(tmp_path, name):
     from printgen.inputs.prototype import load_prototype
@@ -124,6 +127,7 @@ def test_prototype_model_names(tmp_path, name):
         accepted_or_refused(lambda path=path: load_prototype(path), name)
 
 
+@pytest.mark.slow
 @fuzz_names
 def test_design_json_names(design_1_40, name):
     from printgen.design.design_file import design_from_dict

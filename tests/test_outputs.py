@@ -130,7 +130,8 @@ def test_foreign_folder_needs_force(tmp_path):
     out = tmp_path / "thesis"
     out.mkdir()
     (out / "chapter1.tex").write_text("precious")
-    with pytest.raises(OutputError, match=r"not a printgen output folder: it holds chapter1.tex \(the folder has no manifest.json\).*--force"):
+    with pytest.raises(OutputError, match=r"not a printgen output folder: it holds chapter1.tex "
+                                          r"\(the folder has no manifest.json\).*--force"):
         run_into(out, {"a.txt": "1"})
     assert (out / "chapter1.tex").read_text() == "precious"
     run_into(out, {"a.txt": "1"}, force=True)
@@ -176,6 +177,7 @@ LOCK_HOLDER = textwrap.dedent("""
 """)
 
 
+@pytest.mark.slow
 def test_second_run_into_the_same_folder_names_the_holder(tmp_path):
     out = tmp_path / "out"
     holder = subprocess.Popen([sys.executable, "-c", LOCK_HOLDER, str(out)],

@@ -41,6 +41,7 @@ def test_prototype_panel_law_is_reproduced_by_its_derived_strand_law():
     assert d.error < DERIVED_TOL
 
 
+@pytest.mark.slow
 def test_printed_panel_along_the_long_diagonal_is_derived_within_tolerance():
     """The TPE net's free 43 x 23 mm panel loaded along its 20.6 mm diagonal: the clamps hold
     two meshes' length, so the derived law's low-strain slope stays near the formula's."""

@@ -63,6 +63,7 @@ def simulated(code: str) -> subprocess.CompletedProcess:
                           capture_output=True, text=True, env=env, cwd=ROOT, timeout=300)
 
 
+@pytest.mark.slow
 def test_import_help_and_version_need_nothing_linux_only():
     r = simulated("""
         import printgen
@@ -116,6 +117,7 @@ def what_a_worker_sees() -> tuple:
             [t.name for t in __import__("threading").enumerate()])
 
 
+@pytest.mark.slow
 @pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="workers need 2 cores")
 def test_workers_on_a_platform_without_fork_or_prctl(monkeypatch):
     simulate_windows(monkeypatch)
@@ -144,6 +146,7 @@ def sleeper(pid_file: str) -> None:
     time.sleep(START_WITHIN_S * 2)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="workers need 2 cores")
 def test_the_watchdog_ends_workers_whose_parent_was_killed(tmp_path):
     """Without PR_SET_PDEATHSIG a worker ends itself when its parent dies (SIGKILL)."""
@@ -166,6 +169,7 @@ def test_the_watchdog_ends_workers_whose_parent_was_killed(tmp_path):
         time.sleep(0.1)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="workers need 2 cores")
 def test_make_on_a_platform_without_fork_prctl_sighup_fcntl_gives_the_same_files(
         made_1_40, tmp_path, monkeypatch):

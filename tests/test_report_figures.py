@@ -28,6 +28,7 @@ def report(later: bool) -> Report:
     return rep
 
 
+@pytest.mark.slow
 def test_drawings_keep_their_place_and_give_the_same_report(monkeypatch):
     monkeypatch.delenv("PRINTGEN_SERIAL", raising=False)
     now, later = report(False), report(True)

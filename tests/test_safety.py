@@ -155,6 +155,7 @@ def test_foreign_folder_with_a_manifest_is_refused(world, capsys):
     assert "--force" in err and snapshot(world) == before
 
 
+@pytest.mark.slow
 def test_printgen_output_with_a_foreign_file_names_it(world, made, capsys):
     out = earlier_output(made, world / "x" / "out")
     (out / "notes").mkdir()
@@ -416,6 +417,7 @@ def test_check_covers_the_manifest_and_every_entry(world, made, capsys):
     assert code == 1 and lines == ["extra: empty (a folder)", "extra: l (a symbolic link)"]
 
 
+@pytest.mark.slow
 @POSIX_ONLY
 @pytest.mark.parametrize("kind", ["fifo", "dev-zero", "big"])
 def test_non_regular_and_oversized_inputs_are_refused(world, made, capsys, kind):

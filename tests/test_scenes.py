@@ -7,12 +7,10 @@ import math
 
 import numpy as np
 import pytest
+from conftest import planned
 from proto_files import REALISTIC
 
 import solver
-from printgen.design.plan import make_design
-from printgen.design.selection import select
-from printgen.design.similitude import scale_targets
 from printgen.errors import InputError
 from printgen.inputs.prototype import load_prototype
 from printgen.scene import SceneOptions, build_scene
@@ -32,9 +30,7 @@ WIRE_SPRING = 10 * WIRE_RATE * SENSOR_FORCE_N
 
 @pytest.fixture(scope="module")
 def design():
-    p = load_prototype(REALISTIC)
-    t = scale_targets(p, 40)
-    return p, make_design(p, t, select(p, t))
+    return planned(REALISTIC)
 
 
 def _cable_forces(x: np.ndarray, nodes: np.ndarray, law, rest: float) -> np.ndarray:
@@ -137,6 +133,7 @@ def _lateral(s) -> np.ndarray:
 LEVELS = np.array([0.0, 0.5, 1.0])  # enough to load the edges
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("mounting", ["walls", "eyelets"])
 def test_mountings_hold_or_free_the_lateral_edges(design, mounting):
     """walls: the side sheets hold the lateral edge nodes (they do not move); eyelets: only the

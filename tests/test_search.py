@@ -48,6 +48,7 @@ def test_pareto_mask_analytic():
         pareto_mask(np.array([[np.nan, 1.0]]))
 
 
+@pytest.mark.slow
 def test_pareto_set_has_no_dominated_member(serial_run):
     rec = serial_run.record["scales"][f"{SCALE:g}"]
     verified = rec["verified"]
@@ -60,6 +61,7 @@ def test_pareto_set_has_no_dominated_member(serial_run):
         assert (i in members) == (not beaten), f"candidate {i}: member {i in members}"
 
 
+@pytest.mark.slow
 def test_stiffness_objective_pareto_over_every_printable_candidate(tmp_path, monkeypatch):
     import printgen.run.search as run_search
     from printgen.commands.design import SHOW, shown_rows
@@ -88,6 +90,7 @@ def test_stiffness_objective_pareto_over_every_printable_candidate(tmp_path, mon
     assert res.chosen == min(feasible, key=lambda s: (s.score, s.point.index)).point.index
 
 
+@pytest.mark.slow
 def test_same_json_serial_local_cluster_and_remote_scheduler(serial_run):
     from distributed import LocalCluster
 
@@ -103,6 +106,7 @@ def test_same_json_serial_local_cluster_and_remote_scheduler(serial_run):
     assert len(serial_run.results[0].verified) == 2  # one net x two border widths
 
 
+@pytest.mark.slow
 def test_report_names_choice_select_pick_and_design_round_trips(serial_run, tmp_path):
     from printgen.run.search import write_outputs
 

@@ -22,7 +22,8 @@ SIMILITUDE_RTOL = 1e-9  # the issue's bar: E / lambda reproduces the prototype t
 # one decade: the pure law's 1/3 and 2/3 within this (measured 0.3334 and about 0.66)
 LAW_EXPONENT_TOL = 0.02
 LAW_DEPARTURE_TOL = 0.02  # steel's deflection within 2 % of the law anchored at the prototype
-JAM_AS_HYDROSTATIC_RTOL = 1e-9  # porosity 0: the same loads as hydrostatic to round-off (test_loads: 1e-12)
+# porosity 0: the same loads as hydrostatic to round-off (test_loads: 1e-12)
+JAM_AS_HYDROSTATIC_RTOL = 1e-9
 
 
 @pytest.fixture(scope="module")
@@ -50,6 +51,7 @@ def _values(run, row):
     return [run.series.point(row, lam).values for lam in run.series.scales]
 
 
+@pytest.mark.slow
 def test_similitude_identical_at_every_scale(tiny_run):
     vals = _values(tiny_run, "similitude")
     for v in vals[1:]:
@@ -59,6 +61,7 @@ def test_similitude_identical_at_every_scale(tiny_run):
     assert steel[-1]["deflection"] < 0.3 * steel[0]["deflection"]  # Froude only: too stiff
 
 
+@pytest.mark.slow
 def test_similitude_on_the_realistic_scene(tiny_realistic):
     """Border cables sliding and a panel law: E / lambda is still exact; the 1 N sensors on
     the models (--solver-net sensors=on) do not scale and break it."""
@@ -98,6 +101,7 @@ def test_sentence(tiny_run):
     assert in_band([(1, 2.0)]) == []
 
 
+@pytest.mark.slow
 def test_serial_and_dask_give_the_same_numbers(tiny):
     pytest.importorskip("distributed")
     serial = run_series(tiny, [1, 10], serial=True)
@@ -109,6 +113,7 @@ def test_serial_and_dask_give_the_same_numbers(tiny):
         assert all((a.curves[k] == b.curves[k]).all() for k in a.curves)
 
 
+@pytest.mark.slow
 def test_cli_writes_the_folder(capsys, tiny, tmp_path):
     out = tmp_path / "series"
     assert main(["series", str(tiny), "--scales", "1,100", "--materials", "petg",
@@ -148,6 +153,7 @@ def test_check_scales():
             check_scales(bad)
 
 
+@pytest.mark.slow
 def test_sensor_row_says_the_models_pull(tiny_realistic):
     on = run_series(tiny_realistic, [1, 40], serial=True, net=net_options("sensors=on"))
     rows = {a[0]: a[1] for a in on.series.assumptions}
@@ -156,6 +162,7 @@ def test_sensor_row_says_the_models_pull(tiny_realistic):
     assert rows["sensors"].startswith("three 1 N wires pulling")
 
 
+@pytest.mark.slow
 def test_jam_of_porosity_zero_runs_as_hydrostatic(tiny):
     """The series takes a load case's parameters (its spec) and hands each scale its own
     depth and lambda: a jam of porosity 0 is a wall of logs, the hydrostatic case (issue 26's

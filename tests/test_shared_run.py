@@ -49,7 +49,8 @@ def test_a_failed_build_fails_the_waiting_workers(tmp_path, monkeypatch):
     with pytest.raises(ValueError, match="no such barrier"):
         shared_run(Workers(tmp_path, "gw0"), "run", broken)
     monkeypatch.setenv("PYTEST_XDIST_WORKER", "gw1")
-    with pytest.raises(pytest.fail.Exception, match="failed in another worker: ValueError: no such"):
+    with pytest.raises(pytest.fail.Exception,
+                       match="failed in another worker: ValueError: no such"):
         shared_run(Workers(tmp_path, "gw1"), "run", broken)
 
 

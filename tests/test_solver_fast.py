@@ -44,6 +44,7 @@ def _sliding_net() -> tuple[Net, list]:
     return net, [Hydrostatic(free, 0.01, 0.9)]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("current_z", [False, True])
 def test_fast_and_reference_agree_on_simple_pinned(current_z):
     sc = simple_scene(current_z=current_z)
@@ -65,6 +66,7 @@ def test_fast_and_reference_agree_on_a_sliding_cable_net():
     assert fast.cable_tensions[0] == pytest.approx(ref.cable_tensions[0], rel=AGREE)
 
 
+@pytest.mark.slow
 def test_paths_agree_level_by_level():
     """Hydrostatic at the current node height, no drag (its sharp switch at a node's height
     makes the tightest tolerances a matter of luck for either path)."""
@@ -73,10 +75,11 @@ def test_paths_agree_level_by_level():
     fast = solve_path(sc.net, sc.loads_at, levels, tol=TIGHT)
     ref = solve_path(sc.net, sc.loads_at, levels, tol=TIGHT, method="reference")
     assert all(r.converged for r in fast + ref)
-    for f, r in zip(fast, ref):
+    for f, r in zip(fast, ref, strict=True):
         assert _agree(f.displacements, r.displacements) < AGREE
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("refine", [0.5, 1])
 def test_a_drag_load_path_converges_where_the_level_sits_on_a_node_row(refine):
     """simple-pinned with drag from h/h_B = 0 to 1.1 by 0.05: at 0.9 the water level sits on a
@@ -301,6 +304,7 @@ def test_predicted_tensions_follow_the_linearised_law_and_stay_tension_only():
     assert abs(half - (t0 + exact) / 2) <= ROUND * exact
     across = np.array([0.0, 0.1, 0.0]) / ns.L
     assert abs(_predicted_tensions(ns, st, None, across, 1.0, None)[0] - t0) <= ROUND * t0
-    assert evaluate(ns, u + np.vstack([np.zeros(3), across])).bar[1][0] > 1.4 * t0  # +0.1^2 / 2 of strain
+    # +0.1^2 / 2 of strain
+    assert evaluate(ns, u + np.vstack([np.zeros(3), across])).bar[1][0] > 1.4 * t0
     back = np.array([-0.05, 0.0, 0.0]) / ns.L
     assert _predicted_tensions(ns, st, None, back, 1.0, None)[0] == 0.0

@@ -124,7 +124,7 @@ def test_pattern_structure_equals_scipy_assembly():
     qdldl, CSR for PARDISO) and the z columns, on a net with a cable and rollers."""
     ns = NetSystem(_partly_fixed_net())
     p = ns.pattern
-    assert 0 < int((ns.net.fixed_dofs.sum(axis=1) % 3 != 0).sum())  # rollers present
+    assert int((ns.net.fixed_dofs.sum(axis=1) % 3 != 0).sum()) > 0  # rollers present
     rng = np.random.default_rng(3)
     values = rng.normal(size=len(p.keep))
     rows, cols = _slot_rows_cols(ns)
@@ -170,7 +170,7 @@ def _slot_rows_cols(ns: NetSystem) -> tuple[np.ndarray, np.ndarray]:
         parts.append((np.repeat(dof, len(dof)), np.tile(dof, len(dof))))
     every = np.arange(ns.n)
     parts.append(tuple(x.ravel() for x in blocks(every, every)))
-    return tuple(np.concatenate(x) for x in zip(*parts))
+    return tuple(np.concatenate(x) for x in zip(*parts, strict=True))
 
 
 def test_ray_potential_equals_the_potential_along_the_ray():

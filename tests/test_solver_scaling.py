@@ -37,11 +37,13 @@ def test_scaled_modulus_gives_the_same_normalised_deformation(scaled_series):
         assert low == pytest.approx(l1, rel=SIMILAR), lam
 
 
+@pytest.mark.slow
 def test_steel_at_every_scale_deflects_less_as_lambda_grows(scaled_series):
     steel = [normalised(lam, SIMPLE["modulus"])[0] for lam in (10, 30, 100)]
     assert scaled_series[1][0] > steel[0] > steel[1] > steel[2]
 
 
+@pytest.mark.slow
 def test_zero_pretension_net_follows_the_one_third_law():
     """Deflection / width ~ (F / EA)^(1/3) at small strain: vary EA at fixed load."""
     moduli = np.array([1e12, 1e13, 1e14])  # very stiff: strains 1e-5..1e-6
@@ -50,6 +52,7 @@ def test_zero_pretension_net_follows_the_one_third_law():
     assert slope == pytest.approx(1 / 3, rel=SLOPE)
 
 
+@pytest.mark.slow
 def test_mesh_refinement_converges():
     """simple-pinned at 61 x 21, 121 x 41, 181 x 61 nodes, same loads per unit area."""
     d = []
@@ -73,6 +76,7 @@ def test_tightening_the_tolerance_converges():
     assert errs[2] < 1e-9 * np.abs(ref).max()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("lam", [1, 100])
 @pytest.mark.parametrize("slack", [0.002, 0.02])
 def test_slack_nets_converge_and_stay_similar(lam, slack):

@@ -11,14 +11,11 @@ import subprocess
 
 import numpy as np
 import pytest
-from conftest import require_shared, require_tool
+from conftest import coarse_simple_file, planned, require_shared, require_tool
 from numpy.testing import assert_allclose
 from proto_files import SIMPLE, write_variant
 
 from printgen.barrier.patterns.square import square_factor
-from printgen.design.plan import make_design
-from printgen.design.selection import select
-from printgen.design.similitude import scale_targets
 from printgen.errors import GeometryError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
@@ -35,15 +32,9 @@ SLICE_TIMEOUT_S = 120
 REDUCED_MM = (40.0, 30.0)  # a corner of the 300 x 100 mm net: the same strands, cheap to slice
 
 
-def _design(path, scale: float = 40):
-    p = load_prototype(path)
-    t = scale_targets(p, scale)
-    return p, make_design(p, t, select(p, t))
-
-
 @pytest.fixture(scope="module")
 def simple():
-    return _design(SIMPLE)
+    return planned(SIMPLE)
 
 
 @pytest.fixture
@@ -67,7 +58,7 @@ def test_simple_barrier_is_printed_as_a_square_net(simple):
 
 def test_model_pattern_diamond_stays_available(tmp_path):
     path = write_variant(tmp_path, {("model", "pattern"): "diamond"}, base=SIMPLE)
-    _, d = _design(path)
+    _, d = planned(path)
     assert d.net.pattern == "diamond"
     assert d.net.graph().strands[0].size > 2
 
@@ -76,7 +67,7 @@ def test_a_printed_square_net_needs_a_square_mesh(tmp_path):
     path = write_variant(tmp_path, {("model", "mesh_x_mm"): 5.0, ("model", "mesh_y_mm"): 6.0},
                          base=SIMPLE)
     with pytest.raises(GeometryError, match="square mesh needs mesh_x = mesh_y"):
-        _design(path)
+        planned(path)
 
 
 def test_square_membrane_law_is_one_strand_per_mesh(simple):
@@ -93,6 +84,7 @@ def test_square_membrane_law_is_one_strand_per_mesh(simple):
     assert membrane == pytest.approx(want, rel=1e-12)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("size", ["reduced", "full"])
 def test_square_mesh_is_watertight_and_matches_its_analytic_volume(simple, size, tmp_path):
     pytest.importorskip("manifold3d")
@@ -202,6 +194,7 @@ PANEL_REL = 1e-6  # the solver's panel tolerance is 1e-9 of the strand force: fa
 FREE_HOLD_REL = 0.01
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("mode", ["blocked", "free"])
 def test_virtual_panel_of_the_square_net_reads_its_membrane_law(simple, mode):
     """The same panel machinery as the diamond (`scene.panel`): the designed square
@@ -232,13 +225,10 @@ def test_virtual_panel_of_the_square_net_reads_its_membrane_law(simple, mode):
 def coarse_simple(tmp_path_factory):
     """The simple barrier on a mesh twice as coarse (the test's budget: 31 x 11 nodes), its
     printed square net at 10 mm; the same scene as examples/simple_barrier.toml otherwise."""
-    path = write_variant(tmp_path_factory.mktemp("square"),
-                         {("net", "mesh_x_m"): 0.4, ("net", "mesh_y_m"): 0.4,
-                          ("model", "mesh_x_mm"): 10.0, ("model", "mesh_y_mm"): 10.0},
-                         base=SIMPLE)
-    return _design(path)
+    return planned(coarse_simple_file(tmp_path_factory.mktemp("square")))
 
 
+@pytest.mark.slow
 def test_verification_of_the_square_net_converges_at_every_level(coarse_simple):
     """Prototype and printed square net solved at every level of the sweep (h / h_B = 0 to
     1.1 by 0.05), the model with its printed edge frame and pulling sensor wires."""
@@ -255,6 +245,7 @@ def test_verification_of_the_square_net_converges_at_every_level(coarse_simple):
 RING_QUADRATURE = 1e-4  # the analytic area's polar-grid integral over each ring (1.3e-5 seen)
 
 
+@pytest.mark.slow
 def test_square_net_with_border_cables_has_loops_and_lays_its_volume(tmp_path):
     """The simple barrier with border cables: a two-bead frame with a loop on every edge node
     (the cables thread them), a watertight mesh, and a direct G-code laying the mesh's volume."""
@@ -264,7 +255,7 @@ def test_square_net_with_border_cables_has_loops_and_lays_its_volume(tmp_path):
 
     path = tmp_path / "bordered.toml"
     path.write_text(SIMPLE.read_text() + "\n[border]\ndiameter_mm = 24.0\nmodulus_gpa = 100.0\n")
-    _, d = _design(path)
+    _, d = planned(path)
     assert d.net.pattern == "square" and d.net.border_width_mm == 2 * d.net.strand.bead_width_mm
     n = dataclasses.replace(d.net, width_mm=REDUCED_MM[0], height_mm=REDUCED_MM[1])
     printer = load_printer(d.printer)
@@ -283,5 +274,6 @@ def test_square_prototype_with_unequal_sides_is_refused(tmp_path):
     from printgen.errors import InputError
 
     bad = write_variant(tmp_path, {("net", "mesh_y_m"): 0.25}, base=SIMPLE)
-    with pytest.raises(InputError, match=r'pattern "square" needs mesh_x_m = mesh_y_m.*0\.2 x 0\.25'):
+    with pytest.raises(InputError,
+                       match=r'pattern "square" needs mesh_x_m = mesh_y_m.*0\.2 x 0\.25'):
         load_prototype(bad)

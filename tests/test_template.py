@@ -20,7 +20,7 @@ def test_template_loads_as_written_and_names_every_key(tmp_path):
     p.write_text(text)
     proto = load_prototype(p)
     assert proto.width == pytest.approx(12.0) and proto.border is None
-    for table, fields in SCHEMA_TABLES:
+    for _table, fields in SCHEMA_TABLES:
         for f in fields:
             if f.kind is not dict:
                 assert re.search(rf"^# {f.key}: .+", text, re.MULTILINE), f.key

@@ -53,6 +53,7 @@ def pieces(request, tmp_path_factory):
     return d, write_pieces(path, out), out
 
 
+@pytest.mark.slow
 def test_folder_holds_every_piece_its_sidecars_and_the_loop(pieces):
     d, rec, out = pieces
     names = {p.name for p in out.iterdir()}
@@ -149,6 +150,7 @@ def test_coupon_export_of_a_known_modulus_calibrates_back(pieces, tmp_path):
     assert cal.modulus.mean == pytest.approx(e_true, rel=MODULUS_RTOL)
 
 
+@pytest.mark.slow
 def test_bad_orientation_and_non_diamond_net_write_nothing(tmp_path):
     d = reference_design_1_40()
     path = tmp_path / "design.json"
@@ -163,6 +165,7 @@ def test_bad_orientation_and_non_diamond_net_write_nothing(tmp_path):
     assert not (tmp_path / "b").exists()
 
 
+@pytest.mark.slow
 def test_cli_writes_the_folder_and_refuses_bad_input_with_exit_2(pieces, tmp_path, capsys):
     from printgen.cli import main
 

@@ -8,12 +8,9 @@ import json
 
 import numpy as np
 import pytest
-from proto_files import REALISTIC, SIMPLE, write_variant
+from conftest import coarse_simple_file, planned
+from proto_files import REALISTIC
 
-from printgen.design.plan import make_design
-from printgen.design.selection import select
-from printgen.design.similitude import scale_targets
-from printgen.inputs.prototype import load_prototype
 from printgen.report.jsonout import dumps
 from printgen.report.plots import deformed_figure
 from printgen.scene import build_scene
@@ -24,21 +21,11 @@ HOLD_EFFECT = 0.01  # ... and move no normalised deformation by more than 1 % of
 LOW_LEVELS = np.array([0.0, 0.05, 0.1, 0.15, 1.1])  # the dry net is largest at low water
 
 
-def _design(path, scale: float = 40):
-    p = load_prototype(path)
-    t = scale_targets(p, scale)
-    return p, make_design(p, t, select(p, t))
-
-
 @pytest.fixture(scope="module")
 def coarse_simple(tmp_path_factory):
     """The simple barrier (bed and banks, top free) on a mesh twice as coarse (the test's
     budget); the same scene as examples/simple_barrier.toml otherwise."""
-    tmp = tmp_path_factory.mktemp("simple")
-    path = write_variant(tmp, {("net", "mesh_x_m"): 0.4, ("net", "mesh_y_m"): 0.4,
-                               ("model", "mesh_x_mm"): 10.0, ("model", "mesh_y_mm"): 10.0},
-                         base=SIMPLE)
-    return _design(path)
+    return planned(coarse_simple_file(tmp_path_factory.mktemp("simple")))
 
 
 @pytest.mark.parametrize("who", ["prototype", "model"])
@@ -61,7 +48,7 @@ def test_free_top_barrier_solves_every_level(coarse_simple, who):
 
 @pytest.fixture(scope="module")
 def realistic():
-    p, d = _design(REALISTIC)
+    p, d = planned(REALISTIC)
     return verify(p, d, lv=np.array([0.0, 0.5, 1.0, 1.1]))
 
 
@@ -151,7 +138,7 @@ def test_unconverged_level_is_left_out_and_reported(monkeypatch):
     # in this process: a worker started by forkserver (the parent runs other threads, e.g.
     # left by an earlier test's Dask cluster) would not see the patch
     monkeypatch.setenv("PRINTGEN_SERIAL", "1")
-    p, d = _design(REALISTIC)
+    p, d = planned(REALISTIC)
     v = verify(p, d, lv=np.array([0.0, 0.5, 1.0]))
     rec = v.to_record()
     assert v.model.failed == {0.5: "forced"} and list(v.model.deformation.levels) == [0.0, 1.0]

@@ -57,7 +57,11 @@ def expand(paths: Sequence[str | Path], *, exclude: Iterable[str | Path] = ()
     if len(kept) < len(out):
         notes.append("the compliance curve is not a specimen: left out of the exports")
     seen: set[Path] = set()
-    unique = [(f, d) for f, d in kept if not (f.resolve() in seen or seen.add(f.resolve()))]
+    unique = []
+    for f, d in kept:
+        if f.resolve() not in seen:
+            seen.add(f.resolve())
+            unique.append((f, d))
     if not unique:
         raise CalibrationError(f"no tensile-test exports among {', '.join(map(str, paths))}; "
                                f"expected files ending in {', '.join(DATA_SUFFIXES)}")

@@ -276,8 +276,12 @@ def _column_notes(samples) -> list[str]:
         for note in s.notes:
             files.setdefault(note, []).append(Path(s.path).name)
     total = len(samples)
-    return [f"{note} ({'all ' + str(total) + ' files' if len(names) == total > 1 else ', '.join(names)})"
-            for note, names in files.items()]
+    return [f"{note} ({_which(names, total)})" for note, names in files.items()]
+
+
+def _which(names: list[str], total: int) -> str:
+    """'all N files' when a note holds for every one of several files, else their names."""
+    return f"all {total} files" if len(names) == total > 1 else ", ".join(names)
 
 
 def _panel_law(samples: tuple[SampleFit, ...]) -> PanelLawFit:

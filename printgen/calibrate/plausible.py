@@ -13,7 +13,8 @@ from printgen.errors import CalibrationError
 # 300 GPa); a printed polymer lies near 0.01-5 GPa.
 MODULUS_RANGE_PA = (1e6, 500e9)
 MAX_STRESS_PA = 10e9  # above the strength of any polymer, fibre composite or steel wire
-FORCE_FIX = "choose the newton column with --column force=NAME or give its unit with --unit force=kN"
+FORCE_FIX = ("choose the newton column with --column force=NAME or give its unit with "
+             "--unit force=kN")
 
 
 def check_stress(rec: TestRecord, spec: Specimen, strength_pa: float | None) -> None:

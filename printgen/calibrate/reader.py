@@ -38,9 +38,9 @@ log = logging.getLogger(__name__)
 DELIMITERS = (";", "\t", ",")  # preferred first: a decimal comma would split a ',' file
 SNIFF_ROWS = 40  # rows from the table's end used to choose the decimal separator
 TEXT_SUFFIXES = (".csv", ".txt", ".tsv", ".dat")
-# The most one export may hold, checked before it is parsed (a 175 KB zip of 20 M rows ran
-# calibrate > 120 s; issue 20): a 1 kHz test of 16 minutes has 1 M rows, and the reader takes
-# about 10 s for them; real exports hold 10^3 to 10^5.
+# The most one export may hold, checked before it is parsed (a small zip can unpack to tens of
+# millions of rows): a 1 kHz test of 16 minutes has 1 M rows; real exports hold 10^3 to 10^5
+# (benchmarks/measurements.md#calibrate-limits).
 MAX_ROWS = 1_000_000
 # A row of readings is tens of columns (< 1 KiB); Python's csv refuses a field over 128 KiB.
 MAX_LINE_CHARS = 64 << 10
@@ -260,8 +260,8 @@ def _value(cell: str, dec: str) -> float | None:
             pass
         else:
             return v if math.isfinite(v) else None
-    v = parse_number(cell, dec)
-    return _BOOLEAN.get(cell.strip().strip('"').lower()) if v is None else v
+    parsed = parse_number(cell, dec)
+    return _BOOLEAN.get(cell.strip().strip('"').lower()) if parsed is None else parsed
 
 
 def _table_start(rows: list[tuple[int, list[str]]], dec: str, where: str, delim: str) -> int:
@@ -309,7 +309,8 @@ def _body(rows, ncols: int, dec: str, where: str, headers: list[str], delim: str
 
 
 def _assign(headers: list[str], col_units: list[str | None], data: np.ndarray,
-            chosen: Mapping[str, str], where: str) -> tuple[dict[str, int], dict[str, tuple[str, ...]], list[str]]:
+            chosen: Mapping[str, str], where: str
+            ) -> tuple[dict[str, int], dict[str, tuple[str, ...]], list[str]]:
     """(role -> column index, role -> other candidate headers, notes): the options first, then
     the header names, preferring a column whose unit belongs to the role; raw counts are never
     taken and two unitless force columns are an error, not a guess."""
@@ -320,9 +321,9 @@ def _assign(headers: list[str], col_units: list[str | None], data: np.ndarray,
         roles[role] = _find_column(headers, key, where)
     cands: dict[str, list[int]] = {r: [] for r in ROLES}
     for j, h in enumerate(headers):
-        role = role_of(split_name_unit(h)[0])
-        if role is not None and role not in roles and j not in roles.values():
-            cands[role].append(j)
+        named = role_of(split_name_unit(h)[0])
+        if named is not None and named not in roles and j not in roles.values():
+            cands[named].append(j)
     alternatives: dict[str, tuple[str, ...]] = {}
     notes: list[str] = []
     for role, js in cands.items():

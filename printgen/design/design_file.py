@@ -86,7 +86,7 @@ def design_from_dict(data: Any, where: str = "design") -> Design:
         net["pattern"] = get_pattern(str(net["pattern"])).name
     if not isinstance(kw["cables"], list):
         raise InputError(f"{where}.cables must be a list of cables")
-    cables = []
+    cables: list[CableDesign] = []
     for i, c in enumerate(kw["cables"]):
         ckw = _fields(CableDesign, c, f"{where}.cables[{i}]", CABLE)
         name = profile_name(ckw["name"], f"{where}.cables[{i}].name", what="cable")

@@ -21,9 +21,9 @@ def make_design(prototype: Prototype, targets: ScaledTargets, selection: Selecti
     (`printed_pattern`: the diamond's whole half-meshes, the square's whole meshes keep the
     mesh exact: its `span`), the model mesh, the winning strand section and a border frame of
     BORDER_BEADS beads; a square net without border cables gets a frame of the strand's own
-    section instead (its edge rows are strands of the prototype's net, `edge_strands`). Cables (when the prototype has a
-    border): top and bottom span the net's width anchor to anchor (its corner nodes sit on the
-    anchors), the lateral ones its height, so the parts meet at every scale.
+    section instead (its edge rows are strands of the prototype's net, `edge_strands`). Cables
+    (when the prototype has a border): top and bottom span the net's width anchor to anchor (its
+    corner nodes sit on the anchors), the lateral ones its height, so the parts meet at every scale.
     """
     net_c = selection.net[0]
     if not net_c.feasible:

@@ -20,7 +20,7 @@ from printgen.inputs.profiles import list_profiles, load_raw
 from printgen.inputs.schema import Field, positive, read_table
 
 # Materials one selection or design search weighs at most: each costs ~3 ms in select and a
-# grid of sections in the search (20 000 names made select run > 60 s; issue 20).
+# grid of sections in the search (benchmarks/measurements.md#calibrate-limits).
 MAX_MATERIALS = 100
 
 PROVENANCE = [

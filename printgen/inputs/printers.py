@@ -11,7 +11,7 @@ from printgen.inputs.schema import Field, positive, read_table
 
 MAX_LAYER_FRACTION = 0.75  # a layer above 0.75 x nozzle does not bond reliably
 # Holes of 2-6 mm printed with 0.4-0.5 mm nozzles come out 0.1-0.3 mm small in diameter
-# (the issue-12 measurement: a 3.2 mm eyelet at 3.15-3.18 mm, before shrinkage of the
+# (a measured 3.2 mm eyelet came out at 3.15-3.18 mm, before shrinkage of the
 # perimeter); 0.2 mm is the default, measure a test eyelet and set your printer's value.
 HOLE_COMPENSATION_MM = 0.2
 

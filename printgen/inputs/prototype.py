@@ -20,7 +20,7 @@ from printgen.inputs.schema import Field, load_toml, positive, read_table
 
 DEPTH_OVER_HEIGHT_MAX = 2.0  # flow depth / barrier height: beyond it the barrier is drowned
 # Smallest plausible values (file units): far below any real barrier, net or flow, and far
-# above the 1e-300 or 5e-324 that would reach the maths as a zero in disguise (issue 20).
+# above the 1e-300 or 5e-324 that would reach the maths as a zero in disguise.
 MIN_BARRIER_M = 0.1  # a prototype barrier 10 cm wide or high
 MIN_MESH_M = 1e-3  # a 1 mm mesh (real nets: 0.1-0.6 m; the model is printed at 1/lambda)
 MIN_DIAMETER_MM = 0.1  # a 0.1 mm strand or cable

@@ -147,7 +147,7 @@ def check_value(value: Any, f: Field, *, where: str) -> Any:
         return value
     if not isinstance(value, f.kind):
         raise InputError(f"{label} must be a {f.kind.__name__}")
-    if f.kind is list:
+    if isinstance(value, list):  # a list field: value is an f.kind
         check_items(value, f, label)
     return value
 

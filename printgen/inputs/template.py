@@ -95,8 +95,10 @@ def _key(f: Field, value: Any, table_off: bool) -> list[str]:
 
     unit = f" ({f.unit})" if f.unit and f.kind is float else ""
     rng = _range(f)
-    need = ("required in the table" if table_off else "required") if f.required else f"optional, default {f.default!r}" \
-        if f.default not in (None, [], {}) else "optional"
+    if f.required:
+        need = "required in the table" if table_off else "required"
+    else:
+        need = f"optional, default {f.default!r}" if f.default not in (None, [], {}) else "optional"
     note = f"# {f.key}: {MEANING[f.key]}{unit}; {need}" + ("" if rng == "-" else f"; {rng}")
     off = table_off or (not f.required and f.key not in _ACTIVE)
     return [note, ("# " if off else "") + f"{f.key} = {_toml(value)}"]

@@ -109,8 +109,8 @@ def _not_plain(path: Path, what: str) -> LockError:
 
 
 def _busy(dest: Path, holder: str) -> LockError:
-    return LockError(f"output {dest} is being written by another printgen (pid {holder or 'unknown'}); "
-                     f"wait for it to finish or choose another --out")
+    return LockError(f"output {dest} is being written by another printgen "
+                     f"(pid {holder or 'unknown'}); wait for it to finish or choose another --out")
 
 
 def _holder(fd: int) -> str:

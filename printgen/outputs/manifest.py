@@ -129,7 +129,8 @@ def schema_problem(data: Any) -> str | None:
         return "no 'files' table"
     for rel, entry in files.items():
         if not _entry_ok(entry) or not _relative_ok(rel):
-            return f"file entry {rel[:80]!r}: {_short(entry)} is not {{'sha256': hex, 'bytes': size}}"
+            return (f"file entry {rel[:80]!r}: {_short(entry)} is not "
+                    "{'sha256': hex, 'bytes': size}")
     volatile = data.get("volatile", [])
     if not isinstance(volatile, list) or any(v != TIMINGS for v in volatile):
         return f"volatile = {_short(volatile)}: only [{TIMINGS!r}] may be volatile"

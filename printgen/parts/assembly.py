@@ -19,7 +19,7 @@ from printgen.errors import GeometryError
 from printgen.inputs.printers import Printer
 from printgen.parts.geometry.attach import Attachment, attachment_for, corner_nodes, holes
 
-CLOSE_TOL_MM = 0.1  # issue 12: attachment points and anchor spacing agree to 0.1 mm
+CLOSE_TOL_MM = 0.1  # the kit closes: attachment points and anchor spacing agree to 0.1 mm
 SIDE_ANCHORS = {"bottom": (0, 1), "right": (1, 2), "top": (3, 2), "left": (0, 3)}
 
 CHECKLIST = (

@@ -1,4 +1,4 @@
-"""The multi-parameter fit of a measured test in the report (issue 25): the best parameters
+"""The multi-parameter fit of a measured test in the report: the best parameters
 against their bounds, the best of each discrete choice, and what the data determine."""
 
 from __future__ import annotations

@@ -35,51 +35,35 @@ from printgen.errors import InputError
 from printgen.inputs.prototype import Prototype
 from printgen.workers import cores, reporting
 
-# About a minute of `make` on 2 cores (issue 16): the bundled simple barrier (free top) and
-# the 1:40 example both fit.
+# About a minute of `make` on 2 cores: the bundled simple barrier (free top) and the 1:40
+# example both fit (benchmarks/measurements.md#make-no-default-stop).
 DEFAULT_LIMIT_S = 60.0
 LONG_RUN_S = 30.0  # runs estimated longer show their estimate and progress (make, on a terminal)
 LEVELS = 23  # load levels of a sweep (verify.levels(): 0 to 1.1 by 0.05; tests/test_budget.py)
 # Newton iterations (chord steps included) per load level, averaged over a run's sweeps (the
 # nominal pair, the refinement test and the band's variants; a variant's slack strands may
-# take 4 x the nominal's), at REFERENCE_UNKNOWNS, growing as unknowns^ITERATION_GROWTH.
-# Counted by bench make at 1:40: the 1:40 example (border cables, ~1000 unknowns) 2504 over 12
-# sweeps; the simple barrier (free top, 3540) 2167 over 8 (solver of main's 7e27773: one
-# factorization per Newton step; before it 2252 and 1897, and 1170 on the simple barrier's mesh
-# twice as coarse, 870 unknowns: 0.34 from one size to the other). Kept after the mixed-
-# integration-point Newton steps and the cheaper iterations (bench make, quiet: 2706 / 1942
-# iterations counted, the sweeps' CPU 20 / 31 s against 22 / 47 s estimated: within x 2;
-# the two-example refit fits worse, 0.6 and 1.8 of the sweeps' CPU). Refitted after issue
-# 28's last solver changes (bench make, main's 2c0e597, load 0.7-1.9 on a 2-core AMD EPYC,
-# speed factor 0.62-0.65): 2335 / 1899 iterations counted against 2509 / 2162 predicted by
-# 9.0 and 7.8.
+# take 4 x the nominal's), at REFERENCE_UNKNOWNS, growing as unknowns^ITERATION_GROWTH: a net
+# with border cables and one with a free top differ. Counted by bench make at 1:40 on both
+# examples and refitted when the solver changes (benchmarks/measurements.md#budget-iterations).
 ITERATIONS_PER_LEVEL = {"border cables": 8.4, "free top": 6.9}
 REFERENCE_UNKNOWNS = 1000
 ITERATION_GROWTH = 0.34
 # CPU of one iteration on one core: ITERATION_S + ITERATION_S_PER_UNKNOWN x unknowns, a least-
-# squares fit (bench make) over the 20 sweeps of both examples at 1:40 (1000 to 3500 unknowns;
-# each sweep's CPU within 0.66 to 1.59 of the fit given its counted iterations; before
-# 7e27773: 2.7 ms + 7.9 us per unknown). Refitted with the iterations above, in the reference
-# machine's seconds (printgen.run.speed): 44 sweeps, each within 0.56 to 1.54 of the fit
-# (was 3.3 ms + 5.1 us per unknown).
+# squares fit (bench make) over the sweeps of both examples at 1:40 (1000 to 3500 unknowns),
+# given their counted iterations, in the reference machine's seconds (printgen.run.speed;
+# benchmarks/measurements.md#budget-iteration-cpu).
 ITERATION_S = 1.2e-3
 ITERATION_S_PER_UNKNOWN = 2.9e-6
-# CPU beside the sweeps (bench make; PRINTGEN_SERIAL=1 on the 1:40 example): the steel
-# counter-example (1.9 s, a job beside the nominal pair) and the verification's report: the
-# comparison, its figures and tables (5.7 s; the simple barrier's step: 8.0 s with the jobs'
-# start and results; measured before the figures were drawn side by side in the helper's
-# workers, main's ad2ac34). Kept: bench timeline (branch timeline, load 3 to 4.6) measures
-# the counter-example at 1.5 s of CPU, and the report's figures at 3.8 s of CPU on the simple
-# barrier and 7.6 s on the 1:40 example (its kit's included), ~2 and ~4 s on 2 cores; the
-# rest of VERIFY_REPORT_S stands for what the estimate does not count (the fork server's and
-# the helper's start, the hand-over of the sweeps), and both examples already ran longer
-# than estimated
+# CPU beside the sweeps: the steel counter-example (a job beside the nominal pair) and the
+# verification's report (the comparison, its figures and tables); VERIFY_REPORT_S also stands
+# for what the estimate does not count (the fork server's and the helper's start, the hand-over
+# of the sweeps). Measured by bench make and bench timeline
+# (benchmarks/measurements.md#budget-verification-extras).
 COUNTEREXAMPLE_S = 2.0
 VERIFY_REPORT_S = 6.0
-MESH_S_PER_SEGMENT = 1e-4  # meshes step per model net segment (simple 1:40: 4962 in 0.46 s)
-# The parts' steps, CPU of make's own process (bench make, 1:40): 1.1 s on the simple barrier
-# (no cables), 2.4 s on the 1:40 example (its kit's previews now drawn in the helper's workers;
-# 7.2 s before)
+MESH_S_PER_SEGMENT = 1e-4  # meshes step per model net segment
+# The parts' steps, CPU of make's own process (bench make, 1:40; the kit's previews are drawn
+# in the helper's workers: benchmarks/measurements.md#budget-parts)
 CABLE_PARTS_S = 1.3  # the four cables: meshes, 3MF, plate, slicer profiles, G-code
 CABLE_PART_S = CABLE_PARTS_S / 4  # one cable
 FIXED_S = 2.0  # start-up, planning, the net's parts and slicer profile, the report

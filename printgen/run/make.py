@@ -323,8 +323,8 @@ def swept_cases(options: MakeOptions) -> int:
 def run_bound(options: MakeOptions) -> float | None:
     """Seconds after which the run stops: --time-limit when given. Without it a run is only
     refused when estimated over DEFAULT_LIMIT_S, never stopped: a shared machine can run
-    many times slower than the estimate (the 1:40 example, estimated at 7 s, took 6 min
-    under a load of 20 on 2 cores), and a run that does finish should not be lost."""
+    many times slower than the estimate (benchmarks/measurements.md#make-no-default-stop), and
+    a run that does finish should not be lost."""
     limit = options.time_limit_s
     return float(limit) if limit else None
 

@@ -2,14 +2,14 @@
 fixed solve here over its CPU time on the machine budget.py's constants were measured on.
 
 The constants of budget.py are CPU seconds on one machine; a laptop, a lab's desktop or a CI
-runner may be several times faster or slower (issue 28: the simple barrier, estimated at 30 s
-from constants fitted on one machine, ran in 9 s on another). The workload timed here is the
-solver's own (scene simple-pinned at 61 x 21 nodes, barrier-physics.md section 7, solved at
-the tolerance its reference time was measured at): the sweeps are most of a run's time, and the parts' steps are
-numpy and Python work of the same kind. It is timed as CPU of this process
-(`time.process_time`), best of CALIBRATION_REPEAT after one untimed solve (imports and
-first-call costs), so that other processes on a shared machine barely change it: the
-estimate stays what the run costs on this machine, and a loaded machine is not refused for
+runner may be several times faster or slower (benchmarks/measurements.md#speed-reference:
+constants fitted on one machine estimated a run three times too long on another). The workload
+timed here is the solver's own (scene simple-pinned at 61 x 21 nodes, barrier-physics.md
+section 7, solved at the tolerance its reference time was measured at): the sweeps are most of
+a run's time, and the parts' steps are numpy and Python work of the same kind. It is timed as
+CPU of this process (`time.process_time`), best of CALIBRATION_REPEAT after one untimed solve
+(imports and first-call costs), so that other processes on a shared machine barely change it:
+the estimate stays what the run costs on this machine, and a loaded machine is not refused for
 its load. Assumption stated: every step of a run scales with the machine as this solve does.
 """
 
@@ -26,8 +26,7 @@ CALIBRATION_REPEAT = 3  # timed solves (the best kept) after one untimed
 CALIBRATION_TOL = 1e-6  # the tolerance REFERENCE_CPU_S was measured at (bench solver's GOAL_TOL;
 # not the verification's SOLVER_TOL, 1e-7: the reference time is bench solver's)
 # CPU of the calibration solve on the machine budget.py's constants were measured on: bench
-# solver's 61 x 21 solve at tol 1e-6 there, 0.049-0.054 s (issue 28's table; 0.049-0.052 s
-# on main's a82e63a, the same solver as now at that size)
+# solver's 61 x 21 solve at tol 1e-6 there (benchmarks/measurements.md#speed-reference)
 REFERENCE_CPU_S = 0.050
 SPEED_ENV = "PRINTGEN_SPEED"  # a fixed factor instead of the measured one (benchmarks, tests)
 

@@ -1,4 +1,4 @@
-"""Model-form options of the printed model's scene (issue 25), each argued from the material or
+"""Model-form options of the printed model's scene, each argued from the material or
 the test, never fitted to the flume curve (Lambert et al. 2023, doi:10.1061/JHEND8.HYENG-13070):
 
 - net law (`NET_LAWS`): "formula" (the nominal) turns the profile's panel law into a strand
@@ -103,7 +103,7 @@ def held_on_bed(s: BarrierScene) -> BarrierScene:
     fixed[s.rows["bottom"]] = True
     note = ("bed", ("the net's bottom row rests on the flume bed, held there by contact and "
                     "friction under the film's foot (the bottom cable cannot move)"),
-            ("printgen, issue 25 (the film seals on the bed; Lambert et al. 2023: folded film "
+            ("printgen (the film seals on the bed; Lambert et al. 2023: folded film "
              "larger than the barrier)"))
     return dataclasses.replace(s, fixed=fixed, assumptions=(*s.assumptions, note))
 
@@ -117,7 +117,7 @@ def routed(s: BarrierScene, routing: str) -> BarrierScene:
              for k, w in s.wires.items()}
     note = ("sensor routing", ("beyond the right edge node each wire turns downstream to a "
                                "potentiometer behind the barrier"),
-            "printgen, issue 25 (the paper does not state where the potentiometers stood)")
+            "printgen (the paper does not state where the potentiometers stood)")
     return dataclasses.replace(s, wires=wires, assumptions=(*s.assumptions, note))
 
 

@@ -1,4 +1,4 @@
-"""The printed barrier mounted in the flume's free section (issue 25): the paper's printed net
+"""The printed barrier mounted in the flume's free section: the paper's printed net
 is about 330 mm wide (13.2 m / 40) while the side sheets leave a 300 mm free section
 (barrier-physics.md, section 4). How the extra width is held is not stated. Two readings:
 - "printed" (the default): the net spans its own printed width between the lateral supports

@@ -1,4 +1,4 @@
-"""Water pressure normal to the deformed net (issue 25): the loading test's folded film lies on
+"""Water pressure normal to the deformed net: the loading test's folded film lies on
 the net and the water presses it normal to its surface, so each node's load is the pressure
 at its height times its share of the net's current area vector, instead of a force along the
 flow (`solver.Hydrostatic`, the reference's section 3).

@@ -45,7 +45,7 @@ SENSOR_FORCE_N = 1.0  # wire tension of each string potentiometer (reference, se
 SENSOR_EXIT = 0.1  # the potentiometer stands this fraction of the width beyond the right edge
 __all__ = ["FLOW"]  # the flow direction, defined with the load cases (printgen.barrier.loads)
 MOUNTINGS = LATERAL  # lateral mounting in the flume ([flume] lateral), the default first
-# Panel-test orientation (issue 25): the diagonal of the mesh its panel test loaded, the one
+# Panel-test orientation: the diagonal of the mesh its panel test loaded, the one
 # a panel law is read along. The prototype's 1.33 m panel was loaded along the water-drop's
 # long axis; the printed nets' orientation is not stated, and their profile (TPE) records the
 # short diagonal, whose strand modulus matches the datasheet (see `panel_strand_law`).

@@ -1,6 +1,6 @@
 """Uncertainty bands of the pre-print check: the printed model swept for its nominal design
 and for each uncertain input it depends on, one at a time, and the min/max envelope of the
-normalised deformations at every relative loading (issue 10).
+normalised deformations at every relative loading.
 
 The variants of the printed model, as data, and their list: `printgen.verification.variants`.
 

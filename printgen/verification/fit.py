@@ -1,5 +1,5 @@
 """A bounded fit of several parameters of the printed net to a measured loading test, that
-explains the measurement or says it cannot (issue 25).
+explains the measurement or says it cannot.
 
 Parameters, each bounded by what a lab would see or measure (`BOUNDS`):
 - net_factor: multiplier on the printed net's force law (strands and printed border frame);
@@ -47,7 +47,7 @@ BOUNDS = {
     "cable_slack": (0.0, 0.03, 0.0),  # a 3 % slack cable sags 10 % of its span at rest
 }
 Choice = tuple[str, "str | None", "float | None", str]  # mounting, orientation, span, bed
-EXPLAINS = 0.15  # issue 25: RMS mismatch below 15 % of the measured peak on every column
+EXPLAINS = 0.15  # explained: RMS mismatch below 15 % of the measured peak on every column
 MAX_EVALUATIONS = 15  # least-squares steps for a retained choice (each: 1 + free sweeps)
 SCREEN_EVALUATIONS = 3  # ... for every discrete choice first (a screen)
 SCREEN_KEEP = 2  # choices searched on after the screen
@@ -192,8 +192,8 @@ class MultiFit:
         if self.at_bounds and worst < EXPLAINS:
             edge = ", ".join(self.at_bounds)
             return (f"NOT explained: the best set, {what}, leaves {worst:.0%} of the measured "
-                    f"peak, but only with {edge} at the end of its range (issue 25: "
-                    "parameters inside their bounds); no profile is written")
+                    f"peak, but only with {edge} at the end of its range (an "
+                    "explanation needs parameters inside their bounds); no profile is written")
         if self.explains:
             return (f"explained within the bounds by {what} (worst RMS mismatch {worst:.0%} of "
                     f"the measured peak); determined: {', '.join(self.identifiability.determined()) or 'none'}")

@@ -306,7 +306,7 @@ def objective(m: Measurement, predicted: dict[str, np.ndarray]) -> float:
 
 
 Predictor = Callable[[float], dict[str, np.ndarray]]
-FIT_KINDS = ("stiffness", "slack", "multi")  # multi: printgen.verification.fit (issue 25)
+FIT_KINDS = ("stiffness", "slack", "multi")  # multi: printgen.verification.fit
 STIFFNESS_RANGE = (0.2, 5.0)  # net stiffness factors searched: a printed net 5x off is a misprint
 SLACK_RANGE = (0.0, 0.03)  # initial slack searched: 3 % sags visibly, a lab would see it
 XTOL_LOG = 0.005  # stiffness factor known to 0.5 % (bounded Brent on log factor)

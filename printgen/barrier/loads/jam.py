@@ -13,9 +13,10 @@ with Ergun's law for the head gradient of a packed bed (Ergun 1952, Chem. Eng. P
 surface-volume diameter of a long cylinder D_p = 1.5 D. The net carries the jam's head
 difference, rho g [(h_u - z)+ - (h_m - z)+] A* (the logs press it on: the momentum balance of
 a channel-spanning log jam, whose drag is the head difference across it; Schalko, Follett and
-Nepf 2023, Water Resour. Res., doi:10.1029/2023WR034689, and the work it builds on), plus the drag 0.5 rho U_n^2 l d of the water through its strands
-below h_m. Porosity 0: nothing seeps (q = 0), the load is the hydrostatic case's; porosity
-towards 1: the jam vanishes, the load tends to drag only (the barrier in free flow).
+Nepf 2023, Water Resour. Res., doi:10.1029/2023WR034689, and the work it builds on), plus the
+drag 0.5 rho U_n^2 l d of the water through its strands below h_m. Porosity 0: nothing seeps
+(q = 0), the load is the hydrostatic case's; porosity towards 1: the jam vanishes, the load
+tends to drag only (the barrier in free flow).
 
 The load levels are the flume's discharge steps (the paper's log test at 1:40: 2 to 8 L/s):
 each step's upstream depth on the printed model; a step the jam holds above the overflow

@@ -1,8 +1,8 @@
 """The square net: strands across and up the barrier (the simple barrier of the scale series,
 Lambert et al. 2023, doi:10.1061/JHEND8.HYENG-13070). Its mesh is the square's side
-`mesh_x` (both ways; a printed square net must have mesh_y = mesh_x, `check_square`). Under a stretch eps along the load the strands
-up the barrier strain eps and carry it, one per mesh across: N = E A / a_across * eps; the
-strands across carry nothing (transverse strain blocked).
+`mesh_x` (both ways; a printed square net must have mesh_y = mesh_x, `check_square`). Under a
+stretch eps along the load the strands up the barrier strain eps and carry it, one per mesh
+across: N = E A / a_across * eps; the strands across carry nothing (transverse strain blocked).
 
 Graph: nodes at (i a, j a); strands up (family +1, the columns i = 1 .. nx-1) and across
 (family -1, the rows j = 1 .. ny-1) from border to border; the perimeter rows and columns are

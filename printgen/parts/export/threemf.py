@@ -56,7 +56,8 @@ def prusa_config_from_ini(ini_text: str) -> str:
         lines.append(f"; {key} = {value}")
     if len(lines) == 1:
         raise InputError("the PrusaSlicer settings hold no 'key = value' line; pass the .ini "
-                         "text from printgen.parts.slicer.prusa (or None for a 3MF without settings)")
+                         "text from printgen.parts.slicer.prusa (or None for a 3MF without "
+                         "settings)")
     return "\n".join(lines) + "\n"
 
 

@@ -11,6 +11,7 @@ COMB runs over beads already printed in the layer and is not retracted by the wr
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -143,18 +144,20 @@ def check_part(part_kind: str, part: NetDesign | CableDesign, printer: Printer,
     if sec.thickness_mm > printer.max_height_mm:
         raise PrintabilityError(f"{where}: thickness {sec.thickness_mm:g} mm exceeds the "
                                 f"{printer.max_height_mm:g} mm build height of {printer.key}")
-    if part_kind == "net":
-        check_pass(printer, border_bead(part)[1], sec.layer_heights_mm[0], where=f"{where} border")
-        size = np.array(part.graph().size_mm) \
-            + 2 * max(part.border_width_mm / 2, reach_mm)
+    if part_kind == "net":  # part_kind names the part's type (mypy cannot follow a string)
+        net = cast(NetDesign, part)
+        check_pass(printer, border_bead(net)[1], sec.layer_heights_mm[0], where=f"{where} border")
+        size = np.array(net.graph().size_mm) \
+            + 2 * max(net.border_width_mm / 2, reach_mm)
     else:
-        ring_w = ring_layout(part, printer.hole_compensation_mm)[1]
+        cable = cast(CableDesign, part)
+        ring_w = ring_layout(cable, printer.hole_compensation_mm)[1]
         check_pass(printer, ring_w, sec.layer_heights_mm[0], where=f"{where} eyelet ring")
-        if sec.width_mm >= part.eyelet_outer_mm:
+        if sec.width_mm >= cable.eyelet_outer_mm:
             raise PrintabilityError(
                 f"{where}: strip {sec.width_mm:g} mm is not narrower than the eyelet "
-                f"({part.eyelet_outer_mm:g} mm outer diameter); widen the eyelet")
-        size = np.array([part.length_mm + part.eyelet_outer_mm, part.eyelet_outer_mm])
+                f"({cable.eyelet_outer_mm:g} mm outer diameter); widen the eyelet")
+        size = np.array([cable.length_mm + cable.eyelet_outer_mm, cable.eyelet_outer_mm])
     return place_on_bed(size, printer, where=where)
 
 
@@ -176,9 +179,11 @@ def place_on_bed(size_mm: np.ndarray, printer: Printer, *, where: str) -> tuple[
 def wall_loops(part_kind: str, part: NetDesign | CableDesign) -> int:
     """Perimeter loops a slicer needs to fill the widest band of the part (2 beads a loop)."""
     if part_kind == "net":
-        beads = max(part.strand.beads_across, border_bead(part)[0])
+        net = cast(NetDesign, part)
+        beads = max(net.strand.beads_across, border_bead(net)[0])
     else:
-        beads = max(part.section.beads_across, ring_layout(part)[0])
+        cable = cast(CableDesign, part)
+        beads = max(cable.section.beads_across, ring_layout(cable)[0])
     return max(1, -(-beads // 2))
 
 

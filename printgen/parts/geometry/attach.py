@@ -26,7 +26,7 @@ from printgen.barrier.graph import NetGraph
 from printgen.design.record import Design, NetDesign
 from printgen.errors import GeometryError
 
-DEFAULT_CLEARANCE_MM = 0.3  # issue 12: at least 0.3 mm each side of the strip in a loop
+DEFAULT_CLEARANCE_MM = 0.3  # at least 0.3 mm each side of the strip in a loop
 CORNER_EXTRA_RINGS = 1  # full bead rings around the pin hole, inside the border's detour
 MIN_WEB_FRACTION = 1.0  # material between two holes: at least one ring width
 

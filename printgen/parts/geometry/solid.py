@@ -86,12 +86,12 @@ def net_outline(net: NetDesign, attachment: Attachment | None = None):
     from shapely.geometry import Polygon
 
     pieces = [*_strand_bands(net, g), _frame(net, g)]
-    pieces += [Polygon(circle_points(*h.centre_mm, h.outer_r_mm)) for h in hs]
+    pieces += [Polygon(circle_points(h.centre_mm[0], h.centre_mm[1], h.outer_r_mm)) for h in hs]
     outline = shapely.unary_union(pieces)
     if not hs:
         return outline
     return outline.difference(shapely.unary_union(
-        [Polygon(circle_points(*h.centre_mm, h.hole_r_mm)) for h in hs]))
+        [Polygon(circle_points(h.centre_mm[0], h.centre_mm[1], h.hole_r_mm)) for h in hs]))
 
 
 def _strand_bands(net: NetDesign, g: NetGraph) -> list:
@@ -179,7 +179,7 @@ def _strands_near(g: NetGraph, centre_mm: np.ndarray, reach_mm: float) -> list:
     t = np.clip(np.einsum("ij,ij->i", centre_mm - ends[:, 0], d)
                 / np.einsum("ij,ij->i", d, d), 0.0, 1.0)
     gap = np.hypot(*(ends[:, 0] + t[:, None] * d - centre_mm).T)
-    return [s for s, near in zip(g.strands, gap <= reach_mm) if near]
+    return [s for s, near in zip(g.strands, gap <= reach_mm, strict=True) if near]
 
 
 def analytic_net_volume(net: NetDesign, attachment: Attachment | None = None) -> float:

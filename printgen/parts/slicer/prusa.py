@@ -64,7 +64,7 @@ def prusa_settings(part_kind: str, design_part: NetDesign | CableDesign, printer
 
 
 # PrusaSlicer 2.5 lays short moves up to 5.3 % over its own max_volumetric_speed (a TPE
-# coupon's eyelet: 1.58 mm3/s at a 1.5 limit, issue 27); the cap it gets is this x the limit
+# coupon's eyelet: 1.58 mm3/s at a 1.5 limit); the cap it gets is this x the limit
 PRUSA_FLOW_MARGIN = 0.95
 
 
@@ -95,7 +95,7 @@ def _layers(part_kind: str, part: NetDesign | CableDesign, style: PrintStyle,
     sec = part_section(part_kind, part)
     bead = sec.bead_width_mm
     # an odd bead count leaves one medial bead, which needs the wider extrusion; an even one
-    # is filled by whole loops at the bead width (wider, 2-bead strands fail: issue 27)
+    # is filled by whole loops at the bead width (wider, 2-bead strands fail)
     factor = style.slicer_width_factor if sec.beads_across % 2 else 1.0
     width = f"{factor * bead:.4g}"
     s = {
