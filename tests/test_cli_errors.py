@@ -116,6 +116,22 @@ def test_unexpected_error_is_one_line_with_a_hint(capsys, monkeypatch):
     assert code == 1 and "internal error: ZeroDivisionError" in line and "report" in line
 
 
+def test_a_solve_that_did_not_converge_exits_2(capsys, monkeypatch):
+    """One SolverError class, the solver's: printgen's error handling reports it like its own
+    errors (one line, exit 2), and printgen.errors names the same class."""
+    import solver
+    from printgen import errors
+
+    def diverged(*a, **k):
+        raise errors.SolverError("simple barrier prototype: no convergence")
+
+    assert errors.SolverError is solver.SolverError
+    monkeypatch.setattr(api, "targets", diverged)
+    code, _, err = run(capsys, "targets", REALISTIC, "--scale", 40)
+    assert code == 2 and one_line(err) == ("printgen targets: error: simple barrier prototype: "
+                                           "no convergence")
+
+
 def test_a_dead_worker_is_one_line(capsys, monkeypatch):
     from concurrent.futures.process import BrokenProcessPool
 
