@@ -69,12 +69,9 @@ def add_load_args(p: argparse.ArgumentParser, what: str, *, several: bool = Fals
     """--load NAME (a load case of printgen/barrier/loads), its alias --drag, --load-param
     KEY=VALUE (a parameter of the chosen case, e.g. the jam's porosity) and, with `several`,
     --loads A,B (each case's expected readings side by side)."""
-    from printgen.barrier.loads import DEFAULT, case_names
+    from printgen.barrier.loads import case_names
 
-    p.add_argument("--load", choices=case_names(), default=None,
-                   help=f"{what} under this load case (default {DEFAULT}; flow: hydrostatic + "
-                        "drag at a velocity rising with the depth; drag: at a fixed velocity; "
-                        "jam: seepage through a log jam at the flume's discharge steps)")
+    p.add_argument("--load", choices=case_names(), default=None, help=load_help(what))
     p.add_argument("--drag", action="store_const", dest="load", const="drag",
                    help="the same as --load drag")
     p.add_argument("--load-param", action="append", default=[], metavar="KEY=VALUE",
@@ -85,6 +82,15 @@ def add_load_args(p: argparse.ArgumentParser, what: str, *, several: bool = Fals
                        help="also write each load case's expected readings "
                             "(expected-readings-<case>.csv), e.g. hydrostatic,jam; the "
                             "verification runs under --load, or the first of these")
+
+
+def load_help(what: str) -> str:
+    """--load's help: every registered load case with its title, the default named, so a
+    new case module is listed without editing the command line."""
+    from printgen.barrier.loads import DEFAULT, load_cases
+
+    cases = "; ".join(f"{c.name}: {c.title}" for c in load_cases().values())
+    return f"{what} under this load case (default {DEFAULT}; {cases})".replace("%", "%%")
 
 
 def load_list(text: str) -> tuple[str, ...]:
