@@ -12,7 +12,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from solver.result import SolverError
+    from solver.result import SolverError  # noqa: F401 (for type checkers: `__getattr__`)
 
 
 class PrintgenError(Exception):
