@@ -18,6 +18,7 @@ from conftest import alive
 import printgen.run.make as make_mod
 from printgen import workers
 from printgen.report.jsonout import dumps
+from printgen.run.options import RunOptions
 from printgen.run.provenance import split_timings
 
 GONE_WITHIN_S = 5.0  # issue 16: no worker left 5 s after the parent stops
@@ -142,7 +143,7 @@ def test_verification_in_the_helper_equals_the_verification_step(made_simple_dra
     started = []
     monkeypatch.setattr(make_mod, "helper", _spy(make_mod.helper, started))
     ahead = make_mod.make(path, 40, tmp_path / "ahead", steps=steps,
-                          options=make_mod.MakeOptions(load="drag"))
+                          options=RunOptions(load="drag"))
     assert started == ["verification_sweeps", "draw_all"]  # the figures: drawn in its workers
     assert ahead.report.blocks == inline.report.blocks
     assert (dumps(split_timings(ahead.record["verification"])[0])

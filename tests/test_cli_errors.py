@@ -18,6 +18,7 @@ import printgen.run.make as make_mod
 from printgen.cli import main
 from printgen.inputs.prototype import ranges_markdown
 from printgen.run import api
+from printgen.run.options import RunOptions
 from printgen.workers import Interrupted
 
 
@@ -326,5 +327,5 @@ def test_time_limit_zero_is_refused_by_the_api_too(tmp_path):
     from printgen.errors import InputError
 
     with pytest.raises(InputError, match="must be a positive number of seconds"):
-        make_mod.make(REALISTIC, 40, tmp_path / "o", options=make_mod.MakeOptions(time_limit_s=0),
+        make_mod.make(REALISTIC, 40, tmp_path / "o", options=RunOptions(time_limit_s=0),
                       steps=[])

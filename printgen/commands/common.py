@@ -5,13 +5,16 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rich.console import Console
 from rich.table import Table
 
 from printgen.inputs.profiles import profile_name
 from printgen.report.jsonout import dumps
+
+if TYPE_CHECKING:
+    from printgen.run.options import RunOptions
 
 EXIT_INCOMPLETE = 3  # outputs written, but the verdict rests on fewer load levels than asked
 
@@ -127,6 +130,23 @@ def load_specs(args: argparse.Namespace) -> tuple[str | None, tuple[str, ...]]:
         return with_params(name, [x for x in params if x.partition("=")[0].strip() in own])
 
     return (spec(main) if main else None), tuple(spec(x) for x in listed)
+
+
+def run_options(args: argparse.Namespace) -> RunOptions:
+    """The run's options record from the command line: every option of it the command has
+    (the load cases as specs with --load-param's values, `load_specs`), and the command line
+    itself; what the command does not give keeps the record's default."""
+    from printgen.run.options import RunOptions
+
+    given = {"printer": "printer", "step": "step", "pdf": "pdf", "design_file": "design",
+             "time_limit_s": "time_limit", "force": "force", "scheduler": "scheduler",
+             "workers": "workers", "serial": "serial"}
+    kw = {field: getattr(args, arg) for field, arg in given.items()
+          if getattr(args, arg, None) is not None}
+    if hasattr(args, "load"):
+        load, loads = load_specs(args)
+        kw.update({"loads": loads} | ({"load": load} if load is not None else {}))
+    return RunOptions(command=getattr(args, "argv", None), **kw)
 
 
 def add_json_arg(p: argparse.ArgumentParser) -> None:

@@ -8,7 +8,14 @@ import argparse
 import sys
 from pathlib import Path
 
-from printgen.commands.common import add_json_arg, check_profile_args, console, emit_json, table
+from printgen.commands.common import (
+    add_json_arg,
+    check_profile_args,
+    console,
+    emit_json,
+    run_options,
+    table,
+)
 from printgen.errors import InputError
 from printgen.run import api
 from printgen.run.search import DesignRun, SearchOptions
@@ -68,9 +75,8 @@ def run(args: argparse.Namespace) -> int:
         border_beads=_ints(args.border_beads, "--border-beads"), printer=args.printer,
         verify_nets=args.verify_nets, level_step=args.level_step)
     out = args.out or Path("out") / f"{Path(args.prototype).stem}-design"
-    result = api.search_nets(args.prototype, scales, options=opts, scheduler=args.scheduler,
-                             workers=args.workers, serial=args.serial, progress=not args.json,
-                             out=out, main_scale=args.scale)
+    result = api.search_nets(args.prototype, scales, options=opts, run=run_options(args),
+                             progress=not args.json, out=out, main_scale=args.scale)
     if args.json:
         emit_json(result.record)
         return 0

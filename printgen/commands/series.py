@@ -16,7 +16,7 @@ from printgen.commands.common import (
     check_profile_args,
     console,
     emit_json,
-    load_specs,
+    run_options,
     table,
 )
 from printgen.errors import InputError
@@ -66,8 +66,7 @@ def run(args: argparse.Namespace) -> int:
     err = Console(stderr=True, highlight=False)
     with err.status("reading inputs") as status:
         res = api.series(args.prototype, _scales(args.scales), materials=args.materials,
-                         load=load_specs(args)[0], net=args.solver_net, out=out, serial=args.serial,
-                         scheduler=args.scheduler, workers=args.workers, force=args.force,
+                         net=args.solver_net, out=out, options=run_options(args),
                          progress=lambda s: status.update(f"{s} ..."), bar=not args.json)
     if args.json:
         emit_json(res.record)

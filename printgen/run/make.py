@@ -20,7 +20,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from printgen.barrier.loads import DEFAULT as DEFAULT_LOAD
 from printgen.barrier.loads import distinct_specs, get_load
 from printgen.design.design_file import load_design
 from printgen.design.plan import make_design
@@ -45,6 +44,7 @@ from printgen.run.budget import (
     level_bars,
     sweep_cores,
 )
+from printgen.run.options import RunOptions
 from printgen.run.provenance import (  # noqa: F401 (json_output, TIME_KEYS: used via make)
     TIME_KEYS,
     json_output,
@@ -80,28 +80,6 @@ log = logging.getLogger(__name__)
 JOB_MODULES = ("printgen.run.steps", "printgen.verification.pooled", "printgen.report.plots")
 
 
-@dataclass(frozen=True)
-class MakeOptions:
-    """How `make` runs (what the command line gives).
-
-    load : the verification's load case (printgen/barrier/loads, a spec with its parameters);
-    loads : the load cases whose expected readings are written side by side (--loads, the
-    verification's own included when listed); step : also write STEP;
-    design_file : print this design.json instead of the selection's choice; time_limit_s :
-    refuse runs estimated longer; force : replace a folder printgen did not write;
-    command : the command line, recorded in the manifest; pdf : also print report.pdf.
-    """
-
-    load: str = DEFAULT_LOAD
-    loads: tuple[str, ...] = ()  # --loads: each case's expected readings (nominal sweeps)
-    step: bool = False
-    design_file: str | Path | None = None
-    time_limit_s: float | None = None  # None: refused only when estimated over DEFAULT_LIMIT_S
-    force: bool = False
-    command: list[str] | None = None
-    pdf: bool = False
-
-
 @dataclass
 class MakeContext:
     """What the steps share: inputs, the chosen design, the report being built; `record`
@@ -112,7 +90,7 @@ class MakeContext:
     selection: Selection
     design: Design
     report: Report
-    options: MakeOptions = field(default_factory=MakeOptions)
+    options: RunOptions = field(default_factory=RunOptions)
     record: dict[str, Any] = field(default_factory=dict)
     files: list[str] = field(default_factory=list)
     progress: Callable[[str], None] | None = None  # a step's finer progress (STEP per part)
@@ -125,13 +103,13 @@ class MakeContext:
 Step = Callable[[MakeContext, Path], dict[str, Any]]  # its records, by report.json key
 
 
-def plan(prototype_path: str | Path, scale: float, *, printer: str | None = None,
-         options: MakeOptions | None = None) -> MakeContext:
+def plan(prototype_path: str | Path, scale: float, *,
+         options: RunOptions | None = None) -> MakeContext:
     """Targets, selection and design: the fast, file-free part of `make`."""
-    options = options or MakeOptions()
+    options = options or RunOptions()
     proto = load_prototype(prototype_path)
     t = scale_targets(proto, scale)
-    sel = select(proto, t, printer=printer)
+    sel = select(proto, t, printer=options.printer)
     design = make_design(proto, t, sel)
     design_file, own = options.design_file, None
     if design_file:  # the net of `printgen design` (its design.json) instead of select's
@@ -149,8 +127,7 @@ def plan(prototype_path: str | Path, scale: float, *, printer: str | None = None
 
 
 def make(prototype_path: str | Path, scale: float, out: str | Path, *,
-         printer: str | None = None, steps: list[tuple[str, Step]] | None = None,
-         options: MakeOptions | None = None,
+         steps: list[tuple[str, Step]] | None = None, options: RunOptions | None = None,
          progress: Callable[[str], None] | None = None) -> MakeContext:
     """Run every step into a stage folder and swap it in as the whole of `out`.
 
@@ -159,11 +136,11 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     """
     t0 = time.perf_counter()
     warm_up()
-    options = options or MakeOptions()
+    options = options or RunOptions()
     inputs = [prototype_path, options.design_file, *search_dirs()]
     check_destination(Path(out), force=options.force, inputs=inputs)  # fail fast
     with span("make: plan and estimate"):
-        ctx = plan(prototype_path, scale, printer=printer, options=options)
+        ctx = plan(prototype_path, scale, options=options)
         est = size_check(ctx, steps is None or any(s is verify_step for _, s in steps))
     if progress and est.seconds > LONG_RUN_S:
         progress(f"estimate: {est.summary()}")
@@ -244,8 +221,7 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]]) -> Itera
     with helper() as h:
         ctx.helper = h
         ctx.background["verification sweeps"] = ctx.helper.submit(
-            timed, verification_sweeps, ctx.prototype, ctx.design, load=ctx.options.load,
-            loads=ctx.options.loads)
+            timed, verification_sweeps, ctx.prototype, ctx.design, ctx.options)
         try:
             with signals_deferred():  # a signal meanwhile would be lost in trimesh's imports
                 preload_parts()
@@ -295,13 +271,13 @@ def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
     return est
 
 
-def swept_cases(options: MakeOptions) -> int:
+def swept_cases(options: RunOptions) -> int:
     """Load cases the verification sweeps: its own and each other one of --loads."""
     own = get_load(options.load).spec
     return 1 + sum(spec != own for spec in distinct_specs(options.loads))
 
 
-def run_bound(options: MakeOptions) -> float | None:
+def run_bound(options: RunOptions) -> float | None:
     """Seconds after which the run stops: --time-limit when given. Without it a run is only
     refused when estimated over DEFAULT_LIMIT_S, never stopped: a shared machine can run
     many times slower than the estimate (the 1:40 example, estimated at 7 s, took 6 min

@@ -28,6 +28,7 @@ from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import check_destination, write_folder
 from printgen.report.jsonout import dumps
+from printgen.run.options import RunOptions
 from printgen.search.nets import (
     SearchResult,
     VerifyScore,
@@ -104,13 +105,14 @@ def space_for(p: Prototype, scale: float, o: SearchOptions) -> SearchSpace:
 
 
 def search_at_scales(prototype: str | Path | Prototype, scales: list[float], *,
-                    options: SearchOptions = SearchOptions(), scheduler: str | None = None,
-                    workers: int | None = None, serial: bool = False,
-                    progress: bool = False) -> DesignRun:
-    """Search at every scale on one Dask runner (a LocalCluster unless `scheduler`/`serial`)."""
+                    options: SearchOptions = SearchOptions(),
+                    run: RunOptions | None = None, progress: bool = False) -> DesignRun:
+    """Search at every scale on one runner (`run`: this machine's workers, the Dask
+    scheduler at `run.scheduler`, or serially)."""
+    run = run or RunOptions()
     p = prototype if isinstance(prototype, Prototype) else load_prototype(prototype)
     results = []
-    with open_runner(scheduler=scheduler, workers=workers, serial=serial,
+    with open_runner(scheduler=run.scheduler, workers=run.workers, serial=bool(run.serial),
                      progress=progress) as runner:
         for s in scales:
             results.append(search(p, s, runner, objective=options.objective,

@@ -22,6 +22,7 @@ from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import TIMINGS, check_destination, write_folder
 from printgen.report.jsonout import dumps
 from printgen.report.series import series_csv, series_figure, series_report
+from printgen.run.options import RunOptions
 from printgen.search.sweep import open_runner
 from printgen.verification.scenes import SENSOR_FORCE_N
 from printgen.verification.series import (
@@ -53,19 +54,22 @@ class SeriesRun:
 
 
 def run_series(prototype: str | Path | Prototype, scales: list[float], *,
-               materials: tuple[str, ...] = (), load: str | None = None,
-               net: NetOptions | None = None, level: float = LEVEL,
-               level_step: float = LEVEL_STEP, out: str | Path | None = None,
-               serial: bool | None = None, scheduler: str | None = None,
-               workers: int | None = None, force: bool = False,
+               materials: tuple[str, ...] = (), net: NetOptions | None = None,
+               level: float = LEVEL, level_step: float = LEVEL_STEP,
+               out: str | Path | None = None, options: RunOptions | None = None,
                progress: Callable[[str], None] | None = None, bar: bool = False) -> SeriesRun:
     """Check every input, solve every (row, lambda) case, summarise, write `out` (if given).
 
-    `serial` None: serially up to PARALLEL_FROM cases, on a local Dask cluster from there (a
-    `scheduler` address or `workers` always mean Dask); the numbers are the same either way.
+    `options` (`RunOptions`): the load case, where the cases run and whether `out` may be
+    replaced. `options.serial` None: serially up to PARALLEL_FROM cases, in parallel from
+    there (a `scheduler` address or `workers` always mean parallel); the numbers are the same
+    either way.
     """
     say = progress or (lambda _text: None)
     t0 = time.perf_counter()
+    options = options or RunOptions()
+    load, force, serial = options.load, options.force, options.serial
+    scheduler, workers = options.scheduler, options.workers
     lams = check_scales(scales)
     if serial and (workers is not None or scheduler):
         raise InputError("--serial runs in this process: leave out --workers/--scheduler, or "

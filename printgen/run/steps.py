@@ -37,6 +37,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from printgen.parts.gcode.toolpath import Toolpath
     from printgen.report.html import Drawing, FigureFile
     from printgen.run.make import MakeContext
+    from printgen.run.options import RunOptions
     from printgen.verification.bands import Band
     from printgen.verification.verify import Verification
 
@@ -245,8 +246,7 @@ def verify_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     computed here; then every figure of the report, drawn (`draw_figures`)."""
     sweeps = sweeps_done(ctx)
     if sweeps is None:
-        sweeps = verification_sweeps(ctx.prototype, ctx.design, load=ctx.options.load,
-                                     loads=ctx.options.loads)
+        sweeps = verification_sweeps(ctx.prototype, ctx.design, ctx.options)
     with span("verify: report"):
         blocks, figures, record = verification_report(*sweeps, ctx.targets.scale)
     ctx.report.blocks.extend(blocks)
@@ -317,9 +317,10 @@ def timed(fn: Callable, /, *args: Any, **kwargs: Any) -> tuple[Any, float]:
     return fn(*args, **kwargs), time.perf_counter() - t
 
 
-def verification_sweeps(prototype: Prototype, design: Design, *, load: str | None = None,
-                        loads: tuple[str, ...] = ()) -> tuple[Verification, Band]:
-    """Both barriers' load sweeps compared, and the model's uncertainty band.
+def verification_sweeps(prototype: Prototype, design: Design,
+                        options: RunOptions) -> tuple[Verification, Band]:
+    """Both barriers' load sweeps compared, and the model's uncertainty band, under the
+    run's load case (`options.load`; each of `options.loads` too, nominal sweeps only).
 
     The sweep is the scene realistic-1:40 with border cables, simple-free-top without them
     (README: Pre-print verification); every load level is solved on both. Needs nothing from
@@ -330,9 +331,9 @@ def verification_sweeps(prototype: Prototype, design: Design, *, load: str | Non
     from printgen.verification.verify import free_section
 
     # matplotlib is imported while the sweeps run: the figures' workers start with it
-    return verify_with_band(prototype, design, load=load, counterexample=True,
+    return verify_with_band(prototype, design, load=options.load, counterexample=True,
                             free_section=free_section(prototype), meanwhile=load_pyplot,
-                            loads=tuple(loads))
+                            loads=tuple(options.loads))
 
 
 def solver_work(v: Verification, band: Band) -> dict[str, Any]:

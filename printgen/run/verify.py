@@ -33,6 +33,7 @@ from printgen.report.uncertainty import (
     measured_sections,
 )
 from printgen.run.budget import DEFAULT_LIMIT_S, Work, check_budget, sweep_cores
+from printgen.run.options import RunOptions
 from printgen.verification.bands import Band, band_verdicts, model_load_kw
 from printgen.verification.fit import MultiFit, fit_levels, fit_measured
 from printgen.verification.layout import flume_layout
@@ -70,9 +71,8 @@ class VerifyRun:
 
 def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
                   out: str | Path, *, measured: str | Path | None = None,
-                  fit: str = "stiffness", load: str | None = None, force: bool = False,
-                  progress: Callable[[str], None] | None = None,
-                  time_limit_s: float | None = None) -> VerifyRun:
+                  fit: str = "stiffness", options: RunOptions | None = None,
+                  progress: Callable[[str], None] | None = None) -> VerifyRun:
     """Check the design against the prototype with its band; compare and fit `measured`.
 
     Every input is read and checked before the first solve, so a bad file costs nothing; so
@@ -81,6 +81,8 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     """
     say = progress or (lambda _label: None)
     t0 = time.perf_counter()
+    options = options or RunOptions()
+    load, force, time_limit_s = options.load, options.force, options.time_limit_s
     preload(JOB_MODULES)  # a fork server's imports, while the inputs are read
     inputs = [prototype, design_path, measured, *search_dirs()]
     check_destination(Path(out), force=force, inputs=inputs)  # before any work
