@@ -12,7 +12,7 @@ The public verbs (`printgen.run.api`), imported on first use so `import printgen
 - ``verify(prototype, scale, design=None)`` -> `Verification`
 - ``verify_design(prototype, scale, design_file, out)`` -> `VerifyRun` (printgen verify's folder)
 - ``calibrate(paths, material=...)`` -> `Calibration`
-- ``search_nets(prototype, scales)`` -> `DesignRun` (the inverse design, on Dask)
+- ``search_nets(prototype, scales)`` -> `DesignRun` (the inverse design, in parallel)
 - ``series(prototype, scales)`` -> `SeriesRun` (the virtual scale series)
 """
 

@@ -17,8 +17,8 @@ from typing import NoReturn
 
 import printgen
 from printgen.errors import PrintgenError, TimeLimitError, reported
+from printgen.executor.signals import Interrupted, signals_raise
 from printgen.outputs import describe_os_error, os_error_exit_code, tracking_swaps
-from printgen.workers import Interrupted, signals_raise
 
 # One entry per command module; a module may register several subcommands.
 COMMAND_MODULES = (

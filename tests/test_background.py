@@ -16,7 +16,8 @@ import pytest
 from conftest import alive
 
 import printgen.run.make as make_mod
-from printgen import workers
+from printgen.executor import local as workers
+from printgen.executor import signals
 from printgen.report.jsonout import dumps
 from printgen.run.options import RunOptions
 from printgen.run.provenance import split_timings
@@ -108,8 +109,8 @@ def test_a_failure_in_the_block_kills_the_worker_and_its_workers(tmp_path, monke
 
 def test_signals_deferred_holds_a_signal_until_the_block_ends():
     reached = []
-    with pytest.raises(workers.Interrupted) as exc, workers.signals_raise(), \
-            workers.signals_deferred():
+    with pytest.raises(signals.Interrupted) as exc, signals.signals_raise(), \
+            signals.signals_deferred():
         try:
             os.kill(os.getpid(), signal.SIGTERM)
             time.sleep(0.2)  # the handler has run by now: it only held the signal
@@ -128,7 +129,7 @@ def test_signals_deferred_outside_the_main_thread_is_a_no_op():
 
 
 def _deferred_in_thread() -> bool:
-    with workers.signals_deferred():
+    with signals.signals_deferred():
         return True
 
 

@@ -16,10 +16,10 @@ from proto_files import REALISTIC, SIMPLE, write_variant
 
 import printgen.run.make as make_mod
 from printgen.cli import main
+from printgen.executor.signals import Interrupted
 from printgen.inputs.prototype import ranges_markdown
 from printgen.run import api
 from printgen.run.options import RunOptions
-from printgen.workers import Interrupted
 
 
 def run(capsys, *argv):

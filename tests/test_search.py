@@ -97,7 +97,7 @@ def test_same_json_serial_local_cluster_and_remote_scheduler(serial_run):
                       dashboard_address=None) as cluster:
         remote = search_at_scales(REALISTIC, [SCALE], options=SMALL,
                                   run=RunOptions(scheduler=cluster.scheduler_address))
-    assert "local Dask cluster" in local.where and "scheduler" in remote.where
+    assert "local pool" in local.where and "Dask scheduler" in remote.where
     ref = dumps(serial_run.record)
     assert dumps(local.record) == ref
     assert dumps(remote.record) == ref

@@ -99,15 +99,24 @@ def test_sentence(tiny_run):
     assert in_band([(1, 2.0)]) == []
 
 
-def test_serial_and_dask_give_the_same_numbers(tiny):
-    pytest.importorskip("distributed")
+def test_serial_local_pool_and_dask_give_the_same_numbers(tiny):
+    """One executor: the same cases serially, on this machine's pool and on a Dask scheduler
+    (the route of work that may leave the machine) give the same numbers."""
+    from printgen.executor.start import cores
+
+    distributed = pytest.importorskip("distributed")
     serial = run_series(tiny, [1, 10], options=RunOptions(serial=True))
-    dask = run_series(tiny, [1, 10], options=RunOptions(serial=False, workers=1))
-    assert "Dask" in dask.where
-    assert [(r.row, r.scale, r.values) for r in dask.results] == \
-        [(r.row, r.scale, r.values) for r in serial.results]
-    for a, b in zip(serial.results, dask.results, strict=True):
-        assert all((a.curves[k] == b.curves[k]).all() for k in a.curves)
+    local = run_series(tiny, [1, 10], options=RunOptions(serial=False, workers=min(2, cores())))
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        remote = run_series(tiny, [1, 10],
+                            options=RunOptions(scheduler=cluster.scheduler_address))
+    assert "Dask scheduler" in remote.where and "Dask" not in local.where
+    for other in (local, remote):
+        assert [(r.row, r.scale, r.values) for r in other.results] == \
+            [(r.row, r.scale, r.values) for r in serial.results]
+        for a, b in zip(serial.results, other.results, strict=True):
+            assert all((a.curves[k] == b.curves[k]).all() for k in a.curves)
 
 
 def test_cli_writes_the_folder(capsys, tiny, tmp_path):

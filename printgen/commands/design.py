@@ -17,18 +17,18 @@ from printgen.commands.common import (
     table,
 )
 from printgen.errors import InputError
+from printgen.executor.dask import check_address
 from printgen.run import api
 from printgen.run.search import DesignRun, SearchOptions
 from printgen.search.choice import short
 from printgen.search.nets import OBJECTIVES, VERIFY_NETS, SearchResult
-from printgen.search.sweep import check_address
 
 SHOW = 10  # Pareto members shown per scale in the table (all are in report.json)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("design", help="search material x strand x diamond mesh x border for the "
-                                      "net that deforms like the prototype (Dask sweeps)")
+                                      "net that deforms like the prototype (parallel sweeps)")
     p.add_argument("prototype", help="prototype barrier TOML (see examples/)")
     p.add_argument("--scale", "-s", type=float, metavar="LAMBDA",
                    help="geometric scale lambda (1:40 -> 40); or give --scales")
@@ -39,10 +39,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", "-o", type=Path, help="output folder (default out/<name>-design)")
     where = p.add_mutually_exclusive_group()
     where.add_argument("--scheduler", metavar="ADDRESS",
-                       help="a running Dask scheduler (tcp://host:8786); default: a local "
-                            "cluster on every core")
-    where.add_argument("--serial", action="store_true", help="no Dask: run in this process")
-    p.add_argument("--workers", type=int, help="local cluster size (default: every core)")
+                       help="a running Dask scheduler (tcp://host:8786), for work that may "
+                            "leave this machine; default: this machine's worker processes")
+    where.add_argument("--serial", action="store_true", help="run in this process")
+    p.add_argument("--workers", type=int, help="worker processes on this machine (default: every "
+                                                "core)")
     p.add_argument("--materials", nargs="+", metavar="NAME", help="materials to search")
     p.add_argument("--mesh-x-mm", metavar="LO:HI", help="bounds of the diagonal across (mm)")
     p.add_argument("--mesh-y-mm", metavar="LO:HI", help="bounds of the diagonal up (mm)")

@@ -42,8 +42,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     where.add_argument("--scheduler", metavar="ADDRESS",
                        help="a running Dask scheduler (tcp://host:8786)")
     where.add_argument("--serial", action="store_true", default=None,
-                       help="no Dask (default: serial below 12 cases, a local cluster above)")
-    p.add_argument("--workers", type=int, help="local Dask cluster size")
+                       help="run in this process (default: serial below 12 cases, this "
+                            "machine's worker processes above)")
+    p.add_argument("--workers", type=int, help="worker processes on this machine")
     p.add_argument("--force", action="store_true",
                    help="replace an output folder printgen did not write")
     add_json_arg(p)

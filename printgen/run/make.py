@@ -27,6 +27,9 @@ from printgen.design.record import Design
 from printgen.design.selection import Selection, design_net, select
 from printgen.design.similitude import ScaledTargets, scale_targets
 from printgen.errors import TimeLimitError
+from printgen.executor.local import Helper, check_deadline, deadline, helper
+from printgen.executor.signals import signals_deferred
+from printgen.executor.start import cores, quiet_tracker, warm_up
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import MANIFEST, TIMINGS, check_destination, staged_dir
@@ -62,21 +65,12 @@ from printgen.run.steps import (
     verify_step,
 )
 from printgen.trace import span
-from printgen.workers import (
-    Helper,
-    check_deadline,
-    cores,
-    deadline,
-    helper,
-    preload,
-    signals_deferred,
-    start_method,
-)
 
 log = logging.getLogger(__name__)
 # what the workers' jobs import (the verification's sweeps, the report's figures): a fork
-# server imports them once (printgen.workers.preload); matplotlib's pyplot is imported by the
-# helper while its sweeps run (`verification_sweeps`), not here: the helper would wait for it
+# server imports them once (printgen.executor.start.warm_up); matplotlib's pyplot is imported
+# by the helper while its sweeps run (`verification_sweeps`), not here: the helper would wait
+# for it
 JOB_MODULES = ("printgen.run.steps", "printgen.verification.pooled", "printgen.report.plots")
 
 
@@ -135,7 +129,7 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     only file that differs between runs).
     """
     t0 = time.perf_counter()
-    warm_up()
+    warm_up(JOB_MODULES)
     options = options or RunOptions()
     inputs = [prototype_path, options.design_file, *search_dirs()]
     check_destination(Path(out), force=options.force, inputs=inputs)  # fail fast
@@ -212,7 +206,7 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]]) -> Itera
     """Start the verification's sweeps (`verification_sweeps`) in a helper process now, so
     that they run while the parts are built here; `sweeps_done` and `verify_step` collect
     them (a long run's per-level progress comes from the sweeps' workers straight to this
-    process: printgen.workers). Only on 2 cores or more: on one there is nothing to gain."""
+    process: printgen.executor.local). Only on 2 cores or more: on one there is nothing to gain."""
     serial = os.environ.get("PRINTGEN_SERIAL") or cores() < 2
     if serial or not any(s is verify_step for _, s in steps):
         yield
@@ -229,32 +223,6 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]]) -> Itera
         finally:
             ctx.background.clear()
             ctx.helper = None
-
-
-def warm_up() -> None:
-    """Where workers start by `forkserver`, start the fork server now with the jobs' modules
-    (printgen.workers.preload: it imports them beside the planning and the parts), the
-    resource tracker quietened first (`quiet_tracker`: the fork server starts it)."""
-    if not os.environ.get("PRINTGEN_SERIAL") and cores() > 1 and start_method() == "forkserver":
-        quiet_tracker()
-        preload(JOB_MODULES)
-
-
-TRACKER_WARNING = "ignore:resource_tracker:UserWarning"  # a -W option (sys.warnoptions)
-
-
-def quiet_tracker() -> None:
-    """Start multiprocessing's resource tracker without its "leaked semaphore objects" warning.
-    A run stopped at its time limit (or by a signal) kills the helper while its workers' queues
-    are registered with the tracker, which unlinks them when it exits and says so on stderr: a
-    second line after make's one. The tracker inherits the -W options of sys.warnoptions
-    when it starts (at the helper's first queue); one already running is left as it is."""
-    import sys
-    from multiprocessing import resource_tracker
-
-    if TRACKER_WARNING not in sys.warnoptions:
-        sys.warnoptions.append(TRACKER_WARNING)
-    resource_tracker.ensure_running()
 
 
 def size_check(ctx: MakeContext, verifies: bool) -> Estimate:

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from printgen.design.similitude import scale_targets
+from printgen.executor import open_runner
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import check_destination, write_folder
@@ -39,7 +40,6 @@ from printgen.search.nets import (
 from printgen.search.per_material import reachable
 from printgen.search.record import candidates_json, result_record
 from printgen.search.space import SearchSpace, default_space
-from printgen.search.sweep import open_runner
 
 
 def verify_task(shared: VerifyShared, task: VerifyTask) -> VerifyScore:

@@ -1,6 +1,6 @@
 """`printgen series`: the virtual scale series of a prototype (printgen.verification.series)
-run serially or on the design search's Dask runner, summarised (series_table) and written as
-one folder (`outputs.staged_dir`: whole or nothing, locked, with its manifest):
+run serially or on the executor's runner (printgen.executor, as the design search),
+summarised (series_table) and written as one folder (`outputs.staged_dir`: whole or nothing, locked, with its manifest):
 
 - report.html: the sentences, the figure, the table, the law check, the assumptions;
 - report.json: every number of the series (points, curves, law check, assumptions);
@@ -17,13 +17,13 @@ from pathlib import Path
 
 from printgen.barrier.loads import get_load
 from printgen.errors import InputError
+from printgen.executor import open_runner
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import TIMINGS, check_destination, write_folder
 from printgen.report.jsonout import dumps
 from printgen.report.series import series_csv, series_figure, series_report
 from printgen.run.options import RunOptions
-from printgen.search.sweep import open_runner
 from printgen.verification.scenes import SENSOR_FORCE_N
 from printgen.verification.series import (
     LEVEL,
@@ -39,7 +39,7 @@ from printgen.verification.series import (
 )
 from printgen.verification.series_table import Series, summarise
 
-PARALLEL_FROM = 12  # cases from which the series runs on a local Dask cluster by default
+PARALLEL_FROM = 12  # cases from which the series runs on this machine's workers by default
 
 
 @dataclass
@@ -85,7 +85,7 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
     if serial is None:
         serial = len(todo) < PARALLEL_FROM and scheduler is None and workers is None
     say(f"{len(todo)} cases ({len(rows)} rows x {len(lams)} scales)"
-        + ("" if serial else ", starting Dask"))
+        + ("" if serial else ", starting the workers"))
     with open_runner(scheduler=scheduler, workers=workers, serial=serial,
                      progress=bar) as runner:
         results = runner.map(solve_case, todo, shared=shared, label="series cases")

@@ -20,11 +20,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from printgen.errors import TimeLimitError
+from printgen.executor.local import seconds_left
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
 from printgen.report.parts_report import assembly_section, gcode_section, meshes_section
 from printgen.trace import span
-from printgen.workers import seconds_left
 
 HELPER_SWEEPS = "helper: verification sweeps"  # timings_s keys of work done in the helper
 WAIT_SWEEPS = "waiting for the verification sweeps"  # in this process, within a step
@@ -291,7 +291,7 @@ def _draw(ctx: MakeContext, todo: list[Drawing]) -> None:
 
 def draw_all(drawings: list[Drawing]) -> list[bytes]:
     """Each drawing's PNG (carrying its SVG), side by side in worker processes when there are
-    several and two cores (printgen.workers.run_jobs); matplotlib is imported here first, so
+    several and two cores (printgen.executor.local.run_jobs); matplotlib is imported here first, so
     that forked workers start with it."""
     from printgen.report.html import drawn
     from printgen.report.plots import load_pyplot
@@ -302,7 +302,7 @@ def draw_all(drawings: list[Drawing]) -> list[bytes]:
 
 def _collect(pending: Future, what: str) -> Any:
     """A helper job's result, waiting no longer than the run's deadline
-    (`printgen.workers.deadline`): past it, TimeLimitError naming `what` (the helper is then
+    (`printgen.executor.local.deadline`): past it, TimeLimitError naming `what` (the helper is then
     stopped)."""
     left = seconds_left()
     try:

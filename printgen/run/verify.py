@@ -16,6 +16,7 @@ from typing import Any
 
 from printgen.design.design_file import load_design
 from printgen.design.record import Design
+from printgen.executor.start import preload
 from printgen.inputs.materials import load_material
 from printgen.inputs.profiles import profile_name, search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
@@ -48,7 +49,6 @@ from printgen.verification.measured import (
 from printgen.verification.pooled import verify_with_band
 from printgen.verification.readings import design_units
 from printgen.verification.verify import Verification, free_section
-from printgen.workers import preload
 
 # what the workers' jobs import (the sweeps, the figures): a fork server imports them once
 JOB_MODULES = ("printgen.verification.pooled", "printgen.report.plots")
