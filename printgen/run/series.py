@@ -1,6 +1,7 @@
 """`printgen series`: the virtual scale series of a prototype (printgen.verification.series)
 run serially or on the executor's runner (printgen.executor, as the design search),
-summarised (series_table) and written as one folder (`outputs.staged_dir`: whole or nothing, locked, with its manifest):
+summarised (series_table) and written as one folder (`outputs.staged_dir`: whole or nothing,
+locked, with its manifest):
 
 - report.html: the sentences, the figure, the table, the law check, the assumptions;
 - report.json: every number of the series (points, curves, law check, assumptions);
