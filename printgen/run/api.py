@@ -28,7 +28,9 @@ from printgen.run.options import RunOptions
 if TYPE_CHECKING:
     from printgen.calibrate.pipeline import Calibration
     from printgen.calibrate.sample import FitOptions
+    from printgen.inputs.examples import Example
     from printgen.run.make import MakeContext
+    from printgen.run.panel import PanelRun
     from printgen.run.search import DesignRun, SearchOptions
     from printgen.run.series import SeriesRun
     from printgen.run.verify import VerifyRun
@@ -203,3 +205,47 @@ def calibrate(paths: Sequence[str | Path], *, material: str,
     from printgen.calibrate.pipeline import calibrate as _calibrate
 
     return _calibrate(paths, material=material, options=options, **kwargs)
+
+
+def examples() -> dict[str, Path]:
+    """The bundled examples: name -> its prototype TOML or its folder of data files."""
+    from printgen.inputs.examples import examples as _examples
+
+    return _examples()
+
+
+def example(name: str, out: str | Path | None = None) -> Example:
+    """The bundled example `name` and its files, copied into the new folder `out` when
+    given (`printgen example NAME --out DIR`)."""
+    from printgen.inputs.examples import example as _example
+
+    return _example(name, out)
+
+
+def init(path: str | Path, *, force: bool = False) -> Path:
+    """Write the commented prototype template (every key, its unit, meaning and range) into
+    the .toml file `path` (an existing one only with `force`)."""
+    from printgen.inputs.template import write_template
+
+    return write_template(path, force=force)
+
+
+def panel(design_file: str | Path, *, orientations: Sequence[str] | None = None,
+          mode: str = "free") -> list[PanelRun]:
+    """The simulated tensile test of the design's printed net panel along each diagonal of
+    `orientations` (default: both), its sides `mode` free or blocked (`printgen panel`)."""
+    from printgen.run.panel import panel_tests
+
+    return panel_tests(design_file, tuple(orientations) if orientations else None, mode)
+
+
+def testpieces(design_file: str | Path, out: str | Path, *, orientation: str = "short",
+               options: RunOptions | None = None) -> dict[str, Any]:
+    """The tensile coupons and the net test panel of the design, written into the folder
+    `out` (`printgen testpieces`); `options` (`RunOptions`): `force`, `command`. Their
+    record."""
+    from printgen.run.testpieces import testpieces as _testpieces
+
+    opts = options or RunOptions()
+    return _testpieces(design_file, out, orientation=orientation, force=opts.force,
+                       command=opts.command)
