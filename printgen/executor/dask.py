@@ -68,7 +68,7 @@ def check_address(address: str) -> str:
     InputError: other schemes (file://, inproc://, tls://, ucx://) are not connected to."""
     m = ADDRESS.fullmatch(address)
     ok = m is not None and 1 <= int(m["port"]) <= 65535
-    if ok and m["host"].startswith("["):
+    if ok and m is not None and m["host"].startswith("["):
         try:
             ipaddress.IPv6Address(m["host"][1:-1])
         except ValueError:
@@ -76,5 +76,6 @@ def check_address(address: str) -> str:
     if not ok:
         raise InputError(f"--scheduler {address[:100]!r} is not a Dask scheduler address: give "
                          "tcp://HOST:PORT, e.g. tcp://10.0.0.5:8786 (the address `dask "
-                         "scheduler` prints), or leave out --scheduler for a local cluster")
+                         "scheduler` prints), or leave out --scheduler for this machine's "
+                         "workers")
     return address

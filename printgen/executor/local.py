@@ -178,7 +178,7 @@ def submit_jobs(jobs: list[tuple]) -> list[Future]:
     within `shared_pool` on its workers, without waiting; else `run_jobs` runs them now."""
     if _shared is not None:
         return [_shared.submit(fn, *args, **kw) for fn, args, kw in jobs]
-    out = []
+    out: list[Future] = []
     for result in run_jobs(jobs):
         out.append(Future())
         out[-1].set_result(result)
@@ -227,7 +227,7 @@ class _Workers:
 
     def end_reports(self) -> None:
         """The workers are done: pass on the reports left, then end the reader."""
-        if self.reader is not None:
+        if self.reader is not None and self.queue is not None:
             self.queue.put(None)
             self.reader.join(timeout=READER_JOIN_S)
 
