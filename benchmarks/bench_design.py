@@ -66,9 +66,9 @@ def _timed(fn) -> float:
 
 
 def run(out_dir: Path, repeat: int = 2) -> dict:
+    from printgen.executor import open_runner
     from printgen.outputs import write_bytes, write_text
     from printgen.report.jsonout import dumps
-    from printgen.search.sweep import open_runner
 
     p, ctx, points, designs = _setup()
     cores = os.cpu_count() or 1

@@ -77,7 +77,7 @@ def timed_draw(todo: list) -> dict[str, float]:
 
 def side_by_side(named: list, repeat: int) -> dict[str, float]:
     """`timed_draw` in a fresh helper process each time (as make's), the best wall time's."""
-    from printgen.workers import helper
+    from printgen.executor.local import helper
 
     runs = []
     for _ in range(repeat):

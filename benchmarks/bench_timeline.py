@@ -30,7 +30,7 @@ EXAMPLES = {"simple": ROOT / "examples" / "simple_barrier.toml",
 SCALE = 40.0
 GOAL_S = 15.0  # the simple barrier's make in under 15 s on 2 cores
 TRACE = "PRINTGEN_TRACE"  # printgen.trace.TRACE
-POOL = "pool of"  # a pool's life in its parent (printgen.workers.run_jobs), not a job
+POOL = "pool of"  # a pool's life in its parent (printgen.executor.local.run_jobs), not a job
 
 
 def traced_make(example: Path, out: Path) -> dict:
@@ -158,7 +158,7 @@ def figure(name: str, s: dict, path: Path) -> None:
 
 
 def run(out: Path, repeat: int) -> dict:
-    from printgen.workers import cores
+    from printgen.executor.start import cores
 
     out.mkdir(parents=True, exist_ok=True)
     report: dict = {"benchmark": "bench_timeline", "scale": SCALE, "goal_s": GOAL_S,

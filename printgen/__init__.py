@@ -12,8 +12,12 @@ The public verbs (`printgen.run.api`), imported on first use so `import printgen
 - ``verify(prototype, scale, design=None)`` -> `Verification`
 - ``verify_design(prototype, scale, design_file, out)`` -> `VerifyRun` (printgen verify's folder)
 - ``calibrate(paths, material=...)`` -> `Calibration`
-- ``search_nets(prototype, scales)`` -> `DesignRun` (the inverse design, on Dask)
+- ``search_nets(prototype, scales)`` -> `DesignRun` (the inverse design, in parallel)
 - ``series(prototype, scales)`` -> `SeriesRun` (the virtual scale series)
+- ``panel(design_file)`` -> list of `PanelRun` (the simulated net panel tests)
+- ``testpieces(design_file, out)`` -> the record of the test pieces written in `out`
+- ``examples()`` -> the bundled examples; ``example(name, out=None)`` -> `Example`
+- ``init(path)`` -> the prototype template written at `path`
 """
 
 from __future__ import annotations
@@ -23,16 +27,21 @@ from typing import TYPE_CHECKING, Any
 __version__ = "0.1.0"
 
 VERBS = ("targets", "select", "plan", "make", "verify", "verify_design", "calibrate",
-         "search_nets", "series")
+         "search_nets", "series", "panel", "testpieces", "examples", "example", "init")
 __all__ = [
     "__version__",
     "calibrate",
+    "example",
+    "examples",
+    "init",
     "make",
+    "panel",
     "plan",
     "search_nets",
     "select",
     "series",
     "targets",
+    "testpieces",
     "verify",
     "verify_design",
 ]
@@ -40,12 +49,17 @@ __all__ = [
 if TYPE_CHECKING:
     from printgen.run.api import (
         calibrate,
+        example,
+        examples,
+        init,
         make,
+        panel,
         plan,
         search_nets,
         select,
         series,
         targets,
+        testpieces,
         verify,
         verify_design,
     )

@@ -1,8 +1,8 @@
 """printgen's command line: argparse subcommands, each in `printgen/commands/<name>.py`.
 
 A command module defines `register(subparsers)` (adds its parser and sets `func`) and the
-function it sets runs it and returns an exit code. Bad input (`PrintgenError`) exits 2 with a
-one-line message and no traceback.
+function it sets runs it and returns an exit code. Bad input (`PrintgenError`) and a solve that
+did not converge (`SolverError`) exit 2 with a one-line message and no traceback.
 """
 
 from __future__ import annotations
@@ -17,9 +17,9 @@ from concurrent.futures.process import BrokenProcessPool
 from typing import NoReturn
 
 import printgen
-from printgen.errors import PrintgenError, TimeLimitError
+from printgen.errors import PrintgenError, TimeLimitError, reported
+from printgen.executor.signals import Interrupted, signals_raise
 from printgen.outputs import describe_os_error, os_error_exit_code, tracking_swaps
-from printgen.workers import Interrupted, signals_raise
 
 # One entry per command module; a module may register several subcommands.
 COMMAND_MODULES = (
@@ -120,6 +120,8 @@ def run_command(args: argparse.Namespace, name: str) -> int:
             return _fail(f"{name}: error: a worker process died (killed, or out of memory: see "
                          "`dmesg`); outputs left as they were; try again, or a coarser mesh", 1)
         except Exception as exc:
+            if reported(exc):  # the solver's SolverError, not a PrintgenError
+                return _fail(f"{name}: error: {exc}", 2)
             if os.environ.get("PRINTGEN_DEBUG"):
                 raise
             text = " ".join(str(exc).split())[:300]

@@ -1,7 +1,7 @@
 """A timeline of a run, for benchmarks/bench_timeline.py: with PRINTGEN_TRACE set to a file,
 every process of the run (make, its helper, their workers) appends one JSON line per span:
 make's steps, the helper's phases, each pool's life and each job it ran
-(printgen.workers wraps the jobs). Without it, nothing is written and nothing wrapped."""
+(printgen.executor.local wraps the jobs). Without it, nothing is written and nothing wrapped."""
 
 from __future__ import annotations
 

@@ -16,8 +16,10 @@ import pytest
 from conftest import alive
 
 import printgen.run.make as make_mod
-from printgen import workers
+from printgen.executor import local as workers
+from printgen.executor import signals
 from printgen.report.jsonout import dumps
+from printgen.run.options import RunOptions
 from printgen.run.provenance import split_timings
 
 GONE_WITHIN_S = 5.0  # issue 16: no worker left 5 s after the parent stops
@@ -107,8 +109,8 @@ def test_a_failure_in_the_block_kills_the_worker_and_its_workers(tmp_path, monke
 
 def test_signals_deferred_holds_a_signal_until_the_block_ends():
     reached = []
-    with pytest.raises(workers.Interrupted) as exc, workers.signals_raise(), \
-            workers.signals_deferred():
+    with pytest.raises(signals.Interrupted) as exc, signals.signals_raise(), \
+            signals.signals_deferred():
         try:
             os.kill(os.getpid(), signal.SIGTERM)
             time.sleep(0.2)  # the handler has run by now: it only held the signal
@@ -127,7 +129,7 @@ def test_signals_deferred_outside_the_main_thread_is_a_no_op():
 
 
 def _deferred_in_thread() -> bool:
-    with workers.signals_deferred():
+    with signals.signals_deferred():
         return True
 
 
@@ -143,7 +145,7 @@ def test_verification_in_the_helper_equals_the_verification_step(made_simple_dra
     started = []
     monkeypatch.setattr(make_mod, "helper", _spy(make_mod.helper, started))
     ahead = make_mod.make(path, 40, tmp_path / "ahead", steps=steps,
-                          options=make_mod.MakeOptions(load="drag"))
+                          options=RunOptions(load="drag"))
     assert started == ["verification_sweeps", "draw_all"]  # the figures: drawn in its workers
     assert ahead.report.blocks == inline.report.blocks
     assert (dumps(split_timings(ahead.record["verification"])[0])

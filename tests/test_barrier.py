@@ -85,6 +85,31 @@ def test_square_membrane_and_strand_force_are_one_strand_per_mesh():
                                                               rel=EXACT)
 
 
+def test_pattern_specific_rules_are_the_patterns():
+    """What differs between patterns outside the graph and the laws (the mesh's name, the mesh
+    it may have, whether the virtual panel test models it) is each pattern's own data: a new
+    pattern states them (no default, so it is not quietly taken for a diamond)."""
+    from printgen.barrier.patterns import NetPattern
+    from printgen.design.testpieces import panel_for
+    from printgen.errors import GeometryError
+
+    for p in patterns().values():
+        p.check_mesh(0.2, 0.2, "net")  # every pattern takes a mesh equal both ways
+    assert [get_pattern(n).mesh_name for n in ("square", "diamond", "water-drop")] == [
+        "mesh side", "mesh diagonal", "mesh diagonal"]
+    get_pattern("diamond").check_mesh(0.2, 0.3, "net")
+    with pytest.raises(GeometryError, match="printed net: a square mesh needs mesh_x = mesh_y"):
+        get_pattern("square").check_mesh(0.2, 0.3, "printed net")
+    square_pattern = get_pattern("square")
+    with pytest.raises(TypeError, match="mesh_name"):
+        NetPattern("new", *(getattr(square_pattern, f) for f in (
+            "graph", "membrane_factor", "strand_law", "strand_force", "span", "nodes")))
+    square = SimpleNamespace(net=SimpleNamespace(pattern="square"))
+    with pytest.raises(GeometryError, match="needs a diamond net; this design's net is 'square' "
+                                            r"\(the virtual panel test models diamonds only"):
+        panel_for(square, "short", 50.0, 30.0)
+
+
 def _flat_scene(n: int = 5, height: float = 1.0):
     """A vertical column of n nodes 0..height (z), the bottom one anchored: what a load case
     reads of a BarrierScene."""

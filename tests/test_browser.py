@@ -24,6 +24,7 @@ from conftest import ROOT, require_tool
 from proto_files import REALISTIC
 
 import printgen.run.make as make_mod
+from printgen.run.options import RunOptions
 
 ARTIFACTS = ROOT / "artifacts"
 CHROMIUM_S = 120  # a cold headless start on a loaded machine takes a few seconds
@@ -235,7 +236,7 @@ def test_make_pdf_writes_report_pdf_into_the_folder_and_its_manifest(tmp_path):
     require_tool("chromium")
     pypdf = pytest.importorskip("pypdf")
     out = tmp_path / "out"
-    ctx = make_mod.make(REALISTIC, 40, out, steps=[], options=make_mod.MakeOptions(pdf=True))
+    ctx = make_mod.make(REALISTIC, 40, out, steps=[], options=RunOptions(pdf=True))
     assert "report.pdf" in json.loads((out / "manifest.json").read_text())["files"]
     assert "report.pdf" in ctx.record["files"] and "pdf_skipped" not in ctx.record
     assert len(pypdf.PdfReader(out / "report.pdf").pages) >= 1

@@ -22,6 +22,7 @@ from printgen.commands.common import EXIT_INCOMPLETE
 from printgen.commands.make import EXIT_TIME_LIMIT
 from printgen.errors import TimeLimitError
 from printgen.run.budget import LEVELS, estimate
+from printgen.run.options import RunOptions
 from printgen.verification import verify as verify_mod
 
 WORK_FACTOR = 2.0  # issue 28: the estimate within x2 of the run (here its work, counted)
@@ -128,7 +129,7 @@ def test_time_limit_stops_the_helper_process_run(tmp_path, monkeypatch):
                         estimate(p, d, cores=cores, work=work))
     out = tmp_path / "out"
     with pytest.raises(TimeLimitError, match=r"^stopped in step '[^']+'.*estimated at about"):
-        make_mod.make(REALISTIC, 40, out, options=make_mod.MakeOptions(
+        make_mod.make(REALISTIC, 40, out, options=RunOptions(
             time_limit_s=SHORT_LIMIT_S))
     assert not out.exists() and list(tmp_path.iterdir()) == []
 

@@ -16,9 +16,10 @@ from proto_files import REALISTIC, SIMPLE, write_variant
 
 import printgen.run.make as make_mod
 from printgen.cli import main
+from printgen.executor.signals import Interrupted
 from printgen.inputs.prototype import ranges_markdown
 from printgen.run import api
-from printgen.workers import Interrupted
+from printgen.run.options import RunOptions
 
 
 def run(capsys, *argv):
@@ -116,6 +117,22 @@ def test_unexpected_error_is_one_line_with_a_hint(capsys, monkeypatch):
     code, _, err = run(capsys, "targets", REALISTIC, "--scale", 40)
     line = one_line(err)
     assert code == 1 and "internal error: ZeroDivisionError" in line and "report" in line
+
+
+def test_a_solve_that_did_not_converge_exits_2(capsys, monkeypatch):
+    """One SolverError class, the solver's: printgen's error handling reports it like its own
+    errors (one line, exit 2), and printgen.errors names the same class."""
+    import solver
+    from printgen import errors
+
+    def diverged(*a, **k):
+        raise errors.SolverError("simple barrier prototype: no convergence")
+
+    assert errors.SolverError is solver.SolverError
+    monkeypatch.setattr(api, "targets", diverged)
+    code, _, err = run(capsys, "targets", REALISTIC, "--scale", 40)
+    assert code == 2 and one_line(err) == ("printgen targets: error: simple barrier prototype: "
+                                           "no convergence")
 
 
 def test_a_dead_worker_is_one_line(capsys, monkeypatch):
@@ -314,7 +331,7 @@ def test_time_limit_zero_is_refused_by_the_api_too(tmp_path):
     from printgen.errors import InputError
 
     with pytest.raises(InputError, match="must be a positive number of seconds"):
-        make_mod.make(REALISTIC, 40, tmp_path / "o", options=make_mod.MakeOptions(time_limit_s=0),
+        make_mod.make(REALISTIC, 40, tmp_path / "o", options=RunOptions(time_limit_s=0),
                       steps=[])
 
 

@@ -23,12 +23,12 @@ from printgen.calibrate.reader import read_export
 from printgen.calibrate.sample import FitOptions
 from printgen.cli import main
 from printgen.errors import CalibrationError, InputError
+from printgen.executor.start import cores
 from printgen.inputs.materials import MAX_MATERIALS, material_names
 from printgen.inputs.prototype import load_prototype
 from printgen.outputs import write_bytes
 from printgen.run.budget import CABLE_PART_S, Work, estimate
 from printgen.verification.measured import read_measured
-from printgen.workers import cores
 
 
 def run(capsys, *argv):

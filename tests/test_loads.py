@@ -205,3 +205,19 @@ def test_case_readings_are_the_nominal_model_at_the_discharge_steps():
     html = rep.html()
     assert "What the campaign will see" in html and "discharge (L/s)" in html
     assert "loading: jam at each level" in html and "Ergun 1952" in html
+
+
+@pytest.mark.parametrize("command", ["make", "verify", "series"])
+def test_load_help_lists_every_registered_case(command):
+    """--load's help is generated from the load-case registry: every case module appears in
+    it, with its title, without editing the command line."""
+    import argparse
+
+    from printgen.barrier.loads import load_cases
+    from printgen.cli import build_parser
+
+    parser = build_parser([command])
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    text = " ".join(sub.choices[command].format_help().split())
+    for name, case in load_cases().items():
+        assert f"{name}: {' '.join(case.title.split())}" in text

@@ -18,6 +18,7 @@ from printgen.commands.common import EXIT_INCOMPLETE
 from printgen.errors import PrintgenError, TimeLimitError
 from printgen.outputs import check_folder, folder_files
 from printgen.report.jsonout import dumps
+from printgen.run.options import RunOptions
 
 SLICER_ONLY = [s for s in make_mod.default_steps() if s[1] is make_mod.slicer_step]
 REFUSE_WITHIN_S = 15.0  # issue 16: a run too big to do is refused within 15 s
@@ -147,7 +148,7 @@ def test_cli_make_json_and_exit_codes(made_simple_drag, tmp_path, capsys, monkey
     monkeypatch.setattr(api, "make", spy)
     assert main(["make", str(path), "-s", "40", "--out", str(tmp_path / "o"), "--json",
                  "--drag"]) == 0
-    assert [c["load"] for c in calls] == ["drag"]
+    assert [c["options"].load for c in calls] == ["drag"]  # one options record
     rec = json.loads(capsys.readouterr().out)
     assert dumps(rec) == dumps(make_mod.json_output(ctx))
     assert rec["targets"]["scale"] == 40
@@ -204,7 +205,7 @@ def test_time_limit_stops_the_run_in_its_step(tmp_path, monkeypatch):
     out = tmp_path / "out"
     with pytest.raises(TimeLimitError) as err:
         make_mod.make(REALISTIC, 40, out, steps=[("slow step", slow)],
-                      options=make_mod.MakeOptions(time_limit_s=SLOW_STEP_S / 2))
+                      options=RunOptions(time_limit_s=SLOW_STEP_S / 2))
     line = str(err.value)
     assert "\n" not in line and "stopped in step 'slow step'" in line
     assert "estimated at about" in line and "--time-limit" in line

@@ -23,8 +23,9 @@ from conftest import alive
 from proto_files import REALISTIC
 
 import printgen.run.make as make_mod
-from printgen import workers
 from printgen.cli import main
+from printgen.executor import local as workers
+from printgen.executor import start
 from printgen.outputs import folder_files, lock
 from printgen.report.jsonout import dumps
 
@@ -89,7 +90,7 @@ def test_import_help_and_version_need_nothing_linux_only():
 
 
 def simulate_windows(monkeypatch) -> list[Path]:
-    """In this process: no fork (spawn only), no prctl (workers.SYSTEM), no SIGHUP, no fcntl
+    """In this process: no fork (spawn only), no prctl (start.SYSTEM), no SIGHUP, no fcntl
     (the output lock's `exclusive` backend; flock fails the test). The returned list collects
     the folders locked the exclusive way."""
     locked: list[Path] = []
@@ -102,7 +103,7 @@ def simulate_windows(monkeypatch) -> list[Path]:
     monkeypatch.setattr(lock, "_flock", no_flock)
     monkeypatch.setattr(lock, "_exclusive",
                         lambda dest, path: locked.append(dest) or exclusive(dest, path))
-    monkeypatch.setattr(workers, "SYSTEM", "win32")
+    monkeypatch.setattr(start, "SYSTEM", "win32")
     monkeypatch.setattr(multiprocessing, "get_all_start_methods", lambda: ["spawn"])
     monkeypatch.delattr(os, "fork")
     monkeypatch.delattr(signal, "SIGHUP")
@@ -113,7 +114,7 @@ def simulate_windows(monkeypatch) -> list[Path]:
 
 
 def what_a_worker_sees() -> tuple:
-    return (workers.platform(), workers.start_method(), signal.getsignal(signal.SIGINT),
+    return (start.platform(), start.start_method(), signal.getsignal(signal.SIGINT),
             [t.name for t in __import__("threading").enumerate()])
 
 
@@ -121,9 +122,9 @@ def what_a_worker_sees() -> tuple:
 @pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="workers need 2 cores")
 def test_workers_on_a_platform_without_fork_or_prctl(monkeypatch):
     simulate_windows(monkeypatch)
-    plat = workers.platform()
+    plat = start.platform()
     assert plat.signals == (signal.SIGINT, signal.SIGTERM) and not plat.pdeathsig
-    assert workers.start_method() == "spawn"
+    assert start.start_method() == "spawn"
     seen = workers.run_jobs([(what_a_worker_sees, (), {})] * 2)
     for got_plat, method, sigint, threads in seen:  # workers of workers: spawn too
         assert (got_plat, method, sigint) == (plat, "spawn", signal.SIG_IGN)
@@ -133,9 +134,9 @@ def test_workers_on_a_platform_without_fork_or_prctl(monkeypatch):
 ORPHAN = """
     import multiprocessing, sys, time
     from pathlib import Path
-    from printgen import workers
+    from printgen.executor import local as workers, start
     from test_portable import sleeper
-    workers.SYSTEM = "win32"
+    start.SYSTEM = "win32"
     multiprocessing.get_all_start_methods = lambda: ["spawn"]
     workers.run_jobs([(sleeper, (f,), {}) for f in sys.argv[1:]])
 """

@@ -105,10 +105,11 @@ def cli(capsys, *argv) -> tuple[int, str]:
 def made(tmp_path_factory):
     """One real `printgen make` output of the small example (its design, report and manifest;
     no parts: they add nothing here), shared by the cases needing it."""
-    from printgen.run.make import MakeOptions, make
+    from printgen.run.make import make
+    from printgen.run.options import RunOptions
 
     out = tmp_path_factory.mktemp("made") / "out"
-    make(SIMPLE, 40, out, steps=[], options=MakeOptions(command=["printgen", "make"]))  # plan only
+    make(SIMPLE, 40, out, steps=[], options=RunOptions(command=["printgen", "make"]))  # plan only
     return out
 
 

@@ -15,6 +15,7 @@ from conftest import EXAMPLES
 from printgen.design.design_file import design_from_dict, load_design
 from printgen.errors import InputError
 from printgen.report.jsonout import dumps
+from printgen.run.options import RunOptions
 from printgen.run.search import SearchOptions, search_at_scales
 from printgen.search.pareto import dominates, pareto_mask
 
@@ -30,7 +31,7 @@ pytest.importorskip("distributed")
 
 @pytest.fixture(scope="module")
 def serial_run():
-    return search_at_scales(REALISTIC, [SCALE], options=SMALL, serial=True)
+    return search_at_scales(REALISTIC, [SCALE], options=SMALL, run=RunOptions(serial=True))
 
 
 def _objectives(rec: dict, rows: list[dict]) -> np.ndarray:
@@ -94,12 +95,12 @@ def test_stiffness_objective_pareto_over_every_printable_candidate(tmp_path, mon
 def test_same_json_serial_local_cluster_and_remote_scheduler(serial_run):
     from distributed import LocalCluster
 
-    local = search_at_scales(REALISTIC, [SCALE], options=SMALL, workers=2)
+    local = search_at_scales(REALISTIC, [SCALE], options=SMALL, run=RunOptions(workers=2))
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                       dashboard_address=None) as cluster:
         remote = search_at_scales(REALISTIC, [SCALE], options=SMALL,
-                                 scheduler=cluster.scheduler_address)
-    assert "local Dask cluster" in local.where and "scheduler" in remote.where
+                                  run=RunOptions(scheduler=cluster.scheduler_address))
+    assert "local pool" in local.where and "Dask scheduler" in remote.where
     ref = dumps(serial_run.record)
     assert dumps(local.record) == ref
     assert dumps(remote.record) == ref
@@ -126,10 +127,10 @@ def test_report_names_choice_select_pick_and_design_round_trips(serial_run, tmp_
 def test_bad_input_is_named():
     with pytest.raises(InputError, match="mesh x bounds"):
         search_at_scales(REALISTIC, [SCALE], options=SearchOptions(mesh_x_mm=(20.0, 10.0)),
-                        serial=True)
+                         run=RunOptions(serial=True))
     with pytest.raises(InputError, match="objective"):
         search_at_scales(REALISTIC, [SCALE], options=SearchOptions(objective="speed"),
-                        serial=True)
+                         run=RunOptions(serial=True))
     with pytest.raises(InputError, match="unknown keys"):
         design_from_dict({"scale": 40, "printer": "generic-350", "net": {}, "cables": [],
                           "colour": "red"})

@@ -13,6 +13,7 @@ from proto_files import REALISTIC, SIMPLE, write_variant
 
 from printgen.cli import main
 from printgen.errors import InputError
+from printgen.run.options import RunOptions
 from printgen.run.series import run_series
 from printgen.verification.series import check_scales, net_options
 from printgen.verification.series_table import in_band
@@ -36,7 +37,7 @@ def tiny(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def tiny_run(tiny):
-    return run_series(tiny, [1, 10, 100], materials=("petg",), serial=True)
+    return run_series(tiny, [1, 10, 100], materials=("petg",), options=RunOptions(serial=True))
 
 
 @pytest.fixture(scope="module")
@@ -65,11 +66,11 @@ def test_similitude_identical_at_every_scale(tiny_run):
 def test_similitude_on_the_realistic_scene(tiny_realistic):
     """Border cables sliding and a panel law: E / lambda is still exact; the 1 N sensors on
     the models (--solver-net sensors=on) do not scale and break it."""
-    off = run_series(tiny_realistic, [1, 40], serial=True,
+    off = run_series(tiny_realistic, [1, 40], options=RunOptions(serial=True),
                      net=net_options("mounting=eyelets"))
     a, b = _values(off, "similitude")
     assert b["deflection"] == pytest.approx(a["deflection"], rel=SIMILITUDE_RTOL)
-    on = run_series(tiny_realistic, [1, 40], serial=True,
+    on = run_series(tiny_realistic, [1, 40], options=RunOptions(serial=True),
                     net=net_options("mounting=eyelets,sensors=on"))
     a, b = _values(on, "similitude")
     assert abs(b["strain_mid"] / a["strain_mid"] - 1) > 0.1  # the wires pull 1 N at 1:40
@@ -102,15 +103,24 @@ def test_sentence(tiny_run):
 
 
 @pytest.mark.slow
-def test_serial_and_dask_give_the_same_numbers(tiny):
-    pytest.importorskip("distributed")
-    serial = run_series(tiny, [1, 10], serial=True)
-    dask = run_series(tiny, [1, 10], serial=False, workers=1)
-    assert "Dask" in dask.where
-    assert [(r.row, r.scale, r.values) for r in dask.results] == \
-        [(r.row, r.scale, r.values) for r in serial.results]
-    for a, b in zip(serial.results, dask.results, strict=True):
-        assert all((a.curves[k] == b.curves[k]).all() for k in a.curves)
+def test_serial_local_pool_and_dask_give_the_same_numbers(tiny):
+    """One executor: the same cases serially, on this machine's pool and on a Dask scheduler
+    (the route of work that may leave the machine) give the same numbers."""
+    from printgen.executor.start import cores
+
+    distributed = pytest.importorskip("distributed")
+    serial = run_series(tiny, [1, 10], options=RunOptions(serial=True))
+    local = run_series(tiny, [1, 10], options=RunOptions(serial=False, workers=min(2, cores())))
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        remote = run_series(tiny, [1, 10],
+                            options=RunOptions(scheduler=cluster.scheduler_address))
+    assert "Dask scheduler" in remote.where and "Dask" not in local.where
+    for other in (local, remote):
+        assert [(r.row, r.scale, r.values) for r in other.results] == \
+            [(r.row, r.scale, r.values) for r in serial.results]
+        for a, b in zip(serial.results, other.results, strict=True):
+            assert all((a.curves[k] == b.curves[k]).all() for k in a.curves)
 
 
 @pytest.mark.slow
@@ -155,7 +165,8 @@ def test_check_scales():
 
 @pytest.mark.slow
 def test_sensor_row_says_the_models_pull(tiny_realistic):
-    on = run_series(tiny_realistic, [1, 40], serial=True, net=net_options("sensors=on"))
+    on = run_series(tiny_realistic, [1, 40], options=RunOptions(serial=True),
+                    net=net_options("sensors=on"))
     rows = {a[0]: a[1] for a in on.series.assumptions}
     assert "1 N along each wire on the models" in rows["sensor wires"]
     assert "read only (no sensors" not in rows["sensor wires"]
@@ -167,8 +178,8 @@ def test_jam_of_porosity_zero_runs_as_hydrostatic(tiny):
     """The series takes a load case's parameters (its spec) and hands each scale its own
     depth and lambda: a jam of porosity 0 is a wall of logs, the hydrostatic case (issue 26's
     limiting case), at every scale."""
-    jam = run_series(tiny, [1, 10], load="jam:porosity=0", serial=True)
-    hyd = run_series(tiny, [1, 10], serial=True)
+    jam = run_series(tiny, [1, 10], options=RunOptions(load="jam:porosity=0", serial=True))
+    hyd = run_series(tiny, [1, 10], options=RunOptions(serial=True))
     assert jam.record["load_case"].startswith("jam:") and "porosity=0" in jam.record["load_case"]
     for lam in (1, 10):
         a = jam.series.point("similitude", lam).values

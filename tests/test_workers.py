@@ -1,4 +1,4 @@
-"""Worker processes (printgen/workers.py): they die with their parent, leave signals to it, are
+"""Worker processes (printgen/executor/local.py): they die with their parent, leave signals to it, are
 killed when the parent stops, and pass progress reports back."""
 
 from __future__ import annotations
@@ -12,7 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from printgen import workers
+from printgen.executor import local as workers
+from printgen.executor import signals, start
 from printgen.run.budget import level_bars
 
 PR_GET_PDEATHSIG = 2  # linux/prctl.h
@@ -80,7 +81,7 @@ def test_a_signal_in_the_parent_kills_the_workers(tmp_path, monkeypatch):
 
     threading.Thread(target=term_when_started, daemon=True).start()
     t0 = time.monotonic()
-    with pytest.raises(workers.Interrupted) as exc, workers.signals_raise():
+    with pytest.raises(signals.Interrupted) as exc, signals.signals_raise():
         workers.run_jobs([(sleeper, (str(f),), {}) for f in files])
     assert exc.value.exit_code == 143 and time.monotonic() - t0 < SLEEP_S
     pids = [int(f.read_text()) for f in files]
@@ -101,11 +102,11 @@ def _state(pid: int) -> str:
 def _how_it_starts_workers() -> tuple[str, list[str], list[str]]:
     """In a helper: its start method, its threads, and how its own workers started."""
     names = [t.name for t in threading.enumerate()]
-    return workers.start_method(), names, workers.run_jobs([(workers.start_method, (), {})] * 2)
+    return start.start_method(), names, workers.run_jobs([(start.start_method, (), {})] * 2)
 
 
 @two_cores
-@pytest.mark.skipif(not workers.SYSTEM.startswith("linux"), reason="fork: Linux only")
+@pytest.mark.skipif(not start.SYSTEM.startswith("linux"), reason="fork: Linux only")
 def test_a_helper_started_by_the_fork_server_forks_its_own_workers(monkeypatch):
     """Under the command line a spinner thread runs beside make, so its helper starts by the
     fork server and watches its parent from a thread; the helper's workers (the sweeps', the
@@ -115,13 +116,13 @@ def test_a_helper_started_by_the_fork_server_forks_its_own_workers(monkeypatch):
     spinner = threading.Thread(target=stop.wait)
     spinner.start()
     try:
-        assert workers.start_method() == "forkserver"
+        assert start.start_method() == "forkserver"
         with workers.helper() as h:
             method, threads, theirs = h.submit(_how_it_starts_workers).result()
     finally:
         stop.set()
         spinner.join()
-    assert workers.WATCH_THREAD in threads and method == "fork"
+    assert start.WATCH_THREAD in threads and method == "fork"
     assert theirs == ["fork", "fork"]  # in the helper's workers: no watch, one thread
 
 
@@ -139,7 +140,7 @@ def test_shared_pool_runs_every_job_of_the_block_on_its_workers(monkeypatch, ser
         first = pool.submit(pid_of, 0)
         later = workers.run_jobs([(pid_of, (k,), {}) for k in range(4)])
         pids = {*workers.collect([first]), *later}
-    if serial or workers.cores() < 2:
+    if serial or start.cores() < 2:
         assert first.done() and pids == {os.getpid()}
     else:
         assert os.getpid() not in pids and len(pids) <= 2
@@ -149,7 +150,7 @@ def test_shared_pool_runs_every_job_of_the_block_on_its_workers(monkeypatch, ser
 def test_preload_is_a_no_op_where_workers_fork(monkeypatch):
     """Only a fork server imports ahead: under `fork` nothing is started."""
     started = []
-    monkeypatch.setattr(workers, "start_method", lambda plat=None: "fork")
+    monkeypatch.setattr(start, "start_method", lambda plat=None: "fork")
     monkeypatch.setattr("multiprocessing.forkserver.ensure_running", lambda: started.append(1))
-    workers.preload(["json"])
+    start.preload(["json"])
     assert started == []

@@ -5,13 +5,16 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rich.console import Console
 from rich.table import Table
 
 from printgen.inputs.profiles import profile_name
 from printgen.report.jsonout import dumps
+
+if TYPE_CHECKING:
+    from printgen.run.options import RunOptions
 
 EXIT_INCOMPLETE = 3  # outputs written, but the verdict rests on fewer load levels than asked
 
@@ -69,12 +72,9 @@ def add_load_args(p: argparse.ArgumentParser, what: str, *, several: bool = Fals
     """--load NAME (a load case of printgen/barrier/loads), its alias --drag, --load-param
     KEY=VALUE (a parameter of the chosen case, e.g. the jam's porosity) and, with `several`,
     --loads A,B (each case's expected readings side by side)."""
-    from printgen.barrier.loads import DEFAULT, case_names
+    from printgen.barrier.loads import case_names
 
-    p.add_argument("--load", choices=case_names(), default=None,
-                   help=f"{what} under this load case (default {DEFAULT}; flow: hydrostatic + "
-                        "drag at a velocity rising with the depth; drag: at a fixed velocity; "
-                        "jam: seepage through a log jam at the flume's discharge steps)")
+    p.add_argument("--load", choices=case_names(), default=None, help=load_help(what))
     p.add_argument("--drag", action="store_const", dest="load", const="drag",
                    help="the same as --load drag")
     p.add_argument("--load-param", action="append", default=[], metavar="KEY=VALUE",
@@ -85,6 +85,15 @@ def add_load_args(p: argparse.ArgumentParser, what: str, *, several: bool = Fals
                        help="also write each load case's expected readings "
                             "(expected-readings-<case>.csv), e.g. hydrostatic,jam; the "
                             "verification runs under --load, or the first of these")
+
+
+def load_help(what: str) -> str:
+    """--load's help: every registered load case with its title, the default named, so a
+    new case module is listed without editing the command line."""
+    from printgen.barrier.loads import DEFAULT, load_cases
+
+    cases = "; ".join(f"{c.name}: {c.title}" for c in load_cases().values())
+    return f"{what} under this load case (default {DEFAULT}; {cases})".replace("%", "%%")
 
 
 def load_list(text: str) -> tuple[str, ...]:
@@ -121,6 +130,23 @@ def load_specs(args: argparse.Namespace) -> tuple[str | None, tuple[str, ...]]:
         return with_params(name, [x for x in params if x.partition("=")[0].strip() in own])
 
     return (spec(main) if main else None), tuple(spec(x) for x in listed)
+
+
+def run_options(args: argparse.Namespace) -> RunOptions:
+    """The run's options record from the command line: every option of it the command has
+    (the load cases as specs with --load-param's values, `load_specs`), and the command line
+    itself; what the command does not give keeps the record's default."""
+    from printgen.run.options import RunOptions
+
+    given = {"printer": "printer", "step": "step", "pdf": "pdf", "design_file": "design",
+             "time_limit_s": "time_limit", "force": "force", "scheduler": "scheduler",
+             "workers": "workers", "serial": "serial"}
+    kw = {field: getattr(args, arg) for field, arg in given.items()
+          if getattr(args, arg, None) is not None}
+    if hasattr(args, "load"):
+        load, loads = load_specs(args)
+        kw.update({"loads": loads} | ({"load": load} if load is not None else {}))
+    return RunOptions(command=getattr(args, "argv", None), **kw)
 
 
 def add_json_arg(p: argparse.ArgumentParser) -> None:

@@ -8,20 +8,27 @@ import argparse
 import sys
 from pathlib import Path
 
-from printgen.commands.common import add_json_arg, check_profile_args, console, emit_json, table
+from printgen.commands.common import (
+    add_json_arg,
+    check_profile_args,
+    console,
+    emit_json,
+    run_options,
+    table,
+)
 from printgen.errors import InputError
+from printgen.executor.dask import check_address
 from printgen.run import api
 from printgen.run.search import DesignRun, SearchOptions
 from printgen.search.choice import short
 from printgen.search.nets import OBJECTIVES, VERIFY_NETS, SearchResult
-from printgen.search.sweep import check_address
 
 SHOW = 10  # Pareto members shown per scale in the table (all are in report.json)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("design", help="search material x strand x diamond mesh x border for the "
-                                      "net that deforms like the prototype (Dask sweeps)")
+                                      "net that deforms like the prototype (parallel sweeps)")
     p.add_argument("prototype", help="prototype barrier TOML (see examples/)")
     p.add_argument("--scale", "-s", type=float, metavar="LAMBDA",
                    help="geometric scale lambda (1:40 -> 40); or give --scales")
@@ -32,10 +39,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", "-o", type=Path, help="output folder (default out/<name>-design)")
     where = p.add_mutually_exclusive_group()
     where.add_argument("--scheduler", metavar="ADDRESS",
-                       help="a running Dask scheduler (tcp://host:8786); default: a local "
-                            "cluster on every core")
-    where.add_argument("--serial", action="store_true", help="no Dask: run in this process")
-    p.add_argument("--workers", type=int, help="local cluster size (default: every core)")
+                       help="a running Dask scheduler (tcp://host:8786), for work that may "
+                            "leave this machine; default: this machine's worker processes")
+    where.add_argument("--serial", action="store_true", help="run in this process")
+    p.add_argument("--workers", type=int, help="worker processes on this machine (default: every "
+                                                "core)")
     p.add_argument("--materials", nargs="+", metavar="NAME", help="materials to search")
     p.add_argument("--mesh-x-mm", metavar="LO:HI", help="bounds of the diagonal across (mm)")
     p.add_argument("--mesh-y-mm", metavar="LO:HI", help="bounds of the diagonal up (mm)")
@@ -68,9 +76,8 @@ def run(args: argparse.Namespace) -> int:
         border_beads=_ints(args.border_beads, "--border-beads"), printer=args.printer,
         verify_nets=args.verify_nets, level_step=args.level_step)
     out = args.out or Path("out") / f"{Path(args.prototype).stem}-design"
-    result = api.search_nets(args.prototype, scales, options=opts, scheduler=args.scheduler,
-                             workers=args.workers, serial=args.serial, progress=not args.json,
-                             out=out, main_scale=args.scale)
+    result = api.search_nets(args.prototype, scales, options=opts, run=run_options(args),
+                             progress=not args.json, out=out, main_scale=args.scale)
     if args.json:
         emit_json(result.record)
         return 0

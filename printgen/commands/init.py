@@ -7,7 +7,7 @@ import argparse
 from pathlib import Path
 
 from printgen.commands.common import console
-from printgen.errors import InputError
+from printgen.run import api
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -18,13 +18,6 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from printgen.inputs.template import template_text
-    from printgen.outputs import write_text
-
-    if args.file.exists() and not args.force:
-        raise InputError(f"{args.file} exists; choose another name or pass --force")
-    if args.file.suffix != ".toml":
-        raise InputError(f"{args.file}: give a .toml file name")
-    write_text(args.file, template_text())
-    console().print(f"wrote {args.file}; edit it, then: printgen targets {args.file} --scale 40")
+    path = api.init(args.file, force=args.force)
+    console().print(f"wrote {path}; edit it, then: printgen targets {path} --scale 40")
     return 0

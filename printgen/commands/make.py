@@ -18,13 +18,13 @@ from printgen.commands.common import (
     console,
     emit_json,
     incomplete_code,
-    load_specs,
+    run_options,
     seconds,
     table,
 )
 from printgen.run import api
 from printgen.run.budget import DEFAULT_LIMIT_S
-from printgen.run.make import MakeOptions, json_output
+from printgen.run.make import json_output
 
 EXIT_TIME_LIMIT = 4  # stopped at --time-limit (printgen.cli maps TimeLimitError to it)
 
@@ -58,14 +58,10 @@ def run(args: argparse.Namespace) -> int:
     out = args.out or Path("out") / f"{Path(args.prototype).stem}-1-{args.scale:g}"
     err = Console(stderr=True, highlight=False)
     t0 = time.perf_counter()
-    load, loads = load_specs(args)
+    options = run_options(args)
     with err.status("planning") as status:
-        ctx = api.make(args.prototype, args.scale, out, printer=args.printer, load=load,
-                       step=args.step, progress=Progress(status),
-                       options=MakeOptions(force=args.force, loads=loads,
-                                           command=getattr(args, "argv", None),
-                                           design_file=args.design,
-                                           time_limit_s=args.time_limit, pdf=args.pdf))
+        ctx = api.make(args.prototype, args.scale, out, options=options,
+                       progress=Progress(status))
     seconds = time.perf_counter() - t0
     if args.json:
         emit_json(json_output(ctx))

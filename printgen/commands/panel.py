@@ -1,5 +1,5 @@
 """`printgen panel DESIGN [--orientation short|long] [--mode free|blocked] [--json]`: the
-simulated tensile test of a design's printed net panel (printgen.scene.panel), to compare
+simulated tensile test of a design's printed net panel (printgen.run.panel), to compare
 with a printed test panel before printing the barrier."""
 
 from __future__ import annotations
@@ -11,8 +11,7 @@ from printgen.commands.common import add_json_arg, console, emit_json, table
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from printgen.scene.panel import MODES
-    from printgen.scene.scenes import ORIENTATIONS
+    from printgen.run.panel import MODES, ORIENTATIONS
 
     p = sub.add_parser("panel", help="simulate a design's net panel tensile test (print a "
                                      "test panel and compare before printing the barrier)")
@@ -27,28 +26,25 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from printgen.design.design_file import load_design
-    from printgen.scene.panel import design_panel, panel_lockup
-    from printgen.scene.scenes import ORIENTATIONS
+    from printgen.run import api
 
-    d = load_design(args.design)
-    panels = [design_panel(d, o, args.mode) for o in (args.orientation or ORIENTATIONS)]
+    runs = api.panel(args.design, orientations=args.orientation, mode=args.mode)
     if args.json:
         emit_json([{"orientation": dp.orientation, "test": dp.test.describe(),
                     "strand_law": {"knees": dp.law.knees, "slopes_n": dp.law.slopes},
                     "strain": dp.curve.strains, "force_per_width_n_per_m":
                     dp.curve.force_per_width, "measured_n_per_m": dp.measured,
-                    "hold_share": dp.curve.hold_share} for dp in panels])
+                    "hold_share": dp.curve.hold_share} for dp in (r.panel for r in runs)])
         return 0
     c = console()
-    for dp in panels:
+    for r in runs:
+        dp = r.panel
         rows = [[f"{e:.1%}", f"{n:.4g}", f"{k / 1e3:.3g}",
                  "" if dp.measured is None else f"{dp.measured[i]:.4g}"]
                 for i, (e, n, k) in enumerate(zip(dp.curve.strains, dp.curve.force_per_width,
                                                   dp.curve.kappa, strict=True))]
-        lock = panel_lockup(dp.test)
         c.print(table(f"panel test, {dp.orientation} diagonal: {dp.test.describe()}; meshes "
-                      f"lie along the load at {lock:.1%}",
+                      f"lie along the load at {r.lockup:.1%}",
                       ["strain", "force/width N/m", "kappa kN/m/m", "profile N/m"], rows))
         if dp.curve.hold_share > 0.5:
             c.print(f"[bold yellow]the pin-jointed net is a mechanism here[/]: "

@@ -16,7 +16,7 @@ from printgen.commands.common import (
     check_profile_args,
     console,
     emit_json,
-    load_specs,
+    run_options,
     table,
 )
 from printgen.errors import InputError
@@ -42,8 +42,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     where.add_argument("--scheduler", metavar="ADDRESS",
                        help="a running Dask scheduler (tcp://host:8786)")
     where.add_argument("--serial", action="store_true", default=None,
-                       help="no Dask (default: serial below 12 cases, a local cluster above)")
-    p.add_argument("--workers", type=int, help="local Dask cluster size")
+                       help="run in this process (default: serial below 12 cases, this "
+                            "machine's worker processes above)")
+    p.add_argument("--workers", type=int, help="worker processes on this machine")
     p.add_argument("--force", action="store_true",
                    help="replace an output folder printgen did not write")
     add_json_arg(p)
@@ -66,8 +67,7 @@ def run(args: argparse.Namespace) -> int:
     err = Console(stderr=True, highlight=False)
     with err.status("reading inputs") as status:
         res = api.series(args.prototype, _scales(args.scales), materials=args.materials,
-                         load=load_specs(args)[0], net=args.solver_net, out=out, serial=args.serial,
-                         scheduler=args.scheduler, workers=args.workers, force=args.force,
+                         net=args.solver_net, out=out, options=run_options(args),
                          progress=lambda s: status.update(f"{s} ..."), bar=not args.json)
     if args.json:
         emit_json(res.record)

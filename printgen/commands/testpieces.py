@@ -7,7 +7,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from printgen.commands.common import add_json_arg, console, emit_json, table
+from printgen.commands.common import add_json_arg, console, emit_json, run_options, table
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -25,11 +25,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from printgen.run.testpieces import testpieces
+    from printgen.run import api
 
     out = args.out or Path("out") / f"{args.design.stem}-testpieces"
-    rec = testpieces(args.design, out, orientation=args.orientation, force=args.force,
-                     command=getattr(args, "argv", None))
+    rec = api.testpieces(args.design, out, orientation=args.orientation,
+                         options=run_options(args))
     if args.json:
         emit_json(rec)
         return 0

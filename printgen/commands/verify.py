@@ -19,7 +19,7 @@ from printgen.commands.common import (
     console,
     emit_json,
     incomplete_code,
-    load_specs,
+    run_options,
     table,
 )
 from printgen.verification.measured import COLUMNS, FIT_KINDS, LEVEL_COLUMN
@@ -57,9 +57,8 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     with err.status("reading inputs") as status:
         res = api.verify_design(args.prototype, args.scale, args.design, out,
-                                measured=args.measured, fit=args.fit, load=load_specs(args)[0],
-                                force=args.force, progress=lambda s: status.update(f"{s} ..."),
-                                time_limit_s=args.time_limit)
+                                measured=args.measured, fit=args.fit, options=run_options(args),
+                                progress=lambda s: status.update(f"{s} ..."))
     if args.json:
         emit_json(res.record)
         return incomplete_code(res.record, "verify")

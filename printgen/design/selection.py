@@ -17,7 +17,6 @@ import numpy as np
 
 from printgen.barrier.loads import OVERFLOW  # peak relative loading of the loading test
 from printgen.barrier.patterns import AS_DRAWN, get_pattern, mesh_text
-from printgen.barrier.patterns.square import check_square
 from printgen.design.record import NetDesign, Section
 from printgen.design.section import area_m2, equal_area_diameter, net_membrane_law
 from printgen.design.similitude import ScaledTargets
@@ -210,8 +209,9 @@ def model_mesh(p: Prototype, t: ScaledTargets) -> tuple[float, float]:
     m = p.model
     mesh = ((m.mesh_x_mm * MM, m.mesh_y_mm * MM)
             if m.mesh_x_mm is not None and m.mesh_y_mm is not None else (t["mesh_x"], t["mesh_y"]))
-    if printed_pattern(p) == "square":
-        check_square(*mesh, where="printed square net ([model] mesh_x_mm, mesh_y_mm)")
+    pattern = printed_pattern(p)
+    get_pattern(pattern).check_mesh(*mesh, f"printed {pattern} net ([model] mesh_x_mm, "
+                                    "mesh_y_mm)")
     return mesh
 
 

@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+from printgen.barrier.patterns import get_pattern
 from printgen.errors import InputError
 from printgen.inputs.prototype import Prototype
 from printgen.units import NU_WATER, G
@@ -103,7 +104,7 @@ def check_scale(scale: float) -> float:
 def prototype_quantities(p: Prototype) -> list[tuple[str, str, str, float, float]]:
     """(key, label, unit, exponent, prototype value) of every scaled quantity."""
     rho = p.density
-    mesh = "mesh side" if p.net.pattern == "square" else "mesh diagonal"  # what mesh_x_m is
+    mesh = get_pattern(p.net.pattern).mesh_name  # what mesh_x_m is
     q = [
         ("width", "barrier width w_B", "m", -1, p.width),
         ("height", "barrier height h_B", "m", -1, p.height),

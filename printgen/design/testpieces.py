@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from printgen.barrier.patterns import get_pattern, panel_test_patterns
 from printgen.design.record import CableDesign, Design, NetDesign
 from printgen.errors import GeometryError
 
@@ -69,9 +70,11 @@ def panel_for(d: Design, orientation: str, length_mm: float, width_mm: float) ->
     clamp edges `length_mm` apart and `width_mm` across (the virtual test's lattice size:
     whole half-meshes)."""
     n = d.net
-    if n.pattern != "diamond":
-        raise GeometryError(f"a test panel needs a diamond net; this design's net is "
-                            f"{n.pattern!r} (the virtual panel test models diamonds only)")
+    if not get_pattern(n.pattern).panel_test:
+        tested = panel_test_patterns()
+        raise GeometryError(f"a test panel needs a {' or '.join(tested)} net; this design's "
+                            f"net is {n.pattern!r} (the virtual panel test models "
+                            f"{' and '.join(f'{t}s' for t in tested)} only)")
     lo, hi = sorted((n.mesh_x_mm, n.mesh_y_mm))
     if orientation not in ("short", "long"):
         raise GeometryError(f"panel orientation {orientation!r} is not one of short, long")

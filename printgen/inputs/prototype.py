@@ -7,13 +7,11 @@ holds the lab's choices for the printed model (mesh, pattern, printer, print sty
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from printgen.barrier.patterns import pattern_names, printed_pattern_names
-from printgen.barrier.patterns.square import SQUARE_REL
-from printgen.errors import InputError
+from printgen.barrier.patterns import get_pattern, pattern_names, printed_pattern_names
+from printgen.errors import GeometryError, InputError
 from printgen.inputs.materials import MAX_MATERIALS
 from printgen.inputs.profiles import profile_name
 from printgen.inputs.schema import Field, load_toml, positive, read_table
@@ -181,11 +179,13 @@ def load_prototype(path: str | Path) -> Prototype:
         if mesh > limit / 2:
             raise InputError(f"{where} [net]: {label} = {mesh:g} m exceeds half the barrier "
                              f"({limit / 2:g} m); a net needs at least two meshes each way")
-    if net["pattern"] == "square" and not math.isclose(net["mesh_x"], net["mesh_y"],
-                                                       rel_tol=SQUARE_REL):
-        raise InputError(f"{where} [net]: pattern \"square\" needs mesh_x_m = mesh_y_m (the "
-                         f"square's side), got {net['mesh_x']:g} x {net['mesh_y']:g} m; give "
-                         "equal sides")
+    try:
+        get_pattern(net["pattern"]).check_mesh(net["mesh_x"], net["mesh_y"], "[net]")
+    except GeometryError:
+        name = net["pattern"]
+        raise InputError(f"{where} [net]: pattern \"{name}\" needs mesh_x_m = mesh_y_m (the "
+                         f"{name}'s side), got {net['mesh_x']:g} x {net['mesh_y']:g} m; give "
+                         "equal sides") from None
     return Prototype(
         name=top["name"], description=top["description"], width=bar["width"],
         height=bar["height"], anchors=bar["anchors"],

@@ -5,6 +5,7 @@ runs as written; the optional tables and keys are there too, commented out, to f
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 from printgen.inputs.prototype import OPTIONAL_TABLES, SCHEMA_TABLES
@@ -116,3 +117,18 @@ def _toml(v: Any) -> str:
         return "[" + ", ".join(_toml(x) for x in v) + "]"
     return f"{v:g}" if isinstance(v, float) and v != int(v) else (
         f"{v:.1f}" if isinstance(v, float) else str(v))
+
+
+def write_template(path: str | Path, *, force: bool = False) -> Path:
+    """Write the commented template into the new file `path` (.toml; an existing one only
+    with `force`); InputError otherwise."""
+    from printgen.errors import InputError
+    from printgen.outputs import write_text
+
+    path = Path(path)
+    if path.exists() and not force:
+        raise InputError(f"{path} exists; choose another name or pass --force")
+    if path.suffix != ".toml":
+        raise InputError(f"{path}: give a .toml file name")
+    write_text(path, template_text())
+    return path

@@ -30,10 +30,10 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
+from printgen.executor.signals import signals_deferred
 from printgen.outputs.files import FULL_ERRNOS, OutputError, named
 from printgen.outputs.lock import check_lock_path, folder_lock
 from printgen.outputs.manifest import edited_files, foreign_entry, write_manifest
-from printgen.workers import signals_deferred
 
 log = logging.getLogger(__name__)
 

@@ -51,7 +51,7 @@ class Drawing:
     cost: float = 1.0  # its drawing time relative to the others': the costliest go first
 
     def job(self) -> tuple:
-        """(fn, args, kwargs), as printgen.workers.run_jobs takes it."""
+        """(fn, args, kwargs), as printgen.executor.local.run_jobs takes it."""
         return self.fn, self.args, self.kwargs
 
 
@@ -124,7 +124,7 @@ class Report:
 
     def draw(self) -> None:
         """Draw the figures not drawn yet, side by side in worker processes when there are
-        several and two cores (printgen.workers.run_jobs), and put them in."""
+        several and two cores (printgen.executor.local.run_jobs), and put them in."""
         todo = self.pending()
         if todo:
             self.fill(drawn(todo))
@@ -139,9 +139,9 @@ class Report:
 
 def drawn(drawings: list[Drawing]) -> list[bytes]:
     """Each drawing's PNG, side by side in worker processes when there are several and two
-    cores (printgen.workers.run_jobs), the costliest started first (the worker that takes the
+    cores (printgen.executor.local.run_jobs), the costliest started first (the worker that takes the
     last one should not start a long one late); in the drawings' order."""
-    from printgen.workers import run_jobs
+    from printgen.executor.local import run_jobs
 
     order = sorted(range(len(drawings)), key=lambda i: -drawings[i].cost)
     pngs = run_jobs([drawings[i].job() for i in order])

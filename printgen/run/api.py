@@ -13,6 +13,7 @@ lazily, so `import printgen` stays fast::
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -22,11 +23,14 @@ from printgen.design.selection import Selection
 from printgen.design.selection import select as _select
 from printgen.design.similitude import ScaledTargets, scale_targets
 from printgen.inputs.prototype import Prototype, load_prototype
+from printgen.run.options import RunOptions
 
 if TYPE_CHECKING:
     from printgen.calibrate.pipeline import Calibration
     from printgen.calibrate.sample import FitOptions
-    from printgen.run.make import MakeContext, MakeOptions
+    from printgen.inputs.examples import Example
+    from printgen.run.make import MakeContext
+    from printgen.run.panel import PanelRun
     from printgen.run.search import DesignRun, SearchOptions
     from printgen.run.series import SeriesRun
     from printgen.run.verify import VerifyRun
@@ -66,23 +70,31 @@ def plan(prototype: PrototypeLike, scale: float, *, printer: str | None = None) 
 
 def make(prototype: str | Path, scale: float, out: str | Path, *,
          printer: str | None = None, load: str | None = None, drag: bool = False,
-         step: bool = False, options: MakeOptions | None = None,
+         step: bool = False, options: RunOptions | None = None,
          progress: Callable[[str], None] | None = None) -> MakeContext:
     """Targets, selection, parts (STL, 3MF, slicer profiles, G-code), the pre-print
     verification under load case `load` (`printgen.barrier.loads`, default hydrostatic;
     `drag=True` is `load="drag"`) and the report, written into the folder `out` as one
-    whole run; `options` (`printgen.run.make.MakeOptions`) for the rest."""
-    import dataclasses
-
-    from printgen.run.make import MakeOptions
+    whole run; `options` (`RunOptions`) for the rest (`printer`, `load` and `step` are
+    shorthands of its fields)."""
     from printgen.run.make import make as _make
 
-    opts = options or MakeOptions()
-    given = load if load is not None else (None if drag else opts.load)  # drag=True: "drag"
-    opts = dataclasses.replace(opts, load=load_name(given, drag),
-                               loads=tuple(load_name(x, False) for x in opts.loads),
-                               step=step or opts.step)
-    return _make(prototype, scale, out, printer=printer, options=opts, progress=progress)
+    opts = with_load(run_options(options, printer=printer, step=step or None), load, drag)
+    opts = replace(opts, loads=tuple(load_name(x, False) for x in opts.loads))
+    return _make(prototype, scale, out, options=opts, progress=progress)
+
+
+def run_options(options: RunOptions | None = None, **given: Any) -> RunOptions:
+    """`options` (default: `RunOptions()`) with each field of `given` that is not None in
+    place: a verb's keywords are shorthands of the one options record."""
+    return replace(options or RunOptions(), **{k: v for k, v in given.items() if v is not None})
+
+
+def with_load(options: RunOptions, load: str | None, drag: bool) -> RunOptions:
+    """`options` with the load case of `load` (else its own) and the alias `drag` checked
+    and resolved into one spec (`load_name`)."""
+    given = load if load is not None else (None if drag else options.load)  # drag: "drag"
+    return replace(options, load=load_name(given, drag))
 
 
 def load_name(load: str | None, drag: bool) -> str:
@@ -118,40 +130,45 @@ def verify_design(prototype: str | Path, scale: float, design_file: str | Path,
                   out: str | Path, *, measured: str | Path | None = None,
                   fit: str = "stiffness", load: str | None = None, drag: bool = False,
                   force: bool = False, progress: Callable[[str], None] | None = None,
-                  time_limit_s: float | None = None) -> VerifyRun:
+                  time_limit_s: float | None = None,
+                  options: RunOptions | None = None) -> VerifyRun:
     """`printgen verify`: the pre-print check of a design.json with its uncertainty band,
     optionally compared with a lab's `measured` loading test and one factor fitted to it,
     written into the folder `out` (see `printgen.run.verify.verify_design`); refused when
-    estimated longer than `time_limit_s` (None: the budget's default)."""
+    estimated longer than `time_limit_s` (None: the budget's default). `options`
+    (`RunOptions`) for the rest (`load`, `force` and `time_limit_s` are shorthands of its
+    fields)."""
     from printgen.run.verify import verify_design as _verify_design
 
+    opts = run_options(options, force=force or None, time_limit_s=time_limit_s)
     return _verify_design(prototype, scale, design_file, out, measured=measured, fit=fit,
-                          load=load_name(load, drag), force=force, progress=progress,
-                          time_limit_s=time_limit_s)
+                          options=with_load(opts, load, drag), progress=progress)
 
 
 def search_nets(prototype: PrototypeLike, scales: float | Sequence[float], *,
                 options: SearchOptions | None = None, scheduler: str | None = None,
                 serial: bool = False, workers: int | None = None,
                 progress: bool = False, out: str | Path | None = None,
-                main_scale: float | None = None) -> DesignRun:
+                main_scale: float | None = None, run: RunOptions | None = None) -> DesignRun:
     """The inverse design: the printable net that deforms most like the prototype at each
-    scale (screened by the membrane law, the best verified with the solver), on a local Dask
-    cluster, the cluster at `scheduler`, or serially. With `out`, the run's folder is checked
-    before the search and written once, whole, after it (`DesignRun.files`); its design.json
-    is the net at `main_scale` (default: the first scale)."""
+    scale (screened by the membrane law, the best verified with the solver), on this
+    machine's workers, the Dask cluster at `scheduler`, or serially. With `out`, the run's
+    folder is checked before the search and written once, whole, after it
+    (`DesignRun.files`); its design.json is the net at `main_scale` (default: the first
+    scale). `run` (`RunOptions`) for how it runs (`scheduler`, `serial` and
+    `workers` are shorthands of its fields)."""
     from printgen.run.search import SearchOptions, check_out, search_at_scales, write_outputs
 
+    how = run_options(run, scheduler=scheduler, serial=serial or None, workers=workers)
     lams = [float(scales)] if isinstance(scales, int | float) else [float(s) for s in scales]
     if out is not None:
         check_out(out, prototype)  # before the search: a refused folder costs nothing
-    run = search_at_scales(prototype, lams, options=options or SearchOptions(),
-                           scheduler=scheduler, serial=serial, workers=workers,
-                           progress=progress)
+    found = search_at_scales(prototype, lams, options=options or SearchOptions(), run=how,
+                             progress=progress)
     if out is not None:
-        write_outputs(run, out, lams[0] if main_scale is None else float(main_scale),
+        write_outputs(found, out, lams[0] if main_scale is None else float(main_scale),
                       prototype)
-    return run
+    return found
 
 
 def series(prototype: PrototypeLike, scales: Sequence[float] = (1, 10, 30, 50, 100), *,
@@ -159,22 +176,26 @@ def series(prototype: PrototypeLike, scales: Sequence[float] = (1, 10, 30, 50, 1
            net: NetOptions | str | None = None, out: str | Path | None = None,
            serial: bool | None = None, scheduler: str | None = None,
            workers: int | None = None, force: bool = False,
-           progress: Callable[[str], None] | None = None, bar: bool = False) -> SeriesRun:
+           progress: Callable[[str], None] | None = None, bar: bool = False,
+           options: RunOptions | None = None) -> SeriesRun:
     """The virtual scale series (Lambert et al. 2023, Fig. 2): the prototype's scene at each
     1:lambda with its material unscaled, with E / lambda and with each of `materials`, under
     load case `load` at h = h_B; normalised deflection, lowering and mid-height elongation,
     the lambda range where each material stays within +-10 % of the prototype, the check
     against the (F/EA)^(1/3) law. `net`: the solver scene's options (NetOptions, or the
-    `--solver-net` text). Serial for few cases, on Dask for many (the same numbers); written
-    into the folder `out` when given."""
+    `--solver-net` text). Serial for few cases, on this machine's workers for many, on Dask
+    with `scheduler` (the same numbers); written into the folder `out` when given. `options`
+    (`RunOptions`) for how it runs (`load`, `serial`, `scheduler`, `workers` and `force` are
+    shorthands of its fields)."""
     from printgen.run.series import run_series
     from printgen.verification.series import net_options
 
     opts = net if not isinstance(net, str | None) else net_options(net)
+    how = run_options(options, load=load, serial=serial, scheduler=scheduler,
+                      workers=workers, force=force or None)
     return run_series(prototype if isinstance(prototype, Prototype) else Path(prototype),
-                      [float(s) for s in scales], materials=tuple(materials), load=load,
-                      net=opts, out=out, serial=serial, scheduler=scheduler, workers=workers,
-                      force=force, progress=progress, bar=bar)
+                      [float(s) for s in scales], materials=tuple(materials), net=opts,
+                      out=out, options=how, progress=progress, bar=bar)
 
 
 def calibrate(paths: Sequence[str | Path], *, material: str,
@@ -184,3 +205,47 @@ def calibrate(paths: Sequence[str | Path], *, material: str,
     from printgen.calibrate.pipeline import calibrate as _calibrate
 
     return _calibrate(paths, material=material, options=options, **kwargs)
+
+
+def examples() -> dict[str, Path]:
+    """The bundled examples: name -> its prototype TOML or its folder of data files."""
+    from printgen.inputs.examples import examples as _examples
+
+    return _examples()
+
+
+def example(name: str, out: str | Path | None = None) -> Example:
+    """The bundled example `name` and its files, copied into the new folder `out` when
+    given (`printgen example NAME --out DIR`)."""
+    from printgen.inputs.examples import example as _example
+
+    return _example(name, out)
+
+
+def init(path: str | Path, *, force: bool = False) -> Path:
+    """Write the commented prototype template (every key, its unit, meaning and range) into
+    the .toml file `path` (an existing one only with `force`)."""
+    from printgen.inputs.template import write_template
+
+    return write_template(path, force=force)
+
+
+def panel(design_file: str | Path, *, orientations: Sequence[str] | None = None,
+          mode: str = "free") -> list[PanelRun]:
+    """The simulated tensile test of the design's printed net panel along each diagonal of
+    `orientations` (default: both), its sides `mode` free or blocked (`printgen panel`)."""
+    from printgen.run.panel import panel_tests
+
+    return panel_tests(design_file, tuple(orientations) if orientations else None, mode)
+
+
+def testpieces(design_file: str | Path, out: str | Path, *, orientation: str = "short",
+               options: RunOptions | None = None) -> dict[str, Any]:
+    """The tensile coupons and the net test panel of the design, written into the folder
+    `out` (`printgen testpieces`); `options` (`RunOptions`): `force`, `command`. Their
+    record."""
+    from printgen.run.testpieces import testpieces as _testpieces
+
+    opts = options or RunOptions()
+    return _testpieces(design_file, out, orientation=orientation, force=opts.force,
+                       command=opts.command)

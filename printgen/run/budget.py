@@ -32,8 +32,9 @@ from typing import Any
 from printgen.barrier.patterns import get_pattern
 from printgen.design.record import Design
 from printgen.errors import InputError
+from printgen.executor.local import reporting
+from printgen.executor.start import cores
 from printgen.inputs.prototype import Prototype
-from printgen.workers import cores, reporting
 
 # About a minute of `make` on 2 cores: the bundled simple barrier (free top) and the 1:40
 # example both fit (benchmarks/measurements.md#make-no-default-stop).
@@ -338,7 +339,7 @@ BAR_CELLS = 20  # characters of a text progress bar
 @contextlib.contextmanager
 def level_bars(progress: Callable[[str], None] | None) -> Iterator[None]:
     """While the block runs, pass `progress` one line of text bars, one per net being solved,
-    at each load level (from `printgen.workers.report_progress`). None: no reporting."""
+    at each load level (from `printgen.executor.local.report_progress`). None: no reporting."""
     if progress is None:
         yield
         return

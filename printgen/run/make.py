@@ -23,7 +23,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from printgen.barrier.loads import DEFAULT as DEFAULT_LOAD
 from printgen.barrier.loads import distinct_specs, get_load
 from printgen.design.design_file import load_design
 from printgen.design.plan import make_design
@@ -31,6 +30,9 @@ from printgen.design.record import Design
 from printgen.design.selection import Selection, design_net, select
 from printgen.design.similitude import ScaledTargets, scale_targets
 from printgen.errors import TimeLimitError
+from printgen.executor.local import Helper, check_deadline, deadline, helper
+from printgen.executor.signals import signals_deferred
+from printgen.executor.start import cores, quiet_tracker, warm_up
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import MANIFEST, TIMINGS, check_destination, staged_dir
@@ -47,6 +49,7 @@ from printgen.run.budget import (
     level_bars,
     sweep_cores,
 )
+from printgen.run.options import RunOptions
 from printgen.run.provenance import (  # noqa: F401 (json_output, TIME_KEYS: used via make)
     TIME_KEYS,
     json_output,
@@ -64,44 +67,13 @@ from printgen.run.steps import (
     verify_step,
 )
 from printgen.trace import span
-from printgen.workers import (
-    Helper,
-    check_deadline,
-    cores,
-    deadline,
-    helper,
-    preload,
-    signals_deferred,
-    start_method,
-)
 
 log = logging.getLogger(__name__)
 # what the workers' jobs import (the verification's sweeps, the report's figures): a fork
-# server imports them once (printgen.workers.preload); matplotlib's pyplot is imported by the
-# helper while its sweeps run (`verification_sweeps`), not here: the helper would wait for it
+# server imports them once (printgen.executor.start.warm_up); matplotlib's pyplot is imported
+# by the helper while its sweeps run (`verification_sweeps`), not here: the helper would wait
+# for it
 JOB_MODULES = ("printgen.run.steps", "printgen.verification.pooled", "printgen.report.plots")
-
-
-@dataclass(frozen=True)
-class MakeOptions:
-    """How `make` runs (what the command line gives).
-
-    load : the verification's load case (printgen/barrier/loads, a spec with its parameters);
-    loads : the load cases whose expected readings are written side by side (--loads, the
-    verification's own included when listed); step : also write STEP;
-    design_file : print this design.json instead of the selection's choice; time_limit_s :
-    refuse runs estimated longer; force : replace a folder printgen did not write;
-    command : the command line, recorded in the manifest; pdf : also print report.pdf.
-    """
-
-    load: str = DEFAULT_LOAD
-    loads: tuple[str, ...] = ()  # --loads: each case's expected readings (nominal sweeps)
-    step: bool = False
-    design_file: str | Path | None = None
-    time_limit_s: float | None = None  # None: refused only when estimated over DEFAULT_LIMIT_S
-    force: bool = False
-    command: list[str] | None = None
-    pdf: bool = False
 
 
 @dataclass
@@ -116,7 +88,7 @@ class MakeContext:
     selection: Selection
     design: Design
     records: RunRecords
-    options: MakeOptions = field(default_factory=MakeOptions)
+    options: RunOptions = field(default_factory=RunOptions)
     record: dict[str, Any] = field(default_factory=dict)
     timings: dict[str, Any] = field(default_factory=dict)
     report: Report | None = None
@@ -131,13 +103,13 @@ class MakeContext:
 Step = Callable[[MakeContext, Path], dict[str, Any]]  # its records, by report.json key
 
 
-def plan(prototype_path: str | Path, scale: float, *, printer: str | None = None,
-         options: MakeOptions | None = None) -> MakeContext:
+def plan(prototype_path: str | Path, scale: float, *,
+         options: RunOptions | None = None) -> MakeContext:
     """Targets, selection and design: the fast, file-free part of `make`."""
-    options = options or MakeOptions()
+    options = options or RunOptions()
     proto = load_prototype(prototype_path)
     t = scale_targets(proto, scale)
-    sel = select(proto, t, printer=printer)
+    sel = select(proto, t, printer=options.printer)
     design = make_design(proto, t, sel)
     design_file, own = options.design_file, None
     if design_file:  # the net of `printgen design` (its design.json) instead of select's
@@ -152,8 +124,7 @@ def plan(prototype_path: str | Path, scale: float, *, printer: str | None = None
 
 
 def make(prototype_path: str | Path, scale: float, out: str | Path, *,
-         printer: str | None = None, steps: list[tuple[str, Step]] | None = None,
-         options: MakeOptions | None = None,
+         steps: list[tuple[str, Step]] | None = None, options: RunOptions | None = None,
          progress: Callable[[str], None] | None = None) -> MakeContext:
     """Run every step into a stage folder and swap it in as the whole of `out`.
 
@@ -161,12 +132,12 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     only file that differs between runs).
     """
     t0 = time.perf_counter()
-    warm_up()
-    options = options or MakeOptions()
+    warm_up(JOB_MODULES)
+    options = options or RunOptions()
     inputs = [prototype_path, options.design_file, *search_dirs()]
     check_destination(Path(out), force=options.force, inputs=inputs)  # fail fast
     with span("make: plan and estimate"):
-        ctx = plan(prototype_path, scale, printer=printer, options=options)
+        ctx = plan(prototype_path, scale, options=options)
         est = size_check(ctx, steps is None or any(s is verify_step for _, s in steps))
     if progress and est.seconds > LONG_RUN_S:
         progress(f"estimate: {est.summary()}")
@@ -253,7 +224,7 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]]) -> Itera
     """Start the verification's sweeps (`verification_sweeps`) in a helper process now, so
     that they run while the parts are built here; `sweeps_done` and `verify_step` collect
     them (a long run's per-level progress comes from the sweeps' workers straight to this
-    process: printgen.workers). Only on 2 cores or more: on one there is nothing to gain."""
+    process: printgen.executor.local). Only on 2 cores or more: on one there is nothing to gain."""
     serial = os.environ.get("PRINTGEN_SERIAL") or cores() < 2
     if serial or not any(s is verify_step for _, s in steps):
         yield
@@ -262,8 +233,7 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]]) -> Itera
     with helper() as h:
         ctx.helper = h
         ctx.background["verification sweeps"] = ctx.helper.submit(
-            timed, verification_sweeps, ctx.prototype, ctx.design, load=ctx.options.load,
-            loads=ctx.options.loads)
+            timed, verification_sweeps, ctx.prototype, ctx.design, ctx.options)
         try:
             with signals_deferred():  # a signal meanwhile would be lost in trimesh's imports
                 preload_parts()
@@ -273,31 +243,7 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]]) -> Itera
             ctx.helper = None
 
 
-def warm_up() -> None:
-    """Where workers start by `forkserver`, start the fork server now with the jobs' modules
-    (printgen.workers.preload: it imports them beside the planning and the parts), the
-    resource tracker quietened first (`quiet_tracker`: the fork server starts it)."""
-    if not os.environ.get("PRINTGEN_SERIAL") and cores() > 1 and start_method() == "forkserver":
-        quiet_tracker()
-        preload(JOB_MODULES)
-
-
 REPORT = "report (HTML, figures, lab files)"  # the last stage of a run, after its steps
-TRACKER_WARNING = "ignore:resource_tracker:UserWarning"  # a -W option (sys.warnoptions)
-
-
-def quiet_tracker() -> None:
-    """Start multiprocessing's resource tracker without its "leaked semaphore objects" warning.
-    A run stopped at its time limit (or by a signal) kills the helper while its workers' queues
-    are registered with the tracker, which unlinks them when it exits and says so on stderr: a
-    second line after make's one. The tracker inherits the -W options of sys.warnoptions
-    when it starts (at the helper's first queue); one already running is left as it is."""
-    import sys
-    from multiprocessing import resource_tracker
-
-    if TRACKER_WARNING not in sys.warnoptions:
-        sys.warnoptions.append(TRACKER_WARNING)
-    resource_tracker.ensure_running()
 
 
 def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
@@ -314,13 +260,13 @@ def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
     return est
 
 
-def swept_cases(options: MakeOptions) -> int:
+def swept_cases(options: RunOptions) -> int:
     """Load cases the verification sweeps: its own and each other one of --loads."""
     own = get_load(options.load).spec
     return 1 + sum(spec != own for spec in distinct_specs(options.loads))
 
 
-def run_bound(options: MakeOptions) -> float | None:
+def run_bound(options: RunOptions) -> float | None:
     """Seconds after which the run stops: --time-limit when given. Without it a run is only
     refused when estimated over DEFAULT_LIMIT_S, never stopped: a shared machine can run
     many times slower than the estimate (benchmarks/measurements.md#make-no-default-stop), and

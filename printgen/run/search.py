@@ -24,10 +24,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from printgen.design.similitude import scale_targets
+from printgen.executor import open_runner
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import check_destination, write_folder
 from printgen.report.jsonout import dumps
+from printgen.run.options import RunOptions
 from printgen.search.nets import (
     SearchResult,
     VerifyScore,
@@ -44,7 +46,6 @@ from printgen.search.space import (
     default_space,
     half_cell_counts,
 )
-from printgen.search.sweep import open_runner
 
 
 def verify_task(shared: VerifyShared, task: VerifyTask) -> VerifyScore:
@@ -115,14 +116,15 @@ def space_for(p: Prototype, scale: float, o: SearchOptions) -> SearchSpace:
 
 
 def search_at_scales(prototype: str | Path | Prototype, scales: list[float], *,
-                    options: SearchOptions = SearchOptions(), scheduler: str | None = None,
-                    workers: int | None = None, serial: bool = False,
-                    progress: bool = False) -> DesignRun:
-    """Search at every scale on one Dask runner (a LocalCluster unless `scheduler`/`serial`)."""
+                    options: SearchOptions = SearchOptions(),
+                    run: RunOptions | None = None, progress: bool = False) -> DesignRun:
+    """Search at every scale on one runner (`run`: this machine's workers, the Dask
+    scheduler at `run.scheduler`, or serially)."""
+    run = run or RunOptions()
     p = prototype if isinstance(prototype, Prototype) else load_prototype(prototype)
     spaces = {s: space_for(p, s, options) for s in scales}  # every bound checked before work
     results = []
-    with open_runner(scheduler=scheduler, workers=workers, serial=serial,
+    with open_runner(scheduler=run.scheduler, workers=run.workers, serial=bool(run.serial),
                      progress=progress) as runner:
         for s in scales:
             results.append(search(p, s, runner, objective=options.objective,

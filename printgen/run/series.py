@@ -1,6 +1,7 @@
 """`printgen series`: the virtual scale series of a prototype (printgen.verification.series)
-run serially or on the design search's Dask runner, summarised (series_table) and written as
-one folder (`outputs.staged_dir`: whole or nothing, locked, with its manifest):
+run serially or on the executor's runner (printgen.executor, as the design search),
+summarised (series_table) and written as one folder (`outputs.staged_dir`: whole or nothing,
+locked, with its manifest):
 
 - report.html: the sentences, the figure, the table, the law check, the assumptions;
 - report.json: every number of the series (points, curves, law check, assumptions);
@@ -17,13 +18,14 @@ from pathlib import Path
 
 from printgen.barrier.loads import get_load
 from printgen.errors import InputError
+from printgen.executor import open_runner
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import TIMINGS, check_destination, write_folder
 from printgen.report.jsonout import dumps
 from printgen.report.series import series_csv, series_figure, series_report
+from printgen.run.options import RunOptions
 from printgen.scene.scenes import SENSOR_FORCE_N
-from printgen.search.sweep import open_runner
 from printgen.verification.series import (
     LEVEL,
     LEVEL_STEP,
@@ -38,7 +40,7 @@ from printgen.verification.series import (
 )
 from printgen.verification.series_table import Series, summarise
 
-PARALLEL_FROM = 12  # cases from which the series runs on a local Dask cluster by default
+PARALLEL_FROM = 12  # cases from which the series runs on this machine's workers by default
 
 
 @dataclass
@@ -53,19 +55,22 @@ class SeriesRun:
 
 
 def run_series(prototype: str | Path | Prototype, scales: list[float], *,
-               materials: tuple[str, ...] = (), load: str | None = None,
-               net: NetOptions | None = None, level: float = LEVEL,
-               level_step: float = LEVEL_STEP, out: str | Path | None = None,
-               serial: bool | None = None, scheduler: str | None = None,
-               workers: int | None = None, force: bool = False,
+               materials: tuple[str, ...] = (), net: NetOptions | None = None,
+               level: float = LEVEL, level_step: float = LEVEL_STEP,
+               out: str | Path | None = None, options: RunOptions | None = None,
                progress: Callable[[str], None] | None = None, bar: bool = False) -> SeriesRun:
     """Check every input, solve every (row, lambda) case, summarise, write `out` (if given).
 
-    `serial` None: serially up to PARALLEL_FROM cases, on a local Dask cluster from there (a
-    `scheduler` address or `workers` always mean Dask); the numbers are the same either way.
+    `options` (`RunOptions`): the load case, where the cases run and whether `out` may be
+    replaced. `options.serial` None: serially up to PARALLEL_FROM cases, in parallel from
+    there (a `scheduler` address or `workers` always mean parallel); the numbers are the same
+    either way.
     """
     say = progress or (lambda _text: None)
     t0 = time.perf_counter()
+    options = options or RunOptions()
+    load, force, serial = options.load, options.force, options.serial
+    scheduler, workers = options.scheduler, options.workers
     lams = check_scales(scales)
     if serial and (workers is not None or scheduler):
         raise InputError("--serial runs in this process: leave out --workers/--scheduler, or "
@@ -81,7 +86,7 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
     if serial is None:
         serial = len(todo) < PARALLEL_FROM and scheduler is None and workers is None
     say(f"{len(todo)} cases ({len(rows)} rows x {len(lams)} scales)"
-        + ("" if serial else ", starting Dask"))
+        + ("" if serial else ", starting the workers"))
     with open_runner(scheduler=scheduler, workers=workers, serial=serial,
                      progress=bar) as runner:
         results = runner.map(solve_case, todo, shared=shared, label="series cases")

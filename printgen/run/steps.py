@@ -21,10 +21,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from printgen.errors import TimeLimitError
+from printgen.executor.local import seconds_left
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
 from printgen.trace import span
-from printgen.workers import seconds_left
 
 HELPER_SWEEPS = "helper: verification sweeps"  # timings_s keys of work done in the helper
 WAIT_SWEEPS = "waiting for the verification sweeps"  # in this process, within a step
@@ -38,6 +38,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from printgen.report.html import Drawing
     from printgen.report.records import CheckRecords, MeshRecord, PlateRecord
     from printgen.run.make import MakeContext
+    from printgen.run.options import RunOptions
     from printgen.verification.bands import Band
     from printgen.verification.verify import Verification
 
@@ -241,8 +242,7 @@ def verify_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     (`verification_records`), their times in the run's timings."""
     sweeps = sweeps_done(ctx)
     if sweeps is None:
-        sweeps = verification_sweeps(ctx.prototype, ctx.design, load=ctx.options.load,
-                                     loads=ctx.options.loads)
+        sweeps = verification_sweeps(ctx.prototype, ctx.design, ctx.options)
     with span("verify: records"):
         check, times = verification_records(*sweeps, ctx.targets.scale)
     ctx.timings["verification"] = times
@@ -288,7 +288,7 @@ def _draw(ctx: MakeContext, todo: list[Drawing]) -> None:
 
 def draw_all(drawings: list[Drawing]) -> list[bytes]:
     """Each drawing's PNG (carrying its SVG), side by side in worker processes when there are
-    several and two cores (printgen.workers.run_jobs); matplotlib is imported here first, so
+    several and two cores (printgen.executor.local.run_jobs); matplotlib is imported here first, so
     that forked workers start with it."""
     from printgen.report.html import drawn
     from printgen.report.plots import load_pyplot
@@ -299,7 +299,7 @@ def draw_all(drawings: list[Drawing]) -> list[bytes]:
 
 def _collect(pending: Future, what: str) -> Any:
     """A helper job's result, waiting no longer than the run's deadline
-    (`printgen.workers.deadline`): past it, TimeLimitError naming `what` (the helper is then
+    (`printgen.executor.local.deadline`): past it, TimeLimitError naming `what` (the helper is then
     stopped)."""
     left = seconds_left()
     try:
@@ -314,9 +314,10 @@ def timed(fn: Callable, /, *args: Any, **kwargs: Any) -> tuple[Any, float]:
     return fn(*args, **kwargs), time.perf_counter() - t
 
 
-def verification_sweeps(prototype: Prototype, design: Design, *, load: str | None = None,
-                        loads: tuple[str, ...] = ()) -> tuple[Verification, Band]:
-    """Both barriers' load sweeps compared, and the model's uncertainty band.
+def verification_sweeps(prototype: Prototype, design: Design,
+                        options: RunOptions) -> tuple[Verification, Band]:
+    """Both barriers' load sweeps compared, and the model's uncertainty band, under the
+    run's load case (`options.load`; each of `options.loads` too, nominal sweeps only).
 
     The sweep is the scene realistic-1:40 with border cables, simple-free-top without them
     (README: Pre-print verification); every load level is solved on both. Needs nothing from
@@ -327,9 +328,9 @@ def verification_sweeps(prototype: Prototype, design: Design, *, load: str | Non
     from printgen.verification.verify import free_section
 
     # matplotlib is imported while the sweeps run: the figures' workers start with it
-    return verify_with_band(prototype, design, load=load, counterexample=True,
+    return verify_with_band(prototype, design, load=options.load, counterexample=True,
                             free_section=free_section(prototype), meanwhile=load_pyplot,
-                            loads=tuple(loads))
+                            loads=tuple(options.loads))
 
 
 def solver_work(v: Verification, band: Band) -> dict[str, Any]:

@@ -16,6 +16,7 @@ from typing import Any
 
 from printgen.design.design_file import load_design
 from printgen.design.record import Design
+from printgen.executor.start import preload
 from printgen.inputs.materials import load_material
 from printgen.inputs.profiles import profile_name, search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
@@ -26,6 +27,7 @@ from printgen.report.records import CheckRecords, MeasuredRecords, RunRecords
 from printgen.run.budget import DEFAULT_LIMIT_S, Work, check_budget, sweep_cores
 from printgen.scene.flume import flume_layout
 from printgen.scene.readings import design_units
+from printgen.run.options import RunOptions
 from printgen.verification.bands import Band, band_verdicts, model_load_kw
 from printgen.verification.fit import MultiFit, fit_levels, fit_measured
 from printgen.verification.measured import (
@@ -38,7 +40,6 @@ from printgen.verification.measured import (
 )
 from printgen.verification.pooled import verify_with_band
 from printgen.verification.verify import Verification, free_section
-from printgen.workers import preload
 
 # what the workers' jobs import (the sweeps, the figures): a fork server imports them once
 JOB_MODULES = ("printgen.verification.pooled", "printgen.report.plots")
@@ -63,9 +64,8 @@ class VerifyRun:
 
 def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
                   out: str | Path, *, measured: str | Path | None = None,
-                  fit: str = "stiffness", load: str | None = None, force: bool = False,
-                  progress: Callable[[str], None] | None = None,
-                  time_limit_s: float | None = None) -> VerifyRun:
+                  fit: str = "stiffness", options: RunOptions | None = None,
+                  progress: Callable[[str], None] | None = None) -> VerifyRun:
     """Check the design against the prototype with its band; compare and fit `measured`.
 
     Every input is read and checked before the first solve, so a bad file costs nothing; so
@@ -74,6 +74,8 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     """
     say = progress or (lambda _label: None)
     t0 = time.perf_counter()
+    options = options or RunOptions()
+    load, force, time_limit_s = options.load, options.force, options.time_limit_s
     preload(JOB_MODULES)  # a fork server's imports, while the inputs are read
     inputs = [prototype, design_path, measured, *search_dirs()]
     check_destination(Path(out), force=force, inputs=inputs)  # before any work

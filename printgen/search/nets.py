@@ -9,7 +9,7 @@ Two stages over the space of `search_space` (material x strand section x diamond
    the best net of each of the `verify_nets` best material x section pairs, each with every
    border width, and `select`'s pick for comparison.
 
-Both stages run on a `sweep.Runner` (Dask, or serial): each task is a pure function of a small
+Both stages run on a `printgen.executor.Runner` (this machine's workers, a Dask scheduler, or serial): each task is a pure function of a small
 frozen record, so the result does not depend on where it ran. The solver stage is passed in
 (`verifier`) because the verification stage sits above the search stage (`printgen.run.search` wires
 it); with the `stiffness` objective the search stops after stage 1.
@@ -28,6 +28,7 @@ from printgen.design.record import Design, NetDesign
 from printgen.design.selection import select
 from printgen.design.similitude import scale_targets
 from printgen.errors import InputError
+from printgen.executor import Runner, batches
 from printgen.inputs.materials import load_material
 from printgen.inputs.prototype import Prototype
 from printgen.search.choice import binding_constraints, choice_reasons, rank_key
@@ -42,7 +43,6 @@ from printgen.search.space import (
     grid,
     search_context,
 )
-from printgen.search.sweep import Runner, batches
 
 OBJECTIVES = ("deformation", "stiffness")
 VERIFY_NETS = 3  # nets verified by the solver (each with every border width)

@@ -32,7 +32,7 @@ from printgen.trace import span
 from printgen.verification.compare import METRICS
 from printgen.verification.variants import Variant, model_variants
 from printgen.verification.verify import Run, load_keywords, sweep
-from printgen.workers import collect, submit_jobs
+from printgen.executor.local import collect, submit_jobs
 
 COARSENINGS = (2, 3)  # mesh multipliers tried in turn for the variant sweeps
 REFINE_TOL = 0.01  # a coarser net is used when no nominal curve moves by more than 1 % of its peak
@@ -153,7 +153,7 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
     The variants run on the coarsest net that passes the refinement test (`ahead`: its
     sweeps already started, `refinement_test`); there a variant's curve is the nominal plus
     the variant's change on the coarse net. `then` is called once the variants are started
-    (within printgen.workers.shared_pool: to queue more jobs behind them).
+    (within printgen.executor.local.shared_pool: to queue more jobs behind them).
     """
     t0 = time.perf_counter()
     lv = nominal.deformation.levels

@@ -1,4 +1,4 @@
-"""The verification's sweeps on one set of workers (printgen.workers.shared_pool): `verify`'s
+"""The verification's sweeps on one set of workers (printgen.executor.local.shared_pool): `verify`'s
 nominal pair, the band's refinement test and variants (printgen.verification.bands) and the
 steel counter-example, each started as soon as what it needs is known, so that no core waits
 for a pool to finish or for a serial step.
@@ -28,7 +28,7 @@ from printgen.verification.bands import COARSENINGS, Band, meshable, model_band,
 from printgen.verification.cases import case_plan, other_cases, with_cases
 from printgen.verification.variants import Variant
 from printgen.verification.verify import Verification, steel_counterexample, verify_plan
-from printgen.workers import collect, shared_pool
+from printgen.executor.local import collect, shared_pool
 
 
 def verify_with_band(p: Prototype, d: Design, *, load: str | LoadCase | None = None,

@@ -16,7 +16,7 @@ The loads scale by Froude (the load case's own: rho g (h - z) A* with A* / lambd
 v / sqrt(lambda) on d / lambda), the hold of unloaded nodes (a share of rho g A*) as lambda^-2.
 
 A case (row, lambda) is a pure task `solve_case(shared, case)`, so the same series gives the
-same numbers serially or on a Dask cluster (`printgen.search.sweep.Runner`).
+same numbers serially or on a Dask cluster (`printgen.executor.Runner`).
 """
 
 from __future__ import annotations

@@ -34,7 +34,7 @@ from printgen.verification.compare import (
     headline,
     increments,
 )
-from printgen.workers import (  # worker lifecycle: ground floor
+from printgen.executor.local import (  # worker lifecycle: ground floor
     check_deadline,
     report_progress,
     run_jobs,

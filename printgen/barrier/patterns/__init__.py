@@ -7,7 +7,7 @@ pattern is one module plus its test). Lengths of the graph in mm, of the laws in
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from printgen.barrier.graph import NetGraph
 from printgen.errors import InputError
@@ -36,6 +36,11 @@ class NetPattern:
     lockup(a_along, a_across) : the panel strain at which a free pin-jointed panel's strands
       lie along the load (its meshes closed across it: a mechanism below); None: they lie
       along it from the start (the square's strands up)
+    mesh_name : what mesh_x and mesh_y measure, as the outputs name it ("mesh side",
+      "mesh diagonal")
+    check_mesh(mesh_x, mesh_y, where) : GeometryError naming `where` when the pattern cannot
+      have that mesh (the square's sides must be equal; mesh_y None: taken as mesh_x)
+    panel_test : the virtual panel test (`testpieces`, the panel command) models this pattern
     """
 
     name: str
@@ -47,12 +52,25 @@ class NetPattern:
     nodes: Callable[[float, float, float, float], int]
     edge_strands: bool = False
     lockup: Callable[[float, float], float] | None = None
+    # below: no defaults, so that a new pattern states each of them
+    mesh_name: str = field(kw_only=True)
+    check_mesh: Callable[[float, float | None, str], None] = field(kw_only=True)
+    panel_test: bool = field(kw_only=True)
 
 
 def mesh_text(pattern: str, mesh_x_mm: float, mesh_y_mm: float) -> str:
     """How a printed net is named in every output: "square mesh 5 x 5 mm" (the square's
     sides), "diamond mesh 20.6 x 9.4 mm" (the diamond's diagonals), across x up."""
     return f"{pattern} mesh {mesh_x_mm:g} x {mesh_y_mm:g} mm"
+
+
+def any_mesh(mesh_x: float, mesh_y: float | None, where: str = "net") -> None:
+    """`check_mesh` of a pattern that takes any mesh_x and mesh_y (the diamond's diagonals)."""
+
+
+def panel_test_patterns() -> tuple[str, ...]:
+    """The patterns the virtual panel test models (`NetPattern.panel_test`)."""
+    return tuple(name for name, p in patterns().items() if p.panel_test)
 
 
 def pattern_names() -> tuple[str, ...]:

@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from printgen.barrier.graph import NetGraph, check_lengths
-from printgen.barrier.patterns import Law, NetPattern
+from printgen.barrier.patterns import Law, NetPattern, any_mesh
 from printgen.errors import GeometryError
 
 MIN_HALF_CELLS = 2  # fewer half-meshes across than this is not a net
@@ -138,4 +138,5 @@ def _border_loop(index: np.ndarray, nx: int, ny: int) -> np.ndarray:
 
 
 PATTERN = NetPattern("diamond", diamond_net, diamond_factor, strand_law, strand_force,
-                     span, diamond_nodes, lockup=lockup_strain)
+                     span, diamond_nodes, lockup=lockup_strain, mesh_name="mesh diagonal",
+                     check_mesh=any_mesh, panel_test=True)

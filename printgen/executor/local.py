@@ -1,18 +1,15 @@
-"""Worker processes and signals: workers die with their parent, signals end a run cleanly.
+"""The local pool: worker processes on this machine that die with their parent.
 
 `run_jobs` runs independent jobs in a process pool whose workers die with their parent, so a
 `make` killed by SIGKILL leaves no orphan: on Linux the kernel kills them
 (`prctl(PR_SET_PDEATHSIG, SIGKILL)` in the initializer) when the parent forked the worker
 itself; elsewhere, and under `forkserver` (whose workers are the fork server's children), a
 watchdog thread in each worker waits on multiprocessing's parent sentinel and exits when it
-fires. Workers start by
-`fork` where it exists and is safe (Linux, a parent running no other Python thread), else by
-`forkserver` (POSIX) or `spawn` (Windows, macOS): see `start_method`. The workers ignore SIGINT,
-SIGTERM and SIGHUP (where the platform defines it): the parent handles those (`signals_raise`:
-they become an `Interrupted` exception), stops the workers, lets every `finally` remove its
-stage folder, and the command line prints one line and exits with 128 + the signal number (130
-for Ctrl-C, 143 for SIGTERM). What the platform offers is found once in the first process
-(`platform`) and handed to every worker it starts, so workers of workers use the same.
+fires. How they start is `printgen.executor.start`'s (`start_method`). The workers ignore
+SIGINT, SIGTERM and SIGHUP: the parent handles those (`printgen.executor.signals`) and kills
+its workers before the error propagates. `shared_pool` lends one set of workers to a block,
+`helper` one worker that runs jobs while its block goes on; `deadline` and `reporting` carry
+the parent's time limit and progress listener into its workers.
 """
 
 from __future__ import annotations
@@ -21,179 +18,28 @@ import contextlib
 import multiprocessing
 import os
 import signal
-import sys
 import threading
 import time
-import warnings
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures import TimeoutError as FutureTimeout
-from dataclasses import dataclass
 from typing import Any
 
 from printgen.errors import TimeLimitError
+from printgen.executor import start
+from printgen.executor.start import WATCH_THREAD, Platform
 from printgen.trace import span, traced_job
 
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
-SIGNAL_NAMES = ("SIGINT", "SIGTERM", "SIGHUP")  # the stop signals; SIGHUP is POSIX only
-SYSTEM = sys.platform  # "linux", "darwin", "win32", ...
 READER_JOIN_S = 5.0  # the progress reader has only the queued reports left to pass on
-WATCH_THREAD = "printgen-parent-watch"  # the thread of `_watch_parent`
-
-
-@dataclass(frozen=True)
-class Platform:
-    """What the platform offers worker processes: its name (`sys.platform`), multiprocessing's
-    start methods, and the stop signals it defines (numbers)."""
-
-    system: str
-    start_methods: tuple[str, ...]
-    signals: tuple[int, ...]
-
-    @property
-    def pdeathsig(self) -> bool:
-        """The kernel can kill a worker whose parent dies (Linux prctl)."""
-        return self.system.startswith("linux")
-
-
-_inherited: Platform | None = None  # in a worker: the first process's Platform (`init_worker`)
-
-
-def handled_signals() -> tuple[int, ...]:
-    """SIGINT, SIGTERM and SIGHUP, those the platform defines."""
-    return tuple(int(getattr(signal, n)) for n in SIGNAL_NAMES if hasattr(signal, n))
-
-
-def platform() -> Platform:
-    """This platform's offer (in a worker: the one its first ancestor found)."""
-    if _inherited is not None:
-        return _inherited
-    return Platform(SYSTEM, tuple(multiprocessing.get_all_start_methods()), handled_signals())
-
-
-def start_method(plat: Platform | None = None) -> str:
-    """`fork` on Linux while this process runs no other Python thread (forking a threaded
-    process can deadlock the child on a lock another thread held, and Python 3.12+ warns: a
-    notebook kernel, a Dask client) but this module's parent watch (`_watch_parent`: it only
-    waits on a file descriptor, holding no lock, and the child does not inherit it); else
-    `forkserver` where it exists, except on macOS, whose system libraries are unsafe after
-    fork; else `spawn` (Windows). A forked worker starts with its parent's imports; one of
-    the fork server imports printgen, numpy and scipy again (about 1 s of CPU each)."""
-    plat = plat or platform()
-    linux = plat.system.startswith("linux")
-    if "fork" in plat.start_methods and linux and _one_thread():
-        return "fork"
-    if "forkserver" in plat.start_methods and plat.system != "darwin":
-        return "forkserver"
-    return "spawn"
-
-
-def preload(modules: Iterable[str]) -> None:
-    """Where workers start by `forkserver` (`start_method`: the process runs a thread, such as
-    the command line's spinner), have multiprocessing's fork server import `modules` (what the
-    run's jobs need) and start it now, so that it imports them while this process goes on: every
-    worker is then forked from it with them imported, a pool ready in ~0.05 s instead of the
-    3 to 5 s of importing numpy, scipy, printgen and matplotlib again in each worker (measured
-    on 2 shared cores). The first call's modules stay: the server lives as long as this
-    process. Under `fork` and `spawn` nothing is done."""
-    if start_method() != "forkserver":
-        return
-    from multiprocessing import forkserver
-
-    multiprocessing.get_context("forkserver").set_forkserver_preload(list(modules))
-    forkserver.ensure_running()
-
-
-def _one_thread() -> bool:
-    """No Python thread runs here but the main one and the parent watch."""
-    return all(t is threading.main_thread() or t.name == WATCH_THREAD
-               for t in threading.enumerate())
-
-
-@contextlib.contextmanager
-def _watch_is_safe() -> Iterator[None]:
-    """Within the block, Python 3.12+'s warning that forking a process running threads may
-    deadlock the child is not shown: `start_method` forks only beside the parent watch."""
-    with warnings.catch_warnings():
-        warnings.filterwarnings("ignore", message=r".*multi-threaded, use of fork\(\)",
-                                category=DeprecationWarning)
-        yield
-
-
-class Interrupted(BaseException):
-    """A signal asked the run to stop (a BaseException, like KeyboardInterrupt, so that no
-    `except Exception` swallows it)."""
-
-    def __init__(self, signum: int) -> None:
-        super().__init__(signum)
-        self.signum = signum
-
-    @property
-    def name(self) -> str:
-        return signal.Signals(self.signum).name
-
-    @property
-    def exit_code(self) -> int:
-        return 128 + self.signum
-
-
-def cores() -> int:
-    """CPU cores this process may run on: its affinity (a container's or `taskset`'s share),
-    else the machine's count."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except (AttributeError, OSError):
-        return os.cpu_count() or 1
-
-
-def _raise(signum: int, _frame: Any) -> None:
-    raise Interrupted(signum)
-
-
-@contextlib.contextmanager
-def signals_raise() -> Iterator[None]:
-    """Within the block SIGINT, SIGTERM and SIGHUP (`handled_signals`) raise `Interrupted` (main thread only);
-    the previous handlers come back afterwards."""
-    if multiprocessing.parent_process() is not None or not _main_thread():
-        yield
-        return
-    previous = {s: signal.signal(s, _raise) for s in handled_signals()}
-    try:
-        yield
-    finally:
-        for s, h in previous.items():
-            signal.signal(s, h)
-
-
-@contextlib.contextmanager
-def signals_deferred() -> Iterator[None]:
-    """Within the block SIGINT, SIGTERM and SIGHUP are held and re-sent at its end (main
-    thread only), for code that catches BaseException and would swallow `Interrupted`:
-    trimesh's imports turn any exception into a placeholder module and carry on."""
-    if not _main_thread():
-        yield
-        return
-    held: list[int] = []
-    previous = {s: signal.signal(s, lambda signum, _frame: held.append(signum))
-                for s in handled_signals()}
-    try:
-        yield
-    finally:
-        for s, h in previous.items():
-            signal.signal(s, h)
-        if held:
-            signal.raise_signal(held[0])
-
-
-def _main_thread() -> bool:
-    return threading.current_thread() is threading.main_thread()
 
 
 def init_worker(plat: Platform, sink: Any = None, at: float | None = None) -> None:
     """Pool initializer: die with the parent, leave signals to the parent, report progress to
     `sink` (the parent's queue, or None), keep the parent's deadline `at` (`deadline`)."""
-    global _inherited, _sink, _deadline, _shared, _listener
-    _inherited, _sink, _deadline = plat, sink, at
+    global _sink, _deadline, _shared, _listener
+    start.inherit(plat)
+    _sink, _deadline = sink, at
     _shared, _listener = None, None  # a forked worker's copies of its parent's
     for s in plat.signals:
         signal.signal(s, signal.SIG_IGN)
@@ -320,7 +166,7 @@ def run_jobs(jobs: list[tuple]) -> list:
     """
     if _shared is not None:  # within `shared_pool`: its workers
         return collect([_shared.submit(fn, *args, **kw) for fn, args, kw in jobs])
-    workers = min(len(jobs), cores())
+    workers = min(len(jobs), start.cores())
     if workers < 2 or os.environ.get("PRINTGEN_SERIAL"):
         return [_done(*traced_job(*j)).result() for j in jobs]
     with span(f"pool of {workers} for {len(jobs)} jobs"):
@@ -332,7 +178,7 @@ def submit_jobs(jobs: list[tuple]) -> list[Future]:
     within `shared_pool` on its workers, without waiting; else `run_jobs` runs them now."""
     if _shared is not None:
         return [_shared.submit(fn, *args, **kw) for fn, args, kw in jobs]
-    out = []
+    out: list[Future] = []
     for result in run_jobs(jobs):
         out.append(Future())
         out[-1].set_result(result)
@@ -359,8 +205,8 @@ class _Workers:
     this process is itself a worker reporting there (`_relay`)."""
 
     def __init__(self, workers: int) -> None:
-        plat = platform()
-        ctx = multiprocessing.get_context(start_method(plat))
+        plat = start.platform()
+        ctx = multiprocessing.get_context(start.start_method(plat))
         self.queue = ctx.SimpleQueue() if _listener else None
         self.reader: threading.Thread | None = None
         self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
@@ -369,7 +215,7 @@ class _Workers:
 
     def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> Future:
         fn, args, kwargs = traced_job(fn, args, kwargs)
-        with _watch_is_safe():
+        with start.watch_is_safe():
             f = self.pool.submit(fn, *args, **kwargs)
         if self.queue is not None and self.reader is None:
             # started once the workers are (a forking pool starts them all at its first job):
@@ -381,7 +227,7 @@ class _Workers:
 
     def end_reports(self) -> None:
         """The workers are done: pass on the reports left, then end the reader."""
-        if self.reader is not None:
+        if self.reader is not None and self.queue is not None:
             self.queue.put(None)
             self.reader.join(timeout=READER_JOIN_S)
 
@@ -394,6 +240,7 @@ class Pool:
     def __init__(self, workers: int) -> None:
         serial = workers < 2 or os.environ.get("PRINTGEN_SERIAL")
         self.workers = None if serial else _Workers(workers)
+        self.size = 1 if serial else workers  # processes the jobs run on at once
 
     def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> Future:
         if self.workers is None:
@@ -431,7 +278,7 @@ def shared_pool(workers: int | None = None) -> Iterator[Pool]:
     before it propagates."""
     global _shared
     previous = _shared
-    pool = Pool(cores() if workers is None else workers)
+    pool = Pool(start.cores() if workers is None else workers)
     _shared = pool
     try:
         with span("shared pool"):

@@ -1,0 +1,140 @@
+"""How worker processes start on this platform: the start method (`fork`, `forkserver` or
+`spawn`), what the platform offers them (`Platform`, found once in the first process and
+handed to every worker, so workers of workers use the same), the fork server started early
+with the jobs' modules (`preload`, `warm_up`) and multiprocessing's resource tracker quietened
+(`quiet_tracker`). Workers start by `fork` where it exists and is safe (Linux, a parent
+running no other Python thread), else by `forkserver` (POSIX) or `spawn` (Windows, macOS).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import multiprocessing
+import os
+import signal
+import sys
+import threading
+import warnings
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+
+SIGNAL_NAMES = ("SIGINT", "SIGTERM", "SIGHUP")  # the stop signals; SIGHUP is POSIX only
+SYSTEM = sys.platform  # "linux", "darwin", "win32", ...
+WATCH_THREAD = "printgen-parent-watch"  # the thread of `local._watch_parent`
+TRACKER_WARNING = "ignore:resource_tracker:UserWarning"  # a -W option (sys.warnoptions)
+
+
+@dataclass(frozen=True)
+class Platform:
+    """What the platform offers worker processes: its name (`sys.platform`), multiprocessing's
+    start methods, and the stop signals it defines (numbers)."""
+
+    system: str
+    start_methods: tuple[str, ...]
+    signals: tuple[int, ...]
+
+    @property
+    def pdeathsig(self) -> bool:
+        """The kernel can kill a worker whose parent dies (Linux prctl)."""
+        return self.system.startswith("linux")
+
+
+_inherited: Platform | None = None  # in a worker: the first process's Platform (`inherit`)
+
+
+def inherit(plat: Platform) -> None:
+    """In a worker (`local.init_worker`): use the first process's Platform from now on."""
+    global _inherited
+    _inherited = plat
+
+
+def handled_signals() -> tuple[int, ...]:
+    """SIGINT, SIGTERM and SIGHUP, those the platform defines."""
+    return tuple(int(getattr(signal, n)) for n in SIGNAL_NAMES if hasattr(signal, n))
+
+
+def platform() -> Platform:
+    """This platform's offer (in a worker: the one its first ancestor found)."""
+    if _inherited is not None:
+        return _inherited
+    return Platform(SYSTEM, tuple(multiprocessing.get_all_start_methods()), handled_signals())
+
+
+def start_method(plat: Platform | None = None) -> str:
+    """`fork` on Linux while this process runs no other Python thread (forking a threaded
+    process can deadlock the child on a lock another thread held, and Python 3.12+ warns: a
+    notebook kernel, a Dask client) but this module's parent watch (`_watch_parent`: it only
+    waits on a file descriptor, holding no lock, and the child does not inherit it); else
+    `forkserver` where it exists, except on macOS, whose system libraries are unsafe after
+    fork; else `spawn` (Windows). A forked worker starts with its parent's imports; one of
+    the fork server imports printgen, numpy and scipy again (about 1 s of CPU each)."""
+    plat = plat or platform()
+    linux = plat.system.startswith("linux")
+    if "fork" in plat.start_methods and linux and _one_thread():
+        return "fork"
+    if "forkserver" in plat.start_methods and plat.system != "darwin":
+        return "forkserver"
+    return "spawn"
+
+
+def preload(modules: Iterable[str]) -> None:
+    """Where workers start by `forkserver` (`start_method`: the process runs a thread, such as
+    the command line's spinner), have multiprocessing's fork server import `modules` (what the
+    run's jobs need) and start it now, so that it imports them while this process goes on: every
+    worker is then forked from it with them imported, a pool ready in ~0.05 s instead of the
+    3 to 5 s of importing numpy, scipy, printgen and matplotlib again in each worker (measured
+    on 2 shared cores). The first call's modules stay: the server lives as long as this
+    process. Under `fork` and `spawn` nothing is done."""
+    if start_method() != "forkserver":
+        return
+    from multiprocessing import forkserver
+
+    multiprocessing.get_context("forkserver").set_forkserver_preload(list(modules))
+    forkserver.ensure_running()
+
+
+def warm_up(modules: Iterable[str]) -> None:
+    """Where workers start by `forkserver`, start the fork server now with the jobs'
+    `modules` (`preload`: it imports them while the caller goes on), the resource tracker
+    quietened first (`quiet_tracker`: the fork server starts it)."""
+    if not os.environ.get("PRINTGEN_SERIAL") and cores() > 1 and start_method() == "forkserver":
+        quiet_tracker()
+        preload(modules)
+
+
+def quiet_tracker() -> None:
+    """Start multiprocessing's resource tracker without its "leaked semaphore objects" warning.
+    A run stopped at its time limit (or by a signal) kills the helper while its workers' queues
+    are registered with the tracker, which unlinks them when it exits and says so on stderr: a
+    second line after make's one. The tracker inherits the -W options of sys.warnoptions
+    when it starts (at the helper's first queue); one already running is left as it is."""
+    from multiprocessing import resource_tracker
+
+    if TRACKER_WARNING not in sys.warnoptions:
+        sys.warnoptions.append(TRACKER_WARNING)
+    resource_tracker.ensure_running()
+
+
+def cores() -> int:
+    """CPU cores this process may run on: its affinity (a container's or `taskset`'s share),
+    else the machine's count."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
+def _one_thread() -> bool:
+    """No Python thread runs here but the main one and the parent watch."""
+    return all(t is threading.main_thread() or t.name == WATCH_THREAD
+               for t in threading.enumerate())
+
+
+@contextlib.contextmanager
+def watch_is_safe() -> Iterator[None]:
+    """Within the block, Python 3.12+'s warning that forking a process running threads may
+    deadlock the child is not shown: `start_method` forks only beside the parent watch."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=r".*multi-threaded, use of fork\(\)",
+                                category=DeprecationWarning)
+        yield
