@@ -119,7 +119,7 @@ def tested_on(date: str | None) -> str | None:
         day = dt.date.fromisoformat(date.strip())
     except ValueError:
         raise CalibrationError(f"--date {date!r} is not a calendar day in ISO format "
-                               "(YYYY-MM-DD, e.g. 2026-03-31)") from None
+                               "(YYYY-MM-DD: year, month, day)") from None
     latest = dt.date.today() + dt.timedelta(days=1)
     if day > latest:
         raise CalibrationError(f"--date {day.isoformat()} is after {latest.isoformat()}: give the "

@@ -212,7 +212,6 @@ def _check_ranges(p: Path, data: dict[str, np.ndarray], line_numbers: list[int])
         i = int(bad[0])
         raise MeasurementError(f"{p}, line {line_numbers[i]}: {LEVEL_COLUMN} = {lv[i]:g} outside "
                                f"0 to {MAX_LEVEL:g} (the predicted range; h / h_B, not mm)")
-    _check_levels_once(p, lv, line_numbers)
     limits = {**LIMITS, **{c: (-RAW_LIMIT_MM, RAW_LIMIT_MM) for c in RAW_COLUMNS}}
     for col, (lo, hi) in limits.items():
         if col not in data:
@@ -231,6 +230,7 @@ def _check_ranges(p: Path, data: dict[str, np.ndarray], line_numbers: list[int])
     if not np.any(lv > 0):
         raise MeasurementError(f"{p}: every {LEVEL_COLUMN} is 0: the net was never loaded, so "
                                "there is nothing to compare or fit")
+    _check_levels_once(p, lv, line_numbers)
     _check_stretching(p, data, line_numbers)
 
 
