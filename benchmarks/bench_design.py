@@ -28,9 +28,9 @@ LEVEL_STEP = 0.1  # coarser than the verification's 0.05: a benchmark, not a ver
 
 
 def _setup():
-    from printgen.design.plan import make_design
-    from printgen.design.selection import select
-    from printgen.design.similitude import scale_targets
+    from printgen.scaling.plan import make_design
+    from printgen.scaling.selection import select
+    from printgen.scaling.similitude import scale_targets
     from printgen.inputs.prototype import load_prototype
     from printgen.search.space import default_space, grid, search_context
 

@@ -36,10 +36,10 @@ def drawings(example: Path) -> list:
     """(name, Drawing) of every figure `make` draws for `example` at 1:40 (its sweeps run here,
     in worker processes, untimed)."""
     from printgen.report.build import build_report
-    from printgen.run.make import plan
+    from printgen.run.make import plan_run
     from printgen.run.steps import kit_step, verification_records, verification_sweeps
 
-    ctx = plan(example, SCALE)
+    ctx = plan_run(example, SCALE)
     with TemporaryDirectory() as tmp:
         ctx.records.steps.update(kit_step(ctx, Path(tmp)))
     v, band = verification_sweeps(ctx.prototype, ctx.design)

@@ -72,10 +72,10 @@ def one_run(out: Path, example: Path = EXAMPLE) -> dict:
 def predicted_cpu(example: Path) -> float:
     """The estimate's CPU of the verification's sweeps on one core (printgen.run.budget)."""
     from printgen.run.budget import sweeps
-    from printgen.run.make import plan
+    from printgen.run.make import plan_run
     from printgen.run.speed import speed_factor
 
-    ctx = plan(example, SCALE)
+    ctx = plan_run(example, SCALE)
     return speed_factor() * sum(s.seconds for s in sweeps(ctx.prototype, ctx.design))
 
 

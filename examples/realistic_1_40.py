@@ -12,11 +12,11 @@ from pathlib import Path
 
 import numpy as np
 
-from printgen.design.plan import make_design
-from printgen.design.selection import select
-from printgen.design.similitude import scale_targets
+from printgen.scaling.plan import make_design
+from printgen.scaling.selection import select
+from printgen.scaling.similitude import scale_targets
 from printgen.inputs.prototype import load_prototype
-from printgen.verification.verify import Verification, verify
+from printgen.verification.preprint import Verification, verify
 
 HERE = Path(__file__).resolve().parent
 

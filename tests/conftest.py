@@ -62,7 +62,7 @@ def shared_required() -> bool:
 def reference_design_1_40():
     """The reference's final 1:40 design (barrier-physics.md): TPE diamond net 20.6 x 9.4 mm
     with 0.6 x 0.95 mm strands (three passes), PETG cables 0.9 x 0.6 mm (2 x 2 passes)."""
-    from printgen.design.record import CableDesign, Design, NetDesign, Section
+    from printgen.scaling.record import CableDesign, Design, NetDesign, Section
 
     net = NetDesign(
         material="tpe", print_style="net-3pass", width_mm=330.0, height_mm=100.0,
@@ -95,9 +95,9 @@ def coarse_design_1_40(coarser: float):
 def planned(path: Path, scale: float = 40):
     """(prototype, design) of a prototype file at 1:scale: similitude, selection and the
     design, as `make` plans them."""
-    from printgen.design.plan import make_design
-    from printgen.design.selection import select
-    from printgen.design.similitude import scale_targets
+    from printgen.scaling.plan import make_design
+    from printgen.scaling.selection import select
+    from printgen.scaling.similitude import scale_targets
     from printgen.inputs.prototype import load_prototype
 
     p = load_prototype(path)

@@ -13,7 +13,7 @@ from printgen.barrier.patterns.diamond import diamond_net
 from printgen.inputs.printers import load_printer
 from printgen.parts.assembly import CLOSE_TOL_MM, assemble
 from printgen.parts.geometry.attach import DEFAULT_CLEARANCE_MM, holes
-from printgen.run.make import plan
+from printgen.run.make import plan_run
 from printgen.scene import build_scene
 from printgen.units import MM
 
@@ -23,7 +23,7 @@ COORD_MM = 1e-6  # round-off of coordinates built from the graph (mm)
 
 @pytest.fixture(scope="module", params=SCALES)
 def kit(request):
-    d = plan(EXAMPLES / "realistic_barrier.toml", request.param).design
+    d = plan_run(EXAMPLES / "realistic_barrier.toml", request.param).design
     return d, assemble(d, load_printer(d.printer))
 
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from conftest import coarse_design_1_40, reference_design_1_40
 
-from printgen.design.record import Section
+from printgen.scaling.record import Section
 from printgen.scene import SceneOptions, build_scene
 from printgen.scene.scenes import MOUNTINGS
 from printgen.verification import bands

@@ -90,7 +90,7 @@ def test_pattern_specific_rules_are_the_patterns():
     it may have, whether the virtual panel test models it) is each pattern's own data: a new
     pattern states them (no default, so it is not quietly taken for a diamond)."""
     from printgen.barrier.patterns import NetPattern
-    from printgen.design.testpieces import panel_for
+    from printgen.scaling.testpieces import panel_for
     from printgen.errors import GeometryError
 
     for p in patterns().values():
@@ -156,7 +156,7 @@ def test_a_load_case_states_its_assumptions_in_the_scenes(design_1_40):
 
 
 def test_net_design_pattern_defaults_to_diamond_and_is_read_back(design_1_40):
-    from printgen.design.design_file import design_from_dict
+    from printgen.scaling.design_file import design_from_dict
 
     rec = json.loads(json.dumps(design_1_40.to_dict()))  # as design.json holds it
     assert rec["net"]["pattern"] == "diamond"

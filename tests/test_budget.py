@@ -23,7 +23,7 @@ from printgen.commands.make import EXIT_TIME_LIMIT
 from printgen.errors import TimeLimitError
 from printgen.run.budget import LEVELS, estimate
 from printgen.run.options import RunOptions
-from printgen.verification import verify as verify_mod
+from printgen.verification import preprint as verify_mod
 
 WORK_FACTOR = 2.0  # issue 28: the estimate within x2 of the run (here its work, counted)
 VERIFY_ONLY = [s for s in make_mod.default_steps() if s[1] is make_mod.verify_step]

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
-from test_calibrate_checks import _bluehill
+from test_calibrate_windows import _bluehill
 
 from printgen.calibrate.groups import orientation
 from printgen.calibrate.pipeline import calibrate

@@ -9,8 +9,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from proto_files import write_variant
 
-from printgen.design.selection import select
-from printgen.design.similitude import scale_targets
+from printgen.scaling.selection import select
+from printgen.scaling.similitude import scale_targets
 from printgen.errors import PrintgenError
 from printgen.inputs.prototype import load_prototype
 
@@ -89,7 +89,7 @@ DESIGN_KEYS = [("scale",), ("printer",), ("net", "material"), ("net", "width_mm"
 @settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(key=st.sampled_from(DESIGN_KEYS), value=HOSTILE)
 def test_hostile_design_values_are_input_errors(key, value):
-    from printgen.design.design_file import design_from_dict
+    from printgen.scaling.design_file import design_from_dict
     from printgen.errors import InputError
 
     data = design_dict()

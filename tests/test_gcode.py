@@ -14,7 +14,7 @@ from conftest import ROOT, require_shared
 from numpy.testing import assert_allclose
 
 from printgen.barrier.patterns.diamond import diamond_net
-from printgen.design.record import Section
+from printgen.scaling.record import Section
 from printgen.errors import PrintabilityError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
@@ -322,10 +322,10 @@ def kit_net(request):
     from conftest import EXAMPLES
 
     from printgen.parts.geometry.solid import attachment_for, net_solid
-    from printgen.run.make import plan
+    from printgen.run.make import plan_run
 
     proto = EXAMPLES / "realistic_barrier.toml"
-    d = plan(proto, request.param).design
+    d = plan_run(proto, request.param).design
     printer = load_printer(d.printer)
     att = attachment_for(d, hole_compensation_mm=printer.hole_compensation_mm)
     return (d, att, printer, load_print_style(d.net.print_style),

@@ -147,7 +147,7 @@ def test_sensor_and_anchor_layout_is_the_scene_in_mm():
     import csv
     import io
 
-    from printgen.report.layout import layout_csv, layout_figure, layout_rows
+    from printgen.report.flume_drawing import layout_csv, layout_figure, layout_rows
     from printgen.report.plots import _png, axis_labels
     from printgen.scene import build_scene
     from printgen.scene.flume import flume_layout

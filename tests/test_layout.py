@@ -1,5 +1,5 @@
 """The layout by stage (shared/design.md, README "Where things live"): data moves down the flow
-run -> report -> verification -> scene and parts -> design -> inputs and barrier -> ground
+run -> report -> verification -> scene and parts -> scaling -> inputs and barrier -> ground
 floor; a lower stage never imports
 a higher one, and solver/ never imports printgen. Imports are read with `ast`, so a lazy import
 inside a function counts as much as one at the top of a module."""
@@ -18,11 +18,11 @@ RANK = {
     "errors": 0, "units": 0, "outputs": 0, "executor": 0, "trace": 0,  # ground floor
     "inputs": 1,
     "barrier": 1,  # beside inputs: the net patterns and load cases, as data
-    "calibrate": 2,  # tensile exports -> material profiles: feeds inputs, sits beside design
-    "design": 2,
-    "search": 2,  # the design search: screens nets over design, verified by a runner it is handed
+    "calibrate": 2,  # tensile exports -> material profiles: feeds inputs, sits beside scaling
+    "scaling": 2,
+    "search": 2,  # the design search: screens nets over scaling, verified by a runner it is handed
     "parts": 3,
-    "scene": 4,  # the solver scenes: beside parts in the flow, above design (APART keeps them so)
+    "scene": 4,  # the solver scenes: beside parts in the flow, above scaling (APART keeps them so)
     "verification": 5,
     "report": 6,
     "run": 7,
@@ -30,11 +30,11 @@ RANK = {
 }
 APART = {("scene", "parts")}  # (importer, imported) of the same floor: siblings, not stacked
 OUTSIDE = {"benchmarks": 8}  # a source checkout's folders: only the CLI may reach them
-TOP_LEVEL_MODULES_MAX = 8  # issue 17: at most 8 modules at printgen/'s top level
+TOP_LEVEL_MODULES_MAX = 8  # at most 8 modules at printgen/'s top level
 
 
 def part_of(module: str) -> str:
-    """'printgen.verification.verify' -> 'verification'; 'printgen' -> '__init__'."""
+    """'printgen.verification.preprint' -> 'verification'; 'printgen' -> '__init__'."""
     parts = module.split(".")
     return parts[1] if len(parts) > 1 else "__init__"
 
@@ -130,15 +130,15 @@ def test_top_level_stays_small():
 @pytest.mark.slow
 @pytest.mark.parametrize(("victim", "line", "expected"), [
     ("printgen/inputs/schema.py", "from printgen.run.make import make\n", "inputs (rank 1)"),
-    ("printgen/parts/geometry/cable.py", "    from printgen.verification import verify\n",
+    ("printgen/parts/geometry/cable.py", "    from printgen.verification import preprint\n",
      "printgen.verification"),
     ("solver/laws.py", "import printgen.units\n", "solver imports printgen.units"),
-    ("printgen/scene/scenes.py", "    from printgen.verification.verify import sweep\n",
+    ("printgen/scene/scenes.py", "    from printgen.verification.preprint import sweep\n",
      "scene (rank 4) imports printgen.verification"),
     ("printgen/scene/mount.py", "from printgen.parts.geometry import cable\n",
      "scene (rank 4) imports printgen.parts"),
-    ("printgen/design/record.py", "from printgen.scene.scenes import BarrierScene\n",
-     "design (rank 2) imports printgen.scene"),
+    ("printgen/scaling/record.py", "from printgen.scene.scenes import BarrierScene\n",
+     "scaling (rank 2) imports printgen.scene"),
     ("printgen/run/budget.py", "    importlib.import_module('benchmarks.bench_make')\n",
      "outside printgen"),
 ])

@@ -128,7 +128,7 @@ def test_jam_levels_are_the_flumes_discharge_steps():
     free section; a step held above the overflow is read at h/h_B = 1.1."""
     from printgen.inputs.prototype import load_prototype
     from printgen.scene import SceneOptions, build_scene
-    from printgen.verification.verify import load_keywords
+    from printgen.verification.preprint import load_keywords
 
     p, d = load_prototype(REALISTIC), reference_design_1_40()
     for porosity in (0.6, 0.8):

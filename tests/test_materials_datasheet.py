@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
-from printgen.design.selection import CALIBRATE_FIRST, MIN_SAFETY_FACTOR
-from printgen.design.similitude import scale_targets
+from printgen.scaling.selection import CALIBRATE_FIRST, MIN_SAFETY_FACTOR
+from printgen.scaling.similitude import scale_targets
 from printgen.errors import InputError
 from printgen.inputs import materials as mats
 from printgen.inputs.prototype import load_prototype

@@ -10,7 +10,7 @@ import pytest
 from conftest import EXAMPLES, coarse_design_1_40, reference_design_1_40
 
 from printgen.cli import main
-from printgen.design.record import Design
+from printgen.scaling.record import Design
 from printgen.verification.bands import Band
 from printgen.verification.measured import (
     COLUMNS,

@@ -130,7 +130,7 @@ def test_prototype_model_names(tmp_path, name):
 @pytest.mark.slow
 @fuzz_names
 def test_design_json_names(design_1_40, name):
-    from printgen.design.design_file import design_from_dict
+    from printgen.scaling.design_file import design_from_dict
     from printgen.run.verify import fitted_name
 
     base = design_1_40.to_dict()

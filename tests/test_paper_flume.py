@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from printgen.design.design_file import load_design
+from printgen.scaling.design_file import load_design
 from printgen.errors import GeometryError
 from printgen.scene import SceneOptions, build_scene
 from printgen.scene.scenes import panel_axes
@@ -67,11 +67,11 @@ def test_make_with_the_paper_design_shows_its_own_net_error():
     from printgen.inputs.materials import load_material
     from printgen.report.build import build_report
     from printgen.report.summary import chosen_parts
-    from printgen.run.make import plan
+    from printgen.run.make import plan_run
     from printgen.run.options import RunOptions
 
     realistic = HERE.parent / "realistic_barrier.toml"
-    ctx = plan(realistic, 40, options=RunOptions(design_file=HERE / "design.json"))
+    ctx = plan_run(realistic, 40, options=RunOptions(design_file=HERE / "design.json"))
     own = ctx.record["design_net"]
     law = load_material(ctx.design.net.material).panel_law
     assert own["stiffness"] == pytest.approx(law.kappas[0] * law.panel_length, rel=EXACT)

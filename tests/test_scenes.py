@@ -17,7 +17,7 @@ from printgen.scene import SceneOptions, build_scene
 from printgen.scene.scenes import SENSOR_FORCE_N, BarrierScene, Wire
 from printgen.scene.solvernet import WIRE_RATE, WIRE_STRAIN, build, wire_law
 from printgen.verification.compare import wire_elongation
-from printgen.verification.verify import sweep
+from printgen.verification.preprint import sweep
 from solver.assemble import internal, make_bars, make_cable
 
 EXACT = 1e-12  # closed-form geometry: round-off only

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from conftest import EXAMPLES
 
-from printgen.design.design_file import design_from_dict, load_design
+from printgen.scaling.design_file import design_from_dict, load_design
 from printgen.errors import InputError
 from printgen.report.jsonout import dumps
 from printgen.run.options import RunOptions

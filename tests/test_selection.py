@@ -9,10 +9,10 @@ import pytest
 from proto_files import REALISTIC, SIMPLE, write_variant
 
 from printgen.barrier.patterns.diamond import diamond_factor
-from printgen.design.record import Section
-from printgen.design.section import area_m2, net_membrane_law
-from printgen.design.selection import SCORE_DIGITS, select
-from printgen.design.similitude import scale_targets
+from printgen.scaling.record import Section
+from printgen.scaling.section import area_m2, net_membrane_law
+from printgen.scaling.selection import SCORE_DIGITS, select
+from printgen.scaling.similitude import scale_targets
 from printgen.errors import PrintabilityError
 from printgen.inputs.materials import load_material
 from printgen.inputs.prototype import load_prototype

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from proto_files import REALISTIC, SIMPLE, write_variant
 
-from printgen.design.similitude import check_scale, scale_targets
+from printgen.scaling.similitude import check_scale, scale_targets
 from printgen.errors import InputError
 from printgen.inputs.prototype import load_prototype
 

@@ -13,7 +13,7 @@ import pytest
 from conftest import require_shared, require_tool
 from numpy.testing import assert_allclose
 
-from printgen.design.record import Section
+from printgen.scaling.record import Section
 from printgen.errors import PrintabilityError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer

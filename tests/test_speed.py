@@ -10,7 +10,7 @@ from proto_files import REALISTIC
 from printgen.errors import InputError
 from printgen.run import speed
 from printgen.run.budget import Work, check_budget, estimate
-from printgen.run.make import plan
+from printgen.run.make import plan_run
 
 SCALE = 40.0
 SLOW = 1e4  # a machine 10^4 times slower than the reference: every make is over a minute
@@ -30,7 +30,7 @@ def test_calibration_is_a_measured_cpu_time():
 
 
 def test_the_estimate_scales_its_times_not_its_work():
-    ctx = plan(REALISTIC, SCALE)
+    ctx = plan_run(REALISTIC, SCALE)
     one = estimate(ctx.prototype, ctx.design, cores=2, variants=3)
     two = estimate(ctx.prototype, ctx.design, cores=2, variants=3, speed=2.0)
     assert two.seconds == pytest.approx(2 * one.seconds, rel=1e-12)  # linear: a product
@@ -55,7 +55,7 @@ def test_a_bad_factor_is_refused_by_name(fresh_factor, value):
 def test_a_slow_machine_is_refused_with_its_factor(fresh_factor):
     """check_budget measures (here: reads) the factor: the same run that fits on the reference
     machine is over the default minute on one SLOW times slower, and the message says why."""
-    ctx = plan(REALISTIC, SCALE)
+    ctx = plan_run(REALISTIC, SCALE)
     assert check_budget(ctx.prototype, ctx.design, limit_s=60, cores=2, work=Work(),
                         speed=1.0).seconds < 60
     fresh_factor.setenv(speed.SPEED_ENV, str(SLOW))

@@ -77,7 +77,7 @@ def test_square_membrane_law_is_one_strand_per_mesh(simple):
     s = build_scene(d)
     n = d.net
     membrane = s.laws[0].slopes[0] * square_factor(n.mesh_x_mm * 1e-3)
-    from printgen.design.section import net_membrane_law
+    from printgen.scaling.section import net_membrane_law
 
     want = net_membrane_law(load_material(n.material), n.strand, n.mesh_y_mm * 1e-3,
                             n.mesh_x_mm * 1e-3, "square")[1][0]
@@ -201,7 +201,7 @@ def test_virtual_panel_of_the_square_net_reads_its_membrane_law(simple, mode):
     strands, tested as a panel, give the membrane law the design priced (one strand per mesh
     across, `square.membrane_factor`), times (nx + 1) / nx for the panel's two edge strands
     on a width of nx meshes; free or blocked alike (a square net has no Poisson effect)."""
-    from printgen.design.section import net_membrane_law
+    from printgen.scaling.section import net_membrane_law
     from printgen.scene.panel import PanelTest, lattice_size, simulate
 
     _, d = simple
@@ -232,7 +232,7 @@ def coarse_simple(tmp_path_factory):
 def test_verification_of_the_square_net_converges_at_every_level(coarse_simple):
     """Prototype and printed square net solved at every level of the sweep (h / h_B = 0 to
     1.1 by 0.05), the model with its printed edge frame and pulling sensor wires."""
-    from printgen.verification.verify import levels, verify
+    from printgen.verification.preprint import levels, verify
 
     p, d = coarse_simple
     assert d.net.pattern == "square"

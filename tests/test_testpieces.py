@@ -17,7 +17,7 @@ from test_calibrate_files import write_export
 
 from printgen.calibrate.pipeline import calibrate
 from printgen.calibrate.specimen import read_sidecar
-from printgen.design.record import Section
+from printgen.scaling.record import Section
 from printgen.errors import GeometryError
 from printgen.inputs.materials import load_material
 from printgen.report.jsonout import dumps

@@ -14,7 +14,7 @@ from proto_files import REALISTIC
 from printgen.report.jsonout import dumps
 from printgen.report.plots import deformed_figure
 from printgen.scene import build_scene
-from printgen.verification.verify import SHAPE_LEVELS, sweep, verify
+from printgen.verification.preprint import SHAPE_LEVELS, sweep, verify
 
 HOLD_SHARE_MAX = 0.01  # the hold may carry at most 1 % of the applied load (a regularisation)
 HOLD_EFFECT = 0.01  # ... and move no normalised deformation by more than 1 % of its peak

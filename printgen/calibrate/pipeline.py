@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from printgen.calibrate.aggregate import Stats, spread_only, summarise
-from printgen.calibrate.checks import machine_warning, window_warnings
+from printgen.calibrate.windows import machine_warning, window_warnings
 from printgen.calibrate.fit import BREAK_DROP
 from printgen.calibrate.groups import Group, by_orientation, mixed_warning, orientation
 from printgen.calibrate.inputs import expand
@@ -88,7 +88,7 @@ class Calibration:
     preload_change: tuple[float | None, ...] | None = None  # mean at PRELOAD_STEPS x preload
     excluded: tuple[str, ...] = ()  # flagged files left out of the statistics
     skipped: tuple[str, ...] = ()  # directory files that hold no table
-    window_summary: str = ""  # how the modulus window sits on the curves (checks.py)
+    window_summary: str = ""  # how the modulus window sits on the curves (windows.py)
     orientations: dict[str, str | None] = field(default_factory=dict)  # file -> orientation
     groups: tuple[Group, ...] = ()  # per orientation, when the files mix them
 

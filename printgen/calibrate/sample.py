@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from printgen.calibrate.checks import WindowCheck, check_window
+from printgen.calibrate.windows import WindowCheck, check_window
 from printgen.calibrate.compliance import Compliance
 from printgen.calibrate.fit import (
     DEFAULT_ZERO,

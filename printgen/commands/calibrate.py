@@ -22,7 +22,7 @@ from rich.measure import Measurement
 from rich.table import Table
 
 from printgen.calibrate.aggregate import MIN_SAMPLES
-from printgen.calibrate.checks import MACHINE_TOL, machine_refutes
+from printgen.calibrate.windows import MACHINE_TOL, machine_refutes
 from printgen.calibrate.compliance import from_curve, from_stiffness
 from printgen.calibrate.fit import DEFAULT_ZERO, ISO_WINDOW, ZERO_MODES
 from printgen.calibrate.pipeline import Calibration

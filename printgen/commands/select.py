@@ -13,7 +13,7 @@ from printgen.commands.common import (
     fmt,
     table,
 )
-from printgen.design.selection import Candidate, Selection
+from printgen.scaling.selection import Candidate, Selection
 from printgen.inputs.prototype import load_prototype
 from printgen.run import api
 
@@ -46,9 +46,9 @@ def run(args: argparse.Namespace) -> int:
 
 def show_bed(proto, scale: float, s: Selection) -> None:
     """Whether the chosen net fits the printer's bed (and which printers or lambda fit)."""
-    from printgen.design.bedfit import bed_fit
-    from printgen.design.plan import make_design
-    from printgen.design.similitude import scale_targets
+    from printgen.scaling.bedfit import bed_fit
+    from printgen.scaling.plan import make_design
+    from printgen.scaling.similitude import scale_targets
     from printgen.errors import DesignError
 
     try:

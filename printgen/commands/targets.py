@@ -12,7 +12,7 @@ from printgen.commands.common import (
     fmt,
     table,
 )
-from printgen.design.similitude import ScaledTargets
+from printgen.scaling.similitude import ScaledTargets
 from printgen.run import api
 
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from printgen.design.record import Design
+from printgen.scaling.record import Design
 from printgen.errors import GeometryError
 from printgen.inputs.printers import Printer
 from printgen.parts.geometry.attach import Attachment, attachment_for, corner_nodes, holes

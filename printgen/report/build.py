@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from printgen.report.html import Report
 from printgen.report.labfiles import lab_files
-from printgen.report.layout import layout_section
+from printgen.report.flume_drawing import layout_section
 from printgen.report.parts_report import (
     assembly_section,
     gcode_section,

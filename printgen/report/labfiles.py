@@ -2,7 +2,7 @@
 readings in flume units (expected-readings.csv) and a blank measurement sheet in the columns
 `printgen verify --measured` reads, with the model's expected readings beside them
 (measurement-sheet.csv), where the sensors and anchors go (sensor-layout.csv,
-printgen.report.layout), and with `make --loads A,B` each load case's expected readings
+printgen.report.flume_drawing), and with `make --loads A,B` each load case's expected readings
 (expected-readings-<case>.csv: the nominal model at the case's own levels, with what the case
 used at each level, e.g. the jam's discharge in L/s). Column names carry their unit (`_pct`, `_mm`, `_n`, `_kn`; no
 suffix: normalised, dimensionless). The numbers are the record's (`lab_record`, in
@@ -16,14 +16,14 @@ from typing import Any
 
 import numpy as np
 
-from printgen.report.layout import LAYOUT_CSV, layout_csv
+from printgen.report.flume_drawing import LAYOUT_CSV, layout_csv
 from printgen.scene.flume import flume_layout
 from printgen.scene.readings import DEPTH_COLUMN, RAW_COLUMNS, flume_units
 from printgen.units import MM
 from printgen.verification.bands import Band
 from printgen.verification.compare import METRICS
 from printgen.verification.measured import COLUMNS, LEVEL_COLUMN
-from printgen.verification.verify import Verification
+from printgen.verification.preprint import Verification
 
 DIGITS = 8  # significant digits of every number in the CSV files
 NOISE = 1e-6  # |value| below this (in the column's unit: %, mm, N, kN or -) is written as 0

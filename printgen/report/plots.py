@@ -6,7 +6,7 @@ import io
 
 import numpy as np
 
-from printgen.design.similitude import FORCE_EXPONENT, to_prototype
+from printgen.scaling.similitude import FORCE_EXPONENT, to_prototype
 from printgen.errors import PrintgenError
 from printgen.scene.scenes import BarrierScene
 from printgen.verification.bands import Band

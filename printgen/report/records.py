@@ -13,16 +13,16 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:  # pragma: no cover
     import numpy as np
 
-    from printgen.design.record import Design
-    from printgen.design.selection import Candidate, Selection
-    from printgen.design.similitude import ScaledTargets
+    from printgen.scaling.record import Design
+    from printgen.scaling.selection import Candidate, Selection
+    from printgen.scaling.similitude import ScaledTargets
     from printgen.inputs.prototype import Prototype
     from printgen.parts.assembly import Assembly
     from printgen.parts.gcode.estimate import PrintEstimate
     from printgen.report.html import Drawing
     from printgen.verification.bands import Band
     from printgen.verification.measured import Fit, Measurement
-    from printgen.verification.verify import Verification
+    from printgen.verification.preprint import Verification
 
 
 def record_of(value: Any) -> Any:

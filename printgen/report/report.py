@@ -7,13 +7,13 @@ from __future__ import annotations
 import numpy as np
 
 from printgen.barrier.patterns import mesh_text
-from printgen.design.record import Design
-from printgen.design.selection import Candidate, Selection
-from printgen.design.similitude import FORCE_EXPONENT, ScaledTargets, to_prototype
+from printgen.scaling.record import Design
+from printgen.scaling.selection import Candidate, Selection
+from printgen.scaling.similitude import FORCE_EXPONENT, ScaledTargets, to_prototype
 from printgen.inputs.prototype import Prototype
 from printgen.report.html import Drawing, Report
 from printgen.verification.bands import Band
-from printgen.verification.verify import SHAPE_LEVELS, CounterExample, Verification
+from printgen.verification.preprint import SHAPE_LEVELS, CounterExample, Verification
 
 SHOW = 6  # candidates per component in the report's tables (all are in report.json)
 SHOWN_LEVEL = 1.0  # relative loading of the 3D picture of both deformed nets

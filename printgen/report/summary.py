@@ -14,8 +14,8 @@ from printgen.verification.bands import band_verdicts
 from printgen.verification.compare import METRICS
 
 if TYPE_CHECKING:  # pragma: no cover
-    from printgen.design.record import Design, Section
-    from printgen.design.selection import Candidate
+    from printgen.scaling.record import Design, Section
+    from printgen.scaling.selection import Candidate
     from printgen.report.records import GcodeRecord, PlanRecords, RunRecords
 
 NEXT_PASS = ("Print the parts (the .gcode files, or slice the .3mf files), assemble them as the "

@@ -14,7 +14,7 @@ from printgen.report.report import fmt_value, unit_of
 from printgen.verification.bands import Band, BandVerdict, band_verdicts
 from printgen.verification.compare import METRICS, Deformation
 from printgen.verification.measured import Fit, Measurement, mismatch
-from printgen.verification.verify import SHAPE_LEVELS, Verification
+from printgen.verification.preprint import SHAPE_LEVELS, Verification
 
 SHOW_LEVELS = SHAPE_LEVELS  # relative loadings shown in the tables and summaries
 

@@ -17,11 +17,11 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from printgen.design.plan import make_design
-from printgen.design.record import Design
-from printgen.design.selection import Selection
-from printgen.design.selection import select as _select
-from printgen.design.similitude import ScaledTargets, scale_targets
+from printgen.scaling.plan import make_design
+from printgen.scaling.record import Design
+from printgen.scaling.selection import Selection
+from printgen.scaling.selection import select as _select
+from printgen.scaling.similitude import ScaledTargets, scale_targets
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.run.options import RunOptions
 
@@ -35,7 +35,7 @@ if TYPE_CHECKING:
     from printgen.run.series import SeriesRun
     from printgen.run.verify import VerifyRun
     from printgen.verification.series import NetOptions
-    from printgen.verification.verify import Verification
+    from printgen.verification.preprint import Verification
 
 PrototypeLike = str | Path | Prototype
 
@@ -61,8 +61,8 @@ def select(prototype: PrototypeLike, scale: float, *, printer: str | None = None
 
 
 def plan(prototype: PrototypeLike, scale: float, *, printer: str | None = None) -> Design:
-    """The printable design that `make` writes: the selection's choice, sized for the model.
-    (Named `plan`, not `design`: `printgen.design` is the design stage's package.)"""
+    """The printable design that `make` writes: the selection's choice, sized for the model
+    (the verb `design` is the inverse design search: `search_nets`)."""
     p = prototype_of(prototype)
     t = scale_targets(p, scale)
     return make_design(p, t, _select(p, t, printer=printer))
@@ -108,21 +108,22 @@ def load_name(load: str | None, drag: bool) -> str:
     return get_load("drag" if drag else load).spec
 
 
-def verify(prototype: PrototypeLike, scale: float, design_: Design | str | Path | None = None,
+def verify(prototype: PrototypeLike, scale: float, design: Design | str | Path | None = None,
            *, printer: str | None = None, load: str | None = None,
            drag: bool = False) -> Verification:
     """The pre-print check: prototype and printed model solved under the same relative
-    loading, h/h_B = 0 to 1.1, and compared by their normalised deformations. `design_` is a
+    loading, h/h_B = 0 to 1.1, and compared by their normalised deformations. `design` is a
     `Design` or the design.json that `make` wrote; without it, the design `make` would print
     is checked."""
-    from printgen.design.design_file import load_design
-    from printgen.verification.verify import verify as _verify
+    from printgen.scaling.design_file import load_design
+    from printgen.verification.preprint import verify as _verify
 
     p = prototype_of(prototype)
-    if design_ is None:
+    if design is None:
         d = plan(p, scale, printer=printer)
     else:
-        d = design_ if isinstance(design_, Design) else load_design(design_, scale=scale, prototype=p)
+        d = design if isinstance(design, Design) else load_design(design, scale=scale,
+                                                                   prototype=p)
     return _verify(p, d, load=load_name(load, drag))
 
 

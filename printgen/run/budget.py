@@ -3,7 +3,7 @@ time.
 
 The verification's solver work is predicted sweep by sweep (`sweeps`), from the run's structure
 and the meshes alone (no net is built here): the prototype's and the model's nets over the load
-levels (23: h / h_B = 0 to 1.1 by 0.05, `printgen.verification.verify.levels`), each more load
+levels (23: h / h_B = 0 to 1.1 by 0.05, `printgen.verification.preprint.levels`), each more load
 case of `make --loads` the same, the band's refinement test (the model on a net COARSENINGS[0]
 times coarser), then each band variant of the model (`printgen.verification.variants
 .model_variants`: 5 on the simple barrier, 9 on the 1:40 example) on the design's own net: the
@@ -30,7 +30,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from printgen.barrier.patterns import get_pattern
-from printgen.design.record import Design
+from printgen.scaling.record import Design
 from printgen.errors import InputError
 from printgen.executor.local import reporting
 from printgen.executor.start import cores
@@ -190,7 +190,7 @@ def band_variants(p: Prototype, d: Design) -> int:
     """The model variants the uncertainty band sweeps (as `verify` mounts the model)."""
     from printgen.scene.scenes import lateral_mounting
     from printgen.verification.variants import model_variants
-    from printgen.verification.verify import free_section
+    from printgen.verification.preprint import free_section
 
     return len(model_variants(d, lateral_mounting(p), free_section(p))[0])
 

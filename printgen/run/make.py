@@ -24,11 +24,11 @@ from pathlib import Path
 from typing import Any
 
 from printgen.barrier.loads import distinct_specs, get_load
-from printgen.design.design_file import load_design
-from printgen.design.plan import make_design
-from printgen.design.record import Design
-from printgen.design.selection import Selection, design_net, select
-from printgen.design.similitude import ScaledTargets, scale_targets
+from printgen.scaling.design_file import load_design
+from printgen.scaling.plan import make_design
+from printgen.scaling.record import Design
+from printgen.scaling.selection import Selection, design_net, select
+from printgen.scaling.similitude import ScaledTargets, scale_targets
 from printgen.errors import TimeLimitError
 from printgen.executor.local import Helper, check_deadline, deadline, helper
 from printgen.executor.signals import signals_deferred
@@ -103,9 +103,10 @@ class MakeContext:
 Step = Callable[[MakeContext, Path], dict[str, Any]]  # its records, by report.json key
 
 
-def plan(prototype_path: str | Path, scale: float, *,
-         options: RunOptions | None = None) -> MakeContext:
-    """Targets, selection and design: the fast, file-free part of `make`."""
+def plan_run(prototype_path: str | Path, scale: float, *,
+             options: RunOptions | None = None) -> MakeContext:
+    """The run's context: targets, selection and design, the fast, file-free part of `make`
+    (`printgen.plan` gives only its `Design`)."""
     options = options or RunOptions()
     proto = load_prototype(prototype_path)
     t = scale_targets(proto, scale)
@@ -137,7 +138,7 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     inputs = [prototype_path, options.design_file, *search_dirs()]
     check_destination(Path(out), force=options.force, inputs=inputs)  # fail fast
     with span("make: plan and estimate"):
-        ctx = plan(prototype_path, scale, options=options)
+        ctx = plan_run(prototype_path, scale, options=options)
         est = size_check(ctx, steps is None or any(s is verify_step for _, s in steps))
     if progress and est.seconds > LONG_RUN_S:
         progress(f"estimate: {est.summary()}")

@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from printgen.design.design_file import load_design
+from printgen.scaling.design_file import load_design
 from printgen.scene.panel import MODES, DesignPanel, design_panel, panel_lockup
 from printgen.scene.scenes import ORIENTATIONS
 

@@ -2,7 +2,7 @@
 stage wired in, and its output folder.
 
 The search (`printgen.search.nets`) screens the candidates by the analytic membrane law and
-verifies the best few with the pre-print verification (`printgen.verification.verify`); the solver
+verifies the best few with the pre-print verification (`printgen.verification.preprint`); the solver
 task lives here because the verification stage sits above the search stage. Output folder (written
 whole, `outputs.staged_dir`):
 
@@ -23,7 +23,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from printgen.design.similitude import scale_targets
+from printgen.scaling.similitude import scale_targets
 from printgen.executor import open_runner
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
@@ -53,7 +53,7 @@ def verify_task(shared: VerifyShared, task: VerifyTask) -> VerifyScore:
     same task gives the same score in any process (the sweep worker runs it serially)."""
     from threadpoolctl import threadpool_limits
 
-    from printgen.verification.verify import levels, verify
+    from printgen.verification.preprint import levels, verify
 
     lv = None if shared.level_step is None else levels(step=shared.level_step)
     with _serial(), threadpool_limits(limits=1):  # one BLAS thread: the same sums everywhere

@@ -31,7 +31,7 @@ WAIT_SWEEPS = "waiting for the verification sweeps"  # in this process, within a
 FIGURES = "figures (PNG and SVG, side by side)"  # within the report files, after the steps
 
 if TYPE_CHECKING:  # pragma: no cover
-    from printgen.design.record import Design
+    from printgen.scaling.record import Design
     from printgen.inputs.printers import Printer
     from printgen.inputs.prototype import Prototype
     from printgen.parts.gcode.toolpath import Toolpath
@@ -40,7 +40,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from printgen.run.make import MakeContext
     from printgen.run.options import RunOptions
     from printgen.verification.bands import Band
-    from printgen.verification.verify import Verification
+    from printgen.verification.preprint import Verification
 
 
 def preload_parts() -> None:
@@ -325,7 +325,7 @@ def verification_sweeps(prototype: Prototype, design: Design,
     """
     from printgen.report.plots import load_pyplot
     from printgen.verification.pooled import verify_with_band
-    from printgen.verification.verify import free_section
+    from printgen.verification.preprint import free_section
 
     # matplotlib is imported while the sweeps run: the figures' workers start with it
     return verify_with_band(prototype, design, load=options.load, counterexample=True,

@@ -1,7 +1,7 @@
 """`printgen testpieces DESIGN`: the pieces a lab prints and tests before the barrier, written
 atomically into one output folder (staged, locked, with its manifest, as `make`'s).
 
-For the design's net (`printgen.design.testpieces`): a tensile coupon of its strand section
+For the design's net (`printgen.scaling.testpieces`): a tensile coupon of its strand section
 and passes, and a net test panel of its mesh, each as STL, 3MF, PrusaSlicer .ini and direct
 G-code (read back against the toolpath), the sidecar each test's exports need in
 `printgen calibrate` (`<piece>.specimen.toml`, the keys of `printgen.calibrate.specimen`), and
@@ -17,9 +17,9 @@ import io
 from pathlib import Path
 from typing import Any
 
-from printgen.design.design_file import load_design
-from printgen.design.record import Design
-from printgen.design.testpieces import (
+from printgen.scaling.design_file import load_design
+from printgen.scaling.record import Design
+from printgen.scaling.testpieces import (
     COUPON_COUNT,
     COUPON_RING_FACTOR,
     PanelPiece,

@@ -14,8 +14,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from printgen.design.design_file import load_design
-from printgen.design.record import Design
+from printgen.scaling.design_file import load_design
+from printgen.scaling.record import Design
 from printgen.executor.start import preload
 from printgen.inputs.materials import load_material
 from printgen.inputs.profiles import profile_name, search_dirs
@@ -39,7 +39,7 @@ from printgen.verification.measured import (
     read_measured,
 )
 from printgen.verification.pooled import verify_with_band
-from printgen.verification.verify import Verification, free_section
+from printgen.verification.preprint import Verification, free_section
 
 # what the workers' jobs import (the sweeps, the figures): a fork server imports them once
 JOB_MODULES = ("printgen.verification.pooled", "printgen.report.plots")

@@ -29,8 +29,8 @@ from functools import lru_cache
 import numpy as np
 
 from printgen.barrier.patterns import get_pattern
-from printgen.design.record import Design
-from printgen.design.section import area_m2
+from printgen.scaling.record import Design
+from printgen.scaling.section import area_m2
 from printgen.inputs.materials import load_material
 from printgen.scene.panel import PanelTest, derive_law, law_strains, simulate
 from printgen.scene.scenes import (

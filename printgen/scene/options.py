@@ -12,7 +12,7 @@ import dataclasses
 from dataclasses import dataclass
 
 from printgen.barrier.loads import LoadCase
-from printgen.design.record import Design
+from printgen.scaling.record import Design
 from printgen.errors import GeometryError
 from printgen.inputs.prototype import Prototype
 from printgen.scene.forms import BEDS, NET_LAWS, ROUTINGS, held_on_bed, routed, with_derived_law

@@ -36,7 +36,7 @@ import numpy as np
 
 import solver
 from printgen.barrier.patterns import get_pattern
-from printgen.design.record import Design
+from printgen.scaling.record import Design
 from printgen.errors import SolverError
 from printgen.inputs.laws import piecewise_linear
 from printgen.inputs.materials import load_material

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from printgen.design.record import Design
+from printgen.scaling.record import Design
 from printgen.scene.options import build_scene
 from printgen.scene.scenes import BarrierScene
 from printgen.scene.solvernet import path_length

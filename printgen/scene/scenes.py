@@ -33,8 +33,8 @@ import numpy as np
 from printgen.barrier.graph import NetGraph
 from printgen.barrier.loads import FLOW, LoadCase, get_load
 from printgen.barrier.patterns import AS_DRAWN, get_pattern, mesh_text
-from printgen.design.record import Design
-from printgen.design.section import area_m2, net_membrane_law
+from printgen.scaling.record import Design
+from printgen.scaling.section import area_m2, net_membrane_law
 from printgen.errors import GeometryError
 from printgen.inputs.materials import PanelLaw, load_material
 from printgen.inputs.prototype import LATERAL, Prototype

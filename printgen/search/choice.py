@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections import Counter
 from typing import TYPE_CHECKING
 
-from printgen.design.selection import CALIBRATE_FIRST, MIN_SAFETY_FACTOR, NET_ON_TARGET
+from printgen.scaling.selection import CALIBRATE_FIRST, MIN_SAFETY_FACTOR, NET_ON_TARGET
 from printgen.search.screen import Screened
 from printgen.search.space import SearchSpace, half_cell_counts
 

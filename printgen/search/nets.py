@@ -23,10 +23,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from printgen.design.plan import make_design
-from printgen.design.record import Design, NetDesign
-from printgen.design.selection import select
-from printgen.design.similitude import scale_targets
+from printgen.scaling.plan import make_design
+from printgen.scaling.record import Design, NetDesign
+from printgen.scaling.selection import select
+from printgen.scaling.similitude import scale_targets
 from printgen.errors import InputError
 from printgen.executor import Runner, batches
 from printgen.inputs.materials import load_material

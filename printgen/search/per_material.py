@@ -11,7 +11,7 @@ must be measured on the test pieces before the barrier is printed.
 
 from __future__ import annotations
 
-from printgen.design.selection import CALIBRATE_FIRST, MIN_SAFETY_FACTOR
+from printgen.scaling.selection import CALIBRATE_FIRST, MIN_SAFETY_FACTOR
 from printgen.search.choice import SMALL_STRAIN_TOLERANCE, closest_key, near_target, rank_key, short
 from printgen.search.screen import Screened
 

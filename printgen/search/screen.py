@@ -18,9 +18,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from printgen.design.record import Section
-from printgen.design.section import area_m2, equal_area_diameter, net_membrane_law
-from printgen.design.selection import (
+from printgen.scaling.record import Section
+from printgen.scaling.section import area_m2, equal_area_diameter, net_membrane_law
+from printgen.scaling.selection import (
     DATASHEET_PENALTY,
     MIN_SAFETY_FACTOR,
     NET_STRAINS,

@@ -15,13 +15,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from printgen.design.selection import (
+from printgen.scaling.selection import (
     DEFAULT_NET_PRINT,
     DEFAULT_PRINTER,
     MAX_BEADS_ACROSS,
     MAX_LAYERS,
 )
-from printgen.design.similitude import ScaledTargets
+from printgen.scaling.similitude import ScaledTargets
 from printgen.errors import InputError
 from printgen.inputs.materials import Material, load_material, material_names
 from printgen.inputs.printers import Printer, PrintStyle, load_print_style, load_printer

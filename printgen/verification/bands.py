@@ -24,14 +24,14 @@ from typing import Any
 import numpy as np
 
 from printgen.barrier.loads import LoadCase
-from printgen.design.record import Design
+from printgen.scaling.record import Design
 from printgen.errors import GeometryError
 from printgen.inputs.prototype import Prototype
 from printgen.scene.options import SceneOptions, build_scene
 from printgen.trace import span
 from printgen.verification.compare import METRICS
 from printgen.verification.variants import Variant, model_variants
-from printgen.verification.verify import Run, load_keywords, sweep
+from printgen.verification.preprint import Run, load_keywords, sweep
 from printgen.executor.local import collect, submit_jobs
 
 COARSENINGS = (2, 3)  # mesh multipliers tried in turn for the variant sweeps

@@ -12,9 +12,9 @@ from typing import Any
 import numpy as np
 
 from printgen.barrier.loads import distinct_specs, get_load
-from printgen.design.record import Design
+from printgen.scaling.record import Design
 from printgen.inputs.prototype import Prototype
-from printgen.verification.verify import (
+from printgen.verification.preprint import (
     Run,
     Verification,
     VerifyPlan,

@@ -32,13 +32,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from printgen.design.record import Design
+from printgen.scaling.record import Design
 from printgen.scene.forms import BEDS, slack_laws
 from printgen.scene.options import SceneOptions, build_scene
 from printgen.scene.scenes import MOUNTINGS, ORIENTATIONS, BarrierScene
 from printgen.verification.bands import curves
 from printgen.verification.measured import Measurement, mismatch, objective
-from printgen.verification.verify import sweep
+from printgen.verification.preprint import sweep
 
 # (low, high, nominal) of each continuous parameter
 BOUNDS = {

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from printgen.barrier.loads import OVERFLOW
-from printgen.design.record import Design
+from printgen.scaling.record import Design
 from printgen.errors import InputError
 from printgen.inputs.profiles import profile_name
 from printgen.outputs.files import read_input_text

@@ -20,14 +20,14 @@ from collections.abc import Callable
 from concurrent.futures import Future
 
 from printgen.barrier.loads import LoadCase
-from printgen.design.record import Design
+from printgen.scaling.record import Design
 from printgen.inputs.prototype import Prototype
 from printgen.scene.options import SceneOptions
 from printgen.trace import span
 from printgen.verification.bands import COARSENINGS, Band, meshable, model_band, run_variant
 from printgen.verification.cases import case_plan, other_cases, with_cases
 from printgen.verification.variants import Variant
-from printgen.verification.verify import Verification, steel_counterexample, verify_plan
+from printgen.verification.preprint import Verification, steel_counterexample, verify_plan
 from printgen.executor.local import collect, shared_pool
 
 

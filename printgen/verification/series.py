@@ -42,7 +42,7 @@ from printgen.scene.scenes import (
     BarrierScene,
 )
 from printgen.units import RHO_WATER, G
-from printgen.verification.verify import levels, sweep
+from printgen.verification.preprint import levels, sweep
 from solver import linear
 
 SCALES = (1.0, 10.0, 30.0, 50.0, 100.0)  # the paper's series (Lambert et al. 2023, Fig. 2)

@@ -27,8 +27,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from printgen.barrier.patterns import get_pattern
-from printgen.design.record import Design
-from printgen.design.section import area_m2
+from printgen.scaling.record import Design
+from printgen.scaling.section import area_m2
 from printgen.inputs.materials import load_material
 from printgen.scene.options import SceneOptions, build_scene
 from printgen.scene.scenes import MOUNTINGS, ORIENTATIONS, TESTED_PATTERN, recorded_orientation

@@ -1,7 +1,7 @@
 """Part exports: bed layout, binary STL, 3MF with embedded PrusaSlicer settings (STEP:
 `printgen.parts.geometry.cad`). Every writer checks its input before writing, atomically."""
 
-from printgen.parts.export.layout import (
+from printgen.parts.export.bed import (
     Placement,
     fit_angle,
     layout_parts,

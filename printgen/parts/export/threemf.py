@@ -16,7 +16,7 @@ import numpy as np
 from printgen.errors import GeometryError, InputError
 from printgen.inputs.printers import Printer
 from printgen.outputs import write_bytes
-from printgen.parts.export.layout import Placement, layout_parts
+from printgen.parts.export.bed import Placement, layout_parts
 from printgen.parts.export.stl import check_mesh
 
 if TYPE_CHECKING:  # pragma: no cover

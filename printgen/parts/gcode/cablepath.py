@@ -14,7 +14,7 @@ import itertools
 
 import numpy as np
 
-from printgen.design.record import CableDesign
+from printgen.scaling.record import CableDesign
 from printgen.errors import PrintabilityError
 from printgen.inputs.materials import Material
 from printgen.inputs.printers import Printer, PrintStyle

@@ -28,7 +28,7 @@ import itertools
 import numpy as np
 
 from printgen.barrier.graph import NetGraph
-from printgen.design.record import NetDesign, Section
+from printgen.scaling.record import NetDesign, Section
 from printgen.errors import ProfileError
 from printgen.inputs.materials import Material
 from printgen.inputs.printers import Printer, PrintStyle

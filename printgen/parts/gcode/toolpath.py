@@ -15,7 +15,7 @@ from typing import cast
 
 import numpy as np
 
-from printgen.design.record import CableDesign, NetDesign, Section
+from printgen.scaling.record import CableDesign, NetDesign, Section
 from printgen.errors import PrintabilityError, ProfileError
 from printgen.inputs.materials import Material
 from printgen.inputs.printers import Printer, PrintStyle, check_pass

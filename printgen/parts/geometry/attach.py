@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from printgen.barrier.graph import NetGraph
-from printgen.design.record import Design, NetDesign
+from printgen.scaling.record import Design, NetDesign
 from printgen.errors import GeometryError
 
 DEFAULT_CLEARANCE_MM = 0.3  # at least 0.3 mm each side of the strip in a loop

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from printgen.design.record import CableDesign
+from printgen.scaling.record import CableDesign
 from printgen.errors import GeometryError
 
 CIRCLE_SEGMENTS = 128  # eyelet polygon sides: chord sag 3e-4 x radius; area kept exact

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from printgen.barrier.graph import NetGraph
-from printgen.design.record import CableDesign, NetDesign
+from printgen.scaling.record import CableDesign, NetDesign
 from printgen.errors import GeometryError
 from printgen.parts.geometry.attach import Attachment, Hole, attachment_for, holes
 from printgen.parts.geometry.cable import (

@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from printgen.design.record import CableDesign, NetDesign
+from printgen.scaling.record import CableDesign, NetDesign
 from printgen.errors import PrintabilityError
 from printgen.inputs.materials import Material
 from printgen.inputs.printers import Printer, PrintStyle

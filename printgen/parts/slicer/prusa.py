@@ -16,7 +16,7 @@ from functools import cache
 from importlib import resources
 from pathlib import Path
 
-from printgen.design.record import CableDesign, NetDesign
+from printgen.scaling.record import CableDesign, NetDesign
 from printgen.errors import PrintabilityError, ProfileError
 from printgen.inputs.materials import Material
 from printgen.inputs.printers import Printer, PrintStyle

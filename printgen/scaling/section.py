@@ -13,7 +13,7 @@ import math
 
 from printgen.barrier.patterns import get_pattern
 from printgen.barrier.patterns.diamond import diamond_factor
-from printgen.design.record import Section
+from printgen.scaling.record import Section
 from printgen.inputs.materials import Material
 from printgen.units import MM
 

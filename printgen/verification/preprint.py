@@ -16,8 +16,8 @@ import numpy as np
 
 import solver
 from printgen.barrier.loads import OVERFLOW, LoadCase, Site, get_load
-from printgen.design.record import Design
-from printgen.design.similitude import scale_targets
+from printgen.scaling.record import Design
+from printgen.scaling.similitude import scale_targets
 from printgen.errors import SolverError
 from printgen.inputs.prototype import Prototype
 from printgen.scene.options import SceneOptions, build_scene

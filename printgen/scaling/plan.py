@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 from printgen.barrier.patterns import get_pattern
-from printgen.design.record import CableDesign, Design, NetDesign, Section
-from printgen.design.selection import Selection, model_mesh, printed_pattern
-from printgen.design.similitude import ScaledTargets
+from printgen.scaling.record import CableDesign, Design, NetDesign, Section
+from printgen.scaling.selection import Selection, model_mesh, printed_pattern
+from printgen.scaling.similitude import ScaledTargets
 from printgen.errors import DesignError
 from printgen.inputs.prototype import Prototype
 

@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from printgen.barrier.patterns import get_pattern
-from printgen.design.record import CABLE_SIDES, CableDesign, Design, NetDesign, Section
+from printgen.scaling.record import CABLE_SIDES, CableDesign, Design, NetDesign, Section
 from printgen.errors import InputError
 from printgen.inputs.profiles import profile_name
 from printgen.inputs.prototype import MIN_MODEL_MESH_MM, Prototype

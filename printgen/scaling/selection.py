@@ -17,9 +17,9 @@ import numpy as np
 
 from printgen.barrier.loads import OVERFLOW  # peak relative loading of the loading test
 from printgen.barrier.patterns import AS_DRAWN, get_pattern, mesh_text
-from printgen.design.record import NetDesign, Section
-from printgen.design.section import area_m2, equal_area_diameter, net_membrane_law
-from printgen.design.similitude import ScaledTargets
+from printgen.scaling.record import NetDesign, Section
+from printgen.scaling.section import area_m2, equal_area_diameter, net_membrane_law
+from printgen.scaling.similitude import ScaledTargets
 from printgen.errors import InputError, PrintabilityError
 from printgen.inputs.laws import piecewise_linear
 from printgen.inputs.materials import Material, load_material, material_names

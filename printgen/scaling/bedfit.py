@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from printgen.design.record import Design
+from printgen.scaling.record import Design
 from printgen.inputs.printers import Printer, load_printer
 from printgen.inputs.profiles import list_profiles
 

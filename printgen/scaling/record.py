@@ -94,7 +94,7 @@ class Design:
     def from_record(cls, rec: Any, *, where: str = "design record") -> Design:
         """The Design of a `to_dict()` record (the design.json that `printgen make` writes);
         InputError naming the missing, unknown or bad entry otherwise."""
-        from printgen.design.design_file import design_from_dict
+        from printgen.scaling.design_file import design_from_dict
 
         return design_from_dict(rec, where=where)
 

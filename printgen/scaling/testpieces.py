@@ -22,7 +22,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from printgen.barrier.patterns import get_pattern, panel_test_patterns
-from printgen.design.record import CableDesign, Design, NetDesign
+from printgen.scaling.record import CableDesign, Design, NetDesign
 from printgen.errors import GeometryError
 
 COUPON_GAUGE_MM = 50.0  # free strip between the eyelet rings (ISO 527-2 1A: 50 mm gauge)
