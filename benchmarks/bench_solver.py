@@ -31,12 +31,12 @@ from pathlib import Path
 
 import numpy as np
 
-from solver import solve, solve_path
-from solver.driver import FastSolver
-from solver.linsolve import Pardiso
-from solver.loads import total_forces
-from solver.newton import MAX_ITER
-from solver.scenes import simple_scene
+from printgen.solver import solve, solve_path
+from printgen.solver.driver import FastSolver
+from printgen.solver.linsolve import Pardiso
+from printgen.solver.loads import total_forces
+from printgen.solver.newton import MAX_ITER
+from printgen.solver.scenes import simple_scene
 
 REFERENCE_TOL = 1e-13  # the reference solve: round-off level
 TOLERANCES = (1e-4, 1e-6, 1e-8)  # printgen's runs: out-of-balance force / load
@@ -307,7 +307,7 @@ def thread_table(sizes: list[int], counts: list[int]) -> list[dict]:
 def capture_verification_paths() -> list[tuple]:
     """(net, loads_at, levels, keywords) of every load path the 1:40 verification solves,
     recorded while it runs (serially, in this process)."""
-    import solver
+    from printgen import solver
     from printgen.run.api import verify
 
     captured, original = [], solver.solve_path
@@ -330,7 +330,7 @@ def bench_tent(net, tol: float) -> dict:
     """The "tent": the 1:40 model net with no water, pulled only by three 1 N sensor loads
     (flow-wise, at the free nodes nearest the bed-centre, the top-centre and the centre).
     Most strands stay slack, many nodes have no stiffness: the hardest start there is."""
-    from solver import PointLoads
+    from printgen.solver import PointLoads
 
     x = np.asarray(net.nodes)
     lo, span = x.min(axis=0), np.ptp(x, axis=0)
@@ -472,7 +472,7 @@ def run(out: Path, sizes: list[int], with_paths: bool = True, threads: int = THR
         compare_threads: list[int] | None = None) -> dict:
     from threadpoolctl import threadpool_limits
 
-    from solver.linsolve import pardiso_available
+    from printgen.solver.linsolve import pardiso_available
 
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()

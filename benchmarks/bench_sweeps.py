@@ -31,7 +31,7 @@ SWEEPS = ("printed model", "prototype")  # the order `verify` solves them in (lo
 def sweeps(example: Path, scale: float, printer: str | None) -> list[dict]:
     """Per level iterations, factorizations and convergence of each sweep `verify` solves
     (serially, in this process), with each sweep's CPU time."""
-    import solver
+    from printgen import solver
     from printgen.run.api import verify
 
     rows, original = [], solver.solve_path

@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from printgen.inputs.materials import load_material
-from solver import solve
-from solver.scenes import SIMPLE, simple_scene
+from printgen.solver import solve
+from printgen.solver.scenes import SIMPLE, simple_scene
 
 LAMBDAS = np.array([1.0, 10.0, 30.0, 50.0, 100.0])
 SIMILAR = 1e-9  # scaled-E models match the prototype to solver round-off

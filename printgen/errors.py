@@ -3,7 +3,7 @@
 Every message names the value, the limit (with units) and how to fix it. The CLI turns a
 `PrintgenError` into a one-line message and exit code 2, without a traceback; so it does the
 solver's `SolverError` (`reported`), the one class for a solve that did not converge, which
-lives in `solver` because the solver imports nothing of printgen.
+lives in `printgen.solver` because the solver imports nothing else of printgen.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from solver.result import SolverError  # noqa: F401 (for type checkers: `__getattr__`)
+    from printgen.solver.result import SolverError  # noqa: F401 (for type checkers: `__getattr__`)
 
 
 class PrintgenError(Exception):
@@ -52,7 +52,7 @@ def __getattr__(name: str) -> Any:
     """`SolverError`, the solver's, imported on first use: importing the solver costs numpy
     and scipy, which the command line's start does not need."""
     if name == "SolverError":
-        from solver.result import SolverError
+        from printgen.solver.result import SolverError
 
         return SolverError
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
@@ -62,7 +62,7 @@ def reported(exc: BaseException) -> bool:
     """Whether `exc` is an error the command line reports in one line with exit code 2: a
     `PrintgenError` or the solver's `SolverError` (raised only once the solver is imported,
     hence looked up among the loaded modules)."""
-    result = sys.modules.get("solver.result")
+    result = sys.modules.get("printgen.solver.result")
     solver_error = getattr(result, "SolverError", None)
     return isinstance(exc, PrintgenError) or (solver_error is not None
                                               and isinstance(exc, solver_error))

@@ -1,7 +1,7 @@
 """Type-check printgen/ against its error budget: `mypy printgen` may report at most the count in
 scripts/mypy_budget.txt. Prints the count; exits 1 when it rose above the budget (fix the new
 errors), 0 otherwise (when it fell, lower the budget in the same commit so it cannot rise back).
-`mypy solver` must be clean: scripts/test.sh runs it on its own.
+`mypy printgen/solver` must be clean: scripts/test.sh runs it on its own.
 
 Usage: python scripts/mypy_budget.py [--budget FILE]   (the python whose mypy is used)
 """

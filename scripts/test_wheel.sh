@@ -29,7 +29,7 @@ wheel=$(ls "$tmp"/dist/printgen-*.whl)
 built=$SECONDS
 for f in printgen/profiles/materials/petg.toml printgen/profiles/printers/generic-350.toml \
          printgen/examples/realistic_barrier.toml printgen/examples/paper_1_40/measured.csv \
-         printgen/py.typed solver/py.typed; do
+         printgen/py.typed printgen/solver/py.typed; do
   unzip -l "$wheel" "$f" >/dev/null || fail "$f missing from $(basename "$wheel")"
 done
 unzip -l "$wheel" '*.dist-info/licenses/LICENSE' >/dev/null || fail "LICENSE missing from the wheel"

@@ -69,7 +69,7 @@ def test_the_solver_slides_the_cables_through_the_loops(kit):
 
 
 def test_a_cable_of_the_wrong_length_is_reported():
-    d = plan(EXAMPLES / "realistic_barrier.toml", 60).design
+    d = plan_run(EXAMPLES / "realistic_barrier.toml", 60).design
     long = dataclasses.replace(d.cables[0], length_mm=d.cables[0].length_mm + 3.7)
     d = dataclasses.replace(d, cables=(long, *d.cables[1:]))
     problems = assemble(d, load_printer(d.printer)).problems()

@@ -19,7 +19,7 @@ from printgen.barrier.registry import names
 from printgen.cli import build_parser
 from printgen.errors import InputError
 from printgen.units import RHO_WATER, G
-from solver.loads import total_forces
+from printgen.solver.loads import total_forces
 
 EXACT = 1e-12  # closed-form arithmetic, round-off only
 PANEL_MM = (61.0, 47.0, 12.0, 14.0)  # width, height, mesh_x, mesh_y: an odd-sized panel

@@ -65,7 +65,7 @@ def test_predicted_work_of_the_free_top_barrier_is_the_counted_work(made_simple_
 
 def _fail_half(monkeypatch):
     """Every sweep solves FEW_LEVELS, and h/h_B = 0.5 does not converge (serial: in-process)."""
-    import solver
+    from printgen import solver
 
     original = solver.solve_path
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from solver.linsolve import Pardiso, pardiso_available, row_sum_norm
+from printgen.solver.linsolve import Pardiso, pardiso_available, row_sum_norm
 
 needs_pardiso = pytest.mark.skipif(not pardiso_available(), reason="pypardiso not installed")
 LINEAR = 1e-10  # relative residual |b - S x| / |b| of a direct solve of a well-conditioned S

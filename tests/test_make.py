@@ -218,7 +218,7 @@ def test_incomplete_verification_exits_3_with_outputs(tmp_path, monkeypatch, cap
     from printgen.commands import make as make_cmd
 
     def fake(*args, **kwargs):
-        ctx = make_mod.plan(REALISTIC, 40)
+        ctx = make_mod.plan_run(REALISTIC, 40)
         ctx.record["verification"] = {"complete": False, "levels_compared": 20,
                                       "levels_asked": 23, "verdict": "PASS", "summary": "-"}
         ctx.record["files"] = []

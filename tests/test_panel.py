@@ -10,7 +10,7 @@ import pytest
 from printgen.barrier.patterns.diamond import lockup_strain
 from printgen.barrier.patterns.diamond import strand_law as strand_law_from_membrane
 from printgen.scene.panel import PanelTest, analytic_blocked, derive_law, law_strains, simulate
-from solver import Law
+from printgen.solver import Law
 
 MM = 1e-3
 ANALYTIC_TOL = 0.01  # issue 25: a blocked, infinite panel matches the formula within 1 %

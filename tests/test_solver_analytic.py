@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from solver import Net, PointLoads, SlidingCable, SolverError, linear, piecewise, solve
+from printgen.solver import Net, PointLoads, SlidingCable, SolverError, linear, piecewise, solve
 
 EXACT_FORM = 1e-9  # relative error allowed where the closed form is exact (issue 4)
 TIGHT = 1e-13  # solver force tolerance for the analytic cases: far below EXACT_FORM
@@ -152,7 +152,7 @@ def test_bad_models_are_rejected(bad):
 def test_drag_ramps_in_as_the_water_covers_a_node():
     """The drag of a node grows linearly from its height to `ramp` above it, and its
     z-derivative is the slope of that ramp (what Newton needs)."""
-    from solver import Drag
+    from printgen.solver import Drag
 
     full = 0.5 * 1000.0 * 2.0**2 * 0.3 * 0.01  # 0.5 rho v^2 l d
     x = np.array([[0.0, 0.0, 1.0]])
@@ -166,7 +166,7 @@ def test_drag_ramps_in_as_the_water_covers_a_node():
 def test_a_path_reports_unreachable_levels_and_can_go_on():
     """With too few iterations allowed every level fails: the path stops at the first one,
     or with skip_failed keeps going, each failure converged=False with its reason."""
-    from solver import solve_path
+    from printgen.solver import solve_path
 
     nodes = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0]], float)
     net = Net(nodes, _fixed_ends(3), np.array([[0, 1], [1, 2]]), [linear(1e5)])

@@ -9,17 +9,17 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from solver import Hydrostatic, Net, SlidingCable, linear, solve, solve_path
-from solver.driver import FastSolver
-from solver.linsolve import (
+from printgen.solver import Hydrostatic, Net, SlidingCable, linear, solve, solve_path
+from printgen.solver.driver import FastSolver
+from printgen.solver.linsolve import (
     PARDISO_MIN_DOFS,
     Factorization,
     choose_backend,
     ldl_available,
     pardiso_available,
 )
-from solver.scenes import simple_scene, square_net
-from solver.state import NetSystem, evaluate, tangent_values
+from printgen.solver.scenes import simple_scene, square_net
+from printgen.solver.state import NetSystem, evaluate, tangent_values
 
 AGREE = 1e-9  # issue 11: fast and reference displacements agree to 1e-9 of the largest one
 TIGHT = 1e-12  # solver tolerance of both paths here: far below AGREE
@@ -183,7 +183,7 @@ def test_pardiso_turns_to_ldlt_when_the_matrix_is_indefinite():
 def test_a_failing_pardiso_falls_back_to_superlu(monkeypatch):
     """PARDISO raising at the factorization or at a solve: SuperLU on A decides, and the
     whole solve still ends on the reference equilibrium."""
-    from solver import linsolve
+    from printgen.solver import linsolve
 
     sc = simple_scene(current_z=True)
     ns, data = _tangent(sc.net, sc.loads_at(1.0))
@@ -213,7 +213,7 @@ def test_ldl_turns_to_pardiso_on_a_net_factorized_often():
     factorizations, PARDISO (on LDL_PARDISO_THREADS threads) for the later ones; both solve
     the same system (the follower term by GMRES), and a single solve of the 61 x 21 net
     stays on qdldl (no MKL for it)."""
-    from solver import linsolve
+    from printgen.solver import linsolve
 
     sc = simple_scene(current_z=True)
     ns, data = _tangent(sc.net, sc.loads_at(1.0))
@@ -267,7 +267,7 @@ GMRES_TOL = 1e-12  # relative 2-norm residual asked of GMRES (far above round-of
 def test_gmres_reaches_its_target_on_a_nonsymmetric_system():
     """Right-preconditioned GMRES (Givens-reduced Hessenberg) against the stated residual
     target: tight target met, a loose target stops early but still meets it."""
-    from solver.linsolve import gmres
+    from printgen.solver.linsolve import gmres
 
     rng = np.random.default_rng(0)
     n = 200
@@ -288,7 +288,7 @@ def test_predicted_tensions_follow_the_linearised_law_and_stay_tension_only():
     linearised law is exact for a linear law; a transverse step predicts no change (the exact
     tension grows by the second-order stretch it leaves out); a step past the rest length
     predicts zero, never compression; half a step moves the prediction half-way."""
-    from solver.fast import _predicted_tensions
+    from printgen.solver.fast import _predicted_tensions
 
     net = Net(np.array([[0.0, 0, 0], [1.0, 0, 0]]), np.array([True, False]),
               np.array([[0, 1]]), [linear(100.0)])

@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from solver import Hydrostatic, Net, SlidingCable, linear, piecewise
-from solver.assemble import internal, strain_energy
-from solver.linsolve import PARDISO_MIN_DOFS, row_sum_norm
-from solver.scenes import simple_scene, square_net
-from solver.state import NetSystem, evaluate, ray_potential, tangent_values
+from printgen.solver import Hydrostatic, Net, SlidingCable, linear, piecewise
+from printgen.solver.assemble import internal, strain_energy
+from printgen.solver.linsolve import PARDISO_MIN_DOFS, row_sum_norm
+from printgen.solver.scenes import simple_scene, square_net
+from printgen.solver.state import NetSystem, evaluate, ray_potential, tangent_values
 
 KERNEL = 1e-14  # relative: the same products and sums, only reassociated (BLAS, bincount)
 MEMBRANE = 1e-12  # relative residual of a direct sparse solve of the net's Laplacian

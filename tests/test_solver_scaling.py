@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from solver import solve
-from solver.scenes import SIMPLE, simple_scene
+from printgen.solver import solve
+from printgen.solver.scenes import SIMPLE, simple_scene
 
 SIMILAR = 1e-9  # issue 4: same normalised deformation at every lambda with E / lambda
 TIGHT = 1e-12  # solver tolerance for the invariance checks

@@ -81,7 +81,7 @@ def _reference_curves(s, lv: np.ndarray) -> dict[str, np.ndarray]:
     """The model's curves with each pulling sensor wire as one frictionless sliding cable of
     constant tension (not per-segment elements), solved to TIGHT_TOL: an independent
     formulation of the same physics."""
-    import solver
+    from printgen import solver
     from printgen.scene.pressure import loads_function
     from printgen.scene.solvernet import WIRE_STRAIN, build, path_length, wire_law
     from printgen.verification.compare import deformation
@@ -125,7 +125,7 @@ def test_free_top_curves_match_a_tight_sliding_wire_reference(coarse_simple):
 def test_unconverged_level_is_left_out_and_reported(monkeypatch):
     """Issue 28: a level the solver does not reach is listed, left out of the comparison, and
     the record says the verdict rests on fewer levels than asked (no SolverError)."""
-    import solver
+    from printgen import solver
 
     original = solver.solve_path
 

@@ -110,7 +110,7 @@ def _sweep_sections(rep: Report, v: Verification, scale: float, band: Band | Non
     from printgen.verification.compare import METRICS, TOLERANCE
 
     rep.paragraph(
-        f"Both barriers are solved as tension-only cable nets (solver/) under the same relative "
+        f"Both barriers are solved as tension-only cable nets (printgen.solver) under the same relative "
         f"loading, {v.load_case}, h / h_B = 0 to 1.1 in steps of 0.05 (the reference's loading "
         "test: water raised behind a folded film), mounted alike and read by the same three "
         "sensor wires (bottom cable, top cable, mid-height); the model's wires pull 1 N along "

@@ -33,8 +33,8 @@ SPEED_ENV = "PRINTGEN_SPEED"  # a fixed factor instead of the measured one (benc
 
 def calibration_cpu() -> float:
     """CPU seconds of the calibration solve on this machine (best of CALIBRATION_REPEAT)."""
-    from solver import solve
-    from solver.scenes import simple_scene
+    from printgen.solver import solve
+    from printgen.solver.scenes import simple_scene
 
     scene = simple_scene(refine=1)
     best = math.inf

@@ -41,7 +41,7 @@ from printgen.scene.scenes import (
     recorded_orientation,
 )
 from printgen.units import MM
-from solver import Law
+from printgen.solver import Law
 
 NET_LAWS = ("formula", "derived")
 BEDS = ("free", "held")

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-import solver
+from printgen import solver
 from printgen.barrier.patterns import get_pattern
 from printgen.scaling.record import Design
 from printgen.errors import SolverError
@@ -42,7 +42,7 @@ from printgen.inputs.laws import piecewise_linear
 from printgen.inputs.materials import load_material
 from printgen.scene.scenes import TESTED_PATTERN, model_net_law, panel_axes
 from printgen.units import MM
-from solver import Law
+from printgen.solver import Law
 
 MODES = ("blocked", "free")
 PANEL_TOL = 1e-9  # out-of-balance force / strand force scale: exact for a 1 % comparison

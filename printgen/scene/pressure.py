@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-import solver
+from printgen import solver
 from printgen.barrier.loads import FLOW, LoadCase, LoadsAt, Site, get_load
 from printgen.scene.scenes import BarrierScene
 from printgen.units import RHO_WATER, G

@@ -8,7 +8,7 @@ from __future__ import annotations
 import dataclasses
 
 from printgen.scene.scenes import SENSOR_FORCE_N, BarrierScene
-from solver import Law
+from printgen.solver import Law
 
 
 def at_scale(base: BarrierScene, lam: float, name: str, *, sensors: bool = False,

@@ -39,7 +39,7 @@ from printgen.errors import GeometryError
 from printgen.inputs.materials import PanelLaw, load_material
 from printgen.inputs.prototype import LATERAL, Prototype
 from printgen.units import MM, RHO_WATER, G
-from solver import Law, linear
+from printgen.solver import Law, linear
 
 SENSOR_FORCE_N = 1.0  # wire tension of each string potentiometer (reference, section 4)
 SENSOR_EXIT = 0.1  # the potentiometer stands this fraction of the width beyond the right edge

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-import solver
+from printgen import solver
 from printgen.scene.scenes import BarrierScene
 
 WIRE_STRAIN = 3.0  # the spring's strain at rest (its rest length is a quarter of the segment's)

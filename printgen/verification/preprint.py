@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-import solver
+from printgen import solver
 from printgen.barrier.loads import OVERFLOW, LoadCase, Site, get_load
 from printgen.scaling.record import Design
 from printgen.scaling.similitude import scale_targets
@@ -39,7 +39,7 @@ from printgen.executor.local import (  # worker lifecycle: ground floor
     report_progress,
     run_jobs,
 )
-from solver.loads import total_forces
+from printgen.solver.loads import total_forces
 
 if TYPE_CHECKING:  # pragma: no cover
     from printgen.verification.cases import CaseRuns
@@ -320,7 +320,7 @@ class CounterExample:
 def steel_counterexample(scale: float) -> CounterExample:
     """Why stiffness must be scaled: steel at every scale deflects less and less as lambda
     grows (Lambert et al. 2023, Fig. 2), while E / lambda reproduces the prototype."""
-    from solver.scenes import SIMPLE, simple_scene
+    from printgen.solver.scenes import SIMPLE, simple_scene
 
     variants = {"prototype (lambda = 1)": (1.0, SIMPLE["modulus"]),
                 f"1:{scale:g}, E scaled by 1/lambda": (scale, SIMPLE["modulus"] / scale),

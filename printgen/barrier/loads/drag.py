@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-import solver
+from printgen import solver
 from printgen.barrier.loads import FLOW, LoadCase, LoadsAt, SceneView, Site, hydrostatic
 from printgen.units import RHO_WATER
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-import solver
+from printgen import solver
 from printgen.barrier.loads import FLOW, LoadCase, LoadsAt, SceneView, Site
 from printgen.units import RHO_WATER, G
 

@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import brentq
 
-import solver
+from printgen import solver
 from printgen.barrier.loads import (
     FLOW,
     OVERFLOW,

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 from printgen.barrier.graph import NetGraph
 from printgen.errors import InputError
-from solver import Law  # the one force-strain law type: strain knees, force slopes (N)
+from printgen.solver import Law  # the one force-strain law type: strain knees, force slopes (N)
 
 # Prototype patterns drawn as another (the prototype file's [net] pattern), said so in the
 # verification's assumptions.

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from solver.laws import Law
+from .laws import Law
 
 
 @dataclass(frozen=True)

@@ -28,10 +28,10 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from solver.assemble import bar_state, cable_state, internal, nondimensional, strain_energy
-from solver.loads import total_forces
-from solver.model import Net
-from solver.result import Result, SolverError
+from .assemble import bar_state, cable_state, internal, nondimensional, strain_energy
+from .loads import total_forces
+from .model import Net
+from .result import Result, SolverError
 
 TOL_FORCE = 1e-10  # converged when max |R| <= TOL_FORCE x max(|F_ext|, max strand force)
 ROUND_OFF = 1e-15  # nondimensional force (F / S_ref) at the round-off level of the strand laws

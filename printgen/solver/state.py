@@ -16,11 +16,11 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.sparse import csgraph
 
-from solver.assemble import Bars, bar_energy, nondimensional, strand_laws
-from solver.linsolve import PARDISO_MIN_DOFS, Pardiso, ldl_available, pardiso_available
-from solver.loads import total_forces
-from solver.model import Net
-from solver.pattern import SYM_PAIRS, Pattern, pair_values
+from .assemble import Bars, bar_energy, nondimensional, strand_laws
+from .linsolve import PARDISO_MIN_DOFS, Pardiso, ldl_available, pardiso_available
+from .loads import total_forces
+from .model import Net
+from .pattern import SYM_PAIRS, Pattern, pair_values
 
 _SYM_A, _SYM_B = (np.array(x) for x in zip(*SYM_PAIRS, strict=True))
 _SYM_DIAGONAL = np.flatnonzero(_SYM_A == _SYM_B)

@@ -47,8 +47,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from solver.linsolve import Factorization, choose_backend, refine, row_sum_norm
-from solver.newton import (
+from .linsolve import Factorization, choose_backend, refine, row_sum_norm
+from .newton import (
     ARMIJO,
     MAX_BACKTRACK,
     MAX_STEP,
@@ -57,7 +57,7 @@ from solver.newton import (
     POTENTIAL_ROUND_OFF,
     ROUND_OFF,
 )
-from solver.state import NetSystem, State, evaluate, ray_potential, tangent_values
+from .state import NetSystem, State, evaluate, ray_potential, tangent_values
 
 FORCING = 0.1  # inexact Newton: linear solves to min(FORCING, |R| / force scale), relative
 MU_GROWTH = 10.0  # mu grows by this factor when no damped step descends

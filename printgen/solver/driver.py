@@ -13,13 +13,13 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from solver import newton
-from solver.assemble import cable_state
-from solver.fast import Stepper, best_start, iterate, membrane_start
-from solver.model import Net
-from solver.newton import MAX_CUTS, MAX_ITER, TOL_FORCE
-from solver.result import Result, SolverError
-from solver.state import NetSystem, State, evaluate
+from . import newton
+from .assemble import cable_state
+from .fast import Stepper, best_start, iterate, membrane_start
+from .model import Net
+from .newton import MAX_CUTS, MAX_ITER, TOL_FORCE
+from .result import Result, SolverError
+from .state import NetSystem, State, evaluate
 
 METHODS = ("fast", "reference")
 

@@ -34,7 +34,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from solver.pattern import Pattern
+from .pattern import Pattern
 
 LINEAR_RTOL = 1e-13  # backward error a solve must reach: |b - A x| <= tol (|A| |x| + |b|)
 GMRES_RTOL = 1e-14  # GMRES stops at this relative 2-norm residual at the latest

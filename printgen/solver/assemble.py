@@ -15,8 +15,8 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 
-from solver.laws import Law
-from solver.model import Net
+from .laws import Law
+from .model import Net
 
 
 @dataclass(frozen=True)

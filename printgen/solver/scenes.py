@@ -7,9 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.laws import linear
-from solver.loads import Drag, Hydrostatic
-from solver.model import Net
+from .laws import linear
+from .loads import Drag, Hydrostatic
+from .model import Net
 
 # The simple barrier (Lambert et al. 2023): 12 x 4 m, square mesh 0.2 m, d 10 mm, steel
 # 100 GPa, flow 6 m/s, water depth = barrier height.
