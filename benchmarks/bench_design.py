@@ -28,10 +28,10 @@ LEVEL_STEP = 0.1  # coarser than the verification's 0.05: a benchmark, not a ver
 
 
 def _setup():
+    from printgen.inputs.prototype import load_prototype
     from printgen.scaling.plan import make_design
     from printgen.scaling.selection import select
     from printgen.scaling.similitude import scale_targets
-    from printgen.inputs.prototype import load_prototype
     from printgen.search.space import default_space, grid, search_context
 
     p = load_prototype(Path(__file__).resolve().parents[1] / "examples/realistic_barrier.toml")

@@ -12,10 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
+from printgen.inputs.prototype import load_prototype
 from printgen.scaling.plan import make_design
 from printgen.scaling.selection import select
 from printgen.scaling.similitude import scale_targets
-from printgen.inputs.prototype import load_prototype
 from printgen.verification.preprint import Verification, verify
 
 HERE = Path(__file__).resolve().parent

@@ -95,10 +95,10 @@ def coarse_design_1_40(coarser: float):
 def planned(path: Path, scale: float = 40):
     """(prototype, design) of a prototype file at 1:scale: similitude, selection and the
     design, as `make` plans them."""
+    from printgen.inputs.prototype import load_prototype
     from printgen.scaling.plan import make_design
     from printgen.scaling.selection import select
     from printgen.scaling.similitude import scale_targets
-    from printgen.inputs.prototype import load_prototype
 
     p = load_prototype(path)
     t = scale_targets(p, scale)

@@ -18,8 +18,8 @@ from printgen.barrier.patterns import get_pattern, patterns
 from printgen.barrier.registry import names
 from printgen.cli import build_parser
 from printgen.errors import InputError
-from printgen.units import RHO_WATER, G
 from printgen.solver.loads import total_forces
+from printgen.units import RHO_WATER, G
 
 EXACT = 1e-12  # closed-form arithmetic, round-off only
 PANEL_MM = (61.0, 47.0, 12.0, 14.0)  # width, height, mesh_x, mesh_y: an odd-sized panel
@@ -90,8 +90,8 @@ def test_pattern_specific_rules_are_the_patterns():
     it may have, whether the virtual panel test models it) is each pattern's own data: a new
     pattern states them (no default, so it is not quietly taken for a diamond)."""
     from printgen.barrier.patterns import NetPattern
-    from printgen.scaling.testpieces import panel_for
     from printgen.errors import GeometryError
+    from printgen.scaling.testpieces import panel_for
 
     for p in patterns().values():
         p.check_mesh(0.2, 0.2, "net")  # every pattern takes a mesh equal both ways

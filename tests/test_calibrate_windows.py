@@ -19,10 +19,10 @@ import pytest
 from numpy.testing import assert_allclose
 from test_calibrate_files import VARIANTS, number
 
-from printgen.calibrate.windows import MACHINE_TOL, check_window
 from printgen.calibrate.fit import linear_fit
 from printgen.calibrate.pipeline import calibrate
 from printgen.calibrate.sample import FitOptions
+from printgen.calibrate.windows import MACHINE_TOL, check_window
 from printgen.cli import main
 
 QUOTED = VARIANTS["bluehill_quoted"]

@@ -122,8 +122,7 @@ def test_unexpected_error_is_one_line_with_a_hint(capsys, monkeypatch):
 def test_a_solve_that_did_not_converge_exits_2(capsys, monkeypatch):
     """One SolverError class, the solver's: printgen's error handling reports it like its own
     errors (one line, exit 2), and printgen.errors names the same class."""
-    from printgen import solver
-    from printgen import errors
+    from printgen import errors, solver
 
     def diverged(*a, **k):
         raise errors.SolverError("simple barrier prototype: no convergence")

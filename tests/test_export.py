@@ -13,7 +13,6 @@ import numpy as np
 import pytest
 from conftest import require_module, require_tool
 
-from printgen.scaling.record import Section
 from printgen.errors import GeometryError, InputError, PrintabilityError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
@@ -32,6 +31,7 @@ from printgen.parts.export.bed import ANGLE_STEP_DEG, PART_GAP_MM
 from printgen.parts.geometry.cable import CIRCLE_SEGMENTS, circle_scale
 from printgen.parts.geometry.solid import cable_outline, cable_solid, net_solid
 from printgen.parts.slicer.prusa import prusa_ini_text
+from printgen.scaling.record import Section
 
 trimesh = pytest.importorskip("trimesh")
 

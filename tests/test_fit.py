@@ -8,9 +8,9 @@ import pytest
 from conftest import coarse_design_1_40
 
 from printgen.scene.forms import slackened
+from printgen.solver import Law
 from printgen.verification.fit import BOUNDS, Params, at_bounds, fit_measured, predict
 from printgen.verification.measured import Measurement
-from printgen.solver import Law
 
 COARSE = 2  # the 1:40 net with a 2x coarser mesh (distinct top and mid rows): fast sweeps
 LEVELS = np.array([0.0, 0.5, 0.8, 1.0])  # the load path of every evaluation

@@ -7,14 +7,14 @@ import numpy as np
 import pytest
 from proto_files import EXAMPLES
 
-from printgen.scaling.design_file import load_design
 from printgen.inputs.materials import load_material
+from printgen.scaling.design_file import load_design
 from printgen.scene import SceneOptions, build_scene
 from printgen.scene.forms import DERIVE_POINTS, derived_net_law
 from printgen.scene.panel import PanelTest, law_strains, simulate
 from printgen.verification.bands import curves
-from printgen.verification.variants import model_variants
 from printgen.verification.preprint import sweep
+from printgen.verification.variants import model_variants
 
 PAPER = EXAMPLES / "paper_1_40" / "design.json"
 MM = 1e-3

@@ -9,10 +9,10 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from proto_files import write_variant
 
-from printgen.scaling.selection import select
-from printgen.scaling.similitude import scale_targets
 from printgen.errors import PrintgenError
 from printgen.inputs.prototype import load_prototype
+from printgen.scaling.selection import select
+from printgen.scaling.similitude import scale_targets
 
 KEYS = [("barrier", "width_m"), ("barrier", "height_m"), ("barrier", "anchors"),
         ("net", "mesh_x_m"), ("net", "mesh_y_m"), ("net", "strand_diameter_mm"),
@@ -89,8 +89,8 @@ DESIGN_KEYS = [("scale",), ("printer",), ("net", "material"), ("net", "width_mm"
 @settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(key=st.sampled_from(DESIGN_KEYS), value=HOSTILE)
 def test_hostile_design_values_are_input_errors(key, value):
-    from printgen.scaling.design_file import design_from_dict
     from printgen.errors import InputError
+    from printgen.scaling.design_file import design_from_dict
 
     data = design_dict()
     node = data

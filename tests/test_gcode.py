@@ -14,7 +14,6 @@ from conftest import ROOT, require_shared
 from numpy.testing import assert_allclose
 
 from printgen.barrier.patterns.diamond import diamond_net
-from printgen.scaling.record import Section
 from printgen.errors import PrintabilityError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
@@ -29,6 +28,7 @@ from printgen.parts.gcode import (
     write_gcode,
 )
 from printgen.parts.gcode.toolpath import BORDER, COMB, STRAND_MINUS, STRAND_PLUS, TRAVEL
+from printgen.scaling.record import Section
 
 VOLUME_TOL = 0.02  # the brief: read-back volume within 2 % of the design
 E_ROUND_REL = 1e-4  # E written with 5 decimals: relative rounding error of a volume sum

@@ -11,7 +11,6 @@ import pytest
 from conftest import reference_design_1_40
 
 from printgen.barrier.patterns.diamond import diamond_net
-from printgen.scaling.record import Section
 from printgen.errors import GeometryError
 from printgen.parts.geometry.attach import Attachment, holes
 from printgen.parts.geometry.cable import CIRCLE_SEGMENTS, circle_scale
@@ -23,6 +22,7 @@ from printgen.parts.geometry.solid import (
     net_outline,
     net_solid,
 )
+from printgen.scaling.record import Section
 
 pytest.importorskip("manifold3d")
 

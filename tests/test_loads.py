@@ -18,8 +18,8 @@ from printgen.barrier.loads import FLOW, Site, get_load, jam, with_params
 from printgen.barrier.loads.drag import strand_drag
 from printgen.barrier.loads.jam import DISCHARGES_L_PER_S, ergun_gradient, net_factor, seepage
 from printgen.errors import InputError
-from printgen.units import NU_WATER, RHO_WATER, G
 from printgen.solver.loads import total_forces
+from printgen.units import NU_WATER, RHO_WATER, G
 
 EXACT = 1e-12  # closed-form arithmetic, round-off only
 ROOT = 1e-9  # relative: a root found to ROOT_TOL (1e-12 m) on depths of 0.01 to 0.1 m

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
-from printgen.scaling.selection import CALIBRATE_FIRST, MIN_SAFETY_FACTOR
-from printgen.scaling.similitude import scale_targets
 from printgen.errors import InputError
 from printgen.inputs import materials as mats
 from printgen.inputs.prototype import load_prototype
+from printgen.scaling.selection import CALIBRATE_FIRST, MIN_SAFETY_FACTOR
+from printgen.scaling.similitude import scale_targets
 from printgen.search.choice import SMALL_STRAIN_TOLERANCE
 from printgen.search.per_material import first_on_target, per_material, reachable, target_sentence
 from printgen.search.screen import screen_batch

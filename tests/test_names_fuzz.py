@@ -130,8 +130,8 @@ def test_prototype_model_names(tmp_path, name):
 @pytest.mark.slow
 @fuzz_names
 def test_design_json_names(design_1_40, name):
-    from printgen.scaling.design_file import design_from_dict
     from printgen.run.verify import fitted_name
+    from printgen.scaling.design_file import design_from_dict
 
     base = design_1_40.to_dict()
     for where in (("printer",), ("net", "material"), ("net", "print_style"),

@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from printgen.scaling.design_file import load_design
 from printgen.errors import GeometryError
+from printgen.scaling.design_file import load_design
 from printgen.scene import SceneOptions, build_scene
 from printgen.scene.scenes import panel_axes
 from printgen.verification.measured import MeasurementError, mismatch, read_measured

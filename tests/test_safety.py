@@ -264,8 +264,8 @@ def test_profiles_show_and_inherits_do_not_read_outside(world, capsys, monkeypat
 
 
 def test_fitted_profile_is_written_inside_out_and_its_manifest(world, made, monkeypatch):
-    from printgen.scaling.design_file import load_design
     from printgen.run.verify import _write, fitted_name
+    from printgen.scaling.design_file import load_design
 
     d = load_design(made / "design.json")
     out = world / "vout" / "x"
@@ -607,9 +607,9 @@ def test_make_refuses_the_design_of_another_barrier(world, capsys, proto, other)
 
 
 def test_a_design_of_its_own_barrier_is_accepted():
+    from printgen.inputs.prototype import load_prototype
     from printgen.run.api import plan
     from printgen.scaling.design_file import check_design_of
-    from printgen.inputs.prototype import load_prototype
 
     for proto in (SIMPLE, REALISTIC):
         check_design_of(plan(proto, 40), load_prototype(proto), where="design")

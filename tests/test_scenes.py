@@ -16,9 +16,9 @@ from printgen.inputs.prototype import load_prototype
 from printgen.scene import SceneOptions, build_scene
 from printgen.scene.scenes import SENSOR_FORCE_N, BarrierScene, Wire
 from printgen.scene.solvernet import WIRE_RATE, WIRE_STRAIN, build, wire_law
+from printgen.solver.assemble import internal, make_bars, make_cable
 from printgen.verification.compare import wire_elongation
 from printgen.verification.preprint import sweep
-from printgen.solver.assemble import internal, make_bars, make_cable
 
 EXACT = 1e-12  # closed-form geometry: round-off only
 SOLVED = 1e-6  # relative: solver tolerance (1e-7 of the load) plus the spring's 1e-6 slope

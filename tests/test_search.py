@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 from conftest import EXAMPLES
 
-from printgen.scaling.design_file import design_from_dict, load_design
 from printgen.errors import InputError
 from printgen.report.jsonout import dumps
 from printgen.run.options import RunOptions
 from printgen.run.search import SearchOptions, search_at_scales
+from printgen.scaling.design_file import design_from_dict, load_design
 from printgen.search.pareto import dominates, pareto_mask
 
 REALISTIC = EXAMPLES / "realistic_barrier.toml"

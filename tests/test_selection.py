@@ -9,13 +9,13 @@ import pytest
 from proto_files import REALISTIC, SIMPLE, write_variant
 
 from printgen.barrier.patterns.diamond import diamond_factor
+from printgen.errors import PrintabilityError
+from printgen.inputs.materials import load_material
+from printgen.inputs.prototype import load_prototype
 from printgen.scaling.record import Section
 from printgen.scaling.section import area_m2, net_membrane_law
 from printgen.scaling.selection import SCORE_DIGITS, select
 from printgen.scaling.similitude import scale_targets
-from printgen.errors import PrintabilityError
-from printgen.inputs.materials import load_material
-from printgen.inputs.prototype import load_prototype
 
 EXACT = 1e-12  # closed-form arithmetic, round-off only
 

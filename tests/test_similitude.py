@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from proto_files import REALISTIC, SIMPLE, write_variant
 
-from printgen.scaling.similitude import check_scale, scale_targets
 from printgen.errors import InputError
 from printgen.inputs.prototype import load_prototype
+from printgen.scaling.similitude import check_scale, scale_targets
 
 EXACT = 1e-12  # relative: exponents are applied in closed form, only round-off remains
 

@@ -13,7 +13,6 @@ import pytest
 from conftest import require_shared, require_tool
 from numpy.testing import assert_allclose
 
-from printgen.scaling.record import Section
 from printgen.errors import PrintabilityError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
@@ -25,6 +24,7 @@ from printgen.parts.slicer import (
     write_prusa_ini,
 )
 from printgen.parts.slicer.cura import cura_cfg_text, cura_settings, write_cura_cfg
+from printgen.scaling.record import Section
 
 READBACK_VS_CHECKER_TOL = 1e-3  # two parsers of the same file: only E rounding differs
 SKIRT_PATHS = 1  # the .ini asks for one skirt loop: the checker counts it, the read-back does not

@@ -17,12 +17,12 @@ from test_calibrate_files import write_export
 
 from printgen.calibrate.pipeline import calibrate
 from printgen.calibrate.specimen import read_sidecar
-from printgen.scaling.record import Section
 from printgen.errors import GeometryError
 from printgen.inputs.materials import load_material
 from printgen.report.jsonout import dumps
 from printgen.run.testpieces import RECORD
 from printgen.run.testpieces import testpieces as write_pieces
+from printgen.scaling.record import Section
 
 MODULUS_RTOL = 0.01  # the issue: a generated export of the coupon calibrates back within 1 %
 COUPON_VOLUME_TOL = 0.02  # direct coupon G-code vs its STL: as the net's (test_gcode)

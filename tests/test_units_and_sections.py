@@ -9,9 +9,9 @@ import pytest
 
 from printgen.barrier.patterns.diamond import diamond_factor
 from printgen.barrier.patterns.square import square_factor
+from printgen.inputs.laws import piecewise_linear
 from printgen.scaling.record import Section
 from printgen.scaling.section import area_m2, equal_area_diameter
-from printgen.inputs.laws import piecewise_linear
 from printgen.units import GPA, MM, m_to_mm, mm_to_m, split_unit_key
 
 EXACT = 1e-12  # closed-form arithmetic, round-off only

@@ -1,5 +1,5 @@
-"""Worker processes (printgen/executor/local.py): they die with their parent, leave signals to it, are
-killed when the parent stops, and pass progress reports back."""
+"""Worker processes (printgen/executor/local.py): they die with their parent, leave signals to it,
+are killed when the parent stops, and pass progress reports back."""
 
 from __future__ import annotations
 

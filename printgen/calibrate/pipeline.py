@@ -15,7 +15,6 @@ from pathlib import Path
 from typing import Any
 
 from printgen.calibrate.aggregate import Stats, spread_only, summarise
-from printgen.calibrate.windows import machine_warning, window_warnings
 from printgen.calibrate.fit import BREAK_DROP
 from printgen.calibrate.groups import Group, by_orientation, mixed_warning, orientation
 from printgen.calibrate.inputs import expand
@@ -38,6 +37,7 @@ from printgen.calibrate.specimen import (
     read_sidecar,
     resolve,
 )
+from printgen.calibrate.windows import machine_warning, window_warnings
 from printgen.errors import CalibrationError
 from printgen.inputs.profiles import profile_name
 

@@ -14,7 +14,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from printgen.calibrate.windows import WindowCheck, check_window
 from printgen.calibrate.compliance import Compliance
 from printgen.calibrate.fit import (
     DEFAULT_ZERO,
@@ -33,6 +32,7 @@ from printgen.calibrate.plausible import check_modulus, check_stress
 from printgen.calibrate.reader import TestRecord
 from printgen.calibrate.specimen import Specimen, machine_modulus
 from printgen.calibrate.status import set_text
+from printgen.calibrate.windows import WindowCheck, check_window
 from printgen.errors import CalibrationError
 
 DEFAULT_SECANTS = (0.005, 0.01)  # strain where secant moduli are reported (0.5 %, 1 %)

@@ -1,6 +1,6 @@
-"""`printgen bench solver|sweeps|gcode|parts|design|make|figures|timeline --out DIR`: run a benchmark of benchmarks/ (a source
-checkout) and write its JSON/PNG into DIR. An installed wheel has no benchmarks/: there the
-command is not offered (argparse lists the commands that are)."""
+"""`printgen bench solver|sweeps|gcode|parts|design|make|figures|timeline --out DIR`: run a
+benchmark of benchmarks/ (a source checkout) and write its JSON/PNG into DIR. An installed wheel has
+no benchmarks/: there the command is not offered (argparse lists the commands that are)."""
 
 from __future__ import annotations
 

@@ -22,13 +22,13 @@ from rich.measure import Measurement
 from rich.table import Table
 
 from printgen.calibrate.aggregate import MIN_SAMPLES
-from printgen.calibrate.windows import MACHINE_TOL, machine_refutes
 from printgen.calibrate.compliance import from_curve, from_stiffness
 from printgen.calibrate.fit import DEFAULT_ZERO, ISO_WINDOW, ZERO_MODES
 from printgen.calibrate.pipeline import Calibration
 from printgen.calibrate.record import calibration_record, units
 from printgen.calibrate.sample import DEFAULT_SECANTS, PRELOAD_STEPS, FitOptions, SampleFit
 from printgen.calibrate.specimen import KINDS
+from printgen.calibrate.windows import MACHINE_TOL, machine_refutes
 from printgen.commands.common import add_json_arg, console, emit_json, fmt, table
 from printgen.errors import CalibrationError
 from printgen.inputs.profiles import profile_name

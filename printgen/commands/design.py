@@ -50,7 +50,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--mesh-tolerance", type=float, metavar="F",
                    help="default bounds: each diagonal within +-F of the scaled prototype's "
                         "(default 0.25)")
-    p.add_argument("--border-beads", metavar="N1,N2,...", help="border widths in beads, even (default 2,4)")
+    p.add_argument("--border-beads", metavar="N1,N2,...",
+                   help="border widths in beads, even (default 2,4)")
     p.add_argument("--printer", help="printer profile (default: the prototype's [model] choice)")
     p.add_argument("--verify-nets", type=int, default=VERIFY_NETS, metavar="N",
                    help=f"nets verified by the solver, each with every border (default "

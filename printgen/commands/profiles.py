@@ -69,7 +69,8 @@ def _summary(kind: str, name: str) -> str:
 
 def run_show(args: argparse.Namespace) -> int:
     profile_name(args.name, "profiles show")
-    kinds = [args.kind] if args.kind else [k for k in KINDS if args.name.lower() in list_profiles(k)]
+    kinds = [args.kind] if args.kind else [k for k in KINDS
+                                           if args.name.lower() in list_profiles(k)]
     if not kinds:
         known = "; ".join(f"{k}: {', '.join(list_profiles(k))}" for k in KINDS)
         raise ProfileError(f"no profile named {args.name!r}; known: {known}")

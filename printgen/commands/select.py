@@ -13,9 +13,9 @@ from printgen.commands.common import (
     fmt,
     table,
 )
-from printgen.scaling.selection import Candidate, Selection
 from printgen.inputs.prototype import load_prototype
 from printgen.run import api
+from printgen.scaling.selection import Candidate, Selection
 
 SHOW = 8  # candidates shown per component in the table (all are in --json)
 STIFFNESS_WARN = 0.25  # |stiffness error| of the choice beyond which select warns
@@ -46,10 +46,10 @@ def run(args: argparse.Namespace) -> int:
 
 def show_bed(proto, scale: float, s: Selection) -> None:
     """Whether the chosen net fits the printer's bed (and which printers or lambda fit)."""
+    from printgen.errors import DesignError
     from printgen.scaling.bedfit import bed_fit
     from printgen.scaling.plan import make_design
     from printgen.scaling.similitude import scale_targets
-    from printgen.errors import DesignError
 
     try:
         fit = bed_fit(make_design(proto, scale_targets(proto, scale), s))

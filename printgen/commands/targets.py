@@ -12,8 +12,8 @@ from printgen.commands.common import (
     fmt,
     table,
 )
-from printgen.scaling.similitude import ScaledTargets
 from printgen.run import api
+from printgen.scaling.similitude import ScaledTargets
 
 
 def register(sub: argparse._SubParsersAction) -> None:

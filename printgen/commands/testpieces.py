@@ -44,7 +44,7 @@ def run(args: argparse.Namespace) -> int:
              f"{cg['count']})"), f"{rec['coupon']['readback_vs_stl']:+.1%}"],
             ["panel", (f"{pg['printed_mm'][0]:.4g} x {pg['printed_mm'][1]:.4g} mm, clamps "
              f"{pg['width_mm']:.4g} mm wide, {pg['length_mm']:.4g} mm apart, "
-             f"{pg['clamp_depth_mm']:.4g} mm held each end"), 
+             f"{pg['clamp_depth_mm']:.4g} mm held each end"),
              f"{rec['panel']['readback_vs_stl']:+.1%}"]]
     c.print(table(f"test pieces in {out}", ["piece", "geometry", "G-code vs STL"], rows))
     for line in rec["loop"]:

@@ -40,8 +40,8 @@ def _raise(signum: int, _frame: Any) -> None:
 
 @contextlib.contextmanager
 def signals_raise() -> Iterator[None]:
-    """Within the block SIGINT, SIGTERM and SIGHUP (`handled_signals`) raise `Interrupted` (main thread only);
-    the previous handlers come back afterwards."""
+    """Within the block SIGINT, SIGTERM and SIGHUP (`handled_signals`) raise `Interrupted` (main
+    thread only); the previous handlers come back afterwards."""
     if multiprocessing.parent_process() is not None or not _main_thread():
         yield
         return

@@ -7,13 +7,13 @@ every instant the output path holds one complete run or the previous one, never 
 run is killed between the fallback's two renames, the next run to start puts the old folder
 back before anything else, and no run removes an old folder before its own is in place.
 
-What may be replaced: an absent or empty folder, or a printgen output (its manifest reads,
-and the folder holds exactly the files it lists, each as the run wrote it:
-`manifest.foreign_entry`, `manifest.edited_files`); anything else needs `force`. Never
-replaced: a symbolic link, a mount point, a folder holding one of the run's inputs. An exclusive lock beside the output (`lock.folder_lock`) keeps a second run out of the
-same folder; stale stages of the same output (a run killed with SIGKILL) are removed when the
-next run starts. Stage, aside and lock names are matched literally (an output named `*` is the
-folder `*`, not a pattern).
+What may be replaced: an absent or empty folder, or a printgen output (its manifest reads, and the
+folder holds exactly the files it lists, each as the run wrote it: `manifest.foreign_entry`,
+`manifest.edited_files`); anything else needs `force`. Never replaced: a symbolic link, a mount
+point, a folder holding one of the run's inputs. An exclusive lock beside the output
+(`lock.folder_lock`) keeps a second run out of the same folder; stale stages of the same output (a
+run killed with SIGKILL) are removed when the next run starts. Stage, aside and lock names are
+matched literally (an output named `*` is the folder `*`, not a pattern).
 """
 
 from __future__ import annotations

@@ -1,9 +1,9 @@
 """The lock beside an output folder (`.NAME.lock`, holding the pid): one run per folder.
 
-The lock file is opened without following symbolic links (O_NOFOLLOW) and must be a regular
-file with no other name: a symbolic or hard link, a folder or a FIFO planted at its name is
-refused, never written through (a hard link is a regular file to `fstat`; its link count tells). Two ways to hold
-it, chosen by what the platform has:
+The lock file is opened without following symbolic links (O_NOFOLLOW) and must be a regular file
+with no other name: a symbolic or hard link, a folder or a FIFO planted at its name is refused,
+never written through (a hard link is a regular file to `fstat`; its link count tells). Two ways to
+hold it, chosen by what the platform has:
 
 - `flock`: where `fcntl` exists (Linux, macOS, BSD), an advisory lock on the open file; the
   kernel drops it when the process dies, so a SIGKILL leaves nothing to clean up.

@@ -14,10 +14,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from printgen.scaling.record import Design
 from printgen.errors import GeometryError
 from printgen.inputs.printers import Printer
 from printgen.parts.geometry.attach import Attachment, attachment_for, corner_nodes, holes
+from printgen.scaling.record import Design
 
 CLOSE_TOL_MM = 0.1  # the kit closes: attachment points and anchor spacing agree to 0.1 mm
 SIDE_ANCHORS = {"bottom": (0, 1), "right": (1, 2), "top": (3, 2), "left": (0, 3)}

@@ -6,9 +6,9 @@ figures/, the kit's pictures, the lab's CSV files). report.json is the records' 
 
 from __future__ import annotations
 
+from printgen.report.flume_drawing import layout_section
 from printgen.report.html import Report
 from printgen.report.labfiles import lab_files
-from printgen.report.flume_drawing import layout_section
 from printgen.report.parts_report import (
     assembly_section,
     gcode_section,

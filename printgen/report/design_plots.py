@@ -21,7 +21,8 @@ def pareto_figure(res: SearchResult) -> bytes:
                         None if res.select_score is None else res.select_score.mismatch)
     else:
         idx = [s.point.index for s in sc if s.feasible]
-        label, sel_y = "membrane-law error, RMS log over 1-40 % strain (-)", res.select_screened.error_rms_log
+        label = "membrane-law error, RMS log over 1-40 % strain (-)"
+        sel_y = res.select_screened.error_rms_log
     idx = idx[::max(1, len(idx) // MAX_CLOUD)]
     y = np.array([res.objective_value(i) for i in idx])
     cols = [("|dPi2| = |mesh / h_B deviation| (-)", lambda s: abs(s.d_pi2)),

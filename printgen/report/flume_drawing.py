@@ -156,6 +156,6 @@ def _dimensions(ax, w: float, h: float, pot_x: float, sensors: list[dict[str, An
     _dimension(ax, (-0.06 * w, 0), (-0.06 * w, h), f"{h:.1f} mm", (-16, 0))
     for k, s in enumerate(sorted(sensors, key=lambda s: s["anchor_mm"][1])):
         z = s["anchor_mm"][1]
-        if 0 < z:
+        if z > 0:
             x = pot_x + (0.03 + 0.03 * k) * w
             _dimension(ax, (x, 0), (x, z), f"{z:.1f}", (12, 0))

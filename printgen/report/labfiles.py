@@ -1,12 +1,12 @@
-"""Files a lab takes to the flume, beside the report: the curves (curves.csv), the expected
-readings in flume units (expected-readings.csv) and a blank measurement sheet in the columns
-`printgen verify --measured` reads, with the model's expected readings beside them
-(measurement-sheet.csv), where the sensors and anchors go (sensor-layout.csv,
-printgen.report.flume_drawing), and with `make --loads A,B` each load case's expected readings
-(expected-readings-<case>.csv: the nominal model at the case's own levels, with what the case
-used at each level, e.g. the jam's discharge in L/s). Column names carry their unit (`_pct`, `_mm`, `_n`, `_kn`; no
-suffix: normalised, dimensionless). The numbers are the record's (`lab_record`, in
-report.json under "lab"), so the files and the JSON say the same.
+"""Files a lab takes to the flume, beside the report: the curves (curves.csv), the expected readings
+in flume units (expected-readings.csv) and a blank measurement sheet in the columns `printgen verify
+--measured` reads, with the model's expected readings beside them (measurement-sheet.csv), where the
+sensors and anchors go (sensor-layout.csv, printgen.report.flume_drawing), and with `make --loads
+A,B` each load case's expected readings (expected-readings-<case>.csv: the nominal model at the
+case's own levels, with what the case used at each level, e.g. the jam's discharge in L/s). Column
+names carry their unit (`_pct`, `_mm`, `_n`, `_kn`; no suffix: normalised, dimensionless). The
+numbers are the record's (`lab_record`, in report.json under "lab"), so the files and the JSON say
+the same.
 """
 
 from __future__ import annotations

@@ -6,8 +6,8 @@ import io
 
 import numpy as np
 
-from printgen.scaling.similitude import FORCE_EXPONENT, to_prototype
 from printgen.errors import PrintgenError
+from printgen.scaling.similitude import FORCE_EXPONENT, to_prototype
 from printgen.scene.scenes import BarrierScene
 from printgen.verification.bands import Band
 from printgen.verification.compare import METRICS, Deformation

@@ -13,13 +13,13 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:  # pragma: no cover
     import numpy as np
 
-    from printgen.scaling.record import Design
-    from printgen.scaling.selection import Candidate, Selection
-    from printgen.scaling.similitude import ScaledTargets
     from printgen.inputs.prototype import Prototype
     from printgen.parts.assembly import Assembly
     from printgen.parts.gcode.estimate import PrintEstimate
     from printgen.report.html import Drawing
+    from printgen.scaling.record import Design
+    from printgen.scaling.selection import Candidate, Selection
+    from printgen.scaling.similitude import ScaledTargets
     from printgen.verification.bands import Band
     from printgen.verification.measured import Fit, Measurement
     from printgen.verification.preprint import Verification

@@ -7,11 +7,11 @@ from __future__ import annotations
 import numpy as np
 
 from printgen.barrier.patterns import mesh_text
+from printgen.inputs.prototype import Prototype
+from printgen.report.html import Drawing, Report
 from printgen.scaling.record import Design
 from printgen.scaling.selection import Candidate, Selection
 from printgen.scaling.similitude import FORCE_EXPONENT, ScaledTargets, to_prototype
-from printgen.inputs.prototype import Prototype
-from printgen.report.html import Drawing, Report
 from printgen.verification.bands import Band
 from printgen.verification.preprint import SHAPE_LEVELS, CounterExample, Verification
 
@@ -110,7 +110,8 @@ def _sweep_sections(rep: Report, v: Verification, scale: float, band: Band | Non
     from printgen.verification.compare import METRICS, TOLERANCE
 
     rep.paragraph(
-        f"Both barriers are solved as tension-only cable nets (printgen.solver) under the same relative "
+        f"Both barriers are solved as tension-only cable nets (printgen.solver) under the same "
+        "relative "
         f"loading, {v.load_case}, h / h_B = 0 to 1.1 in steps of 0.05 (the reference's loading "
         "test: water raised behind a folded film), mounted alike and read by the same three "
         "sensor wires (bottom cable, top cable, mid-height); the model's wires pull 1 N along "

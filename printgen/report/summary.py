@@ -14,9 +14,9 @@ from printgen.verification.bands import band_verdicts
 from printgen.verification.compare import METRICS
 
 if TYPE_CHECKING:  # pragma: no cover
+    from printgen.report.records import GcodeRecord, PlanRecords, RunRecords
     from printgen.scaling.record import Design, Section
     from printgen.scaling.selection import Candidate
-    from printgen.report.records import GcodeRecord, PlanRecords, RunRecords
 
 NEXT_PASS = ("Print the parts (the .gcode files, or slice the .3mf files), assemble them as the "
              "Assembly section below shows, and run the flume test with measurement-sheet.csv; "

@@ -17,13 +17,13 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from printgen.inputs.prototype import Prototype, load_prototype
+from printgen.run.options import RunOptions
 from printgen.scaling.plan import make_design
 from printgen.scaling.record import Design
 from printgen.scaling.selection import Selection
 from printgen.scaling.selection import select as _select
 from printgen.scaling.similitude import ScaledTargets, scale_targets
-from printgen.inputs.prototype import Prototype, load_prototype
-from printgen.run.options import RunOptions
 
 if TYPE_CHECKING:
     from printgen.calibrate.pipeline import Calibration
@@ -34,8 +34,8 @@ if TYPE_CHECKING:
     from printgen.run.search import DesignRun, SearchOptions
     from printgen.run.series import SeriesRun
     from printgen.run.verify import VerifyRun
-    from printgen.verification.series import NetOptions
     from printgen.verification.preprint import Verification
+    from printgen.verification.series import NetOptions
 
 PrototypeLike = str | Path | Prototype
 

@@ -30,11 +30,11 @@ from dataclasses import dataclass
 from typing import Any
 
 from printgen.barrier.patterns import get_pattern
-from printgen.scaling.record import Design
 from printgen.errors import InputError
 from printgen.executor.local import reporting
 from printgen.executor.start import cores
 from printgen.inputs.prototype import Prototype
+from printgen.scaling.record import Design
 
 # About a minute of `make` on 2 cores: the bundled simple barrier (free top) and the 1:40
 # example both fit (benchmarks/measurements.md#make-no-default-stop).
@@ -189,8 +189,8 @@ MAKE = Work()
 def band_variants(p: Prototype, d: Design) -> int:
     """The model variants the uncertainty band sweeps (as `verify` mounts the model)."""
     from printgen.scene.scenes import lateral_mounting
-    from printgen.verification.variants import model_variants
     from printgen.verification.preprint import free_section
+    from printgen.verification.variants import model_variants
 
     return len(model_variants(d, lateral_mounting(p), free_section(p))[0])
 

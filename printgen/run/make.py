@@ -24,11 +24,6 @@ from pathlib import Path
 from typing import Any
 
 from printgen.barrier.loads import distinct_specs, get_load
-from printgen.scaling.design_file import load_design
-from printgen.scaling.plan import make_design
-from printgen.scaling.record import Design
-from printgen.scaling.selection import Selection, design_net, select
-from printgen.scaling.similitude import ScaledTargets, scale_targets
 from printgen.errors import TimeLimitError
 from printgen.executor.local import Helper, check_deadline, deadline, helper
 from printgen.executor.signals import signals_deferred
@@ -66,6 +61,11 @@ from printgen.run.steps import (
     verification_sweeps,
     verify_step,
 )
+from printgen.scaling.design_file import load_design
+from printgen.scaling.plan import make_design
+from printgen.scaling.record import Design
+from printgen.scaling.selection import Selection, design_net, select
+from printgen.scaling.similitude import ScaledTargets, scale_targets
 from printgen.trace import span
 
 log = logging.getLogger(__name__)

@@ -23,13 +23,13 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from printgen.scaling.similitude import scale_targets
 from printgen.executor import open_runner
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import check_destination, write_folder
 from printgen.report.jsonout import dumps
 from printgen.run.options import RunOptions
+from printgen.scaling.similitude import scale_targets
 from printgen.search.nets import (
     SearchResult,
     VerifyScore,

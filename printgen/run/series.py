@@ -124,8 +124,8 @@ def scaling_assumptions(shared: SeriesShared) -> list[tuple[str, str, str]]:
     p = shared.prototype
     mats = [r for r in shared.rows if r.kind == "material"]
     out = [("scaling", ("every length / lambda (nodes, mesh, strand and cable diameters), so "
-            "sections / lambda^2; loads by Froude: A* / lambda^2, velocity / sqrt(lambda); the hold "
-            "of unloaded nodes / lambda^2 (a share of rho g A*)"), paper),
+            "sections / lambda^2; loads by Froude: A* / lambda^2, velocity / sqrt(lambda); the "
+            "hold of unloaded nodes / lambda^2 (a share of rho g A*)"), paper),
            ("row: prototype material unscaled", ("the prototype's laws with E A / lambda^2 "
             "(same E, the Froude-only practice)"), paper),
            ("row: E / lambda", ("every law's force slope / lambda^3 (similitude: E A like every "
@@ -147,7 +147,8 @@ def scaling_assumptions(shared: SeriesShared) -> list[tuple[str, str, str]]:
     out.append(("solver net", (f"water pressure {o.pressure} ('flow': along the flow, 'normal': "
                 f"normal to the deformed net), initial slack {o.slack:.1%} of every strand and "
                 f"cable, panel law read along its {o.orientation} diagonal (if any), mounting "
-                f"{o.mounting or 'of the file'}"), "--solver-net (defaults: the prototype's scene)"))
+                f"{o.mounting or 'of the file'}"),
+                "--solver-net (defaults: the prototype's scene)"))
     out.append(("prototype reference", ("the prototype row at lambda = 1 (its own material); "
                 "ratio = value / reference"), "printgen"))
     return out

@@ -31,7 +31,6 @@ WAIT_SWEEPS = "waiting for the verification sweeps"  # in this process, within a
 FIGURES = "figures (PNG and SVG, side by side)"  # within the report files, after the steps
 
 if TYPE_CHECKING:  # pragma: no cover
-    from printgen.scaling.record import Design
     from printgen.inputs.printers import Printer
     from printgen.inputs.prototype import Prototype
     from printgen.parts.gcode.toolpath import Toolpath
@@ -39,6 +38,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from printgen.report.records import CheckRecords, MeshRecord, PlateRecord
     from printgen.run.make import MakeContext
     from printgen.run.options import RunOptions
+    from printgen.scaling.record import Design
     from printgen.verification.bands import Band
     from printgen.verification.preprint import Verification
 

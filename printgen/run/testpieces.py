@@ -17,6 +17,12 @@ import io
 from pathlib import Path
 from typing import Any
 
+from printgen.inputs.materials import load_material
+from printgen.inputs.printers import load_print_style, load_printer
+from printgen.inputs.profiles import search_dirs
+from printgen.outputs import staged_dir
+from printgen.report.jsonout import dumps
+from printgen.run.steps import _write_part
 from printgen.scaling.design_file import load_design
 from printgen.scaling.record import Design
 from printgen.scaling.testpieces import (
@@ -27,12 +33,6 @@ from printgen.scaling.testpieces import (
     coupon_gauge_mm,
     panel_for,
 )
-from printgen.inputs.materials import load_material
-from printgen.inputs.printers import load_print_style, load_printer
-from printgen.inputs.profiles import search_dirs
-from printgen.outputs import staged_dir
-from printgen.report.jsonout import dumps
-from printgen.run.steps import _write_part
 from printgen.units import MM
 
 RECORD = "testpieces.json"

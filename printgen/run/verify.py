@@ -14,8 +14,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from printgen.scaling.design_file import load_design
-from printgen.scaling.record import Design
 from printgen.executor.start import preload
 from printgen.inputs.materials import load_material
 from printgen.inputs.profiles import profile_name, search_dirs
@@ -25,9 +23,10 @@ from printgen.report.build import build_report, report_files
 from printgen.report.jsonout import dumps
 from printgen.report.records import CheckRecords, MeasuredRecords, RunRecords
 from printgen.run.budget import DEFAULT_LIMIT_S, Work, check_budget, sweep_cores
-from printgen.scene.flume import flume_layout
-from printgen.scene.readings import design_units
 from printgen.run.options import RunOptions
+from printgen.scaling.design_file import load_design
+from printgen.scaling.record import Design
+from printgen.scene.readings import design_units
 from printgen.verification.bands import Band, band_verdicts, model_load_kw
 from printgen.verification.fit import MultiFit, fit_levels, fit_measured
 from printgen.verification.measured import (

@@ -9,9 +9,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from printgen.scaling.record import Design
 from printgen.inputs.printers import Printer, load_printer
 from printgen.inputs.profiles import list_profiles
+from printgen.scaling.record import Design
 
 EYELET_MARGIN_MM = 4.0  # the net's corner eyelets reach about this far beyond the frame
 

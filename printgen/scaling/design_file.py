@@ -13,12 +13,12 @@ from pathlib import Path
 from typing import Any
 
 from printgen.barrier.patterns import get_pattern
-from printgen.scaling.record import CABLE_SIDES, CableDesign, Design, NetDesign, Section
 from printgen.errors import InputError
 from printgen.inputs.profiles import profile_name
 from printgen.inputs.prototype import MIN_MODEL_MESH_MM, Prototype
 from printgen.inputs.schema import Field, check_value, parse_data, positive, shown
 from printgen.outputs.files import read_input_text
+from printgen.scaling.record import CABLE_SIDES, CableDesign, Design, NetDesign, Section
 
 DESIGN_LIMIT_BYTES = 16 << 20  # a design.json is ~2 kB, a report.json holding one < 1 MB
 

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 from printgen.barrier.patterns import get_pattern
+from printgen.errors import DesignError
+from printgen.inputs.prototype import Prototype
 from printgen.scaling.record import CableDesign, Design, NetDesign, Section
 from printgen.scaling.selection import Selection, model_mesh, printed_pattern
 from printgen.scaling.similitude import ScaledTargets
-from printgen.errors import DesignError
-from printgen.inputs.prototype import Prototype
 
 EYELET_INNER_MM = 3.2  # clearance for the M3 screws that hold the cables on the flume anchors
 EYELET_RING_BEADS = 4  # the eyelet ring is 4 cable beads wide (1.8 mm at 0.45 mm beads)

@@ -13,8 +13,8 @@ import math
 
 from printgen.barrier.patterns import get_pattern
 from printgen.barrier.patterns.diamond import diamond_factor
-from printgen.scaling.record import Section
 from printgen.inputs.materials import Material
+from printgen.scaling.record import Section
 from printgen.units import MM
 
 

@@ -17,14 +17,14 @@ import numpy as np
 
 from printgen.barrier.loads import OVERFLOW  # peak relative loading of the loading test
 from printgen.barrier.patterns import AS_DRAWN, get_pattern, mesh_text
-from printgen.scaling.record import NetDesign, Section
-from printgen.scaling.section import area_m2, equal_area_diameter, net_membrane_law
-from printgen.scaling.similitude import ScaledTargets
 from printgen.errors import InputError, PrintabilityError
 from printgen.inputs.laws import piecewise_linear
 from printgen.inputs.materials import Material, load_material, material_names
 from printgen.inputs.printers import Printer, PrintStyle, check_pass, load_print_style, load_printer
 from printgen.inputs.prototype import Prototype
+from printgen.scaling.record import NetDesign, Section
+from printgen.scaling.section import area_m2, equal_area_diameter, net_membrane_law
+from printgen.scaling.similitude import ScaledTargets
 from printgen.units import MM, G
 
 DEFAULT_PRINTER = "generic-350"

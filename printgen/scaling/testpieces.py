@@ -22,8 +22,8 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from printgen.barrier.patterns import get_pattern, panel_test_patterns
-from printgen.scaling.record import CableDesign, Design, NetDesign
 from printgen.errors import GeometryError
+from printgen.scaling.record import CableDesign, Design, NetDesign
 
 COUPON_GAUGE_MM = 50.0  # free strip between the eyelet rings (ISO 527-2 1A: 50 mm gauge)
 COUPON_RING_FACTOR = 2  # ring width each side of the hole, in strand widths

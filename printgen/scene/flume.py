@@ -56,7 +56,8 @@ class FlumeLayout:
         def r(v):
             return np.round(np.asarray(v, dtype=float), DIGITS).tolist()
 
-        return {"width_mm": round(self.width_mm, DIGITS), "height_mm": round(self.height_mm, DIGITS),
+        return {"width_mm": round(self.width_mm, DIGITS),
+                "height_mm": round(self.height_mm, DIGITS),
                 "mounting": self.mounting, "anchor_pins_mm": r(self.pins_mm),
                 "held_edges": {k: {"by": SIDE_NAMES[k], "nodes": len(v),
                                    "from_mm": r(v[0]), "to_mm": r(v[-1])}

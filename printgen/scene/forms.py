@@ -29,9 +29,9 @@ from functools import lru_cache
 import numpy as np
 
 from printgen.barrier.patterns import get_pattern
+from printgen.inputs.materials import load_material
 from printgen.scaling.record import Design
 from printgen.scaling.section import area_m2
-from printgen.inputs.materials import load_material
 from printgen.scene.panel import PanelTest, derive_law, law_strains, simulate
 from printgen.scene.scenes import (
     TESTED_PATTERN,
@@ -40,8 +40,8 @@ from printgen.scene.scenes import (
     panel_axes,
     recorded_orientation,
 )
-from printgen.units import MM
 from printgen.solver import Law
+from printgen.units import MM
 
 NET_LAWS = ("formula", "derived")
 BEDS = ("free", "held")

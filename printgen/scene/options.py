@@ -12,9 +12,9 @@ import dataclasses
 from dataclasses import dataclass
 
 from printgen.barrier.loads import LoadCase
-from printgen.scaling.record import Design
 from printgen.errors import GeometryError
 from printgen.inputs.prototype import Prototype
+from printgen.scaling.record import Design
 from printgen.scene.forms import BEDS, NET_LAWS, ROUTINGS, held_on_bed, routed, with_derived_law
 from printgen.scene.mount import in_free_section
 from printgen.scene.scenes import (

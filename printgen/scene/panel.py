@@ -3,12 +3,12 @@ its source ran it (barrier-physics.md, sections 4 and 5; Lambert et al. 2023,
 doi:10.1061/JHEND8.HYENG-13070), and the strand law derived so that the simulated test
 reproduces a measured panel law.
 
-Panel: a net of the test's pattern (`barrier.patterns`; the diamond by default) of the net's
-strands only (no border frame; the square's edge columns are strands of its net,
-`edge_strands`, so a square panel of nx meshes holds nx + 1 strands along the load over the
-width nx a it is read on), x across the load, z along it, y out of plane (held: the panel lies flat). The clamp
-rows are the panel's bottom and top node rows; the top clamp moves by eps L along z. Two
-boundary conditions, as the sources describe them:
+Panel: a net of the test's pattern (`barrier.patterns`; the diamond by default) of the net's strands
+only (no border frame; the square's edge columns are strands of its net, `edge_strands`, so a square
+panel of nx meshes holds nx + 1 strands along the load over the width nx a it is read on), x across
+the load, z along it, y out of plane (held: the panel lies flat). The clamp rows are the panel's
+bottom and top node rows; the top clamp moves by eps L along z. Two boundary conditions, as the
+sources describe them:
 - "blocked": every node's transverse (x) displacement blocked (the prototype's 1.33 m panel);
 - "free": the nodes between the clamps free in the plane (the printed 43 mm panels).
 The reading is the clamp force per clamp width, n = F / w (N/m), against the elongation
@@ -36,13 +36,13 @@ import numpy as np
 
 from printgen import solver
 from printgen.barrier.patterns import get_pattern
-from printgen.scaling.record import Design
 from printgen.errors import SolverError
 from printgen.inputs.laws import piecewise_linear
 from printgen.inputs.materials import load_material
+from printgen.scaling.record import Design
 from printgen.scene.scenes import TESTED_PATTERN, model_net_law, panel_axes
-from printgen.units import MM
 from printgen.solver import Law
+from printgen.units import MM
 
 MODES = ("blocked", "free")
 PANEL_TOL = 1e-9  # out-of-balance force / strand force scale: exact for a 1 % comparison
@@ -70,8 +70,8 @@ class PanelTest:
     def describe(self) -> str:
         side = ("transverse displacement blocked" if self.mode == "blocked"
                 else "free between the clamps")
-        return (f"{self.length / MM:g} mm long x {self.width / MM:g} mm clamps, {self.pattern} mesh "
-                f"{self.mesh_along / MM:g} mm along the load x {self.mesh_across / MM:g} mm "
+        return (f"{self.length / MM:g} mm long x {self.width / MM:g} mm clamps, {self.pattern} "
+                f"mesh {self.mesh_along / MM:g} mm along the load x {self.mesh_across / MM:g} mm "
                 f"across, {side}")
 
 
@@ -264,7 +264,7 @@ def derive_law(knees: tuple[float, ...], slopes: tuple[float, ...], t: PanelTest
                         for k in (0.0, *fine))  # the measured slope of each fine segment
     law = get_pattern(t.pattern).strand_law(fine, fine_slopes, t.mesh_along, t.mesh_across)
     passes = 0
-    for passes in range(1, DERIVE_STEPS + 1):
+    for passes in range(1, DERIVE_STEPS + 1):  # noqa: B007 (the count is returned)
         shares, strand_eps = _segment_shares(law, t, eps)
         new, _ = nnls(shares, target * lattice_size(t)[1])
         new = np.maximum(new, 1e-9 * float(np.max(new)))

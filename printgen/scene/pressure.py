@@ -3,12 +3,12 @@ the net and the water presses it normal to its surface, so each node's load is t
 at its height times its share of the net's current area vector, instead of a force along the
 flow (`solver.Hydrostatic`, the reference's section 3).
 
-Faces: the meshes of the net's lattice (the diamond's or the square's: four strand corners;
-three at the edges, where the lattice cuts a mesh), found from the nodes' lattice positions. A node's area vector is a
-quarter (a third for an edge triangle) of each face it is a corner of, oriented downstream at
-rest and scaled so that at rest its magnitude is the scene's A* (the same tributary area as the
-load along the flow): the two variants then differ only by the direction of the force and by
-the growth of the net's area as it stretches.
+Faces: the meshes of the net's lattice (the diamond's or the square's: four strand corners; three at
+the edges, where the lattice cuts a mesh), found from the nodes' lattice positions. A node's area
+vector is a quarter (a third for an edge triangle) of each face it is a corner of, oriented
+downstream at rest and scaled so that at rest its magnitude is the scene's A* (the same tributary
+area as the load along the flow): the two variants then differ only by the direction of the force
+and by the growth of the net's area as it stretches.
 
 `loads_function` gives a scene's loads at each relative loading: its load case's, with the
 hydrostatic part normal to the net when the scene's pressure option says so.

@@ -14,9 +14,9 @@ from printgen.solver import Law
 def at_scale(base: BarrierScene, lam: float, name: str, *, sensors: bool = False,
              factor: float | None = None, net_law: Law | None = None,
              cable_law: Law | None = None) -> BarrierScene:
-    """`base` at 1:`lam`, named `name`: every law times `factor`, or (`net_law` given) the
-    net's strands of `net_law`, its other strand laws (the border frame) times lam^-2 and its
-    cables of `cable_law` (None: their own); the sensor wires pull SENSOR_FORCE_N when `sensors`, else only
+    """`base` at 1:`lam`, named `name`: every law times `factor`, or (`net_law` given) the net's
+    strands of `net_law`, its other strand laws (the border frame) times lam^-2 and its cables of
+    `cable_law` (None: their own); the sensor wires pull SENSOR_FORCE_N when `sensors`, else only
     read."""
     if net_law is not None:
         laws = [net_law] + [law.scaled(lam**-2) for law in base.laws[1:]]

@@ -2,15 +2,14 @@
 printed model as tension-only strand nets, mounted as in the flume and measured by the
 three extension sensors of the loading test (Lambert et al. 2023, doi:10.1061/JHEND8.HYENG-13070).
 
-Plane of the net: x across the barrier, z up (from the flume bed), y the flow direction.
-Net strands are the pattern's graph's strand segments (`printgen.barrier.patterns`: the
-diamond's diagonals, the square's strands up and across, whose edge rows are strands of the
-prototype and the printed border frame of the model); their force-strain law is the panel law turned into a strand law by the
-pattern (`NetPattern.strand_law`). With border cables, the cables
-slide through the net's edge nodes between the four corner anchors; the lateral edges are
-held by the flume's side sheets along their whole height (`walls`, the default) or only the
-lateral cables' eyelets are anchored (`eyelets`). Without border cables the net is anchored
-on the bed and the banks and its top is free.
+Plane of the net: x across the barrier, z up (from the flume bed), y the flow direction. Net strands
+are the pattern's graph's strand segments (`printgen.barrier.patterns`: the diamond's diagonals, the
+square's strands up and across, whose edge rows are strands of the prototype and the printed border
+frame of the model); their force-strain law is the panel law turned into a strand law by the pattern
+(`NetPattern.strand_law`). With border cables, the cables slide through the net's edge nodes between
+the four corner anchors; the lateral edges are held by the flume's side sheets along their whole
+height (`walls`, the default) or only the lateral cables' eyelets are anchored (`eyelets`). Without
+border cables the net is anchored on the bed and the banks and its top is free.
 
 Sensor wires (`Wire`; as solver cables in `printgen.scene.solvernet`): a string
 potentiometer's wire is anchored at the barrier's left edge node of its row, runs along the
@@ -33,13 +32,13 @@ import numpy as np
 from printgen.barrier.graph import NetGraph
 from printgen.barrier.loads import FLOW, LoadCase, get_load
 from printgen.barrier.patterns import AS_DRAWN, get_pattern, mesh_text
-from printgen.scaling.record import Design
-from printgen.scaling.section import area_m2, net_membrane_law
 from printgen.errors import GeometryError
 from printgen.inputs.materials import PanelLaw, load_material
 from printgen.inputs.prototype import LATERAL, Prototype
-from printgen.units import MM, RHO_WATER, G
+from printgen.scaling.record import Design
+from printgen.scaling.section import area_m2, net_membrane_law
 from printgen.solver import Law, linear
+from printgen.units import MM, RHO_WATER, G
 
 SENSOR_FORCE_N = 1.0  # wire tension of each string potentiometer (reference, section 4)
 SENSOR_EXIT = 0.1  # the potentiometer stands this fraction of the width beyond the right edge
@@ -343,5 +342,6 @@ def _common_assumptions(s: BarrierScene, sensors: bool, load: LoadCase) -> list[
         out.append(("unloaded strands", (f"stay where they are: each free node held at rest by "
                     f"{s.hold:.3g} N/m ({HOLD_FRACTION:g} x rho g A*), a regularisation of the "
                     "dry, slack net above the water (a mechanism otherwise)"),
-                    "printgen (README: barriers without border cables); its force share is reported"))
+                    "printgen (README: barriers without border cables); its force share is "
+                    "reported"))
     return out

@@ -9,10 +9,11 @@ Two stages over the space of `search_space` (material x strand section x diamond
    the best net of each of the `verify_nets` best material x section pairs, each with every
    border width, and `select`'s pick for comparison.
 
-Both stages run on a `printgen.executor.Runner` (this machine's workers, a Dask scheduler, or serial): each task is a pure function of a small
-frozen record, so the result does not depend on where it ran. The solver stage is passed in
-(`verifier`) because the verification stage sits above the search stage (`printgen.run.search` wires
-it); with the `stiffness` objective the search stops after stage 1.
+Both stages run on a `printgen.executor.Runner` (this machine's workers, a Dask scheduler, or
+serial): each task is a pure function of a small frozen record, so the result does not depend on
+where it ran. The solver stage is passed in (`verifier`) because the verification stage sits above
+the search stage (`printgen.run.search` wires it); with the `stiffness` objective the search stops
+after stage 1.
 """
 
 from __future__ import annotations
@@ -23,14 +24,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from printgen.scaling.plan import make_design
-from printgen.scaling.record import Design, NetDesign
-from printgen.scaling.selection import select
-from printgen.scaling.similitude import scale_targets
 from printgen.errors import InputError
 from printgen.executor import Runner, batches
 from printgen.inputs.materials import load_material
 from printgen.inputs.prototype import Prototype
+from printgen.scaling.plan import make_design
+from printgen.scaling.record import Design, NetDesign
+from printgen.scaling.selection import select
+from printgen.scaling.similitude import scale_targets
 from printgen.search.choice import binding_constraints, choice_reasons, rank_key
 from printgen.search.pareto import pareto_mask
 from printgen.search.per_material import target_sentence
@@ -155,7 +156,7 @@ def pareto_indices(res_objective: str, screened: list[Screened],
     vals = np.column_stack([first, [abs(screened[i].d_pi2) for i in idx],
                             [abs(screened[i].d_pi3) for i in idx],
                             [screened[i].print_time_s for i in idx]])
-    return tuple(int(i) for i, k in zip(idx, pareto_mask(vals)) if k)
+    return tuple(int(i) for i, k in zip(idx, pareto_mask(vals), strict=True) if k)
 
 
 def _choose(objective: str, screened: list[Screened], verified: dict[int, VerifyScore]
@@ -208,7 +209,8 @@ def search(p: Prototype, scale: float, runner: Runner, *, objective: str = "defo
     chosen = _choose(objective, screened, verified)
     closest, binding = binding_constraints(screened, space)
     res = SearchResult(p.name, t.scale, objective, space, tuple(screened), verified, base,
-                       screen_batch(ctx, [design_point(ctx, base)])[0], select_score, pareto_indices(objective, screened, verified), chosen,
+                       screen_batch(ctx, [design_point(ctx, base)])[0], select_score,
+                       pareto_indices(objective, screened, verified), chosen,
                        None if chosen is None else candidate_design(ctx, screened[chosen].point,
                                                                      base),
                        (), binding, closest)

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from printgen.inputs.laws import piecewise_linear
 from printgen.scaling.record import Section
 from printgen.scaling.section import area_m2, equal_area_diameter, net_membrane_law
 from printgen.scaling.selection import (
@@ -28,7 +29,6 @@ from printgen.scaling.selection import (
     print_limits,
     target_net_law,
 )
-from printgen.inputs.laws import piecewise_linear
 from printgen.search.space import NetPoint, SearchContext
 from printgen.units import MM
 
@@ -171,8 +171,9 @@ def screen_point(ctx: SearchContext, point: NetPoint,
                                       f"{MIN_OPENING_MM:g} mm; use a larger mesh or a thinner "
                                       "strand")))
     dx, dy = ax / t["mesh_x"] - 1, ay / t["mesh_y"] - 1
-    return Screened(point, source, datasheet, slopes[0], t_slope, slopes[0] / t_slope - 1, rms, rms + DATASHEET_PENALTY * datasheet,
-                    force, sf, speed, opening, dx if abs(dx) >= abs(dy) else dy,
+    return Screened(point, source, datasheet, slopes[0], t_slope, slopes[0] / t_slope - 1, rms,
+                    rms + DATASHEET_PENALTY * datasheet, force, sf, speed, opening,
+                    dx if abs(dx) >= abs(dy) else dy,
                     equal_area_diameter(sec) / t["strand_d"] - 1,
                     print_time_s(ctx, point, sec, speed), tuple(violations))
 

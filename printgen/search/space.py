@@ -15,6 +15,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from printgen.errors import InputError
+from printgen.inputs.materials import Material, load_material, material_names
+from printgen.inputs.printers import Printer, PrintStyle, load_print_style, load_printer
+from printgen.inputs.prototype import Prototype
 from printgen.scaling.selection import (
     DEFAULT_NET_PRINT,
     DEFAULT_PRINTER,
@@ -22,10 +26,6 @@ from printgen.scaling.selection import (
     MAX_LAYERS,
 )
 from printgen.scaling.similitude import ScaledTargets
-from printgen.errors import InputError
-from printgen.inputs.materials import Material, load_material, material_names
-from printgen.inputs.printers import Printer, PrintStyle, load_print_style, load_printer
-from printgen.inputs.prototype import Prototype
 
 MESH_TOLERANCE = 0.25  # default bounds: each diagonal within +-25 % of the scaled prototype's
 BORDER_BEADS = (2, 4)  # border frame widths searched, in net beads (even: the frame splits
@@ -164,9 +164,10 @@ def grid(ctx: SearchContext, space: SearchSpace) -> list[NetPoint]:
     if not nxs or not nys:
         which = "x" if not nxs else "y"
         length = ctx.width_mm if which == "x" else ctx.height_mm
-        raise InputError(f"mesh {which} bounds {space.mesh_x_mm if which == 'x' else space.mesh_y_mm}"
-                         f" mm hold no whole number (>= {MIN_HALF_CELLS}) of half-meshes across "
-                         f"the {length:.4g} mm panel; widen the bounds")
+        bounds = space.mesh_x_mm if which == "x" else space.mesh_y_mm
+        raise InputError(f"mesh {which} bounds {bounds} mm hold no whole number (>= "
+                         f"{MIN_HALF_CELLS}) of half-meshes across the {length:.4g} mm panel; "
+                         "widen the bounds")
     check_size(space, len(nxs), len(nys))
     out: list[NetPoint] = []
     for mat in space.materials:

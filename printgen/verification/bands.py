@@ -24,15 +24,15 @@ from typing import Any
 import numpy as np
 
 from printgen.barrier.loads import LoadCase
-from printgen.scaling.record import Design
 from printgen.errors import GeometryError
+from printgen.executor.local import collect, submit_jobs
 from printgen.inputs.prototype import Prototype
+from printgen.scaling.record import Design
 from printgen.scene.options import SceneOptions, build_scene
 from printgen.trace import span
 from printgen.verification.compare import METRICS
-from printgen.verification.variants import Variant, model_variants
 from printgen.verification.preprint import Run, load_keywords, sweep
-from printgen.executor.local import collect, submit_jobs
+from printgen.verification.variants import Variant, model_variants
 
 COARSENINGS = (2, 3)  # mesh multipliers tried in turn for the variant sweeps
 REFINE_TOL = 0.01  # a coarser net is used when no nominal curve moves by more than 1 % of its peak

@@ -12,8 +12,8 @@ from typing import Any
 import numpy as np
 
 from printgen.barrier.loads import distinct_specs, get_load
-from printgen.scaling.record import Design
 from printgen.inputs.prototype import Prototype
+from printgen.scaling.record import Design
 from printgen.verification.preprint import (
     Run,
     Verification,

@@ -196,7 +196,8 @@ class MultiFit:
                     "explanation needs parameters inside their bounds); no profile is written")
         if self.explains:
             return (f"explained within the bounds by {what} (worst RMS mismatch {worst:.0%} of "
-                    f"the measured peak); determined: {', '.join(self.identifiability.determined()) or 'none'}")
+                    "the measured peak); determined: "
+                    f"{', '.join(self.identifiability.determined()) or 'none'}")
         return (f"NOT explained: no parameter set within the bounds brings every column within "
                 f"{EXPLAINS:.0%} of its measured peak; the best, {what}, leaves {worst:.0%}; no "
                 "profile is written")
@@ -273,7 +274,7 @@ def at_bounds(p: Params) -> tuple[str, ...]:
     """The continuous parameters of `p` within AT_BOUND of a bound other than their nominal
     (a fit pushed there wants more than physics allows)."""
     out = []
-    for k, (lo, hi, nom) in BOUNDS.items():
+    for k, (_lo, _hi, nom) in BOUNDS.items():
         u, n = _to_unit(k, getattr(p, k)), _to_unit(k, nom)
         if (u < AT_BOUND and n >= AT_BOUND) or (u > 1 - AT_BOUND and n <= 1 - AT_BOUND):
             out.append(k)

@@ -25,17 +25,18 @@ from pathlib import Path
 import numpy as np
 
 from printgen.barrier.loads import OVERFLOW
-from printgen.scaling.record import Design
 from printgen.errors import InputError
 from printgen.inputs.profiles import profile_name
 from printgen.outputs.files import read_input_text
+from printgen.scaling.record import Design
 from printgen.scene.options import SceneOptions
 from printgen.scene.readings import DEPTH_COLUMN, RAW_COLUMNS, FlumeUnits
 from printgen.verification.bands import Band, curves, run_variant
 from printgen.verification.variants import Variant
 
 LEVEL_COLUMN = "h_over_hb"
-# CSV column -> (METRICS key of printgen.verification.compare, factor from the CSV unit to the key's)
+# CSV column -> (METRICS key of printgen.verification.compare, factor from the CSV unit to the
+# key's)
 COLUMNS = {
     "bottom_cable_elongation_pct": ("strain_bottom", 0.01),
     "top_cable_elongation_pct": ("strain_top", 0.01),

@@ -20,15 +20,15 @@ from collections.abc import Callable
 from concurrent.futures import Future
 
 from printgen.barrier.loads import LoadCase
-from printgen.scaling.record import Design
+from printgen.executor.local import collect, shared_pool
 from printgen.inputs.prototype import Prototype
+from printgen.scaling.record import Design
 from printgen.scene.options import SceneOptions
 from printgen.trace import span
 from printgen.verification.bands import COARSENINGS, Band, meshable, model_band, run_variant
 from printgen.verification.cases import case_plan, other_cases, with_cases
-from printgen.verification.variants import Variant
 from printgen.verification.preprint import Verification, steel_counterexample, verify_plan
-from printgen.executor.local import collect, shared_pool
+from printgen.verification.variants import Variant
 
 
 def verify_with_band(p: Prototype, d: Design, *, load: str | LoadCase | None = None,

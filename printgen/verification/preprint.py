@@ -1,8 +1,9 @@
 """Pre-print verification: the prototype and the printed model, each as a tension-only net
 (`printgen.scene.scenes`), loaded hydrostatically from h / h_B = 0 to 1.1 (the reference's loading
-test: water raised behind a folded film), or another load case of `printgen.barrier.loads`
-(flow, drag, jam: a case may bring its own levels and states what it used at each), and compared by their normalised deformations over the whole range (printgen.verification.compare).
-Also the counter-example the report warns about: the simple barrier with steel at every scale.
+test: water raised behind a folded film), or another load case of `printgen.barrier.loads` (flow,
+drag, jam: a case may bring its own levels and states what it used at each), and compared by their
+normalised deformations over the whole range (printgen.verification.compare). Also the
+counter-example the report warns about: the simple barrier with steel at every scale.
 """
 
 from __future__ import annotations
@@ -16,14 +17,20 @@ import numpy as np
 
 from printgen import solver
 from printgen.barrier.loads import OVERFLOW, LoadCase, Site, get_load
+from printgen.errors import SolverError
+from printgen.executor.local import (  # worker lifecycle: ground floor
+    check_deadline,
+    report_progress,
+    run_jobs,
+)
+from printgen.inputs.prototype import Prototype
 from printgen.scaling.record import Design
 from printgen.scaling.similitude import scale_targets
-from printgen.errors import SolverError
-from printgen.inputs.prototype import Prototype
 from printgen.scene.options import SceneOptions, build_scene
 from printgen.scene.pressure import loads_function
 from printgen.scene.scenes import BarrierScene, lateral_mounting, noted
 from printgen.scene.solvernet import build, hold_share, wire_slack
+from printgen.solver.loads import total_forces
 from printgen.units import MM
 from printgen.verification.compare import (
     Deformation,
@@ -34,12 +41,6 @@ from printgen.verification.compare import (
     headline,
     increments,
 )
-from printgen.executor.local import (  # worker lifecycle: ground floor
-    check_deadline,
-    report_progress,
-    run_jobs,
-)
-from printgen.solver.loads import total_forces
 
 if TYPE_CHECKING:  # pragma: no cover
     from printgen.verification.cases import CaseRuns

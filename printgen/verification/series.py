@@ -41,9 +41,9 @@ from printgen.scene.scenes import (
     PROTOTYPE_ORIENTATION,
     BarrierScene,
 )
+from printgen.solver import linear
 from printgen.units import RHO_WATER, G
 from printgen.verification.preprint import levels, sweep
-from printgen.solver import linear
 
 SCALES = (1.0, 10.0, 30.0, 50.0, 100.0)  # the paper's series (Lambert et al. 2023, Fig. 2)
 OUTPUTS = {"deflection": "mid-height deflection / width",

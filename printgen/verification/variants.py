@@ -27,9 +27,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from printgen.barrier.patterns import get_pattern
+from printgen.inputs.materials import load_material
 from printgen.scaling.record import Design
 from printgen.scaling.section import area_m2
-from printgen.inputs.materials import load_material
 from printgen.scene.options import SceneOptions, build_scene
 from printgen.scene.scenes import MOUNTINGS, ORIENTATIONS, TESTED_PATTERN, recorded_orientation
 from printgen.units import MM

@@ -14,7 +14,6 @@ import itertools
 
 import numpy as np
 
-from printgen.scaling.record import CableDesign
 from printgen.errors import PrintabilityError
 from printgen.inputs.materials import Material
 from printgen.inputs.printers import Printer, PrintStyle
@@ -29,6 +28,7 @@ from printgen.parts.gcode.toolpath import (
     ring_layout,
     speeds,
 )
+from printgen.scaling.record import CableDesign
 
 
 def cable_toolpath(cable: CableDesign, printer: Printer, style: PrintStyle,

@@ -28,7 +28,6 @@ import itertools
 import numpy as np
 
 from printgen.barrier.graph import NetGraph
-from printgen.scaling.record import NetDesign, Section
 from printgen.errors import ProfileError
 from printgen.inputs.materials import Material
 from printgen.inputs.printers import Printer, PrintStyle
@@ -48,6 +47,7 @@ from printgen.parts.gcode.toolpath import (
 )
 from printgen.parts.geometry.attach import CORNER_EXTRA_RINGS, Attachment, Hole, holes
 from printgen.parts.geometry.lattice import crossing_direction, crossing_sin, end_sin
+from printgen.scaling.record import NetDesign, Section
 
 
 def net_toolpath(net: NetDesign, printer: Printer, style: PrintStyle, material: Material, *,

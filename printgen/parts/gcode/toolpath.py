@@ -15,11 +15,11 @@ from typing import cast
 
 import numpy as np
 
-from printgen.scaling.record import CableDesign, NetDesign, Section
 from printgen.errors import PrintabilityError, ProfileError
 from printgen.inputs.materials import Material
 from printgen.inputs.printers import Printer, PrintStyle, check_pass
 from printgen.parts.geometry.attach import border_beads as border_bead
+from printgen.scaling.record import CableDesign, NetDesign, Section
 
 TRAVEL, BORDER, STRAND_PLUS, STRAND_MINUS, CABLE_STRIP, EYELET, COMB = 0, 1, 2, 3, 4, 5, 6
 KIND_NAMES = {TRAVEL: "travel", BORDER: "border", STRAND_PLUS: "strand+",

@@ -23,8 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from printgen.barrier.graph import NetGraph
-from printgen.scaling.record import Design, NetDesign
 from printgen.errors import GeometryError
+from printgen.scaling.record import Design, NetDesign
 
 DEFAULT_CLEARANCE_MM = 0.3  # at least 0.3 mm each side of the strip in a loop
 CORNER_EXTRA_RINGS = 1  # full bead rings around the pin hole, inside the border's detour

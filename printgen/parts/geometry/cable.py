@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from printgen.scaling.record import CableDesign
 from printgen.errors import GeometryError
+from printgen.scaling.record import CableDesign
 
 CIRCLE_SEGMENTS = 128  # eyelet polygon sides: chord sag 3e-4 x radius; area kept exact
 

@@ -20,7 +20,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from printgen.barrier.graph import NetGraph
-from printgen.scaling.record import CableDesign, NetDesign
 from printgen.errors import GeometryError
 from printgen.parts.geometry.attach import Attachment, Hole, attachment_for, holes
 from printgen.parts.geometry.cable import (
@@ -38,6 +37,7 @@ from printgen.parts.geometry.lattice import (
     parallel_spacing,
     strand_ends,
 )
+from printgen.scaling.record import CableDesign, NetDesign
 
 if TYPE_CHECKING:  # pragma: no cover
     import trimesh

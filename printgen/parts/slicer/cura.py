@@ -11,13 +11,13 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from printgen.scaling.record import CableDesign, NetDesign
 from printgen.errors import PrintabilityError
 from printgen.inputs.materials import Material
 from printgen.inputs.printers import Printer, PrintStyle
 from printgen.outputs import write_text
 from printgen.parts.gcode.toolpath import check_part, part_section, wall_loops
 from printgen.parts.gcode.writer import fill_placeholders, placeholder_values
+from printgen.scaling.record import CableDesign, NetDesign
 
 DEFINITION_DIRS = ("/usr/share/cura/resources/definitions",
                    "/opt/cura-pkg/usr/share/cura/resources/definitions")

@@ -16,13 +16,13 @@ from functools import cache
 from importlib import resources
 from pathlib import Path
 
-from printgen.scaling.record import CableDesign, NetDesign
 from printgen.errors import PrintabilityError, ProfileError
 from printgen.inputs.materials import Material
 from printgen.inputs.printers import Printer, PrintStyle
 from printgen.outputs import write_text
 from printgen.parts.gcode.toolpath import check_part, part_section, wall_loops
 from printgen.parts.gcode.writer import placeholder_values
+from printgen.scaling.record import CableDesign, NetDesign
 
 FLAVORS = {"marlin2": "marlin2", "marlin": "marlin", "reprap": "reprapfirmware",
            "klipper": "marlin2"}
