@@ -85,10 +85,12 @@ def staged_dir(final: str | Path, *, force: bool = False,
 
 
 def write_folder(final: str | Path, files: dict[str, str | bytes], *, force: bool = False,
-                 volatile: tuple[str, ...] = (), inputs: Iterable[str | Path] = ()) -> list[str]:
+                 volatile: tuple[str, ...] = (), inputs: Iterable[str | Path] = (),
+                 meta: dict[str, Any] | None = None) -> list[str]:
     """Write `files` (relative path -> text or bytes; sub-folders made) as the whole of
-    `final` through `staged_dir`; returns the relative paths, sorted."""
-    with staged_dir(final, force=force, volatile=volatile, inputs=inputs) as stage:
+    `final` through `staged_dir` (`meta` added to its manifest); returns the relative paths,
+    sorted."""
+    with staged_dir(final, force=force, volatile=volatile, inputs=inputs, meta=meta) as stage:
         for name, data in files.items():
             path = stage / name
             path.parent.mkdir(parents=True, exist_ok=True)

@@ -168,7 +168,7 @@ def search_nets(prototype: PrototypeLike, scales: float | Sequence[float], *,
                              progress=progress)
     if out is not None:
         write_outputs(found, out, lams[0] if main_scale is None else float(main_scale),
-                      prototype)
+                      prototype, how.command)
     return found
 
 

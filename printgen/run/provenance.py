@@ -16,6 +16,7 @@ from printgen.outputs import file_digest
 if TYPE_CHECKING:
     from printgen.report.records import CheckRecords
     from printgen.run.make import MakeContext
+    from printgen.scaling.record import Design
 
 TIME_KEYS = ("timings_s", "seconds", "time_s")  # record keys that hold wall-clock times
 # The packages whose versions can move the outputs' numbers or bytes (meshes, solver, figures);
@@ -56,25 +57,45 @@ def json_output(ctx: MakeContext) -> dict[str, Any]:
 
 
 def provenance(ctx: MakeContext) -> dict[str, Any]:
-    """Version, command line, the sha256 of every input (prototype, each profile used) and the
-    software environment (`environment`)."""
+    """`make`'s provenance (`provenance_record`): its prototype, the design file of `--design`,
+    the design's profiles, and the solver backend of its verification."""
+    return provenance_record(ctx.options.command, prototype=ctx.prototype.path,
+                             files={"design_file": ctx.options.design_file},
+                             design=ctx.design, check=ctx.records.check)
+
+
+def provenance_record(command: list[str] | None, *, prototype: str | Path | None = None,
+                      files: dict[str, str | Path | None] | None = None,
+                      design: Design | None = None,
+                      check: CheckRecords | None = None) -> dict[str, Any]:
+    """Version, command line, the sha256 of every input (the prototype, the other input
+    `files` by label, None ones left out, each profile the `design` uses) and the software
+    environment (`environment`): what every run's manifest.json carries, so `printgen check`
+    names the code and the inputs that made a folder."""
+    inputs = {"prototype": _digest(Path(prototype))} if prototype else {}
+    inputs |= {label: _digest(Path(path)) for label, path in (files or {}).items() if path}
+    if design is not None:
+        inputs |= profile_digests(design)
+    return {"printgen_version": printgen.__version__, "command": command,
+            "inputs": inputs, "environment": environment(check)}
+
+
+def profile_digests(d: Design) -> dict[str, Any]:
+    """The sha256 of every profile file design `d` uses (printer, materials, print styles,
+    each with the files it inherits), by kind/name."""
     from printgen.inputs.profiles import BUNDLED, load_raw
 
-    d = ctx.design
     used = {("printers", d.printer), ("materials", d.net.material),
             ("prints", d.net.print_style)}
     used |= {("materials", c.material) for c in d.cables}
     used |= {("prints", c.print_style) for c in d.cables}
-    inputs = {"prototype": _digest(ctx.prototype.path)} if ctx.prototype.path else {}
-    if ctx.options.design_file:  # make --design FILE: the design is an input too
-        inputs["design_file"] = _digest(Path(ctx.options.design_file))
+    out = {}
     for kind, name in sorted(used):
         for path in load_raw(kind, name)[1]:
             shown = (Path("profiles") / path.relative_to(BUNDLED)
                      if path.is_relative_to(BUNDLED) else path)
-            inputs[f"{kind}/{path.stem}"] = _digest(path, shown)
-    return {"printgen_version": printgen.__version__, "command": ctx.options.command,
-            "inputs": inputs, "environment": environment(ctx.records.check)}
+            out[f"{kind}/{path.stem}"] = _digest(path, shown)
+    return out
 
 
 def environment(check: CheckRecords | None = None) -> dict[str, Any]:

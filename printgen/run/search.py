@@ -29,6 +29,7 @@ from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import check_destination, write_folder
 from printgen.report.jsonout import dumps
 from printgen.run.options import RunOptions
+from printgen.run.provenance import provenance_record
 from printgen.scaling.similitude import scale_targets
 from printgen.search.nets import (
     SearchResult,
@@ -169,7 +170,8 @@ def check_out(out: str | Path, prototype: str | Path | Prototype) -> None:
 
 
 def write_outputs(run: DesignRun, out: str | Path, main_scale: float | None,
-                  prototype: str | Path | Prototype | None = None) -> list[str]:
+                  prototype: str | Path | Prototype | None = None,
+                  command: list[str] | None = None) -> list[str]:
     """Write the folder (whole, atomically); returns the file names."""
     from printgen.report.design_plots import pareto_figure
 
@@ -183,5 +185,7 @@ def write_outputs(run: DesignRun, out: str | Path, main_scale: float | None,
                 files["design.json"] = text
         files[f"pareto-1-{r.scale:g}.png"] = pareto_figure(r)
     inputs = design_inputs(prototype) if prototype is not None else []
-    run.files = write_folder(out, files, inputs=inputs)
+    path = prototype.path if isinstance(prototype, Prototype) else prototype
+    run.files = write_folder(out, files, inputs=inputs,
+                             meta=provenance_record(command, prototype=path))
     return run.files

@@ -25,6 +25,7 @@ from printgen.outputs import TIMINGS, check_destination, write_folder
 from printgen.report.jsonout import dumps
 from printgen.report.series import series_csv, series_figure, series_report
 from printgen.run.options import RunOptions
+from printgen.run.provenance import provenance_record
 from printgen.scene.scenes import SENSOR_FORCE_N
 from printgen.verification.series import (
     LEVEL,
@@ -102,6 +103,7 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
     if out is not None:
         say("writing the report")
         run.files = write_series(run, Path(out), force, inputs,
+                                 provenance_record(options.command, prototype=p.path),
                                  {"total": time.perf_counter() - t0})
     return run
 
@@ -155,8 +157,8 @@ def scaling_assumptions(shared: SeriesShared) -> list[tuple[str, str, str]]:
 
 
 def write_series(run: SeriesRun, out: Path, force: bool, inputs: list,
-                 timings: dict) -> list[str]:
-    """The folder, staged and swapped in whole."""
+                 meta: dict, timings: dict) -> list[str]:
+    """The folder, staged and swapped in whole, its manifest with the run's provenance."""
     fig = series_figure(run.series)
     rep = series_report(run.series, fig)
     files: dict[str, str | bytes] = {"report.html": rep.html(), "report.json": dumps(run.record),
@@ -164,4 +166,4 @@ def write_series(run: SeriesRun, out: Path, force: bool, inputs: list,
                                      TIMINGS: dumps({"timings_s": timings})}
     for f in rep.figures:
         files[f"figures/01-{f.name}.png"], files[f"figures/01-{f.name}.svg"] = f.png, f.svg
-    return write_folder(out, files, force=force, volatile=(TIMINGS,), inputs=inputs)
+    return write_folder(out, files, force=force, volatile=(TIMINGS,), inputs=inputs, meta=meta)

@@ -22,6 +22,7 @@ from printgen.inputs.printers import load_print_style, load_printer
 from printgen.inputs.profiles import search_dirs
 from printgen.outputs import staged_dir
 from printgen.report.jsonout import dumps
+from printgen.run.provenance import provenance_record
 from printgen.run.steps import _write_part
 from printgen.scaling.design_file import load_design
 from printgen.scaling.record import Design
@@ -56,7 +57,9 @@ def testpieces(design_path: str | Path, out: str | Path, *, orientation: str = "
     coupon = coupon_for(d)
     dp, blocked, piece = _panel(d, orientation)
     inputs = [design_path, *search_dirs()]
-    meta: dict[str, Any] = {"command": command, "design_file": Path(design_path).name}
+    meta: dict[str, Any] = {"design_file": Path(design_path).name,
+                            **provenance_record(command, files={"design_file": design_path},
+                                                design=d)}
     with staged_dir(out, force=force, meta=meta, inputs=inputs) as stage:
         rec = {"design_file": Path(design_path).name, "material": d.net.material,
                "material_source": material_source(load_material(d.net.material)),

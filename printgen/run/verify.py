@@ -24,6 +24,7 @@ from printgen.report.jsonout import dumps
 from printgen.report.records import CheckRecords, MeasuredRecords, RunRecords
 from printgen.run.budget import DEFAULT_LIMIT_S, Work, check_budget, sweep_cores
 from printgen.run.options import RunOptions
+from printgen.run.provenance import provenance_record
 from printgen.scaling.design_file import load_design
 from printgen.scaling.record import Design
 from printgen.scene.readings import design_units
@@ -111,7 +112,10 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
         files[fitted_name(d)] = text
     timings = {"total": time.perf_counter() - t0, "band": band.seconds}
     files[TIMINGS] = dumps({"timings_s": timings})
-    written = _write(out, files, force, inputs)
+    meta = provenance_record(options.command, prototype=prototype,
+                             files={"design_file": design_path, "measured": measured},
+                             design=d, check=run.steps["verification"])
+    written = _write(out, files, force, inputs, meta)
     return VerifyRun(p, d, v, band, m, result, text, {**record, "timings_s": timings}, written,
                      run)
 
@@ -144,9 +148,11 @@ def fitted_name(d: Design) -> str:
     return f"{profile_name(d.net.material, 'design net.material')}-fitted.toml"
 
 
-def _write(out: str | Path, files: dict[str, str], force: bool, inputs: list) -> list[str]:
-    """Write `files` (text by name) as the whole output folder; their names, sorted."""
-    with staged_dir(out, force=force, volatile=(TIMINGS,), inputs=inputs) as stage:
+def _write(out: str | Path, files: dict[str, str], force: bool, inputs: list,
+           meta: dict[str, Any] | None = None) -> list[str]:
+    """Write `files` (text by name) as the whole output folder (`meta`: the manifest's
+    provenance); their names, sorted."""
+    with staged_dir(out, force=force, volatile=(TIMINGS,), inputs=inputs, meta=meta) as stage:
         for name, text in files.items():
             (stage / name).write_text(text)
     return sorted(files)
