@@ -102,3 +102,24 @@ def test_bench_is_offered_only_in_a_checkout(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(bench, "ROOT", tmp_path)  # where an installed wheel's ROOT points
     assert main(["bench", "make"]) == 2  # a usage error: one line, exit 2
     assert "invalid choice: 'bench'" in capsys.readouterr().err
+
+
+def test_example_out_leaves_a_users_folder_beside_it(tmp_path, capsys):
+    """A folder the user keeps under the name an older stage had is never removed."""
+    mine = tmp_path / ".ex.example-tmp"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("mine")
+    assert main(["example", "paper_1_40", "--out", str(tmp_path / "ex")]) == 0
+    assert (mine / "notes.txt").read_text() == "mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".ex.example-tmp", "ex"]
+
+
+def test_example_and_init_take_json(tmp_path, capsys):
+    import json
+
+    assert main(["example", "--json"]) == 0
+    assert "paper_1_40" in json.loads(capsys.readouterr().out)["examples"]
+    assert main(["example", "realistic", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["text"].startswith("#")
+    assert main(["init", str(tmp_path / "p.toml"), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out) == {"written": str(tmp_path / "p.toml")}

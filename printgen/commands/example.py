@@ -9,7 +9,20 @@ import argparse
 import sys
 from pathlib import Path
 
+from printgen.commands.common import add_json_arg, emit_json
 from printgen.run import api
+
+
+def _record(args: argparse.Namespace) -> dict:
+    """`--json`: the examples (name -> file or folder name), or the one named: its files
+    (copied ones with --out) and, for a single prototype file, its text."""
+    if args.name is None:
+        return {"examples": {name: path.name for name, path in api.examples().items()}}
+    ex = api.example(args.name, out=args.out)
+    rec: dict = {"name": ex.name, "source": ex.path.name, "files": [str(f) for f in ex.files]}
+    if args.out is None and not ex.is_folder:
+        rec["text"] = ex.path.read_text("utf-8")
+    return rec
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -17,10 +30,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("name", nargs="?", help="which example (none: list them)")
     p.add_argument("--out", "-o", type=Path, metavar="DIR",
                    help="copy the example's files into DIR (a new folder) instead of printing")
+    add_json_arg(p)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.json:
+        emit_json(_record(args))
+        return 0
     if args.name is None:
         for name, path in api.examples().items():
             print(f"{name}\t{path.name}")

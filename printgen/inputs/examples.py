@@ -4,6 +4,7 @@ test), from the package data or the checkout's examples/."""
 
 from __future__ import annotations
 
+import secrets
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
@@ -69,13 +70,16 @@ def copy_example(src: Path, out: Path) -> list[Path]:
     if out.exists() or out.is_symlink():
         raise InputError(f"--out {out} exists; name a new folder")
     files = example_files(src) if src.is_dir() else [src]
-    stage = out.with_name(f".{out.name}.example-tmp")
-    shutil.rmtree(stage, ignore_errors=True)
-    stage.mkdir(parents=True)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    # a name of its own (mkdir refuses one that is there): a folder the user keeps beside
+    # `out`, whatever its name, is never this stage and never removed
+    stage = out.with_name(f".{out.name}.example-{secrets.token_hex(4)}.tmp")
+    stage.mkdir()
     try:
         for f in files:
             write_bytes(stage / f.name, f.read_bytes())
         stage.rename(out)
     finally:
-        shutil.rmtree(stage, ignore_errors=True)
+        if stage.exists():
+            shutil.rmtree(stage, ignore_errors=True)
     return [out / f.name for f in files]
