@@ -186,3 +186,15 @@ def test_jam_of_porosity_zero_runs_as_hydrostatic(tiny):
         b = hyd.series.point("similitude", lam).values
         for k in b:
             assert a[k] == pytest.approx(b[k], rel=JAM_AS_HYDROSTATIC_RTOL), k
+
+
+def test_a_huge_series_is_refused_before_any_solve(tmp_path, capsys):
+    """A net of millions of nodes is refused with its estimate (exit 2), not run out of
+    memory (exit 1), and nothing is written."""
+    huge = write_variant(tmp_path, {("net", "mesh_x_m"): 0.005, ("net", "mesh_y_m"): 0.005},
+                         base=SIMPLE)
+    out = tmp_path / "o"
+    assert main(["series", str(huge), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "this series is too big" in err and "--time-limit" in err and "GB" in err, err
+    assert not out.exists()

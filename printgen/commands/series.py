@@ -13,6 +13,7 @@ from rich.console import Console
 from printgen.commands.common import (
     add_json_arg,
     add_load_args,
+    add_time_limit_arg,
     check_profile_args,
     console,
     emit_json,
@@ -45,6 +46,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                        help="run in this process (default: serial below 12 cases, this "
                             "machine's worker processes above)")
     p.add_argument("--workers", type=int, help="worker processes on this machine")
+    add_time_limit_arg(p)
     p.add_argument("--force", action="store_true",
                    help="replace an output folder printgen did not write")
     add_json_arg(p)

@@ -305,6 +305,34 @@ def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
                      f"{math.ceil(est.seconds * 1.5 / 60) * 60:g}, or {fix}")
 
 
+def check_series_budget(p: Prototype, cases: int, *, limit_s: float, cores: int,
+                        speed: float | None = None) -> tuple[float, float]:
+    """(seconds, bytes) a scale series of `cases` solves of the prototype's net takes on
+    `cores` (each case one sweep of LEVELS levels; the model nets have the prototype's nodes
+    at every scale); InputError naming both, the limit and the fixes when it passes
+    `limit_s`, before any solve (a net too large is refused, not run out of memory)."""
+    if not (math.isfinite(limit_s) and limit_s > 0):
+        raise InputError(f"--time-limit {limit_s:g} s must be a positive number of seconds")
+    if speed is None:
+        from printgen.run.speed import speed_factor
+
+        speed = speed_factor()
+    nodes = prototype_nodes(p)
+    kind = "border cables" if p.border is not None else "free top"
+    one = SweepWork("case", 3 * nodes, LEVELS,
+                    LEVELS * iterations_per_level(kind, 3 * nodes)).seconds
+    c = max(1, cores)
+    seconds = speed * one * math.ceil(cases / c)
+    memory = c * (BASE_MEMORY_B + MEMORY_B_PER_NODE * nodes)
+    if seconds <= limit_s:
+        return seconds, memory
+    raise InputError(f"this series is too big: {cases} cases of a {nodes:,}-node net, about "
+                     f"{seconds:.0f} s and {memory / 1e9:.1f} GB on {c} cores; the limit is "
+                     f"{limit_s:g} s. Raise it with --time-limit "
+                     f"{math.ceil(seconds * 1.5 / 60) * 60:g}, give fewer --scales or "
+                     "--materials, or coarsen the prototype's [net] mesh")
+
+
 def coarsest_fix(p: Prototype, d: Design, *, limit_s: float, cores: int,
                  work: Work = MAKE, variants: int | None = None, speed: float = 1.0) -> str:
     """The smallest uniform coarsening of the meshes that fits `limit_s`, as advice
