@@ -136,7 +136,9 @@ def test_cli_writes_the_folder(capsys, tiny, tmp_path):
     assert {a["what"] for a in rec["assumptions"]} >= {"scaling", "rows: materials", "loading"}
     lines = (out / "series.csv").read_text().splitlines()
     assert lines[0].startswith("row,lambda,deflection") and len(lines) == 1 + 3 * 2
-    assert "PETG keeps deflection" in capsys.readouterr().out
+    captured = capsys.readouterr()
+    assert "PETG keeps deflection" in captured.out
+    assert "\u2501" not in captured.err  # no progress bar on a stderr that is no terminal
 
 
 @pytest.mark.parametrize("argv, word", [

@@ -73,16 +73,19 @@ class Runner:
 
 @contextmanager
 def _bar(show: bool, label: str, total: int) -> Iterator[Callable[[], None]]:
-    """A rich progress bar on stderr (or nothing): yields the function that advances it."""
-    if not show:
+    """A rich progress bar on stderr (or nothing): yields the function that advances it.
+    Only on a terminal: redirected to a file or a log, a bar is noise (its last frame)."""
+    from rich.console import Console
+
+    err = Console(stderr=True)
+    if not show or not err.is_terminal:
         yield lambda: None
         return
-    from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
     with Progress("[progress.description]{task.description}", BarColumn(),
                   MofNCompleteColumn(), TimeElapsedColumn(),
-                  console=Console(stderr=True), transient=False) as bar:
+                  console=err, transient=False) as bar:
         task = bar.add_task(label, total=total)
         yield lambda: bar.advance(task)
 
