@@ -69,8 +69,8 @@ def test_profiles_list_and_show(capsys):
     (["targets", "missing.toml", "--scale", "40"], "file not found: missing.toml"),
     (["select", REALISTIC, "--scale", "40", "--materials", "nylon"],
      "no material profile named 'nylon'"),
-    (["select", REALISTIC, "--scale", "40", "--printer", "prusa-mk4"],
-     "layer height 0.35 mm exceeds 0.3 mm"),
+    (["select", REALISTIC, "--scale", "40", "--printer", "nothere"],
+     "no printer profile named 'nothere'; known: generic-350, prusa-mk4"),
     (["profiles", "show", "unobtainium"], "no profile named 'unobtainium'"),
 ])
 def test_bad_input_exits_2_with_message(capsys, argv, message):

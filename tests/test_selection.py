@@ -11,6 +11,8 @@ from proto_files import REALISTIC, SIMPLE, write_variant
 from printgen.barrier.patterns.diamond import diamond_factor
 from printgen.errors import PrintabilityError
 from printgen.inputs.materials import load_material
+from printgen.inputs.printers import load_printer
+from printgen.inputs.profiles import list_profiles
 from printgen.inputs.prototype import load_prototype
 from printgen.scaling.record import Section
 from printgen.scaling.section import area_m2, net_membrane_law
@@ -99,13 +101,31 @@ def test_simple_barrier_gets_a_net_within_ten_percent():
 
 
 def test_printer_with_a_fine_nozzle_rejects_wide_layers(tmp_path):
-    """prusa-mk4 (0.4 mm nozzle): 0.35 mm first layer > 0.75 x 0.4 = 0.30 mm."""
-    p = load_prototype(REALISTIC)
+    """prusa-mk4 (0.4 mm nozzle) asked for net-3pass in the prototype's own [model]: its
+    0.35 mm first layer > 0.75 x 0.4 = 0.30 mm."""
+    p = load_prototype(write_variant(tmp_path, {("model", "printer"): "prusa-mk4"}))
+    assert p.model.net_print == "net-3pass"
     with pytest.raises(PrintabilityError, match=r"layer height 0.35 mm exceeds 0.3 mm"):
-        select(p, scale_targets(p, 40), printer="prusa-mk4")
+        select(p, scale_targets(p, 40))
 
 
 def test_materials_option_restricts_candidates(tmp_path):
     p = load_prototype(write_variant(tmp_path, {("model", "materials"): ["tpe", "petg"]}))
     s = select(p, scale_targets(p, 40))
     assert {c.material for c in s.cables + s.net} == {"tpe", "petg"}
+
+
+@pytest.mark.parametrize("printer", list_profiles("printers"))
+def test_every_bundled_printer_prints_a_net(printer):
+    """Each printer profile names the print styles its nozzle can lay (a 0.4 mm nozzle
+    cannot lay the default net's 0.35 mm first layer); the prototype's [model] styles go with
+    its [model] printer."""
+    from printgen.inputs.prototype import load_prototype
+    from printgen.scaling.selection import select
+    from printgen.scaling.similitude import scale_targets
+
+    p = load_prototype(REALISTIC)
+    sel = select(p, scale_targets(p, 40), printer=printer)
+    assert sel.net[0].feasible
+    own = load_printer(printer).net_print
+    assert sel.net_print == (own if own and printer != p.model.printer else p.model.net_print)

@@ -35,6 +35,11 @@ PRINTER = [
     Field("gcode_flavor", str, choices=("marlin2", "marlin", "reprap", "klipper"), si=False),
     Field("start_gcode", str, required=False, default="", multiline=True),
     Field("end_gcode", str, required=False, default="", multiline=True),
+    Field("net_print", str, required=False, default="",
+          help="the net print style made for this nozzle (a prototype's [model] net_print "
+               "overrides it; empty: the bundled default)"),
+    Field("cable_print", str, required=False, default="",
+          help="the cable print style made for this nozzle (as net_print)"),
 ]
 PRINT_STYLE = [
     Field("name", str),
@@ -72,6 +77,8 @@ class Printer:
     gcode_flavor: str
     start_gcode: str
     end_gcode: str
+    net_print: str = ""  # the print styles made for its nozzle (empty: the bundled defaults)
+    cable_print: str = ""
 
     @property
     def min_bead_mm(self) -> float:

@@ -252,13 +252,30 @@ def design_net(p: Prototype, t: ScaledTargets, net: NetDesign, printer: str) -> 
                          mesh=(net.mesh_x_mm * MM, net.mesh_y_mm * MM), pattern=net.pattern)
 
 
+def net_print_name(p: Prototype, printer: Printer) -> str:
+    """The net's print style (`print_style_name`)."""
+    return print_style_name(p.model.net_print, p, printer, printer.net_print, DEFAULT_NET_PRINT)
+
+
+def print_style_name(chosen: str | None, p: Prototype, printer: Printer, own: str,
+                     default: str) -> str:
+    """A part's print style: the prototype's [model] choice (`chosen`), made for its [model]
+    printer; on another printer (--printer) that names a style for its nozzle (`own`), that
+    one; else the bundled `default`."""
+    if own and printer.key != (p.model.printer or printer.key):
+        return own
+    return chosen or own or default
+
+
 def select(p: Prototype, t: ScaledTargets, *, printer: str | None = None,
            materials: tuple[str, ...] | None = None) -> Selection:
     """Rank every material x layout for cables and net; best feasible first."""
     printer_obj = load_printer(printer or p.model.printer or DEFAULT_PRINTER)
     mats = [load_material(n) for n in material_names(materials, p.model.materials)]
-    net_style = load_print_style(p.model.net_print or DEFAULT_NET_PRINT)
-    cable_style = load_print_style(p.model.cable_print or DEFAULT_CABLE_PRINT)
+    net_style = load_print_style(net_print_name(p, printer_obj))
+    cable_style = load_print_style(print_style_name(p.model.cable_print, p, printer_obj,
+                                                    printer_obj.cable_print,
+                                                    DEFAULT_CABLE_PRINT))
     for style, comp in ((net_style, "net"), (cable_style, "cable")):
         if style.component != comp:
             raise InputError(f"print style {style.key!r} is for {style.component}s, not {comp}s; "

@@ -20,10 +20,10 @@ from printgen.inputs.materials import Material, load_material, material_names
 from printgen.inputs.printers import Printer, PrintStyle, load_print_style, load_printer
 from printgen.inputs.prototype import Prototype
 from printgen.scaling.selection import (
-    DEFAULT_NET_PRINT,
     DEFAULT_PRINTER,
     MAX_BEADS_ACROSS,
     MAX_LAYERS,
+    net_print_name,
 )
 from printgen.scaling.similitude import ScaledTargets
 
@@ -104,12 +104,12 @@ class SearchContext:
 def search_context(p: Prototype, t: ScaledTargets, space: SearchSpace, *,
                    printer: str | None = None) -> SearchContext:
     """Load the printer, the prototype's net print style and the space's materials."""
-    style = load_print_style(p.model.net_print or DEFAULT_NET_PRINT)
+    printer_obj = load_printer(printer or p.model.printer or DEFAULT_PRINTER)
+    style = load_print_style(net_print_name(p, printer_obj))
     if style.component != "net":
         raise InputError(f"print style {style.key!r} is for {style.component}s, not nets; "
                          "set [model] net_print to a net style (printgen profiles list)")
-    return SearchContext(p, t, load_printer(printer or p.model.printer or DEFAULT_PRINTER),
-                         style, tuple(load_material(m) for m in space.materials))
+    return SearchContext(p, t, printer_obj, style, tuple(load_material(m) for m in space.materials))
 
 
 def default_space(p: Prototype, t: ScaledTargets, *, materials: tuple[str, ...] | None = None,
