@@ -180,3 +180,14 @@ def test_sensor_and_anchor_layout_is_the_scene_in_mm():
     labels = axis_labels(fig)
     _png(fig)
     assert all(name.endswith("(mm)") for _, names in labels for name in names)
+
+
+def test_the_sheets_note_is_one_cell_to_a_csv_reader(made_1_40):
+    """A reader without comment handling (pandas.read_csv's default) sees the note as one
+    cell, not a row of sentence fragments that shifts the header."""
+    import csv
+
+    _, out = made_1_40
+    with open(out / "measurement-sheet.csv", newline="") as fh:
+        rows = list(csv.reader(fh))
+    assert len(rows[0]) == 1 and rows[1][0] == "h_over_hb"

@@ -144,9 +144,9 @@ def sheet_csv(lab: dict[str, Any]) -> str:
     note = ("# printgen measurement sheet: fill the empty columns with the readings in mm "
             "(sensors zeroed at h/h_B = 0; deflection and top lowering from rest); leave a "
             "column empty if not measured. expected_* columns: the printed model's prediction "
-            "(nominal, band min, band max), skipped when read back. Read with: printgen "
+            "(nominal / band min / band max) and skipped when read back. Read with: printgen "
             "verify PROTOTYPE --scale S --design design.json --measured this-file.csv\n")
-    return note + _csv(header, cols)
+    return note + _csv(header, cols)  # the note holds no comma: one cell to any CSV reader
 
 
 def _csv(header: list[str], cols: list[Any]) -> str:
