@@ -129,3 +129,14 @@ def test_every_bundled_printer_prints_a_net(printer):
     assert sel.net[0].feasible
     own = load_printer(printer).net_print
     assert sel.net_print == (own if own and printer != p.model.printer else p.model.net_print)
+
+
+def test_a_selection_prints_in_a_few_lines():
+    """A notebook shows the winners, not 200 kB of every ranked candidate."""
+    from printgen.scaling.selection import select
+    from printgen.scaling.similitude import scale_targets
+
+    p = load_prototype(REALISTIC)
+    text = repr(select(p, scale_targets(p, 40)))
+    assert len(text.splitlines()) == 3 and len(text) < 600
+    assert "net (" in text and "cables (" in text and "stiffness" in text

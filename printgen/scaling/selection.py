@@ -92,6 +92,14 @@ class Candidate:
     def feasible(self) -> bool:
         return not self.reasons
 
+    def __repr__(self) -> str:
+        """One line (a notebook prints it): material, section, stiffness error, printable."""
+        s = self.section
+        state = "printable" if self.feasible else f"not printable: {self.reasons[0]}"
+        return (f"Candidate({self.material} {s.width_mm:g} x {s.thickness_mm:g} mm, "
+                f"{s.passes} passes, stiffness {self.error:+.0%} of target, SF "
+                f"{self.safety_factor:.2g}, {state})")
+
 
 @dataclass(frozen=True)
 class Selection:
@@ -109,6 +117,14 @@ class Selection:
     @property
     def cable(self) -> Candidate | None:
         return self.cables[0] if self.cables and self.cables[0].feasible else None
+
+    def __repr__(self) -> str:
+        """A few lines (a notebook prints it, where the dataclass's own ran to 200 kB): the
+        winners and how many were ranked; `to_record()` holds everything."""
+        cable = repr(self.cables[0]) if self.cables else "none (no border cables)"
+        return (f"Selection(printer {self.printer!r}, {self.net_mesh or 'net'}\n"
+                f"  net ({len(self.net)} ranked): {self.net[0]!r}\n"
+                f"  cables ({len(self.cables)} ranked): {cable})")
 
     def to_record(self) -> dict:
         """JSON-ready record of the ranked selection (stable keys)."""
