@@ -27,7 +27,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from printgen.barrier.patterns import get_pattern
-from printgen.inputs.materials import load_material
+from printgen.inputs.materials import Material, load_material
 from printgen.scaling.record import Design
 from printgen.scaling.section import area_m2
 from printgen.scene.options import SceneOptions, build_scene
@@ -83,16 +83,26 @@ def model_variants(d: Design, mounting: str | None = None, free_section: float |
     return out, notes
 
 
+def _modulus_sd(mat: Material, part: str, notes: list[str]) -> tuple[float, float] | None:
+    """(E, SD) Pa of `mat`'s measured modulus, or None with a note saying why it is left out
+    (`part`: "net" or "cables", as the note names it)."""
+    e, source = mat.modulus()
+    sd = mat.measured_modulus.sd if source == "measured" and mat.measured_modulus else None
+    if not sd:
+        notes.append(f"{mat.name} ({part}): no SD of the {source} modulus in its profile; "
+                     "modulus spread not included (printgen calibrate writes sd_gpa)")
+        return None
+    return e, sd
+
+
 def _modulus_variants(d: Design, notes: list[str]) -> list[Variant]:
     net = load_material(d.net.material)
+    found = _modulus_sd(net, "net", notes)
+    if found is None:
+        return []
+    e, sd = found
     panel = net.panel_law
     law_from_modulus = panel is None or not panel.has_geometry
-    e, source = net.modulus()
-    sd = net.measured_modulus.sd if source == "measured" and net.measured_modulus else None
-    if not sd:
-        notes.append(f"{net.name} (net): no SD of the {source} modulus in its profile; "
-                     "modulus spread not included (printgen calibrate writes sd_gpa)")
-        return []
     out = []
     for sign, word in ((-1, "-"), (1, "+")):
         k = 1 + sign * sd / e
@@ -106,12 +116,10 @@ def _modulus_variants(d: Design, notes: list[str]) -> list[Variant]:
 
 def _cable_variants(d: Design, notes: list[str]) -> list[Variant]:
     mat = load_material(d.cables[0].material)
-    e, source = mat.modulus()
-    sd = mat.measured_modulus.sd if source == "measured" and mat.measured_modulus else None
-    if not sd:
-        notes.append(f"{mat.name} (cables): no SD of the {source} modulus in its profile; "
-                     "modulus spread not included (printgen calibrate writes sd_gpa)")
+    found = _modulus_sd(mat, "cables", notes)
+    if found is None:
         return []
+    e, sd = found
     return [Variant(f"{mat.name} cable modulus {word}1 SD",
                     f"{mat.name} profile: E = {e / 1e9:.3g} +- {sd / 1e9:.2g} GPa",
                     SceneOptions(cable_factor=1 + sign * sd / e))
