@@ -625,3 +625,32 @@ def test_an_edited_measurement_sheet_stops_the_next_run(world, made_1_40, capsys
     code, err = cli(capsys, "make", REALISTIC, "-s", 40, "--out", out)
     assert code == 2 and "measurement-sheet.csv, edited since printgen wrote it" in err, err
     assert "--force" in err and snapshot(world) == before
+
+
+# -- A small file system that fills up during the run (where this machine lets us mount one) --
+
+@pytest.fixture
+def small_fs(tmp_path):
+    """A 400 kB tmpfs: root only, and a machine (or container) that allows mounting."""
+    where = tmp_path / "small"
+    where.mkdir()
+    if not hasattr(os, "geteuid") or os.geteuid() != 0 or shutil.which("mount") is None:
+        pytest.skip("mounting a small file system needs root")
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=400k", "tmpfs", str(where)],
+                          capture_output=True)
+    if done.returncode:
+        pytest.skip(f"cannot mount a tmpfs here: {done.stderr.decode().strip()}")
+    try:
+        yield where
+    finally:
+        subprocess.run(["umount", str(where)], check=True)
+
+
+@POSIX_ONLY
+def test_a_disk_filling_up_keeps_the_previous_run_and_leaves_nothing(small_fs, made, capsys):
+    out = earlier_output(made, small_fs / "out")
+    assert check_folder(out) == []
+    code, err = cli(capsys, "make", REALISTIC, "-s", 40, "--out", out)
+    assert code == 1 and "No space left on device" in err and "nothing was replaced" in err
+    assert len(err.splitlines()) == 1, err
+    assert check_folder(out) == [] and sorted(p.name for p in small_fs.iterdir()) == ["out"]
