@@ -25,9 +25,11 @@ from printgen.scaling.selection import (
     MAX_BEADS_ACROSS,
     MAX_LAYERS,
 )
-from printgen.scaling.similitude import ScaledTargets
+from printgen.scaling.similitude import (  # noqa: F401 (MESH_TOLERANCE: also read from here)
+    MESH_TOLERANCE,  # default bounds: each diagonal within +-25 % of the scaled prototype's
+    ScaledTargets,
+)
 
-MESH_TOLERANCE = 0.25  # default bounds: each diagonal within +-25 % of the scaled prototype's
 BORDER_BEADS = (2, 4)  # border frame widths searched, in net beads (even: the frame splits
 # around the net's corner loops in the parts stage)
 MIN_HALF_CELLS = 4  # fewer half-meshes than this across or up is not a net worth verifying
