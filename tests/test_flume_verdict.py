@@ -16,7 +16,9 @@ from printgen.cli import main
 from printgen.inputs.prototype import load_prototype
 from printgen.report import summary as summary_module
 from printgen.report.build import build_report
+from printgen.report.html import Report
 from printgen.report.records import CheckRecords, RunRecords
+from printgen.report.report import verification_sections
 from printgen.report.summary import summarize
 from printgen.run.api import plan
 from printgen.run.make import plan_run
@@ -103,6 +105,10 @@ def test_a_flume_too_small_is_not_a_pass(verdicts, monkeypatch):
                              steps={"verification": CheckRecords(small, None, SCALE)}))
     assert s.verdict == "FAIL" and s.reason == small.headline
     assert s.next.startswith("Change the scale or the flume before printing: use a scale of 1:45")
+    rep = Report("t")  # the report's verification section: the limit, then what clears it
+    verification_sections(rep, small, None, SCALE)
+    html = "\n".join(rep.blocks)
+    assert html.index("the flume cannot run this test") < html.index("What clears it: use a")
 
 
 def test_a_flume_large_enough_leaves_the_verdict_unchanged(verdicts):

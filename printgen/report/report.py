@@ -121,7 +121,11 @@ def _sweep_sections(rep: Report, v: Verification, scale: float, band: Band | Non
     if v.flow is not None and v.flow.limits:  # the verdict's too: not a pass
         for lim in v.flow.limits:
             rep.verdict(False, f"the flume cannot run this test: {lim.text}")
-        rep.paragraph(f"What clears it: {v.flow.fix}.")
+        rep.paragraph(f"What clears it: {v.flow.fix}. Assumed: the scaled flow fills the "
+                      "flume's width w, so Q = v h w scales as lambda^-1.5 in this flume and the "
+                      "model is w_B / lambda wide; the Froude number is the same at every scale. "
+                      "The hydrostatic test behind the film needs no discharge, but the flowing "
+                      "test the flume is for does, so the verdict counts it.")
     for line in headlines(v.mismatches):  # one per direction of error
         rep.verdict(v.ok, line)
     rep.paragraph(f"Tolerance: {TOLERANCE:.0%} of the prototype's peak, over the whole loading "
