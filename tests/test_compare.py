@@ -12,7 +12,7 @@ from printgen.verification.compare import (
     Deformation,
     compare,
     explain,
-    headline,
+    headlines,
     row_strain,
 )
 
@@ -59,11 +59,31 @@ def test_levels_must_agree():
 
 def test_headline_says_which_way_and_by_how_much():
     lv = np.linspace(0, 1.1, 23)
-    stiff = headline(compare(_deformation(1.0, lv), _deformation(0.5, lv)))
-    assert stiff.startswith("model too stiff: deforms 50% to 50% less than the prototype")
-    assert "; 5 of 5 quantities fail (off by more than 25% of the prototype's peak)" in stiff
-    soft = headline(compare(_deformation(1.0, lv), _deformation(1.5, lv)))
-    assert soft.startswith("model too soft: deforms 50% to 50% more")
-    close = headline(compare(_deformation(1.0, lv), _deformation(0.9, lv)))
-    assert close.startswith("model within 25% of the prototype's peak on all 5 quantities")
-    assert "0.90x to 0.90x" in close
+    stiff = headlines(compare(_deformation(1.0, lv), _deformation(0.5, lv)))
+    assert len(stiff) == 1
+    assert stiff[0].startswith("model too stiff in 5 of 5 quantities (mid-height deflection / "
+                               "width, top-centre lowering / height, bottom cable elongation, ")
+    assert ("deforms 50% less than the prototype above h/h_B = 0.8 (off by more than 25% of "
+            "the prototype's peak)") in stiff[0]
+    soft = headlines(compare(_deformation(1.0, lv), _deformation(1.5, lv)))
+    assert soft[0].startswith("model too soft in 5 of 5 quantities") and "50% more" in soft[0]
+    close = headlines(compare(_deformation(1.0, lv), _deformation(0.9, lv)))
+    assert close[0].startswith("model within 25% of the prototype's peak on all 5 quantities")
+    assert "0.90x to 0.90x" in close[0]
+
+
+def test_one_headline_sentence_per_direction_of_error():
+    """A model stiffer in some quantities and softer in others gets two sentences, each naming
+    its own quantities: never "too stiff ... too soft" in one line."""
+    lv = np.linspace(0, 1.1, 23)
+    model = _deformation(0.6, lv)
+    model.values["strain_mid"] = 1.5 * lv**2
+    model.values["strain_top"] = 1.3 * lv**2
+    lines = headlines(compare(_deformation(1.0, lv), model))
+    assert len(lines) == 2
+    assert lines[0].startswith("model too stiff in 3 of 5 quantities (mid-height deflection / "
+                               "width, top-centre lowering / height, bottom cable elongation): "
+                               "deforms 40% less")
+    assert lines[1].startswith("model too soft in 2 of 5 quantities (top cable elongation, "
+                               "elongation at mid-height): deforms 30% to 50% more")
+    assert not any("stiff" in x and "soft" in x for x in lines)

@@ -9,6 +9,7 @@ import time
 from pathlib import Path
 
 from rich.console import Console
+from rich.markup import escape
 
 from printgen.commands.common import (
     add_json_arg,
@@ -115,7 +116,7 @@ def show_summary(ctx, out: Path, seconds: float) -> None:
     from printgen.report.summary import summary_lines
 
     for line in summary_lines(ctx.record.get("summary") or {})[1:]:  # verdict: in the table
-        c.print(line)
+        c.print(escape(line))  # a warning names its table: "[model] mesh ..."
     if ctx.record.get("pdf_skipped"):
         c.print(ctx.record["pdf_skipped"])
     c.print(f"{len(ctx.record['files'])} files in {out}/ ; open {out / 'report.html'}")

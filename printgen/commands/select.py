@@ -13,6 +13,7 @@ from printgen.commands.common import (
     fmt,
     table,
 )
+from printgen.commands.targets import show_warnings
 from printgen.inputs.prototype import load_prototype
 from printgen.run import api
 from printgen.scaling.selection import Candidate, Selection
@@ -35,12 +36,15 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     check_profile_args(args, "printer", "materials")
     proto = load_prototype(args.prototype)
+    t = api.targets(proto, args.scale)
     s = api.select(proto, args.scale, printer=args.printer, materials=args.materials)
     if args.json:
-        emit_json({"prototype": proto.name, "scale": args.scale, **s.to_record()})
+        emit_json({"prototype": proto.name, "scale": args.scale, **s.to_record(),
+                   "warnings": list(t.warnings)})
         return 0
     show_selection(s, None if args.all else SHOW)
     show_bed(proto, args.scale, s)
+    show_warnings(t)  # the targets' (flume, printed mesh): they hold for any choice above
     return 0
 
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from rich.markup import escape
+
 from printgen.commands.common import (
     add_json_arg,
     add_prototype_args,
@@ -43,5 +45,14 @@ def show_targets(name: str, t: ScaledTargets) -> None:
     out.print(f"Model flow: v = {f.velocity:.3g} m/s, h = {f.depth * 1e3:.3g} mm, "
               f"Fr = {f.froude:.2f}, Re = {f.reynolds:.0f} (R_h = {f.hydraulic_radius * 1e3:.3g} "
               f"mm), Q = {f.discharge * 1e3:.3g} L/s over {f.channel_width * 1e3:.0f} mm")
-    for w in f.warnings:
-        out.print(f"[bold yellow]warning:[/] {w}")
+    show_warnings(t)
+
+
+def show_warnings(t: ScaledTargets) -> None:
+    """The targets' warnings (model flow, the flume's limits, the printed mesh), and what
+    clears the flume's limits."""
+    out = console()
+    for w in t.warnings:
+        out.print(f"[bold yellow]warning:[/] {escape(w)}")
+    if t.flow.fix:
+        out.print(f"[bold]Flume:[/] {escape(t.flow.fix)}")

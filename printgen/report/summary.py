@@ -6,7 +6,7 @@ to do next. Built from the run's records (printgen.report.records); the box, rep
 from __future__ import annotations
 
 import html
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from printgen.barrier.patterns import mesh_text
@@ -27,6 +27,8 @@ NEXT_STIFF = ("Change the net before printing: the model is too stiff. Try a sof
 NEXT_SOFT = ("Change the net before printing: the model is too soft. Try a stiffer material or "
              "more passes (printgen select), or printgen design, then make again.")
 NEXT_NONE = "Run make with the verification step to get the verdict before printing."
+NEXT_FLUME = ("Change the scale or the flume before printing: {fix}. Then make again at that "
+              "scale (the parts are selected anew for it).")
 
 
 def print_rows(gcode: dict[str, GcodeRecord]) -> tuple[list[str], list[list[str]]]:
@@ -55,8 +57,10 @@ def print_totals(gcode: dict[str, GcodeRecord]) -> dict[str, float]:
 
 @dataclass(frozen=True)
 class Summary:
-    """The summary's numbers: verdict and reason, the band verdict of each metric, the chosen
-    parts, print totals (None: no G-code) and the next step (report.json "summary")."""
+    """The summary's numbers: verdict and reason (its sentences one per line), the band
+    verdict of each metric, the chosen parts, print totals (None: no G-code), the next step
+    and the targets' warnings that the verdict does not already say (report.json
+    "summary")."""
 
     verdict: str
     reason: str
@@ -64,10 +68,12 @@ class Summary:
     parts: list[dict[str, Any]]
     next: str
     print: dict[str, float] | None = None
+    warnings: list[str] = field(default_factory=list)
 
     def to_record(self) -> dict[str, Any]:
         out: dict[str, Any] = {"verdict": self.verdict, "reason": self.reason,
-                               "band": self.band, "parts": self.parts, "next": self.next}
+                               "band": self.band, "parts": self.parts, "next": self.next,
+                               "warnings": self.warnings}
         if self.print is not None:
             out["print"] = self.print
         return out
@@ -81,14 +87,27 @@ def summarize(run: RunRecords, next_step: str = "") -> Summary:
         verdict, reason, band, nxt = "not run", "", {}, NEXT_NONE
     else:
         v = check.verification
-        verdict, reason = ("PASS" if v.ok else "FAIL"), v.headline
+        verdict, reason = v.verdict, v.headline
         band = {b.metric: b.text for b in band_verdicts(v.prototype.deformation.values,
                                                         check.band)
                 if b.levels > 0}  # none where nothing deforms
         ratios = [m.ratio_high for m in v.mismatches if not m.ok]
         nxt = NEXT_PASS if v.ok else (NEXT_STIFF if ratios and min(ratios) < 1 else NEXT_SOFT)
+        if not v.runnable and v.flow is not None:  # a new scale changes the parts too
+            nxt = NEXT_FLUME.format(fix=v.flow.fix)
     return Summary(verdict, reason, band, chosen_parts(run.design, run.plan),
-                   next_step or nxt, print_totals(gcode) if gcode else None)
+                   next_step or nxt, print_totals(gcode) if gcode else None,
+                   _warnings(run))
+
+
+def _warnings(run: RunRecords) -> list[str]:
+    """The targets' warnings (the model flow's, a printed mesh chosen for another scale), but
+    the flume's limits the verdict states."""
+    if run.plan is None:
+        return []
+    t = run.plan.targets
+    stated = {lim.text for lim in t.flow.limits} if run.check is not None else set()
+    return [w for w in t.warnings if w not in stated]
 
 
 def chosen_parts(design: Design, plan: PlanRecords | None = None) -> list[dict[str, Any]]:
@@ -141,8 +160,9 @@ def summary_html(s: Summary) -> str:
     e = html.escape
     ok = s.verdict == "PASS"
     tag = ("pass" if ok else "fail") if s.verdict != "not run" else "note"
-    lines = [(f'<p class="verdict"><span class="{tag}">{e(s.verdict)}</span> '
-             f'{e(s.reason or "the verification was not run")}</p>')]
+    reason = "<br>".join(e(x) for x in (s.reason or "the verification was not run").split("\n"))
+    lines = [f'<p class="verdict"><span class="{tag}">{e(s.verdict)}</span> {reason}</p>']
+    lines += [f"<p><b>Warning:</b> {e(w)}</p>" for w in s.warnings]
     if s.band:
         lines.append("<p><b>Uncertainty band</b> (where the prototype lies against the "
                      "model's band):</p><ul>" + "".join(
@@ -175,5 +195,6 @@ def summary_lines(s: dict[str, Any]) -> list[str]:
         t = s["print"]
         out.append(f"printing: {duration(t['print_time_s'])}, {t['filament_mm'] / 1e3:.2f} m "
                    f"of filament, {t['mass_g']:.1f} g")
+    out += [f"warning: {w}" for w in s.get("warnings", [])]
     out.append(f"next: {s['next']}")
     return out

@@ -2,9 +2,7 @@
 printgen reference): Froude scaling in the same fluid, with stiffness scaled too.
 
 Every quantity q of the model is q_prototype * lambda**exponent; the exponents are those of the
-reference's scaling table. Reynolds number: Re = v R_h / nu with the hydraulic radius of the
-approach section R_h = w h / (w + 2 h) (the standard open-channel definition; the paper's
-v w_B h / nu is not dimensionless).
+reference's scaling table. The model flow and the flume's limits: `printgen.scaling.flow`.
 """
 
 from __future__ import annotations
@@ -16,9 +14,13 @@ from typing import Any
 from printgen.barrier.patterns import get_pattern
 from printgen.errors import InputError
 from printgen.inputs.prototype import Prototype
-from printgen.units import NU_WATER, G
+from printgen.scaling.flow import (  # noqa: F401 (RE_TURBULENT: also read from here)
+    RE_TURBULENT,
+    FlowCheck,
+    flow_check,
+)
+from printgen.units import MM, G
 
-RE_TURBULENT = 2500.0  # model flow must stay turbulent (reference, section 2)
 SCALE_MAX = 100.0  # largest lambda of the reference's scale series (1, 10, 30, 50, 100)
 
 
@@ -35,20 +37,6 @@ class TargetRow:
 
 
 @dataclass(frozen=True)
-class FlowCheck:
-    """The model flow: Froude and Reynolds numbers, discharge, and warnings."""
-
-    velocity: float  # m/s
-    depth: float  # m
-    channel_width: float  # m
-    hydraulic_radius: float  # m
-    froude: float
-    reynolds: float
-    discharge: float  # m^3/s over the channel width
-    warnings: tuple[str, ...]
-
-
-@dataclass(frozen=True)
 class ScaledTargets:
     """Targets of the model at 1/scale; `rows` keyed by `TargetRow.key` in `values`."""
 
@@ -59,9 +47,16 @@ class ScaledTargets:
     flow: FlowCheck
     values: dict[str, float] = field(repr=False)
     prototype: str = ""  # the prototype's name
+    mesh_warnings: tuple[str, ...] = ()  # a [model] mesh chosen for another scale
 
     def __getitem__(self, key: str) -> float:
         return self.values[key]
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """Every warning of the targets: the model flow's (the flume's limits among them),
+        then the printed mesh's."""
+        return self.flow.warnings + self.mesh_warnings
 
     def to_record(self) -> dict:
         """JSON-ready record of the targets (stable keys)."""
@@ -72,10 +67,13 @@ class ScaledTargets:
                                 "prototype": r.prototype, "model": r.model} for r in self.rows},
             "pi_groups": {"prototype": self.pi_prototype, "model": self.pi_model},
             "flow": self.flow,
-            "warnings": list(self.flow.warnings),
+            "warnings": list(self.warnings),
         }
 
 
+# A [model] mesh whose size is off the prototype's mesh scaled to this lambda by more than this is
+# warned: the range printgen design searches each diagonal in (printgen.search.space).
+MESH_TOLERANCE = 0.25
 FORCE_EXPONENT = -3  # a force scales as lambda^-3 (Froude similitude, same fluid density)
 
 
@@ -149,7 +147,30 @@ def scale_targets(p: Prototype, scale: float) -> ScaledTargets:
     values = {r.key: r.model for r in rows}
     proto = {r.key: r.prototype for r in rows}
     return ScaledTargets(lam, rows, pi_groups(proto, p), pi_groups(values, p),
-                         flow_check(p, values, lam), values, p.name)
+                         flow_check(p, values, lam, scale_max=SCALE_MAX), values, p.name,
+                         mesh_reuse(p, values, lam))
+
+
+def mesh_reuse(p: Prototype, v: dict[str, float], lam: float) -> tuple[str, ...]:
+    """The warning of a [model] mesh chosen for another scale (none without one or within
+    MESH_TOLERANCE). It compares the mesh's size, the geometric mean of its two diagonals'
+    factors over the prototype's mesh scaled to 1/lam: another scale changes both by the same
+    factor, while a lab may reshape the mesh on purpose (the paper's 1:40 diamond, 20.6 x 9.4 mm,
+    is 1.31x the scaled prototype's across and 1.07x up: 1.18x in size)."""
+    m = p.model
+    if m.mesh_x_mm is None or m.mesh_y_mm is None:
+        return ()
+    fx, fy = m.mesh_x_mm * MM / v["mesh_x"], m.mesh_y_mm * MM / v["mesh_y"]
+    size = math.sqrt(fx * fy)
+    if abs(size - 1) <= MESH_TOLERANCE:
+        return ()
+    sx, sy = v["mesh_x"] / MM, v["mesh_y"] / MM
+    return (f"[model] mesh {m.mesh_x_mm:g} x {m.mesh_y_mm:g} mm is {size:.2f}x the prototype's "
+            f"mesh scaled to 1:{lam:g} ({sx:.3g} x {sy:.3g} mm; {fx:.2f}x across, {fy:.2f}x up: "
+            f"Pi2 = a / h_B {fx - 1:+.0%} off), beyond the +-{MESH_TOLERANCE:.0%} printgen "
+            f"design searches in; its size fits 1:{lam / size:.0f}, so it was chosen for another "
+            "scale. Drop [model] mesh_x_mm and mesh_y_mm to print the prototype's mesh scaled "
+            f"({sx:.3g} x {sy:.3g} mm), or give a mesh chosen for 1:{lam:g}",)
 
 
 def pi_groups(v: dict[str, float], p: Prototype) -> dict[str, float]:
@@ -162,29 +183,3 @@ def pi_groups(v: dict[str, float], p: Prototype) -> dict[str, float]:
         "pi4_froude": v["velocity"] / math.sqrt(G * v["height"]),
         "pi5_modulus_over_dynamic_pressure": modulus / (p.density * v["velocity"] ** 2),
     }
-
-
-def flow_check(p: Prototype, v: dict[str, float], lam: float) -> FlowCheck:
-    """Froude, Reynolds (hydraulic radius) and flume fit of the model flow."""
-    width = p.flume.width if p.flume else v["width"]
-    h, u = v["depth"], v["velocity"]
-    r_h = width * h / (width + 2 * h)
-    froude, reynolds = u / math.sqrt(G * h), u * r_h / NU_WATER
-    discharge = u * h * width
-    warn = []
-    if reynolds < RE_TURBULENT:
-        warn.append(f"model flow Re = {reynolds:.0f} is below {RE_TURBULENT:.0f}: not turbulent; "
-                    "use a smaller scale (lambda) or a faster, deeper flow")
-    if p.flume:
-        f = p.flume
-        if v["width"] > f.width:
-            warn.append(f"model barrier width {v['width'] * 1e3:.0f} mm exceeds the flume width "
-                        f"{f.width * 1e3:.0f} mm; use a larger lambda or a wider flume")
-        if discharge > f.max_discharge:
-            warn.append(f"model discharge {discharge * 1e3:.2f} L/s exceeds the flume's "
-                        f"{f.max_discharge * 1e3:.2f} L/s; lower the prototype velocity or depth "
-                        "or use a larger lambda")
-        if not f.froude_min <= froude <= f.froude_max:
-            warn.append(f"model Froude {froude:.2f} is outside the flume's range "
-                        f"{f.froude_min:g}-{f.froude_max:g}")
-    return FlowCheck(u, h, width, r_h, froude, reynolds, discharge, tuple(warn))

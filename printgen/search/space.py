@@ -6,8 +6,9 @@ across and up the panel (nx, ny): every candidate's diagonals fit the model pane
 (mesh_x = 2 W / nx, mesh_y = 2 H / ny), as `barrier.patterns.diamond.diamond_net` builds it.
 
 The bounds default to the printer's pass limits (`selection.MAX_BEADS_ACROSS`, `MAX_LAYERS`) and
-to each mesh diagonal within +-`MESH_TOLERANCE` of the scaled prototype's (Pi2 = a / h_B); the
-user can set all of them.
+to each mesh diagonal within +-`MESH_TOLERANCE` of the scaled prototype's (Pi2 = a / h_B; the
+tolerance lives in `printgen.scaling.similitude`, which also warns of a [model] mesh chosen for
+another scale with it); the user can set all of them.
 """
 
 from __future__ import annotations
@@ -25,9 +26,8 @@ from printgen.scaling.selection import (
     MAX_LAYERS,
     net_print_name,
 )
-from printgen.scaling.similitude import ScaledTargets
+from printgen.scaling.similitude import MESH_TOLERANCE, ScaledTargets
 
-MESH_TOLERANCE = 0.25  # default bounds: each diagonal within +-25 % of the scaled prototype's
 BORDER_BEADS = (2, 4)  # border frame widths searched, in net beads (even: the frame splits
 # around the net's corner loops in the parts stage)
 MIN_HALF_CELLS = 4  # fewer half-meshes than this across or up is not a net worth verifying

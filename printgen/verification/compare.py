@@ -118,28 +118,30 @@ def increments(d: Deformation) -> Deformation:
                        d.max_strand_tension, d.max_cable_tension)
 
 
-def headline(mismatches: list[Mismatch], *, tolerance: float = TOLERANCE) -> str:
-    """The verdict in one sentence: which way the model is off and by how much (model /
-    prototype above h/h_B = UPPER_RANGE; every quantity is a deformation, so less is stiffer)."""
+def headlines(mismatches: list[Mismatch], *, tolerance: float = TOLERANCE) -> list[str]:
+    """The verdict's sentences: one when the model matches, else one per direction of error,
+    each naming its quantities and by how much they are off (model / prototype above h/h_B =
+    UPPER_RANGE; every quantity is a deformation, so less is stiffer). A model off both ways
+    gets two sentences, never one that says "too stiff" and "too soft" at once."""
     known = [m for m in mismatches if np.isfinite(m.ratio_high)]
     bad = [m for m in known if not m.ok]
     if not known:
-        return "no deformation to compare"
+        return ["no deformation to compare"]
     if not bad:
         lo, hi = min(m.ratio_high for m in known), max(m.ratio_high for m in known)
-        return (f"model within {tolerance:.0%} of the prototype's peak on all {len(mismatches)} "
+        return [f"model within {tolerance:.0%} of the prototype's peak on all {len(mismatches)} "
                 f"quantities; it deforms {lo:.2f}x to {hi:.2f}x the prototype above h/h_B = "
-                f"{UPPER_RANGE:g}")
-    stiff = [m.ratio_high for m in bad if m.ratio_high < 1]
-    soft = [m.ratio_high for m in bad if m.ratio_high >= 1]
-    parts = []
-    if stiff:
-        parts.append(f"too stiff: deforms {1 - max(stiff):.0%} to {1 - min(stiff):.0%} less"
-                     if len(stiff) > 1 else f"too stiff: deforms {1 - stiff[0]:.0%} less")
-    if soft:
-        parts.append(f"too soft: deforms {min(soft) - 1:.0%} to {max(soft) - 1:.0%} more"
-                     if len(soft) > 1 else f"too soft: deforms {soft[0] - 1:.0%} more")
-    way = " in some quantities, ".join(parts) if stiff and soft else parts[0]
-    return (f"model {way} than the prototype above h/h_B = {UPPER_RANGE:g}; {len(bad)} of "
-            f"{len(mismatches)} quantities fail (off by more than {tolerance:.0%} of the "
-            "prototype's peak)")
+                f"{UPPER_RANGE:g}"]
+    out = []
+    for way, less, group in (("stiff", True, [m for m in bad if m.ratio_high < 1]),
+                             ("soft", False, [m for m in bad if m.ratio_high >= 1])):
+        if not group:
+            continue
+        offs = [abs(m.ratio_high - 1) for m in group]
+        least, most = f"{min(offs):.0%}", f"{max(offs):.0%}"
+        by = least if least == most else f"{least} to {most}"
+        names = ", ".join(METRICS[m.metric].split(" (")[0] for m in group)
+        out.append(f"model too {way} in {len(group)} of {len(mismatches)} quantities ({names}): "
+                   f"deforms {by} {'less' if less else 'more'} than the prototype above h/h_B = "
+                   f"{UPPER_RANGE:g} (off by more than {tolerance:.0%} of the prototype's peak)")
+    return out

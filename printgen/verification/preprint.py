@@ -25,7 +25,7 @@ from printgen.executor.local import (  # worker lifecycle: ground floor
 )
 from printgen.inputs.prototype import Prototype
 from printgen.scaling.record import Design
-from printgen.scaling.similitude import scale_targets
+from printgen.scaling.similitude import FlowCheck, scale_targets
 from printgen.scene.options import SceneOptions, build_scene
 from printgen.scene.pressure import loads_function
 from printgen.scene.scenes import BarrierScene, lateral_mounting, noted
@@ -38,7 +38,7 @@ from printgen.verification.compare import (
     compare,
     deformation,
     explain,
-    headline,
+    headlines,
     increments,
 )
 
@@ -153,7 +153,8 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw: Any
 
 @dataclass(frozen=True)
 class Verification:
-    """Prototype vs printed model over the loading sweep."""
+    """Prototype vs printed model over the loading sweep; `flow`: the model flow at this
+    scale, with the limits of the flume that bind the verdict (None: not checked)."""
 
     load_case: str
     prototype: Run
@@ -165,10 +166,24 @@ class Verification:
     asked: int = 0  # load levels asked; the comparison used len(model.deformation.levels)
     load: dict[str, Any] = field(default_factory=dict)  # the case's spec and per-level values
     by_load: dict[str, CaseRuns] = field(default_factory=dict)  # --loads: each case's sweeps
+    flow: FlowCheck | None = None
 
     @property
     def ok(self) -> bool:
+        """True when the model deforms like the prototype (every quantity within tolerance);
+        the verdict also needs a flume that can run the test (`verdict`)."""
         return all(m.ok for m in self.mismatches)
+
+    @property
+    def runnable(self) -> bool:
+        """False when the prototype file's flume cannot run the scaled test (its discharge,
+        width or Froude range: `printgen.scaling.flow`)."""
+        return self.flow is None or not self.flow.limits
+
+    @property
+    def verdict(self) -> str:
+        """PASS when the model deforms like the prototype and the flume can run the test."""
+        return "PASS" if self.ok and self.runnable else "FAIL"
 
     @property
     def compared(self) -> int:
@@ -181,9 +196,17 @@ class Verification:
         return self.compared >= self.asked
 
     @property
+    def headlines(self) -> list[str]:
+        """The verdict's sentences: each flume limit that binds, then the deformations' (one
+        per direction of error: `printgen.verification.compare.headlines`)."""
+        flume = [] if self.flow is None else [f"the flume cannot run this test: {lim.text}"
+                                              for lim in self.flow.limits]
+        return flume + headlines(self.mismatches)
+
+    @property
     def headline(self) -> str:
-        """Which way the model is off and by how much, in one sentence."""
-        return headline(self.mismatches)
+        """The verdict's sentences, one per line."""
+        return "\n".join(self.headlines)
 
     def to_record(self) -> dict[str, Any]:
         """Every number of the verification, JSON-ready."""
@@ -194,8 +217,10 @@ class Verification:
 
         runs = (("prototype", self.prototype), ("model", self.model))
         return {
-            "load_case": self.load_case, "ok": self.ok, "verdict": "PASS" if self.ok else "FAIL",
+            "load_case": self.load_case, "ok": self.ok, "verdict": self.verdict,
             "summary": self.headline,
+            "flume": {"limits": [] if self.flow is None else list(self.flow.limits),
+                      "fix": "" if self.flow is None else self.flow.fix},
             "reasons": self.reasons, "mismatches": self.mismatches,
             "mismatches_from_start": self.from_start,
             "prototype": dump(self.prototype.deformation), "model": dump(self.model.deformation),
@@ -238,6 +263,7 @@ class VerifyPlan:
     ps: BarrierScene
     ms: BarrierScene
     lv: np.ndarray
+    flow: FlowCheck | None = None  # the model flow and the flume's limits (the verdict's)
 
     def jobs(self) -> list[tuple]:
         """(sweep, args, kwargs) of the model, then of the prototype (run_jobs' form)."""
@@ -256,7 +282,7 @@ class VerifyPlan:
         mm = compare(proto.deformation, model.deformation)
         start = compare(increments(proto.deformation), increments(model.deformation))
         return Verification(self.case.title, proto, model, mm, explain(mm), ce, start,
-                            len(self.lv), load_rec)
+                            len(self.lv), load_rec, flow=self.flow)
 
 
 def verify_plan(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
@@ -266,7 +292,8 @@ def verify_plan(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
     if lv is None:  # the usual levels and the case's own (the jam's discharge steps)
         own = case.levels_for(ms, kw_m["site"])
         lv = levels() if own is None else np.unique(np.concatenate([levels(), own]))
-    return VerifyPlan(case, kw_p, kw_m, ps, ms, np.asarray(lv, dtype=float))
+    return VerifyPlan(case, kw_p, kw_m, ps, ms, np.asarray(lv, dtype=float),
+                      scale_targets(p, d.scale).flow)
 
 
 def verify(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
