@@ -27,6 +27,7 @@ from typing import Any
 
 from printgen.errors import TimeLimitError
 from printgen.executor import start
+from printgen.executor.signals import signals_deferred, unblock_signals
 from printgen.executor.start import WATCH_THREAD, Platform
 from printgen.trace import span, traced_job
 
@@ -43,6 +44,7 @@ def init_worker(plat: Platform, sink: Any = None, at: float | None = None) -> No
     _shared, _listener = None, None  # a forked worker's copies of its parent's
     for s in plat.signals:
         signal.signal(s, signal.SIG_IGN)
+    unblock_signals()  # blocked since it started (`_Workers`): ignored now, a pending one dropped
     parent = multiprocessing.parent_process()
     if plat.pdeathsig:
         _die_with_parent_linux()
@@ -206,7 +208,9 @@ class _Workers:
 
     def __init__(self, workers: int) -> None:
         plat = start.platform()
-        ctx = multiprocessing.get_context(start.start_method(plat))
+        method = start.start_method(plat)
+        start.servers_for(method)
+        ctx = multiprocessing.get_context(method)
         self.queue = ctx.SimpleQueue() if _listener else None
         self.reader: threading.Thread | None = None
         self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
@@ -215,7 +219,9 @@ class _Workers:
 
     def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> Future:
         fn, args, kwargs = traced_job(fn, args, kwargs)
-        with start.watch_is_safe():
+        # the workers a submit starts begin with the stop signals blocked: one sent to the
+        # group before `init_worker` ignores them would stop a worker with a traceback
+        with start.watch_is_safe(), signals_deferred():
             f = self.pool.submit(fn, *args, **kwargs)
         if self.queue is not None and self.reader is None:
             # started once the workers are (a forking pool starts them all at its first job):
