@@ -33,6 +33,7 @@ from printgen.trace import span, traced_job
 
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
 READER_JOIN_S = 5.0  # the progress reader has only the queued reports left to pass on
+STOP_JOIN_S = 5.0  # killed workers and their pool's manager thread end at once
 
 
 def init_worker(plat: Platform, sink: Any = None, at: float | None = None) -> None:
@@ -332,12 +333,17 @@ def helper() -> Iterator[Helper]:
 
 
 def stop(pool: ProcessPoolExecutor) -> None:
-    """Kill the pool's workers now and reap them (no waiting for running jobs)."""
+    """Kill the pool's workers now and reap them (no waiting for running jobs), and let its
+    manager thread end: one still closing its wake-up pipe when Python exits makes
+    concurrent.futures' exit hook write to a closed pipe, an "Exception ignored" traceback."""
     procs = list((getattr(pool, "_processes", None) or {}).values())  # no public API for this
     for p in procs:
         with contextlib.suppress(Exception):
             p.kill()
     pool.shutdown(wait=False, cancel_futures=True)
+    manager = getattr(pool, "_executor_manager_thread", None)
+    if manager is not None and manager is not threading.current_thread():
+        manager.join(timeout=STOP_JOIN_S)
     for p in procs:
         with contextlib.suppress(Exception):
-            p.join(timeout=5)
+            p.join(timeout=STOP_JOIN_S)

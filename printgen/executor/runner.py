@@ -58,18 +58,26 @@ class Runner:
 
 @contextmanager
 def _bar(show: bool, label: str, total: int) -> Iterator[Callable[[], None]]:
-    """A rich progress bar on stderr (or nothing): yields the function that advances it."""
-    if not show:
+    """A rich progress bar on stderr when it is a terminal (or nothing: in a log the bar's
+    redraws are noise, and a run that fails or is stopped must end in one line): yields the
+    function that advances it. Erased when the block ends in an error or a signal."""
+    from rich.console import Console
+
+    console = Console(stderr=True)
+    if not show or not console.is_terminal:
         yield lambda: None
         return
-    from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
     with Progress("[progress.description]{task.description}", BarColumn(),
                   MofNCompleteColumn(), TimeElapsedColumn(),
-                  console=Console(stderr=True), transient=False) as bar:
+                  console=console, transient=False) as bar:
         task = bar.add_task(label, total=total)
-        yield lambda: bar.advance(task)
+        try:
+            yield lambda: bar.advance(task)
+        except BaseException:
+            bar.live.transient = True  # the error's (or the signal's) line stands alone
+            raise
 
 
 @contextmanager
