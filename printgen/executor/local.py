@@ -337,11 +337,11 @@ def stop(pool: ProcessPoolExecutor) -> None:
     manager thread end: one still closing its wake-up pipe when Python exits makes
     concurrent.futures' exit hook write to a closed pipe, an "Exception ignored" traceback."""
     procs = list((getattr(pool, "_processes", None) or {}).values())  # no public API for this
+    manager = getattr(pool, "_executor_manager_thread", None)  # (shutdown forgets both)
     for p in procs:
         with contextlib.suppress(Exception):
             p.kill()
     pool.shutdown(wait=False, cancel_futures=True)
-    manager = getattr(pool, "_executor_manager_thread", None)
     if manager is not None and manager is not threading.current_thread():
         manager.join(timeout=STOP_JOIN_S)
     for p in procs:
