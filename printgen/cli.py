@@ -66,13 +66,15 @@ def main(argv: list[str] | None = None) -> int:
     to report it (PRINTGEN_DEBUG=1 re-raises it, traceback and all).
 
     Without `argv` (the console script, `python -m printgen`) the process is the command's:
-    the signal handlers stay after the return, so that a signal while Python shuts down still
-    ends it with the line and the code (`_Outcome.at_end`). With `argv` (a test, a notebook)
-    they are restored."""
+    the signal handlers stay after the return, so that a signal while Python shuts down (its
+    threads joined, its exit hooks run) still ends it with the line and the code
+    (`_Outcome.at_end`); after the last exit hook one changes nothing. With `argv` (a test, a
+    notebook) they are restored."""
     process = argv is None
     argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
     outcome = _Outcome(command_name(argv))
     if process:
+        signals.ignore_at_exit()
         signals.ending(outcome.at_end)
     with signals.signals_raise(restore=not process):
         try:
