@@ -13,6 +13,7 @@ at once, a line only if none was printed yet.
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import os
 import signal
@@ -68,13 +69,13 @@ def main(argv: list[str] | None = None) -> int:
     Without `argv` (the console script, `python -m printgen`) the process is the command's:
     the signal handlers stay after the return, so that a signal while Python shuts down (its
     threads joined, its exit hooks run) still ends it with the line and the code
-    (`_Outcome.at_end`); after the last exit hook one changes nothing. With `argv` (a test, a
-    notebook) they are restored."""
+    (`_Outcome.at_end`), and the last exit hook ends it (`_Outcome.exit_now`). With `argv` (a
+    test, a notebook) they are restored."""
     process = argv is None
     argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
     outcome = _Outcome(command_name(argv))
     if process:
-        signals.ignore_at_exit()
+        atexit.register(outcome.exit_now)  # the first exit hook: run last
         signals.ending(outcome.at_end)
     with signals.signals_raise(restore=not process):
         try:
@@ -195,7 +196,19 @@ class _Outcome:
         if self.code is None:
             return
         code = self.code if self.said else self.stopped(signum)
-        for stream in (sys.stdout, sys.stderr):
-            with contextlib.suppress(Exception):  # a closed pipe: the code still goes out
-                stream.flush()
-        os._exit(code)
+        _exit(code)
+
+    def exit_now(self) -> None:
+        """The last exit hook of the command line's process (the others ran: workers reaped,
+        temporary folders removed): end it now with its code. Python's finalisation, which
+        would follow, resets the signal handlers to the defaults first: a signal then would
+        kill the process with no line, or be lost."""
+        if self.code is not None:  # else an exception is on its way out (PRINTGEN_DEBUG)
+            _exit(self.code)
+
+
+def _exit(code: int) -> None:
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):  # a closed pipe: the code still goes out
+            stream.flush()
+    os._exit(code)

@@ -122,20 +122,6 @@ def ending(then: Callable[[int], None]) -> None:
     _ending = then
 
 
-def ignore_at_exit() -> None:
-    """Register, as the first exit hook (run last), one that ignores the stop signals: once
-    the other hooks ran (workers reaped, temporary folders removed) nothing is left to stop,
-    and Python's finalisation would otherwise reset the handlers to the defaults (the process
-    killed with no line, for the command line's own process)."""
-    import atexit
-
-    def ignore() -> None:
-        for s in handled_signals():
-            signal.signal(s, signal.SIG_IGN)
-
-    atexit.register(ignore)
-
-
 @contextlib.contextmanager
 def signals_deferred() -> Iterator[None]:
     """Within the block SIGINT, SIGTERM and SIGHUP are held and re-sent at its end (main
