@@ -16,6 +16,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import textwrap
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -280,3 +281,33 @@ def test_a_second_signal_does_not_cut_the_first_ones_cleanup_short():
             time.sleep(0.1)
             cleaned.append(True)
     assert exc.value.signum == signal.SIGINT and cleaned == [True]
+
+
+STOP_BIG = """
+    import sys, threading, time
+    from printgen.executor import local
+
+    def big(_):
+        return b"x" * 100_000_000  # written to the result pipe in many pieces
+
+    if __name__ == "__main__":
+        for delay in (0.15, 0.3, 0.45, 0.6):
+            w = local._Workers(2)
+            futures = [w.submit(big, i) for i in range(2)]
+            time.sleep(delay)
+            local.stop(w.pool)
+            left = [t.name for t in threading.enumerate() if t is not threading.main_thread()]
+            assert left == [], (delay, left)
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="workers need 2 cores")
+def test_stopping_workers_while_they_send_results_leaves_no_thread_to_wait_for(tmp_path):
+    """A worker killed while writing its result left the pool's manager thread reading the
+    rest, and Python's exit waiting for it (the stopped command never ended)."""
+    script = tmp_path / "stop_big.py"
+    script.write_text(textwrap.dedent(STOP_BIG))
+    r = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                       timeout=EXIT_S, check=False)
+    assert r.returncode == 0, r.stderr
