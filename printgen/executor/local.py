@@ -335,13 +335,13 @@ def helper() -> Iterator[Helper]:
 def stop(pool: ProcessPoolExecutor) -> None:
     """Kill the pool's workers now and reap them (no waiting for running jobs), and let its
     manager thread end: concurrent.futures' exit hook waits for it, and it may be stuck
-    reading the rest of a result a killed worker was writing, or its queue's feeder writing a
-    job nobody will read (this process holds the other ends of both pipes: no end of file
-    comes), so those ends are closed once the workers are dead. No public API for any of it."""
+    reading the rest of a result a killed worker was writing (this process holds the pipe's
+    other end too: no end of file comes), so that end is closed once the workers are dead.
+    (The manager thread then closes the jobs' pipe itself, which frees its feeder.) No public
+    API for any of it."""
     procs = list((getattr(pool, "_processes", None) or {}).values())
     manager = getattr(pool, "_executor_manager_thread", None)  # (shutdown forgets them)
-    pipes = [getattr(getattr(pool, q, None), end, None)
-             for q, end in (("_result_queue", "_writer"), ("_call_queue", "_reader"))]
+    results = getattr(getattr(pool, "_result_queue", None), "_writer", None)
     for p in procs:
         with contextlib.suppress(Exception):
             p.kill()
@@ -349,8 +349,8 @@ def stop(pool: ProcessPoolExecutor) -> None:
         with contextlib.suppress(Exception):
             p.join(timeout=STOP_JOIN_S)
     pool.shutdown(wait=False, cancel_futures=True)
-    for pipe in pipes:
+    if results is not None:  # only this thread uses that end here: closed once
         with contextlib.suppress(Exception):
-            pipe.close()
+            results.close()
     if manager is not None and manager is not threading.current_thread():
         manager.join(timeout=STOP_JOIN_S)
