@@ -27,11 +27,13 @@ from typing import Any
 
 from printgen.errors import TimeLimitError
 from printgen.executor import start
+from printgen.executor.signals import signals_deferred, unblock_signals
 from printgen.executor.start import WATCH_THREAD, Platform
 from printgen.trace import span, traced_job
 
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
 READER_JOIN_S = 5.0  # the progress reader has only the queued reports left to pass on
+STOP_JOIN_S = 5.0  # killed workers and their pool's manager thread end at once
 
 
 def init_worker(plat: Platform, sink: Any = None, at: float | None = None) -> None:
@@ -43,6 +45,7 @@ def init_worker(plat: Platform, sink: Any = None, at: float | None = None) -> No
     _shared, _listener = None, None  # a forked worker's copies of its parent's
     for s in plat.signals:
         signal.signal(s, signal.SIG_IGN)
+    unblock_signals()  # blocked since it started (`_Workers`): ignored now, a pending one dropped
     parent = multiprocessing.parent_process()
     if plat.pdeathsig:
         _die_with_parent_linux()
@@ -206,7 +209,9 @@ class _Workers:
 
     def __init__(self, workers: int) -> None:
         plat = start.platform()
-        ctx = multiprocessing.get_context(start.start_method(plat))
+        method = start.start_method(plat)
+        start.servers_for(method)
+        ctx = multiprocessing.get_context(method)
         self.queue = ctx.SimpleQueue() if _listener else None
         self.reader: threading.Thread | None = None
         self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
@@ -215,7 +220,9 @@ class _Workers:
 
     def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> Future:
         fn, args, kwargs = traced_job(fn, args, kwargs)
-        with start.watch_is_safe():
+        # the workers a submit starts begin with the stop signals blocked: one sent to the
+        # group before `init_worker` ignores them would stop a worker with a traceback
+        with start.watch_is_safe(), signals_deferred():
             f = self.pool.submit(fn, *args, **kwargs)
         if self.queue is not None and self.reader is None:
             # started once the workers are (a forking pool starts them all at its first job):
@@ -326,12 +333,24 @@ def helper() -> Iterator[Helper]:
 
 
 def stop(pool: ProcessPoolExecutor) -> None:
-    """Kill the pool's workers now and reap them (no waiting for running jobs)."""
-    procs = list((getattr(pool, "_processes", None) or {}).values())  # no public API for this
+    """Kill the pool's workers now and reap them (no waiting for running jobs), and let its
+    manager thread end: concurrent.futures' exit hook waits for it, and it may be stuck
+    reading the rest of a result a killed worker was writing (this process holds the pipe's
+    other end too: no end of file comes), so that end is closed once the workers are dead.
+    (The manager thread then closes the jobs' pipe itself, which frees its feeder.) No public
+    API for any of it."""
+    procs = list((getattr(pool, "_processes", None) or {}).values())
+    manager = getattr(pool, "_executor_manager_thread", None)  # (shutdown forgets them)
+    results = getattr(getattr(pool, "_result_queue", None), "_writer", None)
     for p in procs:
         with contextlib.suppress(Exception):
             p.kill()
-    pool.shutdown(wait=False, cancel_futures=True)
     for p in procs:
         with contextlib.suppress(Exception):
-            p.join(timeout=5)
+            p.join(timeout=STOP_JOIN_S)
+    pool.shutdown(wait=False, cancel_futures=True)
+    if results is not None:  # only this thread uses that end here: closed once
+        with contextlib.suppress(Exception):
+            results.close()
+    if manager is not None and manager is not threading.current_thread():
+        manager.join(timeout=STOP_JOIN_S)

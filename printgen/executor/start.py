@@ -2,8 +2,10 @@
 `spawn`), what the platform offers them (`Platform`, found once in the first process and
 handed to every worker, so workers of workers use the same), the fork server started early
 with the jobs' modules (`preload`, `warm_up`) and multiprocessing's resource tracker quietened
-(`quiet_tracker`). Workers start by `fork` where it exists and is safe (Linux, a parent
-running no other Python thread), else by `forkserver` (POSIX) or `spawn` (Windows, macOS).
+(`quiet_tracker`), both started with the stop signals blocked (`servers_for`: they never see
+the group's signals and end when the processes they serve end). Workers start by `fork` where
+it exists and is safe (Linux, a parent running no other Python thread), else by `forkserver`
+(POSIX) or `spawn` (Windows, macOS).
 """
 
 from __future__ import annotations
@@ -11,14 +13,14 @@ from __future__ import annotations
 import contextlib
 import multiprocessing
 import os
-import signal
 import sys
 import threading
 import warnings
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 
-SIGNAL_NAMES = ("SIGINT", "SIGTERM", "SIGHUP")  # the stop signals; SIGHUP is POSIX only
+from printgen.executor.signals import handled_signals, signals_deferred
+
 SYSTEM = sys.platform  # "linux", "darwin", "win32", ...
 WATCH_THREAD = "printgen-parent-watch"  # the thread of `local._watch_parent`
 TRACKER_WARNING = "ignore:resource_tracker:UserWarning"  # a -W option (sys.warnoptions)
@@ -46,11 +48,6 @@ def inherit(plat: Platform) -> None:
     """In a worker (`local.init_worker`): use the first process's Platform from now on."""
     global _inherited
     _inherited = plat
-
-
-def handled_signals() -> tuple[int, ...]:
-    """SIGINT, SIGTERM and SIGHUP, those the platform defines."""
-    return tuple(int(getattr(signal, n)) for n in SIGNAL_NAMES if hasattr(signal, n))
 
 
 def platform() -> Platform:
@@ -87,18 +84,33 @@ def preload(modules: Iterable[str]) -> None:
     process. Under `fork` and `spawn` nothing is done."""
     if start_method() != "forkserver":
         return
+    multiprocessing.get_context("forkserver").set_forkserver_preload(list(modules))
+    servers_for("forkserver")
+
+
+def servers_for(method: str) -> None:
+    """Start what workers started by `method` need, if not running: multiprocessing's resource
+    tracker (`quiet_tracker`; not for `fork`) and, for `forkserver`, the fork server (with the
+    modules of `preload`), each with the stop signals blocked (`signals.signals_deferred`),
+    which they keep: a signal to the process group (Ctrl-C) would otherwise stop the fork
+    server in its imports, or the tracker (SIGHUP: a relaunched tracker then reports every
+    queue it never saw), each with a traceback. They end when the processes they serve end."""
+    if method == "fork" or os.name != "posix":  # Windows has no resource tracker
+        return
+    quiet_tracker()
+    if method != "forkserver":
+        return
     from multiprocessing import forkserver
 
-    multiprocessing.get_context("forkserver").set_forkserver_preload(list(modules))
-    forkserver.ensure_running()
+    with signals_deferred():
+        forkserver.ensure_running()  # the tracker runs: its check leaves the mask alone
 
 
 def warm_up(modules: Iterable[str]) -> None:
     """Where workers start by `forkserver`, start the fork server now with the jobs'
     `modules` (`preload`: it imports them while the caller goes on), the resource tracker
-    quietened first (`quiet_tracker`: the fork server starts it)."""
+    quietened first (`servers_for`)."""
     if not os.environ.get("PRINTGEN_SERIAL") and cores() > 1 and start_method() == "forkserver":
-        quiet_tracker()
         preload(modules)
 
 
@@ -112,7 +124,8 @@ def quiet_tracker() -> None:
 
     if TRACKER_WARNING not in sys.warnoptions:
         sys.warnoptions.append(TRACKER_WARNING)
-    resource_tracker.ensure_running()
+    with signals_deferred():  # it ignores SIGINT and SIGTERM, and SIGHUP stays blocked
+        resource_tracker.ensure_running()
 
 
 def cores() -> int:

@@ -30,7 +30,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
-from printgen.executor.signals import signals_deferred
+from printgen.executor.signals import raise_received, signals_deferred
 from printgen.outputs.files import FULL_ERRNOS, OutputError, named
 from printgen.outputs.lock import check_lock_path, folder_lock
 from printgen.outputs.manifest import edited_files, foreign_entry, write_manifest
@@ -72,6 +72,7 @@ def staged_dir(final: str | Path, *, force: bool = False,
                 write_manifest(stage, meta or {}, volatile)
             except OSError as exc:  # a full disk fails in write(), which names no file
                 raise (named(exc, stage) if exc.errno in FULL_ERRNOS else exc) from None
+            raise_received()  # a signal a library swallowed: the run stops, its stage goes
             with signals_deferred():  # a signal now comes after the swap and its cleanup
                 check_destination(dest, force=force, inputs=inputs)
                 swap_in(stage, dest)
