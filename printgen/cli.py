@@ -79,6 +79,10 @@ def main(argv: list[str] | None = None) -> int:
         signals.ending(outcome.at_end)
     with signals.signals_raise(restore=not process):
         try:
+            if process:  # the libraries' temporary files in the run's own folder
+                from printgen.outputs.tempdir import private_tempdir
+
+                private_tempdir()
             outcome.code = _parse_and_run(argv, outcome)
         except Interrupted as exc:  # in the imports or the parsing, or just after the command
             outcome.code = outcome.stopped(exc.signum)
