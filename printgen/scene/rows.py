@@ -12,9 +12,10 @@ from printgen.errors import GeometryError
 def mid_levels(x: np.ndarray, z: np.ndarray, w: float, h: float, tol: float
                ) -> list[tuple[float, float]]:
     """(height m, weight) of the one or two node rows that bracket mid-height h/2, weighted by
-    linear interpolation in z (`printgen.scene.scenes`). Rows strictly between the bottom and the top
-    rows only; rows that reach both lateral edges (a sensor wire is anchored at the edge) when
-    two of them bracket h/2, else any rows (`to_edges` carries their wires to the edges)."""
+    linear interpolation in z (`printgen.scene.scenes`). Rows strictly between the bottom and
+    the top rows only; rows that reach both lateral edges (a sensor wire is anchored at the
+    edge) when two of them bracket h/2, else any rows (`to_edges` carries their wires to the
+    edges)."""
     levels = np.unique(np.round(z / tol)) * tol
     inner = levels[(levels > 2 * tol) & (levels < h - 2 * tol)]
     if not inner.size:

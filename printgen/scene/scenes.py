@@ -43,13 +43,15 @@ from printgen.barrier.patterns import AS_DRAWN, get_pattern, mesh_text
 from printgen.errors import GeometryError
 from printgen.inputs.materials import PanelLaw, load_material
 from printgen.inputs.prototype import LATERAL, Prototype
+from printgen.inputs.prototype import SENSOR_FORCE_N as PAPER_SENSOR_N
 from printgen.scaling.record import Design
 from printgen.scaling.section import area_m2, net_membrane_law
 from printgen.scene.rows import mid_levels, to_edges
 from printgen.solver import Law, linear
 from printgen.units import MM, RHO_WATER, G
 
-SENSOR_FORCE_N = 1.0  # wire tension of each string potentiometer (reference, section 4)
+# wire tension of each string potentiometer (reference, section 4), unless [flume] says
+SENSOR_FORCE_N = PAPER_SENSOR_N
 MID_UPPER = "mid_upper"  # the mid-height sensor's wire on the row above h/2 (when between rows)
 SENSOR_EXIT = 0.1  # the potentiometer stands this fraction of the width beyond the right edge
 __all__ = ["FLOW"]  # the flow direction, defined with the load cases (printgen.barrier.loads)
@@ -218,12 +220,15 @@ def lateral_mounting(p: Prototype) -> str:
 
 def prototype_scene(p: Prototype, *, mounting: str | None = None,
                     orientation: str = PROTOTYPE_ORIENTATION,
-                    load: str | LoadCase | None = None) -> BarrierScene:
+                    load: str | LoadCase | None = None,
+                    sensor_force: float = 0.0) -> BarrierScene:
     """The prototype's nominal scene (callers use `printgen.scene.build_scene`, which applies
     the other options): net with its panel law (read along the mesh diagonal `orientation`) or
     linear strands, sliding border cables, mounted like the model (`mounting`, default the
-    file's [flume] lateral); its sensor wires only read (a field barrier carries no sensors);
-    `load`: the load case its assumptions state (default hydrostatic)."""
+    file's [flume] lateral); its sensor wires only read (a field barrier carries no sensors)
+    unless `sensor_force` N > 0 (the model's sensor force scaled by lambda^3, to tell the
+    sensors' disturbance apart); `load`: the load case its assumptions state (default
+    hydrostatic)."""
     mounting = mounting or lateral_mounting(p)
     pattern = get_pattern(p.net.pattern)
     g = pattern.graph(p.width / MM, p.height / MM, p.net.mesh_x / MM, p.net.mesh_y / MM)
@@ -252,18 +257,19 @@ def prototype_scene(p: Prototype, *, mounting: str | None = None,
     if p.border is not None:
         rows.append(("border cables", (f"d = {p.border.diameter / MM:g} mm, E = "
                      f"{p.border.modulus / 1e9:g} GPa, sliding, no pretension"), src))
-    return _finish(s, rows, sensors=False, load=load)
+    return _finish(s, rows, force=sensor_force, load=load, model=False)
 
 
 def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
                 orientation: str | None = None,
-                load: str | LoadCase | None = None) -> BarrierScene:
+                load: str | LoadCase | None = None,
+                sensor_force: float = SENSOR_FORCE_N) -> BarrierScene:
     """The printed model's nominal scene (callers use `printgen.scene.build_scene`, which
     applies the other options): its pattern's net with the material's (measured) law, printed
     border frame, cables of the measured modulus, mounted by `mounting`, and the three sensor
-    wires pulling SENSOR_FORCE_N along themselves. `orientation` ("short", "long"): the mesh
-    diagonal the material's panel test loaded (None: the one its profile records); `load`:
-    the load case its assumptions state (default hydrostatic)."""
+    wires pulling `sensor_force` N along themselves ([flume] sensor_force_n). `orientation`
+    ("short", "long"): the mesh diagonal the material's panel test loaded (None: the one its
+    profile records); `load`: the load case its assumptions state (default hydrostatic)."""
     n = d.net
     pattern = get_pattern(n.pattern)
     g = n.graph()
@@ -290,7 +296,7 @@ def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
              f"({e_src})" + (", on the edge rows (the prototype's edge strands)"
                              if pattern.edge_strands else "")),
              f"design; profile materials/{n.material}"), *rows]
-    return _finish(s, rows, sensors=True, load=load)
+    return _finish(s, rows, force=sensor_force, load=load, model=True)
 
 
 def model_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
@@ -328,17 +334,20 @@ def noted(s: BarrierScene, *rows: Assumption) -> BarrierScene:
     return dataclasses.replace(s, assumptions=(*s.assumptions, *rows))
 
 
-def _finish(s: BarrierScene, rows: list[Assumption], *, sensors: bool,
-            load: str | LoadCase | None) -> BarrierScene:
-    """The scene with its sensor wires pulling (model) or only reading (prototype), and the
-    assumptions shared by every scene after the scene's own."""
-    force = SENSOR_FORCE_N if sensors else 0.0
+def _finish(s: BarrierScene, rows: list[Assumption], *, force: float,
+            load: str | LoadCase | None, model: bool) -> BarrierScene:
+    """The scene with its sensor wires pulling `force` N each (0: they only read), and the
+    assumptions shared by every scene after the scene's own (`model`: the printed model's)."""
+    if not 0 <= force < math.inf:
+        raise GeometryError(f"sensor force {force:g} N must be 0 or more; set [flume] "
+                            "sensor_force_n in the prototype file")
     wires = {k: dataclasses.replace(w, force=force * w.weight) for k, w in s.wires.items()}
-    rows = [*rows, *_common_assumptions(s, sensors, get_load(load))]
+    rows = [*rows, *_common_assumptions(s, force, model, get_load(load))]
     return dataclasses.replace(s, wires=wires, assumptions=tuple(rows))
 
 
-def _common_assumptions(s: BarrierScene, sensors: bool, load: LoadCase) -> list[Assumption]:
+def _common_assumptions(s: BarrierScene, force: float, model: bool, load: LoadCase
+                        ) -> list[Assumption]:
     paper = "Lambert et al. 2023"
     out = []
     if s.cables:
@@ -352,13 +361,18 @@ def _common_assumptions(s: BarrierScene, sensors: bool, load: LoadCase) -> list[
         out.append(("mounting", "anchored on the bed and the banks, top free",
                     ("printgen's scene simple-free-top (README: Pre-print verification, barriers "
                      "without border cables)")))
-    wire = (f"{SENSOR_FORCE_N:g} N along each wire" if sensors
-            else "read only (no sensors on a field barrier)")
+    if force > 0:
+        wire = f"{force:.4g} N along each wire" + (
+            "" if model else " (the model's sensor force x lambda^3: the sensors' share of the "
+            "load as on the model)")
+    else:
+        wire = ("read only (no sensors on a field barrier)" if not model
+                else "read only (sensor_force_n = 0)")
     out += [("sensor wires", (f"bottom, top and mid-height rows, {wire}; anchored at the left "
              f"edge node, over the row's nodes, to the potentiometer {SENSOR_EXIT:.0%} of the "
              "width beyond the right edge; reading = change of wire length"),
-             (f"{paper}: three 1 N extension sensors (Fig. 6a); routing: README, The flume "
-             "test as it is run")),
+             (f"[flume] sensor_force_n (default {SENSOR_FORCE_N:g} N: {paper}, three 1 N "
+              "extension sensors, Fig. 6a); routing: README, The flume test as it is run")),
             _mid_assumption(s),
             *load.assumptions,
             ("initial state", "flat, no pretension, no slack; gravity on the net neglected",
