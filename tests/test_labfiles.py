@@ -127,7 +127,7 @@ def test_summary_of_a_verify_record_without_selection(monkeypatch):
                                 text="no deformation to compare")]
     monkeypatch.setattr(summary, "band_verdicts", lambda values, band: verdicts)
     d = reference_design_1_40()
-    v = SimpleNamespace(ok=False, headline="model too stiff", mismatches=[],
+    v = SimpleNamespace(ok=False, headline="model too stiff", mismatches=[], sensors=None,
                         prototype=SimpleNamespace(deformation=SimpleNamespace(values={})))
     run = RunRecords("t", d, steps={"verification": CheckRecords(v, None, 40.0, nested=False)})
     summary = summarize(run, "fitted: stiffness 0.8 x")
