@@ -178,6 +178,7 @@ class Verification:
     load: dict[str, Any] = field(default_factory=dict)  # the case's spec and per-level values
     by_load: dict[str, CaseRuns] = field(default_factory=dict)  # --loads: each case's sweeps
     sensors: SensorCheck | None = None  # the sensors' share of the load (and its check)
+    loaded_prototype: Run | None = None  # the prototype swept with sensors scaled (sensors)
 
     @property
     def ok(self) -> bool:
@@ -291,7 +292,7 @@ class VerifyPlan:
         mm = compare(proto.deformation, model.deformation)
         start = compare(increments(proto.deformation), increments(model.deformation))
         return Verification(self.case.title, proto, model, mm, explain(mm), ce, start,
-                            len(self.lv), load_rec, sensors=check)
+                            len(self.lv), load_rec, sensors=check, loaded_prototype=loaded)
 
     def _sensors(self, model: Run, loaded: Run | None) -> SensorCheck:
         force, mm = scene_sensor_force(self.ms), None
