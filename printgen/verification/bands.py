@@ -80,6 +80,7 @@ class Band:
     failed: dict[str, list[float]] = field(default_factory=dict)
     mounting: str | None = None  # the nominal run's mounting, kept by every variant
     work: list[dict[str, Any]] = field(default_factory=list)  # Run.work() of every sweep run
+    sensor_force: float | None = None  # N per sensor wire of the nominal run, kept by every variant
 
     def envelope(self, *, from_start: bool = False
                  ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
@@ -194,7 +195,7 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
         if r.failed:
             failed[v.label] = sorted(r.failed)
     return Band(lv, nom, out, {v.label: v.source for v in variants}, list(notes or []), k,
-                change, time.perf_counter() - t0, failed, mounting, work)
+                change, time.perf_counter() - t0, failed, mounting, work, force)
 
 
 SIGNIFICANT = 0.1  # levels where the prototype is below 10 % of its peak carry no verdict
