@@ -1,6 +1,6 @@
 """The mid-height sensor wire: a wire at exactly half the net's height, read between the two
 node rows that bracket it (linear interpolation in z), never the top or bottom row, and
-converging as the mesh is refined."""
+converging as the mesh is refined; the deflection at mid-height alike."""
 
 from __future__ import annotations
 
@@ -70,6 +70,9 @@ def test_coarse_mesh_mid_wire_is_never_the_top_row(tmp_path):
     for w in sensor_wires(s.wires, "mid"):
         assert not edges & set(w.nodes.tolist())
     assert _heights(s) == pytest.approx([1.6, 2.4])
+    centres = [c for c, _ in s.mid_centres]  # the deflection at mid-height: between them
+    assert s.nodes[centres, 2] == pytest.approx([1.6, 2.4])
+    assert [wt for _, wt in s.mid_centres] == pytest.approx([0.5, 0.5])
 
 
 def test_one_wire_reads_as_before():
@@ -83,8 +86,9 @@ def test_one_wire_reads_as_before():
                                                                rel=EXACT)
 
 
-def _mid_strain(k: int) -> float:
-    """Mid-height elongation of the realistic prototype at h/h_B = 1 on its mesh / k."""
+def _mid_readings(k: int) -> tuple[float, float]:
+    """Mid-height elongation and deflection / width of the realistic prototype at h/h_B = 1
+    on its mesh / k."""
     p = load_prototype(REALISTIC)
     q = dataclasses.replace(p, net=dataclasses.replace(p.net, mesh_x=p.net.mesh_x / k,
                                                        mesh_y=p.net.mesh_y / k))
@@ -92,15 +96,17 @@ def _mid_strain(k: int) -> float:
     r = sweep(s, np.array([0.0, 0.25, 0.5, 0.75, 1.0]), load=get_load(None),
               site=Site(q.velocity, q.net.strand_diameter, q.depth, None))
     assert not r.failed
-    return float(r.deformation.values["strain_mid"][-1])
+    v = r.deformation.values
+    return float(v["strain_mid"][-1]), float(v["deflection"][-1])
 
 
 @pytest.mark.slow
 def test_mid_height_reading_converges_under_refinement():
     """x1, x2, x3 refinement of the realistic prototype's net (the same panel law per unit
-    width): the change of the mid-height reading shrinks (the nearest row jumped +6 % at x2
-    and back at x3), and x2 to x3 moves it by under 1 %."""
-    e = [_mid_strain(k) for k in (1, 2, 3)]
-    d1, d2 = e[1] - e[0], e[2] - e[1]
-    assert abs(d2) < abs(d1)
-    assert abs(d2) / e[2] < 0.01  # the x3 net's discretisation error, at most
+    width): the change of the mid-height reading and of the deflection at mid-height shrinks
+    (the nearest row jumped +6 % at x2 and back at x3), and x2 to x3 moves them by under 1 %."""
+    readings = [_mid_readings(k) for k in (1, 2, 3)]
+    for e in zip(*readings, strict=True):
+        d1, d2 = e[1] - e[0], e[2] - e[1]
+        assert abs(d2) < abs(d1), e
+        assert abs(d2) / e[2] < 0.01, e  # the x3 net's discretisation error, at most

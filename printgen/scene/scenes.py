@@ -105,7 +105,8 @@ class BarrierScene:
     nodes : (n, 3) m; fixed : (n,) bool anchors; elements : (m, 2) int; element_law : (m,) int
     index into `laws`; cables : name -> (node sequence anchor..anchor, law);
     rows : name -> node sequence of the bottom, top and mid-height rows (left to right; "mid"
-    the row nearest h/2 among the one or two the mid-height sensor is read from);
+    the row nearest h/2 among the one or two the mid-height sensor is read from); centre : the
+    node nearest the centre of rows["mid"]; top_centre : of the top row;
     wires : the sensor wires by row name (the mid-height sensor's second row: MID_UPPER);
     area_per_node : m^2 (A* = net area / nodes);
     mounting : one of MOUNTINGS; hold : N/m holding each free node at rest (0: none);
@@ -132,6 +133,9 @@ class BarrierScene:
     assumptions: tuple[Assumption, ...] = ()
     pressure: str = "flow"  # one of PRESSURES: the water's force along the flow or normal
     rest_nodes: np.ndarray | None = None  # (n, 3) m printed geometry when mounted otherwise
+    # (node, weight) at the centre of each row the mid-height sensor is read from: the
+    # deflection at mid-height is interpolated between them as the reading is (empty: `centre`)
+    mid_centres: tuple[tuple[int, float], ...] = ()
 
 
 def recorded_orientation(law: PanelLaw) -> str:
@@ -152,9 +156,10 @@ def panel_axes(mesh_a: float, mesh_b: float, orientation: str) -> tuple[float, f
 
 def _net_arrays(g: NetGraph, to_m: float
                 ) -> tuple[np.ndarray, dict[str, np.ndarray], list[tuple[np.ndarray, float]],
-                           int, int]:
+                           tuple[tuple[int, float], ...], int]:
     """3D nodes (m), edge node sequences (corner to corner; "mid": the mid-height row nearest
-    h/2), the mid-height sensor's (wire nodes, weight) rows, centre and top-centre nodes."""
+    h/2), the mid-height sensor's (wire nodes, weight) rows, the (centre node, weight) of each
+    of those rows and the top-centre node."""
     xy = g.nodes_mm * to_m
     nodes = np.column_stack([xy[:, 0], np.zeros(len(xy)), xy[:, 1]])
     w, h = xy[:, 0].max(), xy[:, 1].max()
@@ -171,9 +176,9 @@ def _net_arrays(g: NetGraph, to_m: float
                for level, weight in mid_levels(x, z, w, h, tol)]
     mids = [(to_edges(row, edges["left"], edges["right"], z), wt) for row, wt in bracket]
     edges["mid"] = max(bracket, key=lambda m: m[1])[0]
-    centre = int(edges["mid"][np.argmin(np.abs(x[edges["mid"]] - w / 2))])
+    centres = tuple((int(r[np.argmin(np.abs(x[r] - w / 2))]), wt) for r, wt in bracket)
     top_centre = int(edges["top"][np.argmin(np.abs(x[edges["top"]] - w / 2))])
-    return nodes, edges, mids, centre, top_centre
+    return nodes, edges, mids, centres, top_centre
 
 
 def _scene(name: str, scale: float, g: NetGraph, to_m: float, net_law: Law,
@@ -181,7 +186,8 @@ def _scene(name: str, scale: float, g: NetGraph, to_m: float, net_law: Law,
     if mounting not in MOUNTINGS:
         raise GeometryError(f"mounting {mounting!r} is not one of {', '.join(MOUNTINGS)}; "
                             "set [flume] lateral in the prototype file")
-    nodes, edges, mids, centre, top_centre = _net_arrays(g, to_m)
+    nodes, edges, mids, centres, top_centre = _net_arrays(g, to_m)
+    centre = max(centres, key=lambda c: c[1])[0]
     diag = g.family != 0
     elements, element_law, laws = g.segments[diag], np.zeros(int(diag.sum()), int), [net_law]
     if border_law is not None:
@@ -210,7 +216,8 @@ def _scene(name: str, scale: float, g: NetGraph, to_m: float, net_law: Law,
     area = w * h / len(nodes)
     hold = HOLD_FRACTION * RHO_WATER * G * area if cable_law is None else 0.0
     return BarrierScene(name, scale, w, h, nodes, fixed, elements, element_law, laws, cables,
-                        rows, centre, top_centre, area, wires, mounting, hold)
+                        rows, centre, top_centre, area, wires, mounting, hold,
+                        mid_centres=centres)
 
 
 def lateral_mounting(p: Prototype) -> str:
@@ -396,7 +403,8 @@ def _mid_assumption(s: BarrierScene) -> Assumption:
     else:
         value = (f"{at}, between the node rows at {heights[0] / MM:.4g} and {heights[1] / MM:.4g}"
                  f" mm: their readings and the sensor's pull weighted {mids[0].weight:.3f} and "
-                 f"{mids[1].weight:.3f} (linear interpolation of the net in z)")
+                 f"{mids[1].weight:.3f} (linear interpolation of the net in z; the deflection at "
+                 "mid-height alike, from the rows' centre nodes)")
     return ("mid-height sensor", value,
             "printgen: a wire at exactly mid-height (Lambert et al. 2023: the barrier "
             "mid-height), read between the rows that bracket it; converges as the mesh is "

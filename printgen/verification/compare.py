@@ -60,13 +60,20 @@ def sensor_elongation(x0: np.ndarray, x: np.ndarray, wires: list[Wire]) -> float
     return change / rows
 
 
+def mid_deflection(scene: BarrierScene, x0: np.ndarray, x: np.ndarray) -> float:
+    """Deflection at mid-height in the flow direction / width: the centre nodes of the rows
+    that bracket h/2, linearly interpolated in z as the mid-height sensor is (else `centre`)."""
+    centres = scene.mid_centres or ((scene.centre, 1.0),)
+    return sum(wt * float(x[c, 1] - x0[c, 1]) for c, wt in centres) / scene.width
+
+
 def deformation(scene: BarrierScene, levels: np.ndarray, positions: list[np.ndarray],
                 strand_tension: list[np.ndarray], cable_tension: list[np.ndarray]) -> Deformation:
     """Normalised deformation of `scene` for each solved state (positions (n, 3) m)."""
     x0 = scene.nodes
     vals: dict[str, list[float]] = {k: [] for k in METRICS}
     for x in positions:
-        vals["deflection"].append((x[scene.centre, 1] - x0[scene.centre, 1]) / scene.width)
+        vals["deflection"].append(mid_deflection(scene, x0, x))
         vals["lowering"].append(-(x[scene.top_centre, 2] - x0[scene.top_centre, 2]) / scene.height)
         for row in ("bottom", "top", "mid"):
             vals[f"strain_{row}"].append(
