@@ -29,6 +29,10 @@ from printgen.inputs.prototype import load_prototype
     ({("flow", "velocity_m_per_s"): 500.0}, (r"velocity_m_per_s = 500.0 is out of range: it "
                                             r"must be <= 50 m/s")),
     ({("flume", "froude_min"): True}, r"froude_min = True is not a number"),
+    ({("flume", "sensor_force_n"): -1.0}, r"\[flume\]: sensor_force_n = -1.0 is out of range: "
+                                          r"it must be >= 0 N"),
+    ({("flume", "sensor_force_n"): 500.0}, r"sensor_force_n = 500.0 is out of range: it must "
+                                           r"be <= 100 N"),
     ({("model", "mesh_x_mm"): 0}, r"mesh_x_mm = 0 is out of range"),
 ])
 def test_bad_prototype_values(tmp_path, edit, message):
@@ -102,3 +106,11 @@ def test_measured_values_carry_provenance():
     assert src == "datasheet" and e == pytest.approx(5.17e9)
     assert load_material("tpe").panel_law.kappas == (30e3, 6e3)
     assert REALISTIC.exists()
+
+
+def test_sensor_force_is_an_input_defaulting_to_the_papers(tmp_path):
+    """[flume] sensor_force_n: 1 N when not given (Lambert et al. 2023's string
+    potentiometers), the file's value otherwise, in N."""
+    assert load_prototype(REALISTIC).flume.sensor_force == 1.0
+    p = load_prototype(write_variant(tmp_path, {("flume", "sensor_force_n"): 0.01}))
+    assert p.flume.sensor_force == 0.01

@@ -127,7 +127,7 @@ def test_summary_of_a_verify_record_without_selection(monkeypatch):
                                 text="no deformation to compare")]
     monkeypatch.setattr(summary, "band_verdicts", lambda values, band: verdicts)
     d = reference_design_1_40()
-    v = SimpleNamespace(ok=False, verdict="FAIL", runnable=True, flow=None,
+    v = SimpleNamespace(ok=False, verdict="FAIL", runnable=True, flow=None, sensors=None,
                         headline="model too stiff", mismatches=[],
                         prototype=SimpleNamespace(deformation=SimpleNamespace(values={})))
     run = RunRecords("t", d, steps={"verification": CheckRecords(v, None, 40.0, nested=False)})

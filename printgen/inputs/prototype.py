@@ -29,6 +29,10 @@ MIN_DEPTH_M = 0.01  # 1 cm of flow
 MIN_DENSITY_KG_PER_M3 = 500.0  # lighter than any water or debris mixture
 MIN_FLUME_M = 0.01  # a 1 cm wide flume
 MIN_MODEL_MESH_MM = 0.5  # a printed mesh diagonal narrower than one bead of a 0.4 mm nozzle
+# The string potentiometers' wire tension: about 1 N in the paper's flume (Lambert et al. 2023);
+# 100 N is far beyond any extension sensor a flume model carries.
+SENSOR_FORCE_N = 1.0
+MAX_SENSOR_N = 100.0
 
 TOP = [Field("name", str),
        Field("description", str, required=False, default="", multiline=True),
@@ -64,7 +68,10 @@ FLUME = [positive("width_m", 10.0, MIN_FLUME_M), positive("max_discharge_l_per_s
          positive("free_section_m", 10.0, MIN_DEPTH_M, required=False),
          positive("froude_min", 10.0, si=False), positive("froude_max", 10.0, si=False),
          Field("lateral", str, choices=LATERAL, required=False, default=LATERAL[0],
-               help="walls: side sheets hold the lateral edges; eyelets: only the cables' ends")]
+               help="walls: side sheets hold the lateral edges; eyelets: only the cables' ends"),
+         Field("sensor_force_n", float, lo=0.0, hi=MAX_SENSOR_N, required=False,
+               default=SENSOR_FORCE_N,
+               help="pull of each string-potentiometer wire on the model (0: read only)")]
 MODEL = [positive("mesh_x_mm", 1000.0, MIN_MODEL_MESH_MM, si=False, required=False,
                   help="printed mesh across (default: the prototype's mesh_x_m scaled)"),
          positive("mesh_y_mm", 1000.0, MIN_MODEL_MESH_MM, si=False, required=False,
@@ -106,6 +113,7 @@ class FlumeSpec:
     froude_min: float
     froude_max: float
     lateral: str = LATERAL[0]  # walls: lateral edges held along their height; eyelets: ends only
+    sensor_force: float = SENSOR_FORCE_N  # N, the pull of each sensor wire on the model
 
 
 @dataclass(frozen=True)

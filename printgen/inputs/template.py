@@ -39,6 +39,8 @@ MEANING = {
     "froude_min": "lowest Froude number the flume can run (-)",
     "froude_max": "highest Froude number the flume can run (-)",
     "lateral": "lateral mounting in the flume",
+    "sensor_force_n": ("pull of each of the three string-potentiometer wires on the model "
+                       "(Lambert et al. 2023: about 1 N); 0: the sensors only read"),
     "mesh_x_mm": "printed mesh across (default: mesh_x_m scaled)",
     "mesh_y_mm": "printed mesh up (default: mesh_y_m scaled)",
     "printer": "printer profile (printgen profiles list)",
@@ -67,7 +69,8 @@ VALUES: dict[str, dict[str, Any]] = {  # the simple barrier: runs as written
                  "pretension_n": 0.0},
     "[flow]": {"velocity_m_per_s": 6.0, "depth_m": 4.0, "density_kg_per_m3": 1000.0},
     "[flume]": {"width_m": 0.4, "max_discharge_l_per_s": 8.0, "free_section_m": 0.3,
-                "froude_min": 0.5, "froude_max": 1.4, "lateral": "walls"},
+                "froude_min": 0.5, "froude_max": 1.4, "lateral": "walls",
+                "sensor_force_n": 1.0},
     "[model]": {"mesh_x_mm": 5.0, "mesh_y_mm": 5.0, "pattern": "square", "printer": "generic-350",
                 "net_print": "net-3pass", "cable_print": "cable-4pass", "materials": ["tpe"]},
 }

@@ -171,6 +171,7 @@ def _sweep_sections(rep: Report, v: Verification, scale: float, band: Band | Non
                + ("; shaded: the model's uncertainty band)." if band is not None else ")."),
                "verification")
     _deformed_section(rep, v)
+    _sensor_section(rep, v)
     rep.paragraph(f"Solver: {sum(v.prototype.iterations)} + {sum(v.model.iterations)} Newton "
                   f"iterations over {len(p.levels)} load levels (times in timings.json).",
                   "note")
@@ -203,6 +204,22 @@ def _deformed_section(rep: Report, v: Verification) -> None:
             rep.paragraph(f"{who}: unloaded strands stay where they are (held by "
                           f"{run.scene.hold:.3g} N/m per node); the hold carries at most "
                           f"{run.hold_share:.2%} of the applied load at any level.", "note")
+
+
+def _sensor_section(rep: Report, v: Verification) -> None:
+    """The sensors' share of the model's water load at each level (report.json:
+    verification.sensors)."""
+    s = v.sensors
+    if s is None:
+        return
+    rep.paragraph(f"Sensors: {s.text()}. Share = {s.count} wires x their pull / the "
+                  "hydrostatic resultant on the model's net (rho g sum(h - z) A*); threshold "
+                  f"{s.threshold:.0%} at h/h_B = {s.level:g}.", "note")
+    shown = [i for i, lv in enumerate(s.levels)  # every 0.1, as the other tables
+             if lv > 0 and abs(lv * 10 - round(lv * 10)) < 1e-9]
+    rep.table(["h/h_B", "water load on the model (N)", "sensors' pull / water load"],
+              [[f"{s.levels[i]:g}", f"{s.load_n[i]:.3g}", f"{s.shares[i]:.1%}"]
+               for i in shown])
 
 
 def _assumption_tables(rep: Report, v: Verification) -> None:

@@ -29,6 +29,10 @@ NEXT_SOFT = ("Change the net before printing: the model is too soft. Try a stiff
 NEXT_NONE = "Run make with the verification step to get the verdict before printing."
 NEXT_FLUME = ("Change the scale or the flume before printing: {fix}. Then make again at that "
               "scale (the parts are selected anew for it).")
+NEXT_SENSORS = ("Keep the net: it matches the prototype once the prototype's sensors pull as "
+                "much of its load. Use weaker sensors: set flume.sensor_force_n <= {limit:.2g} "
+                "N in the prototype file (each wire's pull; the sensors' share of the water "
+                "load at h/h_B = {level:g} is then at most {share:.0%}), then make again.")
 
 
 def print_rows(gcode: dict[str, GcodeRecord]) -> tuple[list[str], list[list[str]]]:
@@ -69,6 +73,7 @@ class Summary:
     next: str
     print: dict[str, float] | None = None
     warnings: list[str] = field(default_factory=list)
+    sensors: str = ""  # the sensors' share of the model's water load, one sentence
 
     def to_record(self) -> dict[str, Any]:
         out: dict[str, Any] = {"verdict": self.verdict, "reason": self.reason,
@@ -76,6 +81,8 @@ class Summary:
                                "warnings": self.warnings}
         if self.print is not None:
             out["print"] = self.print
+        if self.sensors:
+            out["sensors"] = self.sensors
         return out
 
 
@@ -83,6 +90,7 @@ def summarize(run: RunRecords, next_step: str = "") -> Summary:
     """The run's summary, from its records (`next_step` replaces the one chosen from the
     verdict)."""
     check, gcode = run.check, run.steps.get("gcode")
+    sensors = ""
     if check is None:
         verdict, reason, band, nxt = "not run", "", {}, NEXT_NONE
     else:
@@ -93,11 +101,16 @@ def summarize(run: RunRecords, next_step: str = "") -> Summary:
                 if b.levels > 0}  # none where nothing deforms
         ratios = [m.ratio_high for m in v.mismatches if not m.ok]
         nxt = NEXT_PASS if v.ok else (NEXT_STIFF if ratios and min(ratios) < 1 else NEXT_SOFT)
+        if v.sensors is not None:
+            sensors = v.sensors.text()
+            if v.sensors_to_blame:  # the net is similar: the sensors, not the material
+                nxt = NEXT_SENSORS.format(limit=v.sensors.limit_n, level=v.sensors.level,
+                                          share=v.sensors.threshold)
         if not v.runnable and v.flow is not None:  # a new scale changes the parts too
             nxt = NEXT_FLUME.format(fix=v.flow.fix)
     return Summary(verdict, reason, band, chosen_parts(run.design, run.plan),
                    next_step or nxt, print_totals(gcode) if gcode else None,
-                   _warnings(run))
+                   _warnings(run), sensors)
 
 
 def _warnings(run: RunRecords) -> list[str]:
@@ -173,6 +186,8 @@ def summary_html(s: Summary) -> str:
         + ("" if p["stiffness_error"] is None else
            f", stiffness {p['stiffness_error']:+.0%} off target") for p in s.parts)
     lines.append(f"<p><b>Chosen:</b> {parts}</p>")
+    if s.sensors:
+        lines.append(f"<p><b>Sensors:</b> {e(s.sensors)}</p>")
     if s.print is not None:
         t = s.print
         lines.append(f"<p><b>Printing:</b> {e(duration(t['print_time_s']))}, "
@@ -191,6 +206,8 @@ def summary_lines(s: dict[str, Any]) -> list[str]:
     if not s:
         return []
     out = [f"{s['verdict']}: {s['reason']}" if s["reason"] else s["verdict"]]
+    if s.get("sensors") and s["sensors"] != s["reason"]:
+        out.append(f"sensors: {s['sensors']}")
     if "print" in s:
         t = s["print"]
         out.append(f"printing: {duration(t['print_time_s'])}, {t['filament_mm'] / 1e3:.2f} m "

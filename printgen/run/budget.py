@@ -35,6 +35,7 @@ from printgen.executor.local import reporting
 from printgen.executor.start import cores
 from printgen.inputs.prototype import Prototype
 from printgen.scaling.record import Design
+from printgen.units import RHO_WATER, G
 
 # About a minute of `make` on 2 cores: the bundled simple barrier (free top) and the 1:40
 # example both fit (benchmarks/measurements.md#make-no-default-stop).
@@ -213,11 +214,25 @@ def sweeps(p: Prototype, d: Design, *, proto_factor: float = 1.0, model_factor: 
         out += [one("prototype", prototype_nodes(p, proto_factor), "nominal"),
                 one("model", m_nodes, "nominal")]
     out.append(one(f"refinement x{COARSENINGS[0]}", m_nodes / COARSENINGS[0] ** 2, "pooled"))
+    if sensors_compared(p, d):  # the prototype again, its wires pulling force x lambda^3
+        out.append(one("prototype, sensors scaled", prototype_nodes(p, proto_factor), "pooled"))
     n_band = band_variants(p, d) if variants is None else variants
     out += [one("band variant", m_nodes, "band")] * n_band
     if work.fit:
         out += [one("fit", m_nodes / COARSENED_BY**2, "serial")] * FIT_SWEEPS
     return tuple(out)
+
+
+def sensors_compared(p: Prototype, d: Design) -> bool:
+    """True when the sensors pull more than their threshold share of the model's water load
+    (`printgen.verification.sensors`; here from the continuous hydrostatic resultant, no net
+    built), so the verification sweeps the prototype a second time."""
+    from printgen.scene.readings import SENSORS
+    from printgen.verification.preprint import sensor_force
+    from printgen.verification.sensors import SENSOR_LEVEL, SENSOR_SHARE
+
+    w, h = p.width / d.scale, SENSOR_LEVEL * p.height / d.scale
+    return len(SENSORS) * sensor_force(p) > SENSOR_SHARE * RHO_WATER * G * w * h**2 / 2
 
 
 def iterations_per_level(kind: str, unknowns: float) -> float:

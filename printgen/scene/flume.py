@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from printgen.scene.readings import SENSORS
-from printgen.scene.scenes import BarrierScene
+from printgen.scene.scenes import BarrierScene, sensor_wires
 from printgen.units import MM
 
 DIGITS = 4  # decimals of mm kept in the record (0.1 um)
@@ -100,11 +100,16 @@ def flume_layout(scene: BarrierScene) -> FlumeLayout:
     cables = {k: xz[nodes] for k, (nodes, _) in scene.cables.items()}
     sensors = []
     for metric, row in SENSORS.items():
-        w = scene.wires[row]
-        route = xz[w.nodes]
-        along = float(np.sum(np.linalg.norm(np.diff(x0[w.nodes], axis=0), axis=1))) / MM
+        wires = sensor_wires(scene.wires, row)
+        w = max(wires, key=lambda v: v.weight)
+        route, exit_xz = xz[w.nodes].copy(), _xz(w.exit)
+        if len(wires) > 1:  # read between two rows: drawn at its own height (the module)
+            z = sum(v.weight * float(np.median(xz[v.nodes, 1])) for v in wires)
+            route[:, 1], exit_xz[1] = z, z
+        along = sum(v.weight * float(np.sum(np.linalg.norm(np.diff(x0[v.nodes], axis=0),
+                                                           axis=1))) for v in wires) / MM
         free = float(np.linalg.norm(w.exit - x0[w.nodes[-1]])) / MM
-        sensors.append(Sensor(metric, row, tuple(route[0]), tuple(_xz(w.exit)), route, along,
-                              free, w.force))
+        sensors.append(Sensor(metric, row, tuple(route[0]), tuple(exit_xz), route, along,
+                              free, sum(v.force for v in wires)))
     return FlumeLayout(float(hi[0] - lo[0]), float(hi[1] - lo[1]), scene.mounting, pins, held,
                        cables, xz[scene.elements], tuple(sensors))

@@ -21,6 +21,7 @@ from printgen.scene.scenes import (
     MOUNTINGS,
     PRESSURES,
     PROTOTYPE_ORIENTATION,
+    SENSOR_FORCE_N,
     BarrierScene,
     model_scene,
     prototype_scene,
@@ -41,7 +42,8 @@ class SceneOptions:
     net_factor, frame_factor, cable_factor : multipliers on the force laws of the net's
     strands, the printed border frame and the border cables; coarsen : the design's meshes
     this many times coarser, its strands as many times stiffer (the same membrane stiffness
-    per unit width).
+    per unit width); sensor_force : N pulled by each sensor wire (None: the nominal, the
+    paper's SENSOR_FORCE_N on the model, read only on the prototype).
     """
 
     mounting: str | None = None
@@ -56,6 +58,7 @@ class SceneOptions:
     frame_factor: float = 1.0
     cable_factor: float = 1.0
     coarsen: int = 1
+    sensor_force: float | None = None
 
     def __post_init__(self) -> None:
         for name, allowed in (("pressure", PRESSURES), ("net_law", NET_LAWS), ("bed", BEDS),
@@ -78,11 +81,13 @@ def build_scene(source: Prototype | Design, options: SceneOptions = NOMINAL) -> 
             raise GeometryError("the prototype's scene takes neither a derived net law nor a "
                                 "coarser mesh (design options)")
         s = prototype_scene(source, mounting=o.mounting,
-                            orientation=o.orientation or PROTOTYPE_ORIENTATION, load=o.load)
+                            orientation=o.orientation or PROTOTYPE_ORIENTATION, load=o.load,
+                            sensor_force=o.sensor_force or 0.0)
     else:
         d = coarsened(source, o.coarsen)
         s = model_scene(d, mounting=o.mounting or MOUNTINGS[0], orientation=o.orientation,
-                        load=o.load)
+                        load=o.load, sensor_force=SENSOR_FORCE_N if o.sensor_force is None
+                        else o.sensor_force)
         if o.net_law == "derived":
             s = with_derived_law(s, d, o.orientation)
     if (o.net_factor * o.coarsen, o.frame_factor, o.cable_factor) != (1.0, 1.0, 1.0):

@@ -17,7 +17,7 @@ import numpy as np
 
 from printgen.scaling.record import Design
 from printgen.scene.options import build_scene
-from printgen.scene.scenes import BarrierScene
+from printgen.scene.scenes import BarrierScene, sensor_wires
 from printgen.scene.solvernet import path_length
 from printgen.units import MM
 
@@ -52,9 +52,10 @@ def flume_units(scene: BarrierScene) -> FlumeUnits:
     """The lengths of `scene` (the printed model's solver scene) in mm."""
     x0 = scene.nodes
     rows = {}
-    for row, w in scene.wires.items():
-        rest = path_length(x0, w.nodes, w.exit)
-        rows[row] = (rest - float(np.linalg.norm(w.exit - x0[w.nodes[-1]]))) / MM
+    for row in SENSORS.values():  # a sensor read from two rows: their weighted rest lengths
+        rows[row] = sum(w.weight * (path_length(x0, w.nodes, w.exit)
+                                    - float(np.linalg.norm(w.exit - x0[w.nodes[-1]])))
+                        for w in sensor_wires(scene.wires, row)) / MM
     return FlumeUnits(scene.width / MM, scene.height / MM, rows)
 
 

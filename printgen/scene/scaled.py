@@ -27,7 +27,7 @@ def at_scale(base: BarrierScene, lam: float, name: str, *, sensors: bool = False
         laws = [law.scaled(f) for law in base.laws]
         cables = {k: (n, law.scaled(f)) for k, (n, law) in base.cables.items()}
     force = SENSOR_FORCE_N if sensors else 0.0
-    wires = {k: dataclasses.replace(w, exit=w.exit / lam, force=force)
+    wires = {k: dataclasses.replace(w, exit=w.exit / lam, force=force * w.weight)
              for k, w in base.wires.items()}
     return dataclasses.replace(
         base, name=name, scale=lam, width=base.width / lam, height=base.height / lam,

@@ -15,9 +15,17 @@ Sensor wires (`Wire`; as solver cables in `printgen.scene.solvernet`): a string
 potentiometer's wire is anchored at the barrier's left edge node of its row, runs along the
 row of nodes (the nodes are the points the wire bends over, frictionless), leaves the right
 edge node and runs on, in line with the row at rest, to the potentiometer `SENSOR_EXIT` x width
-beyond the right edge. Its spring keeps it taut at `SENSOR_FORCE_N` whatever its length. The
-reading is the change of the wire's length from the anchor to the potentiometer; the
-elongation is that change over the row's rest length.
+beyond the right edge. Its spring keeps it taut at the sensor's force (`SENSOR_FORCE_N` unless
+the prototype file's [flume] sensor_force_n says otherwise) whatever its length. The reading
+is the change of the wire's length from the anchor to the potentiometer; the elongation is
+that change over the row's rest length.
+The mid-height wire lies at exactly half the net's height, which in general falls between two
+node rows (z1 < h/2 < z2). The net between them is represented by linear interpolation in z,
+so a wire at h/2 is the two rows' wires weighted (z2 - h/2) / (z2 - z1) and (h/2 - z1) /
+(z2 - z1): its reading is the weighted change of their lengths over the weighted rest length,
+and its pull is split between them in the same proportions (the consistent nodal forces of a
+wire between the rows). As the mesh is refined both rows close in on h/2, so the reading
+converges; it is never the top or bottom row's.
 On the model the wires pull (the flume test as it is run); on the prototype they only read.
 """
 
@@ -35,12 +43,16 @@ from printgen.barrier.patterns import AS_DRAWN, get_pattern, mesh_text
 from printgen.errors import GeometryError
 from printgen.inputs.materials import PanelLaw, load_material
 from printgen.inputs.prototype import LATERAL, Prototype
+from printgen.inputs.prototype import SENSOR_FORCE_N as PAPER_SENSOR_N
 from printgen.scaling.record import Design
 from printgen.scaling.section import area_m2, net_membrane_law
+from printgen.scene.rows import mid_levels, to_edges
 from printgen.solver import Law, linear
 from printgen.units import MM, RHO_WATER, G
 
-SENSOR_FORCE_N = 1.0  # wire tension of each string potentiometer (reference, section 4)
+# wire tension of each string potentiometer (reference, section 4), unless [flume] says
+SENSOR_FORCE_N = PAPER_SENSOR_N
+MID_UPPER = "mid_upper"  # the mid-height sensor's wire on the row above h/2 (when between rows)
 SENSOR_EXIT = 0.1  # the potentiometer stands this fraction of the width beyond the right edge
 __all__ = ["FLOW"]  # the flow direction, defined with the load cases (printgen.barrier.loads)
 MOUNTINGS = LATERAL  # lateral mounting in the flume ([flume] lateral), the default first
@@ -65,11 +77,25 @@ Assumption = tuple[str, str, str]  # (what, value, source)
 @dataclass(frozen=True)
 class Wire:
     """A sensor wire: `nodes` (k,) the row it follows, anchor first; `exit` (3,) m the fixed
-    point where it enters the potentiometer; `force` N its tension (0: it only reads)."""
+    point where it enters the potentiometer; `force` N its tension (0: it only reads);
+    `weight` its share of its sensor (of the reading and of the sensor's pull: 1 unless the
+    sensor lies between two rows, see the module)."""
 
     nodes: np.ndarray
     exit: np.ndarray
     force: float
+    weight: float = 1.0
+
+
+def sensor_of(key: str) -> str:
+    """The sensor ("bottom", "top", "mid") a wire of `BarrierScene.wires` belongs to: its key,
+    up to an underscore (MID_UPPER is the mid-height sensor's second wire)."""
+    return key.split("_")[0]
+
+
+def sensor_wires(wires: dict[str, Wire], sensor: str) -> list[Wire]:
+    """The wires of `sensor` in `wires` (one, or the two rows a mid-height wire lies between)."""
+    return [w for k, w in wires.items() if sensor_of(k) == sensor]
 
 
 @dataclass(frozen=True)
@@ -78,8 +104,11 @@ class BarrierScene:
 
     nodes : (n, 3) m; fixed : (n,) bool anchors; elements : (m, 2) int; element_law : (m,) int
     index into `laws`; cables : name -> (node sequence anchor..anchor, law);
-    rows : name -> node sequence of the bottom, top and mid-height rows (left to right);
-    wires : the three sensor wires by row name; area_per_node : m^2 (A* = net area / nodes);
+    rows : name -> node sequence of the bottom, top and mid-height rows (left to right; "mid"
+    the row nearest h/2 among the one or two the mid-height sensor is read from); centre : the
+    node nearest the centre of rows["mid"]; top_centre : of the top row;
+    wires : the sensor wires by row name (the mid-height sensor's second row: MID_UPPER);
+    area_per_node : m^2 (A* = net area / nodes);
     mounting : one of MOUNTINGS; hold : N/m holding each free node at rest (0: none);
     assumptions : (what, value, source) of every modelling choice, for the report.
     """
@@ -104,6 +133,9 @@ class BarrierScene:
     assumptions: tuple[Assumption, ...] = ()
     pressure: str = "flow"  # one of PRESSURES: the water's force along the flow or normal
     rest_nodes: np.ndarray | None = None  # (n, 3) m printed geometry when mounted otherwise
+    # (node, weight) at the centre of each row the mid-height sensor is read from: the
+    # deflection at mid-height is interpolated between them as the reading is (empty: `centre`)
+    mid_centres: tuple[tuple[int, float], ...] = ()
 
 
 def recorded_orientation(law: PanelLaw) -> str:
@@ -122,8 +154,12 @@ def panel_axes(mesh_a: float, mesh_b: float, orientation: str) -> tuple[float, f
     return (lo, hi) if orientation == "short" else (hi, lo)
 
 
-def _net_arrays(g: NetGraph, to_m: float) -> tuple[np.ndarray, dict[str, np.ndarray], int, int]:
-    """3D nodes (m), edge node sequences (corner to corner), centre and top-centre nodes."""
+def _net_arrays(g: NetGraph, to_m: float
+                ) -> tuple[np.ndarray, dict[str, np.ndarray], list[tuple[np.ndarray, float]],
+                           tuple[tuple[int, float], ...], int]:
+    """3D nodes (m), edge node sequences (corner to corner; "mid": the mid-height row nearest
+    h/2), the mid-height sensor's (wire nodes, weight) rows, the (centre node, weight) of each
+    of those rows and the top-centre node."""
     xy = g.nodes_mm * to_m
     nodes = np.column_stack([xy[:, 0], np.zeros(len(xy)), xy[:, 1]])
     w, h = xy[:, 0].max(), xy[:, 1].max()
@@ -136,20 +172,13 @@ def _net_arrays(g: NetGraph, to_m: float) -> tuple[np.ndarray, dict[str, np.ndar
     x, z = nodes[:, 0], nodes[:, 2]
     edges = {"bottom": edge(z < tol, x), "top": edge(z > h - tol, x),
              "left": edge(x < tol, z), "right": edge(x > w - tol, z)}
-    edges["mid"] = edge(np.abs(z - _mid_level(x, z, w, h, tol)) < 2 * tol, x)
-    centre = int(edges["mid"][np.argmin(np.abs(x[edges["mid"]] - w / 2))])
+    bracket = [(edge(np.abs(z - level) < 2 * tol, x), weight)
+               for level, weight in mid_levels(x, z, w, h, tol)]
+    mids = [(to_edges(row, edges["left"], edges["right"], z), wt) for row, wt in bracket]
+    edges["mid"] = max(bracket, key=lambda m: m[1])[0]
+    centres = tuple((int(r[np.argmin(np.abs(x[r] - w / 2))]), wt) for r, wt in bracket)
     top_centre = int(edges["top"][np.argmin(np.abs(x[edges["top"]] - w / 2))])
-    return nodes, edges, centre, top_centre
-
-
-def _mid_level(x: np.ndarray, z: np.ndarray, w: float, h: float, tol: float) -> float:
-    """Height of the node row nearest mid-height that reaches both lateral edges (a sensor
-    wire is anchored at the edge), else of the row nearest mid-height."""
-    levels = np.unique(np.round(z / tol)) * tol
-    spans = [lv for lv in levels if np.any((np.abs(z - lv) < 2 * tol) & (x < tol))
-             and np.any((np.abs(z - lv) < 2 * tol) & (x > w - tol))]
-    pool = np.array(spans) if spans else levels
-    return float(pool[np.argmin(np.abs(pool - h / 2))])
+    return nodes, edges, mids, centres, top_centre
 
 
 def _scene(name: str, scale: float, g: NetGraph, to_m: float, net_law: Law,
@@ -157,7 +186,8 @@ def _scene(name: str, scale: float, g: NetGraph, to_m: float, net_law: Law,
     if mounting not in MOUNTINGS:
         raise GeometryError(f"mounting {mounting!r} is not one of {', '.join(MOUNTINGS)}; "
                             "set [flume] lateral in the prototype file")
-    nodes, edges, centre, top_centre = _net_arrays(g, to_m)
+    nodes, edges, mids, centres, top_centre = _net_arrays(g, to_m)
+    centre = max(centres, key=lambda c: c[1])[0]
     diag = g.family != 0
     elements, element_law, laws = g.segments[diag], np.zeros(int(diag.sum()), int), [net_law]
     if border_law is not None:
@@ -179,12 +209,15 @@ def _scene(name: str, scale: float, g: NetGraph, to_m: float, net_law: Law,
         fixed[np.concatenate([edges["bottom"], edges["left"], edges["right"]])] = True
     w, h = float(nodes[:, 0].max()), float(nodes[:, 2].max())
     rows = {k: edges[k] for k in ("bottom", "top", "mid")}
-    wires = {k: Wire(r, nodes[r[-1]] + np.array([SENSOR_EXIT * w, 0.0, 0.0]), 0.0)
-             for k, r in rows.items()}
+    beyond = np.array([SENSOR_EXIT * w, 0.0, 0.0])
+    wires = {k: Wire(edges[k], nodes[edges[k][-1]] + beyond, 0.0) for k in ("bottom", "top")}
+    for key, (r, weight) in zip(("mid", MID_UPPER), mids, strict=False):
+        wires[key] = Wire(r, nodes[r[-1]] + beyond, 0.0, weight)
     area = w * h / len(nodes)
     hold = HOLD_FRACTION * RHO_WATER * G * area if cable_law is None else 0.0
     return BarrierScene(name, scale, w, h, nodes, fixed, elements, element_law, laws, cables,
-                        rows, centre, top_centre, area, wires, mounting, hold)
+                        rows, centre, top_centre, area, wires, mounting, hold,
+                        mid_centres=centres)
 
 
 def lateral_mounting(p: Prototype) -> str:
@@ -194,12 +227,15 @@ def lateral_mounting(p: Prototype) -> str:
 
 def prototype_scene(p: Prototype, *, mounting: str | None = None,
                     orientation: str = PROTOTYPE_ORIENTATION,
-                    load: str | LoadCase | None = None) -> BarrierScene:
+                    load: str | LoadCase | None = None,
+                    sensor_force: float = 0.0) -> BarrierScene:
     """The prototype's nominal scene (callers use `printgen.scene.build_scene`, which applies
     the other options): net with its panel law (read along the mesh diagonal `orientation`) or
     linear strands, sliding border cables, mounted like the model (`mounting`, default the
-    file's [flume] lateral); its sensor wires only read (a field barrier carries no sensors);
-    `load`: the load case its assumptions state (default hydrostatic)."""
+    file's [flume] lateral); its sensor wires only read (a field barrier carries no sensors)
+    unless `sensor_force` N > 0 (the model's sensor force scaled by lambda^3, to tell the
+    sensors' disturbance apart); `load`: the load case its assumptions state (default
+    hydrostatic)."""
     mounting = mounting or lateral_mounting(p)
     pattern = get_pattern(p.net.pattern)
     g = pattern.graph(p.width / MM, p.height / MM, p.net.mesh_x / MM, p.net.mesh_y / MM)
@@ -228,18 +264,19 @@ def prototype_scene(p: Prototype, *, mounting: str | None = None,
     if p.border is not None:
         rows.append(("border cables", (f"d = {p.border.diameter / MM:g} mm, E = "
                      f"{p.border.modulus / 1e9:g} GPa, sliding, no pretension"), src))
-    return _finish(s, rows, sensors=False, load=load)
+    return _finish(s, rows, force=sensor_force, load=load, model=False)
 
 
 def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
                 orientation: str | None = None,
-                load: str | LoadCase | None = None) -> BarrierScene:
+                load: str | LoadCase | None = None,
+                sensor_force: float = SENSOR_FORCE_N) -> BarrierScene:
     """The printed model's nominal scene (callers use `printgen.scene.build_scene`, which
     applies the other options): its pattern's net with the material's (measured) law, printed
     border frame, cables of the measured modulus, mounted by `mounting`, and the three sensor
-    wires pulling SENSOR_FORCE_N along themselves. `orientation` ("short", "long"): the mesh
-    diagonal the material's panel test loaded (None: the one its profile records); `load`:
-    the load case its assumptions state (default hydrostatic)."""
+    wires pulling `sensor_force` N along themselves ([flume] sensor_force_n). `orientation`
+    ("short", "long"): the mesh diagonal the material's panel test loaded (None: the one its
+    profile records); `load`: the load case its assumptions state (default hydrostatic)."""
     n = d.net
     pattern = get_pattern(n.pattern)
     g = n.graph()
@@ -266,7 +303,7 @@ def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
              f"({e_src})" + (", on the edge rows (the prototype's edge strands)"
                              if pattern.edge_strands else "")),
              f"design; profile materials/{n.material}"), *rows]
-    return _finish(s, rows, sensors=True, load=load)
+    return _finish(s, rows, force=sensor_force, load=load, model=True)
 
 
 def model_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
@@ -304,17 +341,20 @@ def noted(s: BarrierScene, *rows: Assumption) -> BarrierScene:
     return dataclasses.replace(s, assumptions=(*s.assumptions, *rows))
 
 
-def _finish(s: BarrierScene, rows: list[Assumption], *, sensors: bool,
-            load: str | LoadCase | None) -> BarrierScene:
-    """The scene with its sensor wires pulling (model) or only reading (prototype), and the
-    assumptions shared by every scene after the scene's own."""
-    force = SENSOR_FORCE_N if sensors else 0.0
-    wires = {k: dataclasses.replace(w, force=force) for k, w in s.wires.items()}
-    rows = [*rows, *_common_assumptions(s, sensors, get_load(load))]
+def _finish(s: BarrierScene, rows: list[Assumption], *, force: float,
+            load: str | LoadCase | None, model: bool) -> BarrierScene:
+    """The scene with its sensor wires pulling `force` N each (0: they only read), and the
+    assumptions shared by every scene after the scene's own (`model`: the printed model's)."""
+    if not 0 <= force < math.inf:
+        raise GeometryError(f"sensor force {force:g} N must be 0 or more; set [flume] "
+                            "sensor_force_n in the prototype file")
+    wires = {k: dataclasses.replace(w, force=force * w.weight) for k, w in s.wires.items()}
+    rows = [*rows, *_common_assumptions(s, force, model, get_load(load))]
     return dataclasses.replace(s, wires=wires, assumptions=tuple(rows))
 
 
-def _common_assumptions(s: BarrierScene, sensors: bool, load: LoadCase) -> list[Assumption]:
+def _common_assumptions(s: BarrierScene, force: float, model: bool, load: LoadCase
+                        ) -> list[Assumption]:
     paper = "Lambert et al. 2023"
     out = []
     if s.cables:
@@ -328,13 +368,19 @@ def _common_assumptions(s: BarrierScene, sensors: bool, load: LoadCase) -> list[
         out.append(("mounting", "anchored on the bed and the banks, top free",
                     ("printgen's scene simple-free-top (README: Pre-print verification, barriers "
                      "without border cables)")))
-    wire = (f"{SENSOR_FORCE_N:g} N along each wire" if sensors
-            else "read only (no sensors on a field barrier)")
+    if force > 0:
+        wire = f"{force:.4g} N along each wire" + (
+            "" if model else " (the model's sensor force x lambda^3: the sensors' share of the "
+            "load as on the model)")
+    else:
+        wire = ("read only (no sensors on a field barrier)" if not model
+                else "read only (sensor_force_n = 0)")
     out += [("sensor wires", (f"bottom, top and mid-height rows, {wire}; anchored at the left "
              f"edge node, over the row's nodes, to the potentiometer {SENSOR_EXIT:.0%} of the "
              "width beyond the right edge; reading = change of wire length"),
-             (f"{paper}: three 1 N extension sensors (Fig. 6a); routing: README, The flume "
-             "test as it is run")),
+             (f"[flume] sensor_force_n (default {SENSOR_FORCE_N:g} N: {paper}, three 1 N "
+              "extension sensors, Fig. 6a); routing: README, The flume test as it is run")),
+            _mid_assumption(s),
             *load.assumptions,
             ("initial state", "flat, no pretension, no slack; gravity on the net neglected",
              f"{paper}: no pretension in the main cables at installation")]
@@ -345,3 +391,21 @@ def _common_assumptions(s: BarrierScene, sensors: bool, load: LoadCase) -> list[
                     "printgen (README: barriers without border cables); its force share is "
                     "reported"))
     return out
+
+
+def _mid_assumption(s: BarrierScene) -> Assumption:
+    """The row of the assumptions that says where the mid-height wire is read."""
+    mids = sensor_wires(s.wires, "mid")
+    heights = [float(np.median(s.nodes[w.nodes, 2])) for w in mids]
+    at = f"at h/2 = {s.height / 2 / MM:.4g} mm"
+    if len(mids) == 1:
+        value = f"{at}: the node row at {heights[0] / MM:.4g} mm"
+    else:
+        value = (f"{at}, between the node rows at {heights[0] / MM:.4g} and {heights[1] / MM:.4g}"
+                 f" mm: their readings and the sensor's pull weighted {mids[0].weight:.3f} and "
+                 f"{mids[1].weight:.3f} (linear interpolation of the net in z; the deflection at "
+                 "mid-height alike, from the rows' centre nodes)")
+    return ("mid-height sensor", value,
+            "printgen: a wire at exactly mid-height (Lambert et al. 2023: the barrier "
+            "mid-height), read between the rows that bracket it; converges as the mesh is "
+            "refined")

@@ -32,6 +32,7 @@ from printgen.scene.options import SceneOptions, build_scene
 from printgen.trace import span
 from printgen.verification.compare import METRICS
 from printgen.verification.preprint import Run, load_keywords, sweep
+from printgen.verification.sensors import scene_sensor_force
 from printgen.verification.variants import Variant, model_variants
 
 COARSENINGS = (2, 3)  # mesh multipliers tried in turn for the variant sweeps
@@ -79,6 +80,7 @@ class Band:
     failed: dict[str, list[float]] = field(default_factory=dict)
     mounting: str | None = None  # the nominal run's mounting, kept by every variant
     work: list[dict[str, Any]] = field(default_factory=list)  # Run.work() of every sweep run
+    sensor_force: float | None = None  # N per sensor wire of the nominal run, kept by every variant
 
     def envelope(self, *, from_start: bool = False
                  ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
@@ -158,12 +160,15 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
     t0 = time.perf_counter()
     lv = nominal.deformation.levels
     mounting = getattr(nominal.scene, "mounting", None)
+    force = scene_sensor_force(nominal.scene)  # every variant's sensors pull as the nominal's
     if variants is None:
         variants, auto_notes = model_variants(d, mounting, free_section)
         notes = [*(notes or []), *auto_notes]
-    variants = [v if v.options.mounting else dataclasses.replace(
-        v, options=dataclasses.replace(v.options, mounting=mounting)) for v in variants]
-    nominal_variant = Variant(options=SceneOptions(mounting=mounting))
+    variants = [dataclasses.replace(v, options=dataclasses.replace(
+        v.options, mounting=v.options.mounting or mounting,
+        sensor_force=force if v.options.sensor_force is None else v.options.sensor_force))
+        for v in variants]
+    nominal_variant = Variant(options=SceneOptions(mounting=mounting, sensor_force=force))
     nom = curves(nominal)
     work: list[dict[str, Any]] = []
     with span("band: refinement test"):
@@ -190,7 +195,7 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
         if r.failed:
             failed[v.label] = sorted(r.failed)
     return Band(lv, nom, out, {v.label: v.source for v in variants}, list(notes or []), k,
-                change, time.perf_counter() - t0, failed, mounting, work)
+                change, time.perf_counter() - t0, failed, mounting, work, force)
 
 
 SIGNIFICANT = 0.1  # levels where the prototype is below 10 % of its peak carry no verdict

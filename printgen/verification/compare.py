@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from printgen.scene.scenes import BarrierScene, Wire
+from printgen.scene.scenes import BarrierScene, Wire, sensor_wires
 from printgen.scene.solvernet import path_length
 
 # Normalised quantities compared between prototype and model, with their labels.
@@ -48,16 +48,36 @@ def wire_elongation(x0: np.ndarray, x: np.ndarray, wire: Wire) -> float:
     return (path_length(x, wire.nodes, wire.exit) - rest) / row
 
 
+def sensor_elongation(x0: np.ndarray, x: np.ndarray, wires: list[Wire]) -> float:
+    """What a sensor read from one or two rows' wires reads, as a strain: the wires' changes
+    of length weighted by their `weight` (linear interpolation in z between the rows), over
+    their rest lengths along the rows weighted alike (one wire: `wire_elongation`)."""
+    change = rows = 0.0
+    for w in wires:
+        rest = path_length(x0, w.nodes, w.exit)
+        change += w.weight * (path_length(x, w.nodes, w.exit) - rest)
+        rows += w.weight * (rest - float(np.linalg.norm(w.exit - x0[w.nodes[-1]])))
+    return change / rows
+
+
+def mid_deflection(scene: BarrierScene, x0: np.ndarray, x: np.ndarray) -> float:
+    """Deflection at mid-height in the flow direction / width: the centre nodes of the rows
+    that bracket h/2, linearly interpolated in z as the mid-height sensor is (else `centre`)."""
+    centres = scene.mid_centres or ((scene.centre, 1.0),)
+    return sum(wt * float(x[c, 1] - x0[c, 1]) for c, wt in centres) / scene.width
+
+
 def deformation(scene: BarrierScene, levels: np.ndarray, positions: list[np.ndarray],
                 strand_tension: list[np.ndarray], cable_tension: list[np.ndarray]) -> Deformation:
     """Normalised deformation of `scene` for each solved state (positions (n, 3) m)."""
     x0 = scene.nodes
     vals: dict[str, list[float]] = {k: [] for k in METRICS}
     for x in positions:
-        vals["deflection"].append((x[scene.centre, 1] - x0[scene.centre, 1]) / scene.width)
+        vals["deflection"].append(mid_deflection(scene, x0, x))
         vals["lowering"].append(-(x[scene.top_centre, 2] - x0[scene.top_centre, 2]) / scene.height)
         for row in ("bottom", "top", "mid"):
-            vals[f"strain_{row}"].append(wire_elongation(x0, x, scene.wires[row]))
+            vals[f"strain_{row}"].append(
+                sensor_elongation(x0, x, sensor_wires(scene.wires, row)))
     return Deformation(np.asarray(levels, float), {k: np.array(v) for k, v in vals.items()},
                        np.array([t.max() if t.size else 0.0 for t in strand_tension]),
                        np.array([t.max() if t.size else 0.0 for t in cable_tension]))

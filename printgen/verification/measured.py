@@ -396,7 +396,8 @@ def model_predictor(d: Design, band: Band, m: Measurement, kind: str = "stiffnes
     above = np.flatnonzero(band.levels >= top - 1e-9)
     n = int(above[0]) + 1 if above.size else len(band.levels)
     lv, k = band.levels[:n], band.coarsen
-    nominal = Variant(options=SceneOptions(mounting=band.mounting))
+    nominal = Variant(options=SceneOptions(mounting=band.mounting,
+                                           sensor_force=band.sensor_force))
     base = curves(run_variant(d, nominal, lv, k, load_kw)) if k > 1 else None
 
     def predict(value: float) -> dict[str, np.ndarray]:

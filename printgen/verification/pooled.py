@@ -28,6 +28,7 @@ from printgen.trace import span
 from printgen.verification.bands import COARSENINGS, Band, meshable, model_band, run_variant
 from printgen.verification.cases import case_plan, other_cases, with_cases
 from printgen.verification.preprint import Verification, steel_counterexample, verify_plan
+from printgen.verification.sensors import scene_sensor_force
 from printgen.verification.variants import Variant
 
 
@@ -40,7 +41,9 @@ def verify_with_band(p: Prototype, d: Design, *, load: str | LoadCase | None = N
     case of `loads` (`with_cases`; queued behind the band's variants); `meanwhile` is called
     here once the first sweeps have started (this process then only waits)."""
     plan = verify_plan(p, d, load=load)
-    base, first = Variant(options=SceneOptions(mounting=plan.ms.mounting)), COARSENINGS[0]
+    base = Variant(options=SceneOptions(mounting=plan.ms.mounting,
+                                        sensor_force=scene_sensor_force(plan.ms)))
+    first = COARSENINGS[0]
     cases: dict[str, list[Future]] = {}
     with shared_pool() as pool:
 
@@ -50,13 +53,15 @@ def verify_with_band(p: Prototype, d: Design, *, load: str | LoadCase | None = N
                                in case_plan(p, d, spec, plan.ms.mounting).jobs()]
 
         pair = [pool.submit(fn, *args, **kw) for fn, args, kw in plan.jobs()]
+        loaded = [pool.submit(fn, *args, **kw) for fn, args, kw in plan.sensor_jobs()]
         ahead = ({first: pool.submit(run_variant, d, base, plan.lv, first, plan.kw_m)}
                  if meshable(d, first) else {})
         ce = pool.submit(steel_counterexample, d.scale) if counterexample else None
         if meanwhile is not None:
             meanwhile()
         with span("verify: nominal sweeps"):
-            v = plan.verified(*collect(pair))
+            model, proto = collect(pair)
+            v = plan.verified(model, proto, None, collect(loaded)[0] if loaded else None)
         with span("verify: band"):
             band = model_band(d, v.model, load_kw=plan.kw_m, free_section=free_section,
                               ahead=ahead, then=queue_cases)

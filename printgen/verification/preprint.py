@@ -28,7 +28,7 @@ from printgen.scaling.record import Design
 from printgen.scaling.similitude import FlowCheck, scale_targets
 from printgen.scene.options import SceneOptions, build_scene
 from printgen.scene.pressure import loads_function
-from printgen.scene.scenes import BarrierScene, lateral_mounting, noted
+from printgen.scene.scenes import SENSOR_FORCE_N, BarrierScene, lateral_mounting, noted
 from printgen.scene.solvernet import build, hold_share, wire_slack
 from printgen.solver.loads import total_forces
 from printgen.units import MM
@@ -40,6 +40,12 @@ from printgen.verification.compare import (
     explain,
     headlines,
     increments,
+)
+from printgen.verification.sensors import (
+    SensorCheck,
+    needs_loaded_prototype,
+    scene_sensor_force,
+    sensor_check,
 )
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -62,6 +68,12 @@ def levels(step: float = LEVEL_STEP, top: float = OVERFLOW) -> np.ndarray:
 def free_section(p: Prototype) -> float | None:
     """The flume's free section (m) of the prototype file's [flume] table, or None."""
     return p.flume.free_section if p.flume is not None else None
+
+
+def sensor_force(p: Prototype) -> float:
+    """The pull (N) of each sensor wire on the model: [flume] sensor_force_n, else the
+    paper's SENSOR_FORCE_N."""
+    return p.flume.sensor_force if p.flume is not None else SENSOR_FORCE_N
 
 
 def load_keywords(p: Prototype, d: Design, load: str | LoadCase | None = None
@@ -167,6 +179,8 @@ class Verification:
     load: dict[str, Any] = field(default_factory=dict)  # the case's spec and per-level values
     by_load: dict[str, CaseRuns] = field(default_factory=dict)  # --loads: each case's sweeps
     flow: FlowCheck | None = None
+    sensors: SensorCheck | None = None  # the sensors' share of the load (and its check)
+    loaded_prototype: Run | None = None  # the prototype swept with sensors scaled (sensors)
 
     @property
     def ok(self) -> bool:
@@ -196,11 +210,22 @@ class Verification:
         return self.compared >= self.asked
 
     @property
+    def sensors_to_blame(self) -> bool:
+        """True when the model fails only because its sensors pull too hard at this scale
+        (it matches a prototype whose sensors pull as much of its load)."""
+        s = self.sensors
+        return not self.ok and s is not None and s.too_strong and s.net_similar
+
+    @property
     def headlines(self) -> list[str]:
         """The verdict's sentences: each flume limit that binds, then the deformations' (one
-        per direction of error: `printgen.verification.compare.headlines`)."""
+        per direction of error: `printgen.verification.compare.headlines`), or the sensors'
+        when they are what is off."""
         flume = [] if self.flow is None else [f"the flume cannot run this test: {lim.text}"
                                               for lim in self.flow.limits]
+        if self.sensors_to_blame:
+            assert self.sensors is not None
+            return [*flume, self.sensors.text()]
         return flume + headlines(self.mismatches)
 
     @property
@@ -234,6 +259,7 @@ class Verification:
             "hold_share": {who: run.hold_share for who, run in runs},
             "deformed_shape": self.model.shape_record(),
             "load": self.load,
+            "sensors": None if self.sensors is None else self.sensors.to_record(),
             "by_load": {name: c.to_record() for name, c in self.by_load.items()},
             "assumptions": {who: [dict(zip(("what", "value", "source"), a, strict=True))
                                   for a in run.scene.assumptions] for who, run in runs},
@@ -248,7 +274,8 @@ def barriers(p: Prototype, d: Design, load: str | LoadCase | None, mounting: str
     kw_p, kw_m = load_keywords(p, d, load)
     case = kw_m["load"]
     options = SceneOptions(mounting=mounting, load=case)
-    return case, kw_p, kw_m, build_scene(p, options), build_scene(d, options)
+    model = dataclasses.replace(options, sensor_force=sensor_force(p))
+    return case, kw_p, kw_m, build_scene(p, options), build_scene(d, model)
 
 
 @dataclass(frozen=True)
@@ -264,14 +291,23 @@ class VerifyPlan:
     ms: BarrierScene
     lv: np.ndarray
     flow: FlowCheck | None = None  # the model flow and the flume's limits (the verdict's)
+    loaded: BarrierScene | None = None  # the prototype, its sensors pulling force x lambda^3
 
     def jobs(self) -> list[tuple]:
         """(sweep, args, kwargs) of the model, then of the prototype (run_jobs' form)."""
         return [(sweep, (self.ms, self.lv), self.kw_m), (sweep, (self.ps, self.lv), self.kw_p)]
 
-    def verified(self, model: Run, proto: Run, ce: CounterExample | None = None
-                 ) -> Verification:
-        """The comparison of the two sweeps, at the levels where both converged."""
+    def sensor_jobs(self) -> list[tuple]:
+        """The sweep of the prototype with sensors pulling as much of its load as the model's,
+        when they pull more than SENSOR_SHARE of the model's (`printgen.verification.sensors`);
+        none otherwise."""
+        return [] if self.loaded is None else [(sweep, (self.loaded, self.lv), self.kw_p)]
+
+    def verified(self, model: Run, proto: Run, ce: CounterExample | None = None,
+                 loaded: Run | None = None) -> Verification:
+        """The comparison of the two sweeps, at the levels where both converged (`loaded`:
+        the run of `sensor_jobs`)."""
+        check = self._sensors(model, loaded)
         bad = set(proto.failed) | set(model.failed)
         if bad:  # compare only where both barriers converged
             keep = np.array([lvl not in bad for lvl in self.lv])
@@ -282,7 +318,16 @@ class VerifyPlan:
         mm = compare(proto.deformation, model.deformation)
         start = compare(increments(proto.deformation), increments(model.deformation))
         return Verification(self.case.title, proto, model, mm, explain(mm), ce, start,
-                            len(self.lv), load_rec, flow=self.flow)
+                            len(self.lv), load_rec, flow=self.flow, sensors=check,
+                            loaded_prototype=loaded)
+
+    def _sensors(self, model: Run, loaded: Run | None) -> SensorCheck:
+        force, mm = scene_sensor_force(self.ms), None
+        if loaded is not None:
+            bad = set(loaded.failed) | set(model.failed)
+            keep = np.array([lvl not in bad for lvl in self.lv])
+            mm = compare(_only(loaded, keep).deformation, _only(model, keep).deformation)
+        return sensor_check(self.ms, force, self.lv, mm)
 
 
 def verify_plan(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
@@ -292,8 +337,12 @@ def verify_plan(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
     if lv is None:  # the usual levels and the case's own (the jam's discharge steps)
         own = case.levels_for(ms, kw_m["site"])
         lv = levels() if own is None else np.unique(np.concatenate([levels(), own]))
+    force, loaded = sensor_force(p), None
+    if needs_loaded_prototype(ms, force):  # forces scale as lambda^-3
+        loaded = build_scene(p, SceneOptions(mounting=ps.mounting, load=case,
+                                             sensor_force=force * d.scale**3))
     return VerifyPlan(case, kw_p, kw_m, ps, ms, np.asarray(lv, dtype=float),
-                      scale_targets(p, d.scale).flow)
+                      flow=scale_targets(p, d.scale).flow, loaded=loaded)
 
 
 def verify(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
@@ -303,11 +352,12 @@ def verify(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
     hydrostatic) and compare them; both are mounted by `mounting` (default: the prototype
     file's [flume] lateral)."""
     plan = verify_plan(p, d, load=load, lv=lv, mounting=mounting)
-    jobs = plan.jobs()  # longest first
+    jobs = plan.jobs() + plan.sensor_jobs()  # longest first
     if counterexample:
         jobs.append((steel_counterexample, (d.scale,), {}))
-    model, proto, *ce = run_jobs(jobs)
-    return plan.verified(model, proto, ce[0] if ce else None)
+    model, proto, *rest = run_jobs(jobs)
+    loaded = rest.pop(0) if plan.loaded is not None else None
+    return plan.verified(model, proto, rest[0] if rest else None, loaded)
 
 
 def stated(case: LoadCase, runs: tuple[Run, Run], sites: tuple[Site, Site]
