@@ -160,3 +160,14 @@ def test_a_search_too_large_is_refused_before_any_work(tmp_path, capsys, extra, 
     err = capsys.readouterr().err
     assert re.search(message, err) and len(err.strip().splitlines()) == 1, err
     assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_a_search_over_its_time_limit_is_refused_before_any_work(tmp_path, capsys):
+    from printgen.cli import main
+
+    out = tmp_path / "o"
+    assert main(["design", str(EXAMPLES / "simple_barrier.toml"), "--scale", "40", "--serial",
+                 "--time-limit", "5", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "this design search is too big: 228,800 nets to screen and 7 to verify" in err, err
+    assert "--time-limit" in err and not out.exists()

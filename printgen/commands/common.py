@@ -38,13 +38,14 @@ def add_prototype_args(p: argparse.ArgumentParser) -> None:
                    help="geometric scale lambda = prototype / model, >= 1 (1:40 -> 40)")
 
 
-def add_time_limit_arg(p: argparse.ArgumentParser) -> None:
-    """--time-limit SECONDS: the run's estimate must fit it (printgen.run.budget)."""
+def add_time_limit_arg(p: argparse.ArgumentParser, default: float | None = None) -> None:
+    """--time-limit SECONDS: the run's estimate must fit it (printgen.run.budget); `default`
+    None: a minute (`DEFAULT_LIMIT_S`)."""
     from printgen.run.budget import DEFAULT_LIMIT_S
 
-    p.add_argument("--time-limit", type=seconds, default=DEFAULT_LIMIT_S, metavar="SECONDS",
-                   help=f"refuse runs estimated longer than this (default {DEFAULT_LIMIT_S:g} s,"
-                        " about a minute on 2 cores)")
+    limit = DEFAULT_LIMIT_S if default is None else default
+    p.add_argument("--time-limit", type=seconds, default=limit, metavar="SECONDS",
+                   help=f"refuse runs estimated longer than this (default {limit:g} s)")
 
 
 def seconds(text: str) -> float:

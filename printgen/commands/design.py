@@ -10,6 +10,7 @@ from pathlib import Path
 
 from printgen.commands.common import (
     add_json_arg,
+    add_time_limit_arg,
     check_profile_args,
     console,
     emit_json,
@@ -19,6 +20,7 @@ from printgen.commands.common import (
 from printgen.errors import InputError
 from printgen.executor.dask import check_address
 from printgen.run import api
+from printgen.run.budget import DESIGN_LIMIT_S
 from printgen.run.search import DesignRun, SearchOptions
 from printgen.search.choice import short
 from printgen.search.nets import OBJECTIVES, VERIFY_NETS, SearchResult
@@ -58,6 +60,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                         f"{VERIFY_NETS})")
     p.add_argument("--level-step", type=float, metavar="R",
                    help="load-level step of the solver stage (default: the verification's 0.05)")
+    add_time_limit_arg(p, DESIGN_LIMIT_S)
     add_json_arg(p)
     p.set_defaults(func=run)
 

@@ -40,6 +40,10 @@ from printgen.units import RHO_WATER, G
 # About a minute of `make` on 2 cores: the bundled simple barrier (free top) and the 1:40
 # example both fit (benchmarks/measurements.md#make-no-default-stop).
 DEFAULT_LIMIT_S = 60.0
+DESIGN_LIMIT_S = 600.0  # a design search runs minutes by nature; the limit stops a runaway
+# The search verifies its best candidates, soft nets close to the prototype's deformation: each
+# takes several times the Newton iterations of select's pick (measurements.md#design-verification)
+SEARCH_VERIFY_FACTOR = 6.0
 LONG_RUN_S = 30.0  # runs estimated longer show their estimate and progress (make, on a terminal)
 LEVELS = 23  # load levels of a sweep (verify.levels(): 0 to 1.1 by 0.05; tests/test_budget.py)
 # Newton iterations (chord steps included) per load level, averaged over a run's sweeps (the
@@ -320,6 +324,41 @@ def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
                      f"{math.ceil(est.seconds * 1.5 / 60) * 60:g}, or {fix}")
 
 
+def prototype_sweep_s(p: Prototype) -> float:
+    """CPU seconds (reference machine) of one sweep of the prototype's net over LEVELS
+    levels: the cost of a series case, and of a design search's verification sweep (the
+    model's net has about as many nodes at any scale)."""
+    nodes = prototype_nodes(p)
+    kind = "border cables" if p.border is not None else "free top"
+    return SweepWork("sweep", 3 * nodes, LEVELS,
+                     LEVELS * iterations_per_level(kind, 3 * nodes)).seconds
+
+
+def check_design_budget(p: Prototype, screened: int, verified: int, *, limit_s: float,
+                        cores: int, speed: float | None = None) -> float:
+    """Seconds a design search takes on `cores`: `screened` nets at SCREEN_RATE per second
+    and `verified` solver verifications (a prototype and a model sweep each); InputError
+    naming both, the limit and the fixes when it passes `limit_s`, before any work."""
+    from printgen.search.space import SCREEN_RATE
+
+    if not (math.isfinite(limit_s) and limit_s > 0):
+        raise InputError(f"--time-limit {limit_s:g} s must be a positive number of seconds")
+    if speed is None:
+        from printgen.run.speed import speed_factor
+
+        speed = speed_factor()
+    c = max(1, cores)
+    one = 2 * prototype_sweep_s(p) * SEARCH_VERIFY_FACTOR  # a prototype and a model sweep
+    seconds = speed * (screened / SCREEN_RATE + verified * one) / c
+    if seconds <= limit_s:
+        return seconds
+    raise InputError(f"this design search is too big: {screened:,} nets to screen and "
+                     f"{verified} to verify with the solver, about {seconds:.0f} s on {c} "
+                     f"cores; the limit is {limit_s:g} s. Raise it with --time-limit "
+                     f"{math.ceil(seconds * 1.5 / 60) * 60:g}, or narrow --mesh-x-mm / "
+                     "--mesh-y-mm, --materials or --verify-nets")
+
+
 def check_series_budget(p: Prototype, cases: int, *, limit_s: float, cores: int,
                         speed: float | None = None) -> tuple[float, float]:
     """(seconds, bytes) a scale series of `cases` solves of the prototype's net takes on
@@ -333,9 +372,7 @@ def check_series_budget(p: Prototype, cases: int, *, limit_s: float, cores: int,
 
         speed = speed_factor()
     nodes = prototype_nodes(p)
-    kind = "border cables" if p.border is not None else "free top"
-    one = SweepWork("case", 3 * nodes, LEVELS,
-                    LEVELS * iterations_per_level(kind, 3 * nodes)).seconds
+    one = prototype_sweep_s(p)
     c = max(1, cores)
     seconds = speed * one * math.ceil(cases / c)
     memory = c * (BASE_MEMORY_B + MEMORY_B_PER_NODE * nodes)

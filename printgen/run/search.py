@@ -24,13 +24,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from printgen.executor import open_runner
+from printgen.executor.start import cores as all_cores
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import check_destination, write_folder
 from printgen.report.jsonout import dumps
+from printgen.run.budget import DESIGN_LIMIT_S, check_design_budget
 from printgen.run.options import RunOptions
 from printgen.run.provenance import provenance_record
-from printgen.scaling.similitude import scale_targets
+from printgen.scaling.similitude import ScaledTargets, scale_targets
 from printgen.search.nets import (
     SearchResult,
     VerifyScore,
@@ -111,9 +113,29 @@ def space_for(p: Prototype, scale: float, o: SearchOptions) -> SearchSpace:
     t = scale_targets(p, scale)
     space = default_space(p, t, **kw)
     check_level_step(o.level_step)
-    check_size(space, len(half_cell_counts(t["width"] * 1e3, space.mesh_x_mm)),
-               len(half_cell_counts(t["height"] * 1e3, space.mesh_y_mm)))
+    check_size(space, *meshes_of(space, t))
     return space
+
+
+def meshes_of(space: SearchSpace, t: ScaledTargets) -> tuple[int, int]:
+    """How many meshes across and up the space holds at the targets' scale."""
+    return (len(half_cell_counts(t["width"] * 1e3, space.mesh_x_mm)),
+            len(half_cell_counts(t["height"] * 1e3, space.mesh_y_mm)))
+
+
+def check_work(p: Prototype, spaces: dict[float, SearchSpace], o: SearchOptions,
+               run: RunOptions) -> None:
+    """The search's size against its time limit (`budget.check_design_budget`), before any
+    work: every scale's nets screened, and with the deformation objective `verify_nets` of
+    of them (with every border) and select's pick verified."""
+    screened = sum(math.prod((len(sp.materials), len(sp.beads), len(sp.layers),
+                              *meshes_of(sp, scale_targets(p, s)), len(sp.border_beads)))
+                   for s, sp in spaces.items())
+    verified = sum(o.verify_nets * len(sp.border_beads) + 1 for sp in spaces.values()) \
+        if o.objective == "deformation" else 0  # each net with every border, select's pick
+    cores = 1 if run.serial or run.workers == 1 else (run.workers or min(2, all_cores()))
+    limit = DESIGN_LIMIT_S if run.time_limit_s is None else run.time_limit_s
+    check_design_budget(p, screened, verified, limit_s=limit, cores=cores)
 
 
 def search_at_scales(prototype: str | Path | Prototype, scales: list[float], *,
@@ -124,6 +146,7 @@ def search_at_scales(prototype: str | Path | Prototype, scales: list[float], *,
     run = run or RunOptions()
     p = prototype if isinstance(prototype, Prototype) else load_prototype(prototype)
     spaces = {s: space_for(p, s, options) for s in scales}  # every bound checked before work
+    check_work(p, spaces, options, run)
     results = []
     with open_runner(scheduler=run.scheduler, workers=run.workers, serial=bool(run.serial),
                      progress=progress) as runner:
