@@ -43,7 +43,7 @@ def private_tempdir(base: str | Path | None = None) -> Path | None:
 
 def remove_stale(root: Path) -> list[Path]:
     """Remove the run folders under `root` whose process no longer runs (killed runs')."""
-    gone = []
+    gone: list[Path] = []
     try:
         entries = list(os.scandir(root))
     except OSError:
