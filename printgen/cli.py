@@ -20,6 +20,7 @@ import signal
 import sys
 from typing import TYPE_CHECKING, Any
 
+from printgen import commands
 from printgen.executor import signals
 from printgen.executor.signals import Interrupted
 
@@ -29,24 +30,7 @@ if TYPE_CHECKING:
 
     from printgen.commands.parser import Parser, UsageError, build_parser, printable  # noqa: F401
 
-# One entry per command module; a module may register several subcommands (the parser,
-# `printgen.commands.parser`, imports them).
-COMMAND_MODULES = (
-    "printgen.commands.targets",
-    "printgen.commands.select",
-    "printgen.commands.profiles",
-    "printgen.commands.make",
-    "printgen.commands.design",
-    "printgen.commands.series",
-    "printgen.commands.verify",
-    "printgen.commands.check",
-    "printgen.commands.panel",
-    "printgen.commands.testpieces",
-    "printgen.commands.bench",
-    "printgen.commands.calibrate",
-    "printgen.commands.example",
-    "printgen.commands.init",
-)
+COMMAND_MODULES = commands.COMMAND_MODULES  # the one list, in printgen.commands
 COMMANDS = frozenset(m.rsplit(".", 1)[-1] for m in COMMAND_MODULES)  # each registers its own
 PARSER_NAMES = ("Parser", "UsageError", "build_parser", "printable")  # `__getattr__`'s
 REPORT_URL = "the printgen maintainers (an issue with the command line and this line)"

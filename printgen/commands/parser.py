@@ -11,7 +11,7 @@ import re
 from typing import NoReturn
 
 import printgen
-from printgen.cli import COMMAND_MODULES
+from printgen.commands import COMMAND_MODULES
 from printgen.errors import PrintgenError
 
 
