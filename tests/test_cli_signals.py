@@ -26,6 +26,7 @@ from conftest import reference_design_1_40
 from proto_files import REALISTIC, SIMPLE
 
 import printgen.run.make as make_mod
+from benchmarks.signals_at_random import session  # the processes a session has left
 from printgen.cli import run_command
 from printgen.executor import signals
 from printgen.outputs import check_folder, staged_dir, write_folder
@@ -55,18 +56,6 @@ def descendants(pid: int) -> list[int]:
     return out
 
 
-def live_in_session(sid: int) -> list[int]:
-    """Processes of session `sid` that are not zombies."""
-    pids = []
-    for stat in Path("/proc").glob("[0-9]*/stat"):
-        try:
-            text = stat.read_text()
-        except OSError:
-            continue
-        fields = text[text.rindex(")") + 2:].split()  # after "pid (comm) "
-        if int(fields[3]) == sid and fields[0] != "Z":
-            pids.append(int(stat.parent.name))
-    return pids
 
 
 def start_and_wait_for_workers(out: Path) -> subprocess.Popen:
@@ -105,9 +94,9 @@ def test_kills_during_verification_leave_nothing_behind(tmp_path):
         if sig != signal.SIGKILL:
             assert err.strip() == f"printgen make: stopped by {sig.name}; outputs left as they were"
         deadline = time.monotonic() + GONE_AFTER_S
-        while live_in_session(proc.pid) and time.monotonic() < deadline:
+        while session(proc.pid) and time.monotonic() < deadline:
             time.sleep(0.1)
-        assert live_in_session(proc.pid) == [], f"{sig.name}: processes left after 5 s"
+        assert session(proc.pid) == [], f"{sig.name}: processes left after 5 s"
         assert sorted(p.name for p in out.iterdir()) == before and check_folder(out) == []
         left = sorted(p.name for p in tmp_path.iterdir() if p.name != "out")
         if sig == signal.SIGKILL:
@@ -187,9 +176,9 @@ def signalled(tmp_path: Path, argv: list[str], sigs: list[signal.Signals],
             os.killpg(proc.pid, sig)
     _, err = proc.communicate(timeout=EXIT_S)
     deadline = time.monotonic() + GONE_AFTER_S
-    while live_in_session(proc.pid) and time.monotonic() < deadline:
+    while session(proc.pid) and time.monotonic() < deadline:
         time.sleep(0.05)
-    assert live_in_session(proc.pid) == [], "processes left after the signal"
+    assert session(proc.pid) == [], "processes left after the signal"
     return proc.returncode, err, out
 
 

@@ -341,22 +341,32 @@ def check_design_budget(p: Prototype, screened: int, verified: int, *, limit_s: 
     naming both, the limit and the fixes when it passes `limit_s`, before any work."""
     from printgen.search.space import SCREEN_RATE
 
+    speed = _checked(limit_s, speed)
+    c = max(1, cores)
+    one = 2 * prototype_sweep_s(p) * SEARCH_VERIFY_FACTOR  # a prototype and a model sweep
+    seconds = speed * (screened / SCREEN_RATE + verified * one) / c
+    if seconds > limit_s:
+        _too_big(f"design search is too big: {screened:,} nets to screen and {verified} to "
+                 f"verify with the solver, about {seconds:.0f} s on {c} cores", seconds,
+                 limit_s, "narrow --mesh-x-mm / --mesh-y-mm, --materials or --verify-nets")
+    return seconds
+
+
+def _checked(limit_s: float, speed: float | None) -> float:
+    """This machine's speed factor (`speed` when given), once the limit is a valid one."""
     if not (math.isfinite(limit_s) and limit_s > 0):
         raise InputError(f"--time-limit {limit_s:g} s must be a positive number of seconds")
     if speed is None:
         from printgen.run.speed import speed_factor
 
         speed = speed_factor()
-    c = max(1, cores)
-    one = 2 * prototype_sweep_s(p) * SEARCH_VERIFY_FACTOR  # a prototype and a model sweep
-    seconds = speed * (screened / SCREEN_RATE + verified * one) / c
-    if seconds <= limit_s:
-        return seconds
-    raise InputError(f"this design search is too big: {screened:,} nets to screen and "
-                     f"{verified} to verify with the solver, about {seconds:.0f} s on {c} "
-                     f"cores; the limit is {limit_s:g} s. Raise it with --time-limit "
-                     f"{math.ceil(seconds * 1.5 / 60) * 60:g}, or narrow --mesh-x-mm / "
-                     "--mesh-y-mm, --materials or --verify-nets")
+    return speed
+
+
+def _too_big(what: str, seconds: float, limit_s: float, fixes: str) -> None:
+    """InputError: this run's estimate `what`, the limit, the limit that would fit, `fixes`."""
+    raise InputError(f"this {what}; the limit is {limit_s:g} s. Raise it with --time-limit "
+                     f"{math.ceil(seconds * 1.5 / 60) * 60:g}, or {fixes}")
 
 
 def check_series_budget(p: Prototype, cases: int, *, limit_s: float, cores: int,
@@ -365,24 +375,16 @@ def check_series_budget(p: Prototype, cases: int, *, limit_s: float, cores: int,
     `cores` (each case one sweep of LEVELS levels; the model nets have the prototype's nodes
     at every scale); InputError naming both, the limit and the fixes when it passes
     `limit_s`, before any solve (a net too large is refused, not run out of memory)."""
-    if not (math.isfinite(limit_s) and limit_s > 0):
-        raise InputError(f"--time-limit {limit_s:g} s must be a positive number of seconds")
-    if speed is None:
-        from printgen.run.speed import speed_factor
-
-        speed = speed_factor()
+    speed = _checked(limit_s, speed)
     nodes = prototype_nodes(p)
-    one = prototype_sweep_s(p)
     c = max(1, cores)
-    seconds = speed * one * math.ceil(cases / c)
+    seconds = speed * prototype_sweep_s(p) * math.ceil(cases / c)
     memory = c * (BASE_MEMORY_B + MEMORY_B_PER_NODE * nodes)
-    if seconds <= limit_s:
-        return seconds, memory
-    raise InputError(f"this series is too big: {cases} cases of a {nodes:,}-node net, about "
-                     f"{seconds:.0f} s and {memory / 1e9:.1f} GB on {c} cores; the limit is "
-                     f"{limit_s:g} s. Raise it with --time-limit "
-                     f"{math.ceil(seconds * 1.5 / 60) * 60:g}, give fewer --scales or "
-                     "--materials, or coarsen the prototype's [net] mesh")
+    if seconds > limit_s:
+        _too_big(f"series is too big: {cases} cases of a {nodes:,}-node net, about "
+                 f"{seconds:.0f} s and {memory / 1e9:.1f} GB on {c} cores", seconds, limit_s,
+                 "give fewer --scales or --materials, or coarsen the prototype's [net] mesh")
+    return seconds, memory
 
 
 def coarsest_fix(p: Prototype, d: Design, *, limit_s: float, cores: int,

@@ -1,6 +1,6 @@
 """Signals at random moments to printgen commands' process groups, counted.
 
-    python scripts/signals_at_random.py make:SIGHUP,design:SIGINT,testpieces:SIGTERM 20 --seed 1
+    python -m benchmarks.signals_at_random make:SIGHUP,design:SIGINT,testpieces:SIGTERM 20 --seed 1
 
 Each run starts `printgen COMMAND ... --out OUT` (OUT holding a previous run) in a session of
 its own, sleeps a random 0 to --max-delay seconds, sends the signal to the group and checks:
