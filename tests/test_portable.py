@@ -215,3 +215,22 @@ def test_files_are_written_without_o_nofollow(tmp_path, monkeypatch, capsys):
 
     assert write_text(tmp_path / "materials" / "x.toml", "a = 1\n").read_text() == "a = 1\n"
     assert "internal error" not in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("guarded", [False, True])
+def test_a_script_without_a_main_guard_is_told_so_where_workers_run_it_again(tmp_path, guarded):
+    """Under spawn (macOS, Windows) each worker runs the main script again: without `if
+    __name__ == "__main__":` its calls would run in every worker and break the pool, which
+    read as "a worker died / out of memory"; the check names the script and the fix."""
+    body = 'import printgen.executor.start as s\ns.check_main_guard("spawn")\nprint("ok")\n'
+    if guarded:
+        body = 'if __name__ == "__main__":\n' + textwrap.indent(body, "    ")
+    script = tmp_path / "my_run.py"
+    script.write_text(body)
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    if guarded:
+        assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr
+    else:
+        assert done.returncode == 1 and "my_run.py runs printgen's parallel work" in done.stderr
+        assert 'if __name__ == "__main__":' in done.stderr

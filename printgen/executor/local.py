@@ -210,6 +210,7 @@ class _Workers:
     def __init__(self, workers: int) -> None:
         plat = start.platform()
         method = start.start_method(plat)
+        start.check_main_guard(method)
         start.servers_for(method)
         ctx = multiprocessing.get_context(method)
         self.queue = ctx.SimpleQueue() if _listener else None

@@ -13,12 +13,15 @@ from __future__ import annotations
 import contextlib
 import multiprocessing
 import os
+import re
 import sys
 import threading
 import warnings
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
+from pathlib import Path
 
+from printgen.errors import InputError
 from printgen.executor.signals import handled_signals, signals_deferred
 
 SYSTEM = sys.platform  # "linux", "darwin", "win32", ...
@@ -151,3 +154,31 @@ def watch_is_safe() -> Iterator[None]:
         warnings.filterwarnings("ignore", message=r".*multi-threaded, use of fork\(\)",
                                 category=DeprecationWarning)
         yield
+
+
+_GUARD = re.compile(r"""^\s*if\s+__name__\s*==\s*["']__main__["']\s*:""", re.MULTILINE)
+
+
+def check_main_guard(method: str) -> None:
+    """InputError before any worker starts when `method` starts workers by running the main
+    script again (spawn, fork server: macOS and Windows, or a process with threads) and that
+    script has its calls outside `if __name__ == "__main__":`: each worker would run them again
+    and the pool would break, which used to read as a worker killed or out of memory. A
+    notebook, the command line and `python -m` have no such script."""
+    if method == "fork":
+        return
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    spec = getattr(main, "__spec__", None)
+    if not path or not str(path).endswith(".py") or (spec is not None
+                                                      and spec.name.endswith("__main__")):
+        return
+    try:
+        text = Path(path).read_text("utf-8", errors="replace")
+    except OSError:
+        return
+    if not _GUARD.search(text):
+        raise InputError(f"{path} runs printgen's parallel work, whose worker processes start "
+                         f"by running this script again ({method}: macOS and Windows start "
+                         "them so): put the script's calls under `if __name__ == \"__main__\":` "
+                         "(README: Python API), or set PRINTGEN_SERIAL=1 to run in one process")
