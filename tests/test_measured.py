@@ -151,3 +151,31 @@ def test_design_record_round_trip_and_errors():
 
     with pytest.raises(InputError, match="'net'"):
         Design.from_record({"scale": 40, "printer": "generic-350", "cables": []})
+
+
+def test_a_fit_that_worsens_a_column_says_so_and_is_no_profile():
+    from printgen.report.uncertainty import fit_sentence
+    from printgen.verification.measured import Fit, Mismatch
+
+    def mm(col, rel, points=2):
+        return Mismatch(col, col, rel, rel, points, 0)
+
+    before = [mm("bottom", 0.30, 0), mm("mid", 0.472), mm("top", 0.555)]
+    after = [mm("bottom", 0.10, 0), mm("mid", 0.483), mm("top", 0.555)]
+    fit = Fit("stiffness", 1.6, before, after, {}, 9, False)
+    assert fit.worsened == [("mid", 0.472, 0.483)]  # a bound-only column does not count
+    assert "mid 47.2% -> 48.3%" in fit_sentence(fit) and "no profile" in fit_sentence(fit)
+    assert Fit("stiffness", 1.0, before, before, {}, 3, False).worsened == []
+
+
+@pytest.mark.slow
+def test_the_default_fit_of_the_papers_test_writes_no_profile(tmp_path, capsys):
+    """The one-factor fit of the bundled paper test improves the bottom cable's bound at the
+    price of the mid-height and top columns: it explains nothing, and no profile is offered."""
+    out = tmp_path / "o"
+    assert main(["verify", str(EXAMPLES / "realistic_barrier.toml"), "--scale", "40",
+                 "--design", str(EXAMPLES / "paper_1_40" / "design.json"), "--measured",
+                 str(EXAMPLES / "paper_1_40" / "measured.csv"), "--out", str(out)]) in (0, 3)
+    text = " ".join(capsys.readouterr().out.split())  # the terminal wraps its lines
+    assert "at the price of others" in text and "No profile to feed back" in text
+    assert not list(out.glob("*-fitted.toml"))

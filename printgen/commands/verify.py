@@ -70,13 +70,13 @@ def run(args: argparse.Namespace) -> int:
                   " (prototype vs the model's band)", ["quantity", "verdict"], rows))
     if res.fit is not None:
         c.print(res.record["measured"]["fit"]["sentence"])
-        if res.profile_text and not res.fit.at_bound:
+        if res.profile_text:
             from printgen.inputs.profiles import user_folder_hint
 
             name = fitted_name(res.design)
             c.print(f"Feed it back: {out / name} is the fitted profile; "
                     f"{user_folder_hint('materials', name)}, and use it as the net's material.")
-        elif res.fit.at_bound:
+        elif res.fit.kind != "multi":
             c.print("No profile to feed back: look for the cause in the test (sensor zero, "
                     "mounting, slack) before changing the material.")
     c.print(f"{len(res.files)} files in {out}/ ; open {out / 'report.html'}")

@@ -147,6 +147,12 @@ def fit_sentence(fit: Fit) -> str:
             else f"initial slack {fit.value:.2%} of the net")
     edge = (" The best value is at the end of the searched range: the measurement is outside "
             "what this factor can explain." if fit.at_bound else "")
+    worse = "; ".join(f"{col} {before:.1%} -> {after:.1%}"
+                      for col, before, after in fit.worsened)
+    if worse:
+        edge += (f" It fits some columns at the price of others (RMS of the measured peak, "
+                 f"nominal -> fitted: {worse}): this one factor does not explain the test, so "
+                 "no profile is written (--fit multi tries several).")
     return (f"The printed net behaved like a model with {what} (one-factor fit, "
             f"{fit.evaluations} solver sweeps).{edge}")
 

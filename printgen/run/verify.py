@@ -98,7 +98,8 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
         say(f"fit of the net's {fit} to {Path(measured).name}")
         result = fit_factor(m, model_predictor(d, band, m, fit, load_kw=load_kw), fit)
         # a factor at the end of its range explains nothing: no profile to feed back
-        text = "" if result.at_bound else _profile_text(d, result, Path(measured).name)
+        text = ("" if result.at_bound or result.worsened
+                else _profile_text(d, result, Path(measured).name))
     run = RunRecords(f"printgen verify: {p.name} at 1:{d.scale:g}", d)
     run.steps["verification"] = CheckRecords(v, band, d.scale, nested=False)
     if m is not None:

@@ -45,6 +45,8 @@ COLUMNS = {
     "lowering_over_height": ("lowering", 1.0),
 }
 MEASURED_LIMIT_BYTES = 4 << 20  # a loading test is tens of lines; 4 MiB is surely not one
+# A column is fitted worse when its RMS grows by more than this share (round-off is below)
+WORSE_TOL = 1e-3
 MAX_LEVEL = OVERFLOW  # the sweep's last relative loading: no prediction beyond it
 IGNORED_PREFIX = "expected_"  # columns of the measurement sheet that hold the model's readings
 LEVEL_AGREE = 0.01  # h_over_hb and water_depth_mm / h_B may differ by this much (h / h_B)
@@ -332,6 +334,15 @@ class Fit:
     predicted: dict[str, np.ndarray]
     evaluations: int
     at_bound: bool
+
+    @property
+    def worsened(self) -> list[tuple[str, float, float]]:
+        """(column, RMS before, after, of the measured peak) of every column with measured
+        values that the fitted factor fits worse than the nominal: a factor that buys one
+        column with another explains neither, and its profile is not written."""
+        return [(a.column, b.rms_rel, a.rms_rel) for b, a in zip(self.before, self.after,
+                                                                 strict=True)
+                if a.points > 0 and a.rms_rel > b.rms_rel * (1 + WORSE_TOL)]
 
 
 def fit_factor(m: Measurement, predict: Predictor, kind: str = "stiffness") -> Fit:
