@@ -96,10 +96,11 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
         text = _multi_profile_text(d, result, Path(measured).name) if result.explains else ""
     elif m is not None:
         say(f"fit of the net's {fit} to {Path(measured).name}")
-        result = fit_factor(m, model_predictor(d, band, m, fit, load_kw=load_kw), fit)
-        # a factor at the end of its range explains nothing: no profile to feed back
-        text = ("" if result.at_bound or result.worsened
-                else _profile_text(d, result, Path(measured).name))
+        one = fit_factor(m, model_predictor(d, band, m, fit, load_kw=load_kw), fit)
+        # a factor at the end of its range, or one that fits a column worse, explains
+        # nothing: no profile to feed back
+        text = "" if one.at_bound or one.worsened else _profile_text(d, one, Path(measured).name)
+        result = one
     run = RunRecords(f"printgen verify: {p.name} at 1:{d.scale:g}", d)
     run.steps["verification"] = CheckRecords(v, band, d.scale, nested=False)
     if m is not None:
