@@ -1,4 +1,4 @@
-"""Fuzz `printgen make` (issue 13): random prototypes inside the documented ranges (README's
+"""Fuzz `printgen make` (issue 13): random prototypes inside the documented ranges (the user guide's
 table, `ranges_markdown()`), at random scales in 1 ... 100. Each run either succeeds, leaving
 a folder that matches its manifest, or exits 2 with one line; never a traceback, never exit 1,
 never a partial folder, stage or lock left behind.

@@ -1,5 +1,5 @@
 """The development habits the CI holds (CONTRIBUTING.md): ruff's rule set, mypy pinned with an
-error budget for printgen/ that the README states, the `slow` marker registered."""
+error budget for printgen/ that docs/development.md states, the `slow` marker registered."""
 
 from __future__ import annotations
 
@@ -23,9 +23,10 @@ def _budget_module():
 
 def test_readme_states_the_mypy_budget():
     budget = _budget_module().read_budget()
-    note = (ROOT / "README.md").read_text("utf-8").split("Typing:", 1)[1].split("\n\n", 1)[0]
+    text = (ROOT / "docs" / "development.md").read_text("utf-8")
+    note = text.split("Typing:", 1)[1].split("\n\n", 1)[0]
     assert f"`scripts/mypy_budget.txt`, {budget} errors" in note, \
-        f"the README's Typing note does not state the budget of {budget} errors"
+        f"docs/development.md's Typing note does not state the budget of {budget} errors"
 
 
 @pytest.mark.parametrize(("output", "count"), [

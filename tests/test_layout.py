@@ -1,8 +1,7 @@
-"""The layout by stage (shared/design.md, README "Where things live"): data moves down the flow
-run -> report -> verification -> scene and parts -> scaling -> inputs and barrier -> ground
-floor; a lower stage never imports
-a higher one, and solver/ never imports printgen. Imports are read with `ast`, so a lazy import
-inside a function counts as much as one at the top of a module."""
+"""The layout by stage (shared/design.md, docs/development.md "Where things live"): data moves down
+the flow run -> report -> verification -> scene and parts -> scaling -> inputs and barrier -> ground
+floor; a lower stage never imports a higher one, and solver/ never imports printgen. Imports are
+read with `ast`, so a lazy import inside a function counts as much as one at the top of a module."""
 
 from __future__ import annotations
 

@@ -80,7 +80,7 @@ def add_load_args(p: argparse.ArgumentParser, what: str, *, several: bool = Fals
                    help="the same as --load drag")
     p.add_argument("--load-param", action="append", default=[], metavar="KEY=VALUE",
                    help="a parameter of the load case(s), e.g. porosity=0.4 for jam "
-                        "(README: Load cases); repeat for several")
+                        "(docs/physics.md: Load cases); repeat for several")
     if several:
         p.add_argument("--loads", type=load_list, default=(), metavar="A,B",
                        help="also write each load case's expected readings "
@@ -124,7 +124,7 @@ def load_specs(args: argparse.Namespace) -> tuple[str | None, tuple[str, ...]]:
         if item.partition("=")[0].strip() not in keys:
             raise InputError(f"--load-param {item}: none of the load cases "
                              f"{', '.join(dict.fromkeys(chosen))} has that parameter; give one "
-                             "of theirs (README: Load cases)")
+                             "of theirs (docs/physics.md: Load cases)")
 
     def spec(name: str) -> str:
         own = {p.name for p in get_load(name).params}

@@ -181,4 +181,5 @@ def check_main_guard(method: str) -> None:
         raise InputError(f"{path} runs printgen's parallel work, whose worker processes start "
                          f"by running this script again ({method}: macOS and Windows start "
                          "them so): put the script's calls under `if __name__ == \"__main__\":` "
-                         "(README: Python API), or set PRINTGEN_SERIAL=1 to run in one process")
+                         "(printgen docs: Python API), or set PRINTGEN_SERIAL=1 to run in one "
+                         "process")

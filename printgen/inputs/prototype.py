@@ -254,8 +254,9 @@ CROSS_CHECKS = (
 
 
 def ranges_markdown() -> str:
-    """The README's table of every key of the prototype schema with its range (generated here,
-    and compared with the README by the tests, so the two cannot drift apart)."""
+    """The user guide's table (docs/user-guide.md) of every key of the prototype schema with its
+    range (generated here, and compared with that page by the tests, so the two cannot drift
+    apart)."""
     rows = ["| table | key | type | range | required |", "|---|---|---|---|---|"]
     for table, fields in SCHEMA_TABLES:
         for f in fields:

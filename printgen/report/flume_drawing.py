@@ -69,7 +69,7 @@ def layout_section(rep: Report, layout: FlumeLayout) -> None:
     rep.paragraph(f"Where the flume test's parts go, from the solver scene the check used "
                   f"(mounting: {lay['mounting']}); the same positions are in {LAYOUT_CSV} and "
                   "in report.json (verification.lab.layout). The routing of the wires is "
-                  "printgen's assumption (README: The flume test as it is run).")
+                  "printgen's assumption (printgen docs: The flume test as it is run).")
     rep.figure(Drawing(layout_png, (lay, strands)), CAPTION, "sensor-and-anchor-layout")
     rep.table(["item", "x (mm)", "z (mm)", "note"], layout_rows(lay))
 

@@ -320,8 +320,8 @@ def verification_sweeps(prototype: Prototype, design: Design,
     run's load case (`options.load`; each of `options.loads` too, nominal sweeps only).
 
     The sweep is the scene realistic-1:40 with border cables, simple-free-top without them
-    (README: Pre-print verification); every load level is solved on both. Needs nothing from
-    the other steps, so it can run in a worker process while they run.
+    (docs/physics.md: Pre-print verification); every load level is solved on both. Needs nothing
+    from the other steps, so it can run in a worker process while they run.
     """
     from printgen.report.plots import load_pyplot
     from printgen.verification.pooled import verify_with_band

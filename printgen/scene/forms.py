@@ -14,7 +14,7 @@ the test, never fitted to the flume curve (Lambert et al. 2023, doi:10.1061/JHEN
   full head; contact and friction hold the bottom edge (with the net squeezed into the free
   section, its slack bottom cable can only lie on the bed);
 - sensor routing (`ROUTINGS`): beyond the barrier's right edge node the wire runs "in-line"
-  to its potentiometer (the nominal, README: The flume test as it is run) or turns
+  to its potentiometer (the nominal, docs/physics.md: The flume test as it is run) or turns
   "downstream" to a potentiometer standing behind the barrier, out of the water (the paper
   does not say where they stood). Where the rows' end nodes are held (walls mounting) the
   exit segment is fixed at both ends: the routing changes neither the net nor the reading, and

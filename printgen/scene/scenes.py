@@ -363,11 +363,11 @@ def _common_assumptions(s: BarrierScene, force: float, model: bool, load: LoadCa
         out.append(("mounting", (f"{s.mounting}: {held}; top and bottom cables on the four "
                      "corner anchors"),
                     (f"[flume] lateral (default walls: {paper}, the 1:40 model fixed to the "
-                     "flume's side sheets; README: Pre-print verification, Mounting)")))
+                     "flume's side sheets; printgen docs: Pre-print verification, Mounting)")))
     else:
         out.append(("mounting", "anchored on the bed and the banks, top free",
-                    ("printgen's scene simple-free-top (README: Pre-print verification, barriers "
-                     "without border cables)")))
+                    ("printgen's scene simple-free-top (printgen docs: Pre-print verification, "
+                     "barriers without border cables)")))
     if force > 0:
         wire = f"{force:.4g} N along each wire" + (
             "" if model else " (the model's sensor force x lambda^3: the sensors' share of the "
@@ -379,7 +379,7 @@ def _common_assumptions(s: BarrierScene, force: float, model: bool, load: LoadCa
              f"edge node, over the row's nodes, to the potentiometer {SENSOR_EXIT:.0%} of the "
              "width beyond the right edge; reading = change of wire length"),
              (f"[flume] sensor_force_n (default {SENSOR_FORCE_N:g} N: {paper}, three 1 N "
-              "extension sensors, Fig. 6a); routing: README, The flume test as it is run")),
+              "extension sensors, Fig. 6a); routing: printgen docs: The flume test as it is run")),
             _mid_assumption(s),
             *load.assumptions,
             ("initial state", "flat, no pretension, no slack; gravity on the net neglected",
@@ -388,7 +388,7 @@ def _common_assumptions(s: BarrierScene, force: float, model: bool, load: LoadCa
         out.append(("unloaded strands", (f"stay where they are: each free node held at rest by "
                     f"{s.hold:.3g} N/m ({HOLD_FRACTION:g} x rho g A*), a regularisation of the "
                     "dry, slack net above the water (a mechanism otherwise)"),
-                    "printgen (README: barriers without border cables); its force share is "
+                    "printgen (printgen docs: barriers without border cables); its force share is "
                     "reported"))
     return out
 

@@ -77,7 +77,7 @@ def model_variants(d: Design, mounting: str | None = None, free_section: float |
     if not opts:
         notes.append("mounting: the model scene has one mounting only; no mounting variant")
     out.append(Variant(f"initial slack {SLACK_MAX:.0%}", "printed net hung with 0 to 1 % "
-                       "slack (printgen; README: Uncertainty band)", slack=SLACK_MAX,
+                       "slack (printgen; printgen docs: Uncertainty band)", slack=SLACK_MAX,
                        effort=SLOWEST))
     out += _model_form_variants(d, free_section, notes, nominal)
     return out, notes

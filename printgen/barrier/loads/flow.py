@@ -57,5 +57,5 @@ CASE = LoadCase(
       "one node row; v(h) = v_f sqrt(h / h_f): the prototype's Froude number v_f / sqrt(g "
       "h_f) held as the water rises; model v_f / sqrt(lambda) at h_f / lambda (Froude)"),
      ("Lambert et al. 2023: hydrodynamic nodal loads, drag coefficient 1 (barrier-physics.md "
-      "sections 2, 3); the depth rule is printgen's (README: Load cases)"))),
+      "sections 2, 3); the depth rule is printgen's (printgen docs: Load cases)"))),
     per_level=per_level)
