@@ -169,6 +169,12 @@ def model_nodes(d: Design, factor: float = 1.0) -> int:
                                         n.mesh_y_mm * factor)
 
 
+def run_cores(serial: bool, workers: int | None) -> int:
+    """Cores the parallel work of `design` or `series` runs on, for their estimates: 1
+    serially, else its `workers` (default: up to 2, this machine's pool)."""
+    return 1 if serial else (workers or min(2, cores()))
+
+
 def sweep_cores() -> int:
     """Cores the verification's two sweeps (prototype, model) run on: 1 under
     PRINTGEN_SERIAL, else up to 2."""

@@ -24,12 +24,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from printgen.executor import open_runner
-from printgen.executor.start import cores as all_cores
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import check_destination, write_folder
 from printgen.report.jsonout import dumps
-from printgen.run.budget import DESIGN_LIMIT_S, check_design_budget
+from printgen.run.budget import DESIGN_LIMIT_S, check_design_budget, run_cores
 from printgen.run.options import RunOptions
 from printgen.run.provenance import provenance_record
 from printgen.scaling.similitude import ScaledTargets, scale_targets
@@ -48,6 +47,7 @@ from printgen.search.space import (
     check_size,
     default_space,
     half_cell_counts,
+    space_factors,
 )
 
 
@@ -127,13 +127,12 @@ def check_work(p: Prototype, spaces: dict[float, SearchSpace], o: SearchOptions,
                run: RunOptions) -> None:
     """The search's size against its time limit (`budget.check_design_budget`), before any
     work: every scale's nets screened, and with the deformation objective `verify_nets` of
-    of them (with every border) and select's pick verified."""
-    screened = sum(math.prod((len(sp.materials), len(sp.beads), len(sp.layers),
-                              *meshes_of(sp, scale_targets(p, s)), len(sp.border_beads)))
+    them (with every border) and select's pick verified."""
+    screened = sum(math.prod(space_factors(sp, *meshes_of(sp, scale_targets(p, s))))
                    for s, sp in spaces.items())
     verified = sum(o.verify_nets * len(sp.border_beads) + 1 for sp in spaces.values()) \
         if o.objective == "deformation" else 0  # each net with every border, select's pick
-    cores = 1 if run.serial or run.workers == 1 else (run.workers or min(2, all_cores()))
+    cores = run_cores(bool(run.serial), run.workers)
     limit = DESIGN_LIMIT_S if run.time_limit_s is None else run.time_limit_s
     check_design_budget(p, screened, verified, limit_s=limit, cores=cores)
 

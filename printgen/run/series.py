@@ -19,13 +19,12 @@ from pathlib import Path
 from printgen.barrier.loads import get_load
 from printgen.errors import InputError
 from printgen.executor import open_runner
-from printgen.executor.start import cores
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import TIMINGS, check_destination, write_folder
 from printgen.report.jsonout import dumps
 from printgen.report.series import series_csv, series_figure, series_report
-from printgen.run.budget import DEFAULT_LIMIT_S, check_series_budget
+from printgen.run.budget import DEFAULT_LIMIT_S, check_series_budget, run_cores
 from printgen.run.options import RunOptions
 from printgen.run.provenance import provenance_record
 from printgen.scene.scenes import SENSOR_FORCE_N
@@ -89,7 +88,7 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
         serial = len(todo) < PARALLEL_FROM and scheduler is None and workers is None
     limit = DEFAULT_LIMIT_S if options.time_limit_s is None else options.time_limit_s
     check_series_budget(p, len(todo), limit_s=limit,  # before the net is even built
-                        cores=1 if serial else (workers or min(2, cores())))
+                        cores=run_cores(serial, workers))
     base = base_scene(shared)  # geometry errors now, not in a worker
     say(f"{len(todo)} cases ({len(rows)} rows x {len(lams)} scales)"
         + ("" if serial else ", starting the workers"))

@@ -183,11 +183,17 @@ def grid(ctx: SearchContext, space: SearchSpace) -> list[NetPoint]:
     return out
 
 
+def space_factors(space: SearchSpace, n_across: int, n_up: int) -> tuple[int, ...]:
+    """How many materials, beads, layers, meshes across and up (`n_across`, `n_up`: the
+    targets' scale's) and borders the space combines: its size is their product."""
+    return (len(space.materials), len(space.beads), len(space.layers), n_across, n_up,
+            len(space.border_beads))
+
+
 def check_size(space: SearchSpace, n_across: int, n_up: int) -> None:
     """InputError before any work when the space holds more than MAX_CANDIDATES nets: each
     screened net is kept (its record, candidates.json), so time and memory grow with it."""
-    factors = (len(space.materials), len(space.beads), len(space.layers), n_across, n_up,
-               len(space.border_beads))
+    factors = space_factors(space, n_across, n_up)
     n = math.prod(factors)
     if n > MAX_CANDIDATES:
         raise InputError(
