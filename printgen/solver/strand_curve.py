@@ -110,31 +110,42 @@ def shallow_stiffness(s: Strand) -> float:
 
 @dataclass(frozen=True)
 class StrandCurve:
-    """A strand's solved chord force (N) at chord strains (k,), with the initial slope (N per
-    unit strain, at zero), the last tangent (the straightened slope when the strains reach
-    past the straightening), the elements used and the Newton iterations spent.
+    """A strand's solved chord force (N) and tangent stiffness (N per unit strain) at chord
+    strains (k,), with the initial slope (at zero), the elements used and the Newton
+    iterations spent.
 
-    Its bilinear summary: `intercept`, the strain where the line of the last tangent reaches
-    zero force (for a linear material, where a straightened strand of the wave's arc length
-    would start to stretch: it tends to the excess path length as the strand straightens), and
-    `knee`, where that line meets the initial one (the knee of the bilinear law of the same
-    two slopes)."""
+    Its bilinear summary: the straightened slope `straight_slope`, the largest tangent (where
+    the strand is straight and its material not yet softened: the last one for a linear
+    material); `intercept`, the strain where the line of that tangent through its point
+    reaches zero force (for a linear material, where a straight strand of the wave's arc
+    length would start to stretch: it tends to the excess path length as the strand
+    straightens); `knee`, where that line meets the initial one (the knee of the bilinear
+    law of the two slopes)."""
 
     strand: Strand
     strains: np.ndarray
     forces: np.ndarray
+    tangents: np.ndarray
     initial_slope: float
-    final_slope: float
     elements: int
     newton_iterations: int
 
     @property
+    def final_slope(self) -> float:
+        return float(self.tangents[-1])
+
+    @property
+    def straight_slope(self) -> float:
+        return float(np.max(self.tangents))
+
+    @property
     def intercept(self) -> float:
-        return float(self.strains[-1] - self.forces[-1] / self.final_slope)
+        i = int(np.argmax(self.tangents))
+        return float(self.strains[i] - self.forces[i] / self.tangents[i])
 
     @property
     def knee(self) -> float:
-        return self.intercept / (1.0 - self.initial_slope / self.final_slope)
+        return self.intercept / (1.0 - self.initial_slope / self.straight_slope)
 
     def law(self) -> Law:
         """The curve as a tension-only piecewise-linear strand law (force per chord strain):
@@ -161,8 +172,7 @@ def strand_curve(s: Strand, strains: np.ndarray,
     pull = 3 * m
     _, k = beam.forces(d)
     initial = _condensed_stiffness(k, free, pull) * s.chord
-    forces, iterations, last = [], 0, 0.0
-    tangent = initial
+    forces, tangents, iterations, last = [], [], 0, 0.0
     for target in strains:
         steps = max(1, math.ceil((target - last) / STEP_STRAIN - 1e-9))
         for e in last + (target - last) * np.arange(1, steps + 1) / steps:
@@ -171,8 +181,8 @@ def strand_curve(s: Strand, strains: np.ndarray,
             iterations += its
         last = target
         forces.append(f[pull])
-        tangent = _condensed_stiffness(k, free, pull) * s.chord
-    return StrandCurve(s, strains, np.array(forces), float(initial), float(tangent), m,
+        tangents.append(_condensed_stiffness(k, free, pull) * s.chord)
+    return StrandCurve(s, strains, np.array(forces), np.array(tangents), float(initial), m,
                        iterations)
 
 
