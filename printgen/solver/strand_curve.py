@@ -44,6 +44,7 @@ from scipy.sparse import coo_matrix, csc_matrix
 from scipy.sparse.linalg import spsolve
 
 from .laws import Law
+from .result import SolverError
 
 ELEMENTS_PER_HALF_WAVE = 24  # default mesh: the curve converges as h^2 (`tests`: < 0.1 %)
 ALONG_POINTS = 3  # Gauss points along an element (curvature is linear: 2 would be exact for
@@ -159,7 +160,7 @@ class StrandCurve:
 def strand_curve(s: Strand, strains: np.ndarray,
                  elements_per_half_wave: int = ELEMENTS_PER_HALF_WAVE) -> StrandCurve:
     """Solve the strand pulled along its chord to each of `strains` (increasing, > 0) in
-    turn, each from the last equilibrium; ValueError when an equilibrium is not found."""
+    turn, each from the last equilibrium; SolverError when an equilibrium is not found."""
     strains = np.asarray(strains, float)
     if strains.ndim != 1 or len(strains) == 0 or np.any(np.diff(strains) <= 0) or strains[0] <= 0:
         raise ValueError(f"strains must increase from above 0, got {strains}")
@@ -199,7 +200,7 @@ def _equilibrium(beam: _Beam, d: np.ndarray, free: np.ndarray,
         step = spsolve(k[free][:, free], -r)
         d = d.copy()
         d[free] += step
-    raise ValueError(f"strand not in equilibrium after {NEWTON_STEPS} Newton iterations at "
+    raise SolverError(f"strand not in equilibrium after {NEWTON_STEPS} Newton iterations at "
                      f"chord strain {d[3 * (len(d) // 3 - 1)] / s.chord:.4g}; use smaller "
                      "strain steps")
 

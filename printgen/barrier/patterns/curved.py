@@ -9,11 +9,12 @@ stacked layers: the strand's in-plane width (beads x bead width) is the dimensio
 Its law is the chord force against the chord strain of the large-deflection beam model
 (`printgen.solver.strand_curve`), with the material's own stress-strain law (`stress_law`).
 
-The junctions, the graph, the mesh and the membrane-to-strand mapping are the layout's: a
-curved net is the layout's net with another strand law. So its membrane law is the strand
-curve mapped by the layout (strand strain per net strain and membrane force per strand
-force, as the layout's `strand_law` states them): `membrane_law` gives it and its bilinear
-summary (low-strain slope, straightened slope, knee strain).
+The junctions, the graph and the mesh are the layout's: a curved net is the layout's net with
+another strand law. Its membrane law (`membrane_law`) is the strand curve carried through the
+blocked, infinite net at finite strain (every chord stretched alike and turned toward the load),
+which the virtual panel test reproduces; at small strain it is the layout's mapping (strand
+strain per net strain, membrane force per strand force, as the layout's `strand_law` states
+them). Its bilinear summary: low-strain slope, straightened slope, knee strain.
 
 Printability (`check_wave`), each limit named in its error:
 - the wave's smallest centre-line radius 1 / (a k^2), k = n pi / L, less the offset of the
@@ -42,6 +43,8 @@ from printgen.units import MM
 LAYOUTS = ("square", "diamond")
 MIN_RADIUS_BEADS = 1.0  # innermost bead's centre-line radius >= 1 bead width (printable curve)
 TOP_STRAIN = 0.3  # chord strain the curve is solved to at least (beyond: its last tangent)
+FIRST_POINT = 0.01  # first solved point at 1 % of the excess: the law's first slope (its
+# secant from zero) is the initial tangent there (the curve's tangent varies on the excess)
 KNEE_POINTS = 16  # solved points up to twice the excess length (the unbending and the knee)
 TAIL_POINTS = 8  # ... and from there to the top strain (straightened: nearly straight)
 
@@ -74,9 +77,7 @@ class CurvedStrands:
 def chord(layout: str, mesh_along: float, mesh_across: float) -> float:
     """Junction-to-junction chord of a strand along the load (any length unit): the square's
     side, the diamond's half-diagonals' hypotenuse."""
-    if layout == "square":
-        return mesh_along
-    return math.hypot(mesh_along / 2, mesh_across / 2)
+    return math.hypot(*chord_parts(layout, mesh_along, mesh_across))
 
 
 def spacing(layout: str, mesh_along: float, mesh_across: float) -> float:
@@ -128,11 +129,11 @@ def check_wave(layout: str, s: CurvedStrands, mesh_x_mm: float, mesh_y_mm: float
 
 
 def curve_strains(excess: float, top: float = TOP_STRAIN) -> np.ndarray:
-    """Chord strains the curve is solved at: KNEE_POINTS up to twice the excess length (where
-    the law bends), TAIL_POINTS on to max(top, 3 x excess)."""
+    """Chord strains the curve is solved at: FIRST_POINT x the excess length, KNEE_POINTS up
+    to twice the excess (where the law bends), TAIL_POINTS on to max(top, 3 x excess)."""
     knee = 2.0 * excess
     end = max(top, 1.5 * knee)
-    return np.concatenate([np.linspace(0.0, knee, KNEE_POINTS + 1)[1:],
+    return np.concatenate([[FIRST_POINT * excess], np.linspace(0.0, knee, KNEE_POINTS + 1)[1:],
                            np.linspace(knee, end, TAIL_POINTS + 1)[1:]])
 
 
@@ -155,10 +156,12 @@ def strand_law(layout: str, s: CurvedStrands, mesh_along: float, mesh_across: fl
 
 @dataclass(frozen=True)
 class MembraneLaw:
-    """A curved net's membrane law along the load (transverse strain blocked, small-strain
-    mapping of the layout): knees (net strain) and slopes (N/m), its bilinear summary (the
-    low-strain and straightened slopes N/m, the knee strain where their lines meet) and the
-    strands' excess path length S / L - 1."""
+    """A curved net's membrane law along the load, transverse strain blocked (the blocked,
+    infinite panel, at finite strain: `blocked_membrane`): knees (net strain) and slopes
+    (N/m) through the net strains at which the strands reach the curve's solved points, its
+    bilinear summary (the low-strain slope, the straightened slope where the strand's own
+    tangent peaks, and the knee strain where their lines meet, all N/m or net strain) and the
+    strands' excess path length S / L - 1 (a strand strain)."""
 
     knees: tuple[float, ...]
     slopes: tuple[float, ...]
@@ -168,23 +171,65 @@ class MembraneLaw:
     excess: float
 
 
+def chord_parts(layout: str, mesh_along: float, mesh_across: float) -> tuple[float, float]:
+    """(along the load, across it) components of a loaded strand's chord (any length unit)."""
+    if layout == "square":
+        return mesh_along, 0.0
+    return mesh_along / 2, mesh_across / 2
+
+
+def _per_width(layout: str, mesh_along: float, mesh_across: float) -> float:
+    """Loaded strands per unit width (1/m): the layout's membrane factor (its small-strain
+    slope per strand E A) is that count times sin^3 of the chord's angle to the cross
+    direction."""
+    up, side = chord_parts(layout, mesh_along, mesh_across)
+    return get_pattern(layout).membrane_factor(mesh_along, mesh_across) / \
+        (up / math.hypot(up, side)) ** 3
+
+
+def blocked_membrane(layout: str, s: CurvedStrands, mesh_along: float, mesh_across: float,
+                     strains: np.ndarray) -> np.ndarray:
+    """Membrane force per width (N/m) of the blocked, infinite curved net at panel `strains`
+    along the load, at finite strain: every chord stretched alike by the affine stretch (its
+    along-load part times 1 + eps, its across part held), each strand pulling along its
+    chord with the curve's force at its chord strain."""
+    up, side = chord_parts(layout, mesh_along, mesh_across)
+    l0 = math.hypot(up, side)
+    e = np.asarray(strains, float)
+    l1 = np.hypot(side, up * (1 + e))
+    force = strand_law(layout, s, mesh_along, mesh_across).force_and_tangent(l1 / l0 - 1)[0]
+    return _per_width(layout, mesh_along, mesh_across) * force * up * (1 + e) / l1
+
+
 def strain_ratio(layout: str, mesh_along: float, mesh_across: float) -> float:
-    """Strand strain per net strain along the load (1 for the square, sin^2 for the
-    diamond): the layout's strand law of a unit knee."""
+    """Strand strain per net strain along the load at small strain (1 for the square,
+    sin^2 for the diamond): the layout's strand law of a unit knee."""
     return get_pattern(layout).strand_law((1.0,), (1.0, 1.0), mesh_along, mesh_across).knees[0]
 
 
 def membrane_law(layout: str, s: CurvedStrands, mesh_along: float,
                  mesh_across: float) -> MembraneLaw:
-    """The membrane law of the curved net along `mesh_along` (m): the strand curve mapped by
-    the layout (the inverse of the layout's `strand_law`)."""
+    """The membrane law of the curved net along `mesh_along` (m): `blocked_membrane` at the
+    net strains of the curve's solved points, with its tangents there (the strand's tangent
+    and the chord's turn toward the load, both exact for the affine stretch)."""
     curve = strand_curve_of(layout, s, mesh_along, mesh_across)
-    law = curve.law()
-    ratio = strain_ratio(layout, mesh_along, mesh_across)
-    factor = get_pattern(layout).membrane_factor(mesh_along, mesh_across)
-    return MembraneLaw(tuple(k / ratio for k in law.knees), tuple(v * factor for v in law.slopes),
-                       curve.initial_slope * factor, curve.straight_slope * factor,
-                       curve.knee / ratio, curve.strand.excess())
+    up, side = chord_parts(layout, mesh_along, mesh_across)
+    l0 = math.hypot(up, side)
+    l1 = l0 * (1 + curve.strains)
+    u = np.sqrt(l1**2 - side**2)  # along-load part of the stretched chord
+    net = u / up - 1
+    per = _per_width(layout, mesh_along, mesh_across)
+    force = per * curve.forces * u / l1
+    # d/d eps of per F(e) u / l1: de/d eps = up u / (l0 l1), d(u / l1)/d eps = up side^2 / l1^3
+    tangent = per * (curve.tangents * up * u * u / (l0 * l1 * l1)
+                     + curve.forces * up * side**2 / l1**3)
+    low = per * curve.initial_slope * (up / l0) ** 3
+    i = int(np.argmax(curve.tangents))
+    intercept = net[i] - force[i] / tangent[i]
+    secants = np.diff(np.concatenate([[0.0], force])) / np.diff(np.concatenate([[0.0], net]))
+    return MembraneLaw(tuple(float(k) for k in net[:-1]), tuple(float(v) for v in secants),
+                       float(low), float(tangent[i]), float(intercept / (1 - low / tangent[i])),
+                       curve.strand.excess())
 
 
 def stress_law(mat: Material) -> tuple[Law, str]:
