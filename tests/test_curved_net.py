@@ -104,8 +104,8 @@ def test_the_membrane_law_softens_then_straightens(layout):
     straight = get_pattern(layout).membrane_factor(along, across) * s.strand(1.0).ea
     assert m.low_slope < 0.2 * straight
     curve = strand_curve_of(layout, s, along, across)
-    assert curve.straight_slope == pytest.approx(curve.strand.ea / (1 + m.excess),
-                                                 rel=STRAIGHTENED)
+    assert max(curve.tangents) == pytest.approx(curve.strand.ea / (1 + m.excess),
+                                                rel=STRAIGHTENED)
     assert m.straight_slope > 5 * m.low_slope  # the net stiffens as its strands straighten
     curve = strand_curve_of(layout, s, along, across)
     assert KNEE_BAND[0] * m.excess < curve.knee < KNEE_BAND[1] * m.excess

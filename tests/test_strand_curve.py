@@ -22,6 +22,8 @@ STRAIGHTENED_REL = 0.002  # at 100 % chord strain the tangent is within 0.2 % of
 INTERCEPT_REL = 0.06  # ... and its zero-force intercept within 6 % of the excess length: the
 # clamped ends keep a bent boundary layer of length ~ sqrt(EI / P), so the intercept creeps
 # towards the excess as 1 / sqrt(P) and is never reached exactly
+KNEE_BAND = (0.7, 1.1)  # the bilinear knee as a fraction of the excess length: below it, as
+# the strand straightens progressively and the two lines cut the rounded knee short
 
 
 def strand(amplitude: float, half_waves: int = 1, stress: Law | None = None) -> Strand:
@@ -74,11 +76,20 @@ def test_a_stretched_strand_straightens():
     s = strand(1.5e-3)
     excess = s.excess()
     arc = CHORD * (1 + excess)
-    near = strand_curve(s, np.array([0.1, 0.3])).intercept
     c = strand_curve(s, np.array([0.1, 0.3, 0.6, 1.0]))
     assert c.final_slope == pytest.approx(s.ea * CHORD / arc, rel=STRAIGHTENED_REL)
-    assert c.intercept == pytest.approx(excess, rel=INTERCEPT_REL)
-    assert abs(c.intercept - excess) < abs(near - excess)  # closer as it straightens
+    intercepts = c.strains - c.forces / c.tangents  # where each point's tangent line hits 0
+    assert intercepts[-1] == pytest.approx(excess, rel=INTERCEPT_REL)
+    assert np.all(np.diff(np.abs(intercepts - excess)) < 0)  # closer as it straightens
+
+
+def test_the_knee_of_the_bilinear_summary_is_near_the_excess_length():
+    """Sampled finely to 30 %, the strand counts as straightened before 3 x its excess length
+    and its bilinear knee lies within KNEE_BAND of the excess."""
+    s = strand(1.5e-3)
+    c = strand_curve(s, np.linspace(0.005, 0.3, 60))
+    assert c.strains[c.straightened] < 3 * s.excess()
+    assert KNEE_BAND[0] * s.excess() < c.knee < KNEE_BAND[1] * s.excess()
     assert c.initial_slope < 0.15 * s.ea  # and it began bending-dominated (0.12 EA)
 
 

@@ -52,6 +52,7 @@ ALONG_POINTS = 3  # Gauss points along an element (curvature is linear: 2 would 
 WIDTH_FIBRES = 8  # Gauss-Legendre fibres across the width (exact for a linear material)
 NEWTON_TOL = 1e-10  # out-of-balance force / (EA scale): equilibrium to round-off
 NEWTON_STEPS = 40  # Newton iterations per strain step at most
+STRAIGHT_FRACTION = 0.9  # straightened: the tangent is within 10 % of its largest
 STEP_STRAIN = 0.01  # largest chord-strain step between two equilibria (the path is followed)
 
 
@@ -115,13 +116,14 @@ class StrandCurve:
     strains (k,), with the initial slope (at zero), the elements used and the Newton
     iterations spent.
 
-    Its bilinear summary: the straightened slope `straight_slope`, the largest tangent (where
-    the strand is straight and its material not yet softened: the last one for a linear
-    material); `intercept`, the strain where the line of that tangent through its point
-    reaches zero force (for a linear material, where a straight strand of the wave's arc
-    length would start to stretch: it tends to the excess path length as the strand
-    straightens); `knee`, where that line meets the initial one (the knee of the bilinear
-    law of the two slopes)."""
+    Its bilinear summary: the strand counts as straightened at the first point whose tangent
+    reaches STRAIGHT_FRACTION of its largest (beyond it a linear material's tangent only creeps
+    toward E A L / S as the clamped ends' bent layers shrink, and a softening material's
+    falls): `straight_slope` is the tangent there; `intercept`, the strain where the line of
+    that tangent through that point reaches zero force (for a linear material, near where a
+    straight strand of the wave's arc length would start to stretch: it tends to the excess
+    path length as the strand straightens); `knee`, where that line meets the initial one
+    (the knee of the bilinear law of the two slopes)."""
 
     strand: Strand
     strains: np.ndarray
@@ -136,12 +138,18 @@ class StrandCurve:
         return float(self.tangents[-1])
 
     @property
+    def straightened(self) -> int:
+        """Index of the first solved point whose tangent reaches STRAIGHT_FRACTION of the
+        largest."""
+        return int(np.argmax(self.tangents >= STRAIGHT_FRACTION * np.max(self.tangents)))
+
+    @property
     def straight_slope(self) -> float:
-        return float(np.max(self.tangents))
+        return float(self.tangents[self.straightened])
 
     @property
     def intercept(self) -> float:
-        i = int(np.argmax(self.tangents))
+        i = self.straightened
         return float(self.strains[i] - self.forces[i] / self.tangents[i])
 
     @property

@@ -159,9 +159,9 @@ class MembraneLaw:
     """A curved net's membrane law along the load, transverse strain blocked (the blocked,
     infinite panel, at finite strain: `blocked_membrane`): knees (net strain) and slopes
     (N/m) through the net strains at which the strands reach the curve's solved points, its
-    bilinear summary (the low-strain slope, the straightened slope where the strand's own
-    tangent peaks, and the knee strain where their lines meet, all N/m or net strain) and the
-    strands' excess path length S / L - 1 (a strand strain)."""
+    bilinear summary (the low-strain slope, the net's tangent where the strands count as
+    straightened, `StrandCurve.straightened`, and the knee strain where their lines meet) and
+    the strands' excess path length S / L - 1 (a strand strain)."""
 
     knees: tuple[float, ...]
     slopes: tuple[float, ...]
@@ -224,7 +224,7 @@ def membrane_law(layout: str, s: CurvedStrands, mesh_along: float,
     tangent = per * (curve.tangents * up * u * u / (l0 * l1 * l1)
                      + curve.forces * up * side**2 / l1**3)
     low = per * curve.initial_slope * (up / l0) ** 3
-    i = int(np.argmax(curve.tangents))
+    i = curve.straightened
     intercept = net[i] - force[i] / tangent[i]
     secants = np.diff(np.concatenate([[0.0], force])) / np.diff(np.concatenate([[0.0], net]))
     return MembraneLaw(tuple(float(k) for k in net[:-1]), tuple(float(v) for v in secants),
