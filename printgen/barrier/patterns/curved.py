@@ -19,8 +19,9 @@ them). Its bilinear summary: low-strain slope, straightened slope, knee strain.
 Printability (`check_wave`), each limit named in its error:
 - the wave's smallest centre-line radius 1 / (a k^2), k = n pi / L, less the offset of the
   innermost bead ((W - w) / 2, W the strand width, w the bead width), is at least
-  MIN_RADIUS_BEADS bead widths: a bead laid on a tighter path folds on its inner edge (its
-  inner edge's radius goes below the half-width the nozzle lays down);
+  MIN_RADIUS_BEADS bead widths: on a tighter path the bead's inner edge turns on a radius
+  below its half-width and the extrusion piles up inside the bend (a rule of thumb, not yet
+  checked by a printed coupon);
 - the band the wave sweeps, 2 a + W, fits between two parallel strands (their spacing across
   the chord): wider, neighbouring strands' waves overlap and would fuse.
 """
@@ -255,9 +256,9 @@ def curved_pattern(layout: str, s: CurvedStrands) -> NetPattern:
     """The layout's pattern with curved strands `s`: its graph, span, node count, mesh and
     membrane-to-strand mapping; membrane_factor the low-strain (bending-dominated) membrane
     slope per strand E A; check_mesh refuses a wave it cannot print (`check_wave`)."""
-    base = get_pattern(layout)
     if layout not in LAYOUTS:
         raise GeometryError(f"curved net: layout {layout!r} is not one of {', '.join(LAYOUTS)}")
+    base = get_pattern(layout)
 
     def factor(mesh_along: float, mesh_across: float) -> float:
         curve = strand_curve_of(layout, s, mesh_along, mesh_across)
