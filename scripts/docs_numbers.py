@@ -1,7 +1,7 @@
-"""The worked numbers of the tutorial (docs/tutorial.md) and the README, written from a run of
-the bundled 1:40 example so that no number on those pages is typed by hand. Each number sits
-between markers, `<!--n:KEY-->value<!--/n-->` (invisible in the rendered page), and KEY is one
-of NUMBERS, read from the run's report.json.
+"""The worked numbers of the tutorial (docs/tutorial.md), the physics page (its 1:40 example)
+and the README, written from a run of the bundled 1:40 example so that no number there is
+typed by hand. Each number sits between markers, `<!--n:KEY-->value<!--/n-->` (invisible in
+the rendered page), and KEY is one of NUMBERS, read from the run's report.json.
 
     python scripts/docs_numbers.py           # a fresh `make` of the example, then rewrite the pages
     python scripts/docs_numbers.py OUT       # the same from OUT, a folder that `printgen make
@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 ROOT = Path(__file__).resolve().parent.parent
-PAGES = (ROOT / "docs" / "tutorial.md", ROOT / "README.md")
+PAGES = (ROOT / "docs" / "tutorial.md", ROOT / "docs" / "physics.md", ROOT / "README.md")
 EXAMPLE = ROOT / "examples" / "realistic_barrier.toml"
 SCALE = 40
 MARK = re.compile(r"<!--n:([a-z_]+)-->(.*?)<!--/n-->", re.DOTALL)
@@ -33,6 +33,23 @@ NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?")
 def _part(r: dict[str, Any], which: str) -> dict[str, Any]:
     """The summary's row of the net or of the border cables."""
     return next(p for p in r["summary"]["parts"] if p["part"].startswith(which))
+
+
+def _net(r: dict[str, Any], passes: int) -> dict[str, Any]:
+    """The selection's first TPE net of one bead across in `passes` passes."""
+    return next(c for c in r["selection"]["net"]["ranked"] if c["material"] == "tpe"
+                and c["section"]["beads_across"] == 1 and c["section"]["passes"] == passes)
+
+
+def _at_1(r: dict[str, Any], quantity: str, which: str) -> float:
+    """The compared quantity at h / h_B = 1 (the model's nominal or the prototype's)."""
+    return r["verification"]["bands"]["at"]["1"][quantity][which]
+
+
+def _steel(r: dict[str, Any], variant: str) -> float:
+    """The counter-example's deflection / width of the simple barrier at 1:lambda."""
+    found = r["verification"]["counterexample"]["deflection"]
+    return next(v for k, v in found.items() if k.endswith(variant))
 
 
 def _duration(seconds: float) -> str:
@@ -63,6 +80,17 @@ NUMBERS: dict[str, Callable[[dict[str, Any]], str]] = {
     "net_size": lambda r: "{:.1f} x {:.1f} mm".format(*r["assembly"]["net_size_mm"]),
     "nodes_prototype": lambda r: str(r["size"]["nets"]["prototype"]["nodes"]),
     "nodes_model": lambda r: str(r["size"]["nets"]["model"]["nodes"]),
+    "cable_ea": lambda r: f"{r['selection']['cable']['ranked'][0]['stiffness']:.0f} N",
+    "paper_net_stiffness": lambda r: f"{_net(r, 3)['stiffness']:.0f} N/m",
+    "paper_net_error": lambda r: f"{100 * _net(r, 3)['error_low_strain']:+.0f} %",
+    "paper_net_error_high": lambda r: f"{100 * _net(r, 3)['error_high_strain']:+.0f} %",
+    "net_error_high": lambda r: f"{100 * _net(r, 2)['error_high_strain']:+.0f} %",
+    "deflection_model": lambda r: f"{_at_1(r, 'deflection', 'nominal'):.3f}",
+    "deflection_prototype": lambda r: f"{_at_1(r, 'deflection', 'prototype'):.3f}",
+    "strain_mid_model": lambda r: f"{100 * _at_1(r, 'strain_mid', 'nominal'):.1f} %",
+    "strain_mid_prototype": lambda r: f"{100 * _at_1(r, 'strain_mid', 'prototype'):.1f} %",
+    "steel_deflection": lambda r: f"{_steel(r, 'steel E'):.3f}",
+    "scaled_e_deflection": lambda r: f"{_steel(r, 'E scaled by 1/lambda'):.3f}",
     "verdict": lambda r: r["summary"]["verdict"],
     "reason": lambda r: _one_line(r["summary"]["reason"]),
     "band_deflection": lambda r: r["summary"]["band"]["deflection"],
