@@ -141,3 +141,20 @@ def test_no_issue_number_in_the_documentation():
     found = [f"{p.name}: {m.group(0)}" for p in texts
              for m in PATTERNS["issue number"].finditer(p.read_text("utf-8"))]
     assert found == []
+
+
+def test_the_install_table_names_every_extra():
+    """docs/index.md's table of extras against pyproject.toml: one row per extra, and the
+    `all` row names the extras `all` pulls in."""
+    import tomllib
+
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text("utf-8"))["project"][
+        "optional-dependencies"]
+    text = (ROOT / "docs" / "index.md").read_text("utf-8").split("## Installing", 1)[1]
+    rows = {m.group(1): m.group(2) for m in re.finditer(r"^\| `([\w-]+)` \| ([^|]*)\|", text,
+                                                        re.MULTILINE)}
+    assert set(rows) == set(extras)
+    pulled = set(re.findall(r"printgen\[([^\]]*)\]", " ".join(extras["all"])))
+    named = {e for group in pulled for e in group.split(",")}
+    assert set(re.findall(r"`([\w-]+)`", rows["all"])) == named
+    assert "docs" not in named  # the site's tools stay out of a developer's `all`
