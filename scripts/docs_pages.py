@@ -60,7 +60,11 @@ def _help(parser: argparse.ArgumentParser, action: argparse.Action) -> str:
 
 
 def _default(action: argparse.Action) -> str:
-    if action.default in (None, False, argparse.SUPPRESS) or action.nargs == 0 \
+    """The default column: "required", the default value, or empty (a flag, a positional, no
+    default, an empty list)."""
+    if action.required and action.option_strings:
+        return "required"
+    if action.default in (None, False, "", argparse.SUPPRESS, [], ()) or action.nargs == 0 \
             or not action.option_strings:
         return ""
     return f"`{action.default}`"
