@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import types
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -102,16 +103,24 @@ def cli_page() -> str:
     return "\n".join(out)
 
 
-def api_page() -> str:
-    """docs/api.md: one mkdocstrings entry per name of `printgen.__all__`, the version aside."""
+def api_entries() -> list[tuple[str, str]]:
+    """(public name, the object's home as mkdocstrings finds it) for every function or class
+    of `printgen.__all__`: `printgen/__init__.py` imports its verbs lazily from their home
+    (printgen.run.api), and `printgen.calibrate` is also a subpackage's name."""
     import printgen
-    from printgen.run import api
 
-    # printgen's verbs live in printgen.run.api (printgen/__init__.py imports them lazily), and
-    # `printgen.calibrate` is also a subpackage's name: each entry names the verb's home.
-    names = [n for n in printgen.__all__ if not n.startswith("_")]
-    if missing := [n for n in names if not callable(getattr(api, n, None))]:
-        raise SystemExit(f"printgen.__all__ names {missing}, not verbs of printgen.run.api")
+    out = []
+    for name in printgen.__all__:
+        obj = getattr(printgen, name)
+        if isinstance(obj, types.ModuleType):  # a subpackage of that name, once imported,
+            obj = printgen.__getattr__(name)   # hides the lazily imported verb
+        if callable(obj):
+            out.append((name, f"{obj.__module__}.{obj.__qualname__}"))
+    return out
+
+
+def api_page() -> str:
+    """docs/api.md: one mkdocstrings entry per function or class of `printgen.__all__`."""
     out = ["# Python API", "",
            GENERATED.format(source="printgen.__all__ and the verbs' docstrings"), "",
            "The public verbs of `import printgen` (the names of `printgen.__all__`). Each "
@@ -120,8 +129,8 @@ def api_page() -> str:
            "`make`, `verify` or a search keeps its calls under "
            '`if __name__ == "__main__":` (the worker processes start by importing it on macOS '
            "and Windows).", ""]
-    for name in names:
-        out += [f"::: printgen.run.api.{name}", ""]
+    for _, home in api_entries():
+        out += [f"::: {home}", ""]
     return "\n".join(out)
 
 
