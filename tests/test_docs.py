@@ -118,6 +118,11 @@ def test_the_pages_mark_only_known_numbers():
         keys = [k for k, _ in numbers.marked(page.read_text("utf-8"))]
         assert keys, f"{page.name} holds no worked number"
         assert set(keys) <= set(numbers.NUMBERS), (page.name, set(keys) - set(numbers.NUMBERS))
+        # A line that starts with `<!--` starts an HTML block (CommonMark, Python-Markdown): it
+        # would cut its paragraph or list item in two and show its Markdown as written.
+        starts = [line for line in page.read_text("utf-8").splitlines()
+                  if line.lstrip().startswith("<!--n:")]
+        assert starts == [], page.name
 
 
 def test_the_worked_numbers_are_those_of_a_run(made_1_40):
