@@ -214,12 +214,17 @@ def _mesh_parts(d: Design, comp: float) -> list[tuple]:
 
 
 def _write_part(stage: Path, name: str, kind: str, part, body, printer, outline,
-                expected: float, ini: str) -> MeshRecord:
+                expected: float, ini: str | None = None) -> MeshRecord:
     """Place `body` on the bed and write its STL, 3MF carrying the PrusaSlicer settings `ini`
-    (and STEP from `outline` when given); its record."""
+    (None: the part's own, its presets named after it alone) and STEP from `outline` when
+    given; its record."""
     from printgen.parts.export import place_mesh, prusa_config_from_ini, stl_bytes, threemf_bytes
+    from printgen.parts.slicer.prusa import prusa_ini_text
     from printgen.report.records import MeshRecord
 
+    if ini is None:
+        ini = prusa_ini_text(kind, part, printer, load_print_style(part.print_style),
+                             load_material(part.material))
     mesh, angle = place_mesh(body, printer, name)
     (stage / f"{name}.stl").write_bytes(stl_bytes(mesh))
     (stage / f"{name}.3mf").write_bytes(threemf_bytes([(name, mesh)],

@@ -17,6 +17,7 @@ loaded after a printer config (`prusa-slicer --load printer.ini --load part.ini`
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from dataclasses import dataclass
@@ -246,16 +247,25 @@ def prusa_presets(part_kind: str, design_part: NetDesign | CableDesign, printer:
 
 def unique_preset_names(presets: list[PrusaPresets]) -> list[PrusaPresets]:
     """The presets with each name naming one set of settings: where parts' presets of one
-    kind share a name but differ, each takes its part's name after a dash."""
+    kind share a name but differ, the first part's settings keep the name and each other set
+    takes the name of the first part holding it after a dash (parts with equal settings
+    share their preset)."""
     out = list(presets)
     for kind in PRESET_KINDS:
-        by_name: dict[str, set[tuple]] = {}
+        first: dict[tuple[str, tuple], str] = {}  # (name, settings) -> first part holding them
+        variants: dict[str, list[tuple]] = {}
         for p in presets:
-            by_name.setdefault(p.names[kind], set()).add(tuple(sorted(p.settings[kind].items())))
-        out = [p if len(by_name[p.names[kind]]) == 1 else
-               PrusaPresets(p.part, {**p.names, kind: f"{p.names[kind]} - {p.part}"},
-                            p.settings, p.compatible, p.header)
-               for p in out]
+            key = tuple(sorted(p.settings[kind].items()))
+            first.setdefault((p.names[kind], key), p.part)
+            if key not in variants.setdefault(p.names[kind], []):
+                variants[p.names[kind]].append(key)
+        renamed = []
+        for p in out:
+            name, key = p.names[kind], tuple(sorted(p.settings[kind].items()))
+            if variants[name].index(key):
+                name = f"{name} - {first[(name, key)]}"
+            renamed.append(dataclasses.replace(p, names={**p.names, kind: name}))
+        out = renamed
     return out
 
 
