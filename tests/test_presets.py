@@ -306,6 +306,22 @@ def test_print_and_filament_presets_slice_on_top_of_a_printer_preset(
     assert r.stdout.strip().splitlines()[-1].startswith("GCODE-CHECK OK")
 
 
+@pytest.mark.slow
+def test_prusaslicer_reads_the_preset_names_of_the_3mf(design, presets, tmp_path):
+    exe = require_tool("prusa-slicer")
+    _, _, mesh = _part(design, "cable-left")
+    path = tmp_path / "cable-left.3mf"
+    path.write_bytes(threemf_bytes([("cable-left", mesh)],
+                                   presets_ini_text(presets["cable-left"])))
+    out = tmp_path / "cable-left.gcode"
+    r = subprocess.run([exe, "--loglevel", "1", "--export-gcode", "--output", str(out),
+                        str(path)], capture_output=True, text=True, timeout=SLICE_TIMEOUT_S,
+                       check=False)
+    assert r.returncode == 0, r.stderr[-800:]
+    got = _trailer(out)
+    assert {k: got[k] for k in SETTINGS_IDS.values()} == presets["cable-left"].ids()
+
+
 # ----------------------------------------------------------------------------- Cura
 def _cura_tree(defs: Path) -> dict[str, dict]:
     out: dict[str, dict] = {}
@@ -493,6 +509,10 @@ def test_make_writes_the_presets_and_names_them_in_the_3mfs(made_1_40):
                    if "_settings_id = " in ln)
         for kind, key in SETTINGS_IDS.items():
             assert f"{kind}:{ids[key].strip(chr(34))}" in cp.sections(), (threemf, kind)
+    guide = (Path(__file__).resolve().parents[1] / "docs" / "user-guide.md").read_text()
+    for pattern in ("prusaslicer-bundle.ini", "PART.prusa-print.ini", "PART.prusa.ini",
+                    "cable-NAME.curaprofile", "cable-NAME.cura-settings.csv"):
+        assert f"`{pattern}`" in guide, pattern  # the user guide says what each file is for
     for p in parts:  # the flat print+filament file holds no printer key
         groups = prusa_key_presets()
         flat = _flat((out / f"{p}.prusa-print.ini").read_text())
