@@ -100,6 +100,9 @@ def test_bundle_holds_one_section_per_preset_with_only_its_own_keys(presets, des
          "print:printgen cable PETG 0.9 x 0.6 mm (cable-4pass)",
          "filament:printgen TPE 1.75 mm", "filament:printgen PETG 1.75 mm",
          "printer:printgen Generic 350 x 350 (0.5 mm nozzle)", "presets"])
+    # the import selects printgen's print and filament presets, not its printer: the lab's
+    # own printer stays active
+    assert set(cp["presets"]) == {"print", "filament"}
     for kind, name in cp["presets"].items():
         assert f"{kind}:{name}" in cp.sections()
     # every setting of every part is in its presets: the bundle loses nothing

@@ -298,8 +298,9 @@ def presets_ini_text(presets: PrusaPresets, kinds: tuple[str, ...] = PRESET_KIND
 def prusa_bundle_text(presets: list[PrusaPresets]) -> str:
     """A PrusaSlicer config bundle: one `[print:NAME]`, `[filament:NAME]` and
     `[printer:NAME]` section per distinct preset (names made unique first), and `[presets]`
-    selecting the first part's. Import it in the GUI with File > Import > Import Config
-    Bundle; each print preset is offered with printers whose nozzle its condition admits."""
+    selecting the first part's print and filament presets. Import it in the GUI with File >
+    Import > Import Config Bundle; each print preset is offered with printers whose nozzle its
+    condition admits."""
     presets = unique_preset_names(presets)
     seen: set[tuple[str, str]] = set()
     out = ["# printgen: PrusaSlicer 2.5 config bundle: print and filament presets for the "
@@ -315,7 +316,10 @@ def prusa_bundle_text(presets: list[PrusaPresets]) -> str:
             if kind == "print":
                 s["compatible_printers_condition"] = p.compatible
             out += ["", f"[{kind}:{p.names[kind]}]", *_lines(s)]
-    out += ["", "[presets]", *(f"{kind} = {presets[0].names[kind]}" for kind in PRESET_KINDS)]
+    # [presets] selects on import: the print and filament only, so that the lab's own
+    # printer stays the active one (PrusaSlicer's bundle loader activates every one named)
+    out += ["", "[presets]", *(f"{kind} = {presets[0].names[kind]}"
+                               for kind in ("print", "filament"))]
     return "\n".join(out) + "\n"
 
 
