@@ -325,6 +325,29 @@ def test_prusaslicer_reads_the_preset_names_of_the_3mf(design, presets, tmp_path
     assert {k: got[k] for k in SETTINGS_IDS.values()} == presets["cable-left"].ids()
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("part", ["net", "cable-top"])
+def test_prusaslicer_evaluates_the_nozzle_condition_of_each_print_preset(presets, tmp_path,
+                                                                         part):
+    """The GUI offers a print preset where its compatible_printers_condition holds; PrusaSlicer
+    evaluates the same expression language in custom G-code, so a slice with the condition
+    in the start G-code shows how it evaluates, nozzle by nozzle."""
+    trimesh = pytest.importorskip("trimesh")
+    cube = trimesh.creation.box((10.0, 10.0, 0.4))
+    cube.apply_translation((100.0, 100.0, 0.2))
+    stl = tmp_path / "cube.stl"
+    cube.export(stl)
+    cond = presets[part].compatible
+    lo, hi = map(float, re.findall(r"[<>]=([\d.]+)", cond))
+    for nozzle in (0.3, 0.4, 0.5, 0.6, 0.8):
+        gcode = _slice(tmp_path, stl, extra=(
+            "--nozzle-diameter", f"{nozzle:g}", "--layer-height", "0.2",
+            "--first-layer-height", "0.2",
+            "--start-gcode", f"{{if {cond}}};offered{{else}};not offered{{endif}}"))
+        offered = ";offered\n" in gcode.read_text()
+        assert offered == (lo <= nozzle <= hi), (cond, nozzle)
+
+
 # ----------------------------------------------------------------------------- Cura
 def _cura_tree(defs: Path) -> dict[str, dict]:
     out: dict[str, dict] = {}
