@@ -483,6 +483,7 @@ def _pair_outcome(base: Path, printer: str, style: str, tmp_path: Path) -> str:
     return "prints"
 
 
+@pytest.mark.slow  # 16 selections and designs: a few seconds
 def test_every_bundled_printer_and_print_style_prints_the_examples_or_names_the_limit(
         tmp_path):
     outcomes = {(ex.stem, printer, style): _pair_outcome(ex, printer, style, tmp_path)
