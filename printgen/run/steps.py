@@ -154,9 +154,9 @@ def slicer_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
             (stage / f"{name}.curaprofile").write_bytes(curaprofile_bytes(name, s))
             written.append(f"{name}.curaprofile")
         for file, text in files.items():
-            (stage / file).write_text(text)
+            (stage / file).write_text(text, encoding="utf-8")  # Cura's units hold a degree sign
         written += list(files)
-    (stage / BUNDLE_FILE).write_text(prusa_bundle_text(list(presets.values())))
+    (stage / BUNDLE_FILE).write_text(prusa_bundle_text(list(presets.values())), encoding="utf-8")
     written.append(BUNDLE_FILE)
     ctx.files += written
     return {"slicer_profiles": sorted(written)}
