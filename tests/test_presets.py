@@ -418,12 +418,20 @@ def test_cura_profile_is_an_instance_container_cura_4_13_imports(design):
             assert not isinstance(hi, (int, float)) or x <= hi, (key, value, hi)
 
 
-def test_cura_keys_table_matches_the_definitions():
+# CuraEngine settings that are the printer's in Cura's GUI though not in its Machine category
+PRINTER_OWN = {"material_diameter", "relative_extrusion"}
+
+
+def test_cura_keys_table_matches_the_definitions(design):
     defs = _require_definitions()
     tree = _cura_tree(defs)
     for key, (category, label, unit) in cura_profile_keys().items():
         d = tree[key]
         assert (category, label, unit) == (d["category"], d["label"], d.get("unit", "")), key
+    # every CuraEngine setting left out of the profile is the printer's
+    left_out = set(_cable_settings(design)) - set(cura_profile_keys())
+    assert {k for k in left_out if k not in PRINTER_OWN
+            and tree[k]["category"] not in ("Machine", "Command Line Settings")} == set()
 
 
 def test_cura_settings_table_reads_as_one_header_row(design):
