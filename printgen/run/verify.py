@@ -96,9 +96,10 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     d = load_design(design_path, scale=scale, prototype=p)
     m = read_measured(measured, design_units(d)) if measured is not None else None
     limit = DEFAULT_LIMIT_S if time_limit_s is None else time_limit_s
-    check_budget(p, d, limit_s=limit, cores=sweep_cores(),
-                 work=Work(parts=False, fit=m is not None, model_follows=False,
-                           fit_plan=fit_plan(m, fit, free_section(p)) if m else None))
+    plan = fit_plan(m, fit, free_section(p)) if m is not None else None
+    est = check_budget(p, d, limit_s=limit, cores=sweep_cores(),
+                       work=Work(parts=False, fit=m is not None, model_follows=False,
+                                 fit_plan=plan))
     load_kw = model_load_kw(p, d, load)
     say("verification (prototype and model load sweeps) and its uncertainty band (model "
         "variants)")
@@ -129,7 +130,8 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     if text:
         files[fitted_name(d)] = text
     timings = {"total": time.perf_counter() - t0, "band": band.seconds,
-               **({"fit": fit_s} if m is not None else {})}
+               "estimate": est.seconds, "estimate_speed_factor": est.speed,
+               **({"fit": fit_s, "estimate_fit_sweeps": plan.sweeps} if plan else {})}
     files[TIMINGS] = dumps({"timings_s": timings})
     meta = provenance_record(options.command, prototype=prototype,
                              files={"design_file": design_path, "measured": measured},

@@ -421,12 +421,19 @@ def _fit(d: Design, m: Measurement, lv: np.ndarray, coarsen: int, load_kw: dict 
     ident, profiles = _determination(runs, params, idx, coarsen)
     edge = at_bounds(params)
     idle = tuple(k for k in IDLE if k in free and _idle(fitted, nominal))
-    ok = (all(mm.rms_rel < EXPLAINS for mm in after if not math.isnan(mm.rms_rel))
-          and not edge and not not_improved(before, after))
+    ok = explained(before, after, params)
     sweeps = {("own net" if k == coarsen else f"coarse x{k // coarsen}"): n
               for k, n in sorted(runs.count.items())}
     return MultiFit(params, before, after, pred, best, ident, sum(runs.count.values()), ok,
                     edge, idle, profiles, sweeps)
+
+
+def explained(before: list, after: list, params: Params) -> bool:
+    """The module docstring's rule: every column's scored RMS mismatch below EXPLAINS, every
+    measured column improved on the nominal (`measured.not_improved`), and every parameter
+    inside its bounds (`at_bounds`). Only then may a profile be written from the fit."""
+    close = all(mm.rms_rel < EXPLAINS for mm in after if not math.isnan(mm.rms_rel))
+    return close and not not_improved(before, after) and not at_bounds(params)
 
 
 def _screen(runs: Trials, bases: list[Params], idx: list[int], k: int
