@@ -6,21 +6,20 @@ default one-factor fit and with `--fit multi`, each a fresh process.
 
     python -m benchmarks.bench_fit --out DIR [--repeat 1]     (or: printgen bench fit)
 
-For each: the wall time of the whole command (and its CPU, workers included: on a shared
-machine, CPU over the cores bounds the quiet wall time) and of the fit alone (timings.json
-"fit"), the
+For each: the wall time of the whole command and of the fit alone (timings.json "fit"), the
+fit's CPU over every process that ran its sweeps ("fit_cpu": on a machine busier than its
+cores, the CPU shared out on them stands for the quiet time), the
 sweeps the fit ran (report.json) against the sweeps and the time the run's estimate counted
 (timings.json "estimate_fit_sweeps", "estimate"), and the fit's verdict (explained, profile
 written). The machine is shared: the load average is recorded beside each run. Goals: the
-multi fit within GOAL_MULTI_S, the one-factor fit within GOAL_ONE_S (wall, the fit alone),
-and the estimate within ESTIMATE_FACTOR of the measured run. Writes bench_fit.json.
+multi fit within GOAL_MULTI_S, the one-factor fit within GOAL_ONE_S (the fit alone, quiet),
+and the estimate of the fit within ESTIMATE_FACTOR of its quiet time. Writes bench_fit.json.
 """
 
 from __future__ import annotations
 
 import json
 import os
-import resource
 import statistics
 import subprocess
 import sys
@@ -35,6 +34,7 @@ GOAL_MULTI_S = 60.0  # --fit multi on the paper test: a minute on 2 cores, quiet
 GOAL_ONE_S = 10.0  # the one-factor fit alone
 ESTIMATE_FACTOR = 2.0  # the run's estimate within x2 of the measured run
 FITS = ("stiffness", "multi")
+CORES = 2  # the sweep cores verify runs on (printgen.run.budget.sweep_cores)
 
 
 def one_run(out: Path, fit: str) -> dict:
@@ -43,16 +43,17 @@ def one_run(out: Path, fit: str) -> dict:
            "--design", str(PAPER / "design.json"), "--measured", str(PAPER / "measured.csv"),
            "--fit", fit, "--out", str(out), "--force", "--time-limit", "3600"]
     load = os.getloadavg()[0]
-    t, cpu = time.perf_counter(), _children_cpu()
+    t = time.perf_counter()
     proc = subprocess.run(cmd, check=False, capture_output=True, text=True, cwd=ROOT,
                           env={**os.environ, "PYTHONPATH": str(ROOT)})
-    wall, cpu = time.perf_counter() - t, _children_cpu() - cpu
+    wall = time.perf_counter() - t
     if proc.returncode not in (0, 1, 3):  # 1: a mismatch, 3: a verdict on fewer levels
         raise RuntimeError(f"printgen verify failed ({proc.returncode}): {proc.stderr[-2000:]}")
     timings = json.loads((out / "timings.json").read_text())["timings_s"]
     fitted = json.loads((out / "report.json").read_text())["measured"]["fit"]
-    return {"fit": fit, "wall_s": round(wall, 2), "cpu_s": round(cpu, 2),
-            "fit_s": round(timings["fit"], 2),
+    return {"fit": fit, "wall_s": round(wall, 2),
+            "fit_s": round(timings["fit"], 2), "fit_cpu_s": round(timings["fit_cpu"], 2),
+            "estimate_fit_s": round(timings["estimate_fit"], 2),
             "band_s": round(timings["band"], 2), "estimate_s": round(timings["estimate"], 2),
             "speed_factor": round(timings["estimate_speed_factor"], 3),
             "sweeps": fitted["evaluations"], "sweeps_by_net": fitted.get("sweeps", {}),
@@ -64,12 +65,6 @@ def one_run(out: Path, fit: str) -> dict:
             "load_after": round(os.getloadavg()[0], 2)}
 
 
-def _children_cpu() -> float:
-    """CPU seconds of this process's finished children (the command and its workers)."""
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
-
-
 def run(out: Path, repeat: int = 1) -> dict:
     out.mkdir(parents=True, exist_ok=True)
     report: dict = {"benchmark": "bench_fit", "cores": os.cpu_count(), "runs": []}
@@ -79,16 +74,27 @@ def run(out: Path, repeat: int = 1) -> dict:
             print(f"verify --fit {fit} ({i + 1}/{repeat}) ...", file=sys.stderr, flush=True)
             rows.append(one_run(out / f"{fit}-{i}", fit))
         report["runs"] += rows
-        med = statistics.median(r["fit_s"] for r in rows)
-        wall = statistics.median(r["wall_s"] for r in rows)
-        est = rows[0]["estimate_s"]
-        report[f"{fit}_fit_s"] = med
-        report[f"{fit}_wall_s"] = wall
-        report[f"{fit}_estimate_over_measured"] = round(est / wall, 2)
-    report["goal_met"] = bool(
-        report["multi_fit_s"] <= GOAL_MULTI_S and report["stiffness_fit_s"] <= GOAL_ONE_S
-        and all(1 / ESTIMATE_FACTOR <= report[f"{f}_estimate_over_measured"] <= ESTIMATE_FACTOR
-                for f in FITS))
+        load = max(r["load_before"] for r in rows)
+        fit_cpu = statistics.median(r["fit_cpu_s"] for r in rows)
+        # the multi fit's batches share out on the sweep cores; the one-factor search is serial
+        quiet = fit_cpu / (CORES if fit == "multi" else 1)
+        report[fit] = {
+            "fit_wall_s": statistics.median(r["fit_s"] for r in rows),
+            "fit_cpu_s": fit_cpu, "fit_quiet_s": round(quiet, 2),
+            "estimate_fit_s": rows[0]["estimate_fit_s"],
+            "estimate_fit_over_quiet": round(rows[0]["estimate_fit_s"] / quiet, 2),
+            "wall_s": statistics.median(r["wall_s"] for r in rows),
+            "estimate_s": rows[0]["estimate_s"],
+            "sweeps": rows[0]["sweeps"], "estimate_sweeps": rows[0]["estimate_sweeps"],
+            "load": load,
+            # on a machine busier than its cores the wall time is the others' load: the fit's
+            # CPU shared out on the cores stands for the quiet machine's time
+            "basis": "wall" if load < CORES else "CPU over the cores (loaded machine)"}
+    goal = {"multi": GOAL_MULTI_S, "stiffness": GOAL_ONE_S}
+    report["goal_met"] = all(
+        (r["fit_wall_s"] if r["basis"] == "wall" else r["fit_quiet_s"]) <= goal[f]
+        and 1 / ESTIMATE_FACTOR <= r["estimate_fit_over_quiet"] <= ESTIMATE_FACTOR
+        for f, r in ((f, report[f]) for f in FITS))
     (out / "bench_fit.json").write_text(json.dumps(report, indent=1) + "\n")
     return report
 

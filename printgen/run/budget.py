@@ -354,7 +354,7 @@ def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
                        speed=speed)
     which = ("the default, about a minute of make on 2 cores" if limit_s == DEFAULT_LIMIT_S
              else "from --time-limit")
-    fit = _fit_share(est, cores) if work.fit else ""
+    fit = _fit_share(est) if work.fit else ""
     if fit and work.fit_plan is not None and work.fit_plan.parallel:
         fix += (f"; or fit one factor of the net (--fit stiffness), a search of at most "
                 f"{default_fit().sweeps} sweeps")
@@ -363,15 +363,21 @@ def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
                      f"{math.ceil(est.seconds * 1.5 / 60) * 60:g}, or {fix}")
 
 
-def _fit_share(est: Estimate, cores: int) -> str:
-    """The fit's part of an estimate, as words: its sweeps and their time."""
-    fit = [s for s in est.sweeps if s.group in ("fit", "serial") and s.name.startswith("fit")]
+def fit_estimate(est: Estimate) -> float:
+    """Seconds of the measured test's fit in `est` (on this machine): its sweeps' CPU, shared
+    out on the sweep cores when the fit runs in batches."""
+    fit = [s for s in est.sweeps if s.name.startswith("fit")]
     if not fit:
-        return ""
-    c = max(1, min(cores, 2)) if fit[0].group == "fit" else 1
-    seconds = est.speed * sum(s.seconds for s in fit) / c
-    return (f", of which the measured test's fit: {len(fit)} sweeps, about "
-            f"{seconds:.0f} s")
+        return 0.0
+    c = max(1, min(est.cores, 2)) if fit[0].group == "fit" else 1
+    return est.speed * sum(s.seconds for s in fit) / c
+
+
+def _fit_share(est: Estimate) -> str:
+    """The fit's part of an estimate, as words: its sweeps and their time."""
+    n = sum(1 for s in est.sweeps if s.name.startswith("fit"))
+    return (f", of which the measured test's fit: {n} sweeps, about "
+            f"{fit_estimate(est):.0f} s") if n else ""
 
 
 def prototype_sweep_s(p: Prototype) -> float:

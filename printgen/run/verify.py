@@ -22,7 +22,14 @@ from printgen.outputs import TIMINGS, check_destination, staged_dir
 from printgen.report.build import build_report, report_files
 from printgen.report.jsonout import dumps
 from printgen.report.records import CheckRecords, MeasuredRecords, RunRecords
-from printgen.run.budget import DEFAULT_LIMIT_S, FitPlan, Work, check_budget, sweep_cores
+from printgen.run.budget import (
+    DEFAULT_LIMIT_S,
+    FitPlan,
+    Work,
+    check_budget,
+    fit_estimate,
+    sweep_cores,
+)
 from printgen.run.options import RunOptions
 from printgen.run.provenance import provenance_record
 from printgen.scaling.design_file import load_design
@@ -105,7 +112,7 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
         "variants)")
     v, band = verify_with_band(p, d, load=load, free_section=free_section(p))
     result, text = None, ""
-    t_fit = time.perf_counter()
+    t_fit, cpu_fit = time.perf_counter(), time.process_time()
     if m is not None and fit == "multi":
         say(f"multi-parameter fit of the printed net to {Path(measured).name}")
         result = fit_measured(d, m, fit_levels(m), load_kw=load_kw, free_section=free_section(p))
@@ -118,6 +125,8 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
         text = _profile_text(d, one, Path(measured).name) if one.writes_profile else ""
         result = one
     fit_s = time.perf_counter() - t_fit
+    # the fit's CPU: its sweeps' in the workers (multi), else this process's (one factor)
+    fit_cpu = result.cpu_s if isinstance(result, MultiFit) else time.process_time() - cpu_fit
     run = RunRecords(f"printgen verify: {p.name} at 1:{d.scale:g}", d)
     run.steps["verification"] = CheckRecords(v, band, d.scale, nested=False)
     if m is not None:
@@ -131,7 +140,8 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
         files[fitted_name(d)] = text
     timings = {"total": time.perf_counter() - t0, "band": band.seconds,
                "estimate": est.seconds, "estimate_speed_factor": est.speed,
-               **({"fit": fit_s, "estimate_fit_sweeps": plan.sweeps} if plan else {})}
+               **({"fit": fit_s, "fit_cpu": fit_cpu, "estimate_fit_sweeps": plan.sweeps,
+                   "estimate_fit": fit_estimate(est)} if plan else {})}
     files[TIMINGS] = dumps({"timings_s": timings})
     meta = provenance_record(options.command, prototype=prototype,
                              files={"design_file": design_path, "measured": measured},

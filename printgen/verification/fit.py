@@ -42,6 +42,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -144,16 +145,19 @@ class Trial:
 
     curves: dict[str, np.ndarray]
     cable_n: float
+    cpu_s: float = 0.0  # the trial's CPU in its process (scene and sweep)
 
 
 def trial(d: Design, p: Params, m: Measurement, lv: np.ndarray, coarsen: int = 1,
           load_kw: dict | None = None) -> Trial:
     """The model swept with `p` over `lv` (a worker job: module-level, picklable)."""
+    cpu = time.process_time()
     run = sweep(fit_scene(d, p, coarsen), lv, **(load_kw or {}))
     c = curves(run)
     cable = run.deformation.max_cable_tension
     return Trial({k: np.interp(m.levels, lv, c[k] - c[k][0]) for k in m.values},
-                 float(np.nanmax(cable)) if cable.size else 0.0)
+                 float(np.nanmax(cable)) if cable.size else 0.0,
+                 time.process_time() - cpu)
 
 
 def predict(d: Design, p: Params, m: Measurement, lv: np.ndarray, coarsen: int = 1,
@@ -181,22 +185,27 @@ class Trials:
         self.d, self.m, self.lv, self.load_kw = d, m, lv, load_kw
         self.cache: dict[tuple[Params, int], Trial] = {}
         self.count: dict[int, int] = {}
+        self.cpu_s = 0.0  # the sweeps' CPU, summed over the processes that ran them
 
     def many(self, ps: list[Params], coarsen: int = 1) -> list[Trial]:
         todo = list(dict.fromkeys(p for p in ps if (p, coarsen) not in self.cache))
-        jobs = [(trial, (self.d, p, self.m, self.lv, coarsen, self.load_kw), {}) for p in todo]
+        jobs: list[tuple] = [(trial, (self.d, p, self.m, self.lv, coarsen, self.load_kw), {})
+                             for p in todo]
         for p, t in zip(todo, collect(submit_jobs(jobs)), strict=True):
             self.cache[(p, coarsen)] = t
+            self.cpu_s += t.cpu_s
         self.count[coarsen] = self.count.get(coarsen, 0) + len(todo)
         return [self.cache[(p, coarsen)] for p in ps]
 
     def one(self, p: Params, coarsen: int = 1) -> Trial:
         return self.many([p], coarsen)[0]
 
-    def add(self, p: Params, t: Trial, sweeps: int, coarsen: int = 1) -> None:
-        """A trial run elsewhere (a worker's search) and the sweeps that search ran."""
+    def add(self, p: Params, t: Trial, sweeps: int, cpu_s: float, coarsen: int = 1) -> None:
+        """A trial run elsewhere (a worker's search), the sweeps that search ran and their
+        CPU."""
         self.cache[(p, coarsen)] = t
         self.count[coarsen] = self.count.get(coarsen, 0) + sweeps
+        self.cpu_s += cpu_s
 
 
 @dataclass(frozen=True)
@@ -254,6 +263,7 @@ class MultiFit:
     idle: tuple[str, ...] = ()  # the slacks whose part carries no load in the fit (IDLE)
     profiles: dict[str, Profile] = field(default_factory=dict)
     sweeps: dict[str, int] = field(default_factory=dict)  # "coarse x2", "own net": sweeps run
+    cpu_s: float = 0.0  # the sweeps' CPU over every process (bench fit)
 
     kind = "multi"
     at_bound = False  # the one-factor fit's flag; a multi fit says `explains` instead
@@ -342,8 +352,6 @@ class MultiFit:
                 f"{worst:.0%}{idle}; no profile is written{det}")
 
 
-PATH_STEP = 0.1  # kept for callers that sweep a finer path than the measured levels
-
 
 def fit_levels(m: Measurement) -> np.ndarray:
     """The load path a fit sweeps: h / h_B = 0 and every measured level
@@ -409,9 +417,10 @@ def _fit(d: Design, m: Measurement, lv: np.ndarray, coarsen: int, load_kw: dict 
     else:
         starts = bases
     # 2. the search on the design's own net, one choice per worker
-    jobs = [(search_job, (d, m, lv, load_kw, s, tuple(idx), coarsen), {}) for s in starts]
-    for p, obj, t, n in collect(submit_jobs(jobs)):
-        runs.add(p, t, n, coarsen)
+    jobs: list[tuple] = [(search_job, (d, m, lv, load_kw, s, tuple(idx), coarsen), {})
+                         for s in starts]
+    for p, obj, t, n, cpu in collect(submit_jobs(jobs)):
+        runs.add(p, t, n, cpu, coarsen)
         best[p.choice] = (p, obj)
     params = min((best[s.choice] for s in starts), key=lambda pv: pv[1])[0]
     fitted = runs.one(params, coarsen)
@@ -425,7 +434,7 @@ def _fit(d: Design, m: Measurement, lv: np.ndarray, coarsen: int, load_kw: dict 
     sweeps = {("own net" if k == coarsen else f"coarse x{k // coarsen}"): n
               for k, n in sorted(runs.count.items())}
     return MultiFit(params, before, after, pred, best, ident, sum(runs.count.values()), ok,
-                    edge, idle, profiles, sweeps)
+                    edge, idle, profiles, sweeps, runs.cpu_s)
 
 
 def explained(before: list, after: list, params: Params) -> bool:
@@ -479,9 +488,9 @@ def _probe(p: Params, i: int) -> tuple[Params, float]:
 
 def search_job(d: Design, m: Measurement, lv: np.ndarray, load_kw: dict | None,
                base: Params, idx: tuple[int, ...], coarsen: int
-               ) -> tuple[Params, float, Trial, int]:
+               ) -> tuple[Params, float, Trial, int, float]:
     """The bounded least-squares search of one choice from `base` (a worker job): the best
-    parameters, their objective and trial, and the sweeps it ran."""
+    parameters, their objective and trial, the sweeps it ran and their CPU."""
     from scipy.optimize import least_squares
 
     cache: dict[Params, Trial] = {}
@@ -501,7 +510,7 @@ def search_job(d: Design, m: Measurement, lv: np.ndarray, load_kw: dict | None,
                         max_nfev=MAX_EVALUATIONS, xtol=XTOL)
     fitted = base.with_scaled(full(res.x))
     t = run(fitted)
-    return fitted, objective(m, t.curves), t, len(cache)
+    return fitted, objective(m, t.curves), t, len(cache), sum(c.cpu_s for c in cache.values())
 
 
 def at_bounds(p: Params) -> tuple[str, ...]:
