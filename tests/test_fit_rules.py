@@ -6,6 +6,7 @@ by --time-limit."""
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -13,6 +14,7 @@ import pytest
 from conftest import EXAMPLES
 from proto_files import REALISTIC
 
+from printgen.cli import main
 from printgen.errors import InputError
 from printgen.inputs.prototype import load_prototype
 from printgen.run.budget import FitPlan, Work, check_budget, estimate
@@ -204,3 +206,35 @@ def test_the_estimate_counts_the_fit_s_sweeps_and_refuses_up_front():
 def test_a_plan_without_a_screen_counts_fine_sweeps_only():
     assert planned_sweeps(1, 2)["coarse"] == 0
     assert FitPlan(((2, 3), (1, 4)), 4).sweeps == 7
+
+
+PAPER_ARGS = ["verify", str(REALISTIC), "--scale", "40",
+              "--design", str(EXAMPLES / "paper_1_40" / "design.json"),
+              "--measured", str(EXAMPLES / "paper_1_40" / "measured.csv")]
+TIGHT_LIMIT_S = 5.0  # far below the multi fit's estimate on any machine (hundreds of sweeps)
+
+
+@pytest.mark.slow
+def test_time_limit_refuses_the_multi_fit_before_any_solve(tmp_path, capsys):
+    out = tmp_path / "o"
+    assert main([*PAPER_ARGS, "--fit", "multi", "--out", str(out), "--time-limit",
+                 f"{TIGHT_LIMIT_S:g}"]) == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert "the measured test's fit:" in err and "--fit stiffness" in err
+    assert "--time-limit" in err and not out.exists()
+
+
+@pytest.mark.slow
+def test_the_multi_fit_of_the_papers_test_says_what_the_data_determine(tmp_path):
+    """The whole command: no profile written, a profile of the mismatch along every
+    parameter in report.json, no more sweeps than the estimate counted."""
+    out = tmp_path / "o"
+    assert main([*PAPER_ARGS, "--fit", "multi", "--out", str(out), "--time-limit",
+                 "3600"]) in (0, 1, 3)
+    assert not list(out.glob("*-fitted.toml"))
+    fit = json.loads((out / "report.json").read_text())["measured"]["fit"]
+    assert set(fit["profiles"]) == set(BOUNDS) and "scoring" in fit
+    assert not fit["explains"] and "no profile is written" in fit["sentence"]
+    timings = json.loads((out / "timings.json").read_text())["timings_s"]
+    assert fit["evaluations"] <= timings["estimate_fit_sweeps"]
+    assert "Scoring:" in (out / "report.html").read_text()
