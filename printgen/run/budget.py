@@ -15,8 +15,10 @@ core that many iterations of ITERATION_S + ITERATION_S_PER_UNKNOWN x its unknown
 node). The run counts the same work (`counted_work`, report.json "verification" ->
 "solver_work" against "size" -> "solver_work"); tests/test_budget.py checks the prediction
 against the count on both examples and `printgen bench make` (benchmarks/bench_make.py)
-measures the constants, the estimate against the measured time and the CPU. The parts' steps
-(meshes, slicer profiles, G-code, previews) have constants of their own. The estimate is meant
+measures the constants, the estimate against the measured time and the CPU. `verify
+--measured` adds its fit's sweeps as the fit plans them (`FitPlan`: every sweep it may run, on
+its nets, over its levels; `printgen bench fit` measures them). The parts' steps (meshes,
+slicer profiles, G-code, previews) have constants of their own. The estimate is meant
 to be right within a factor of about two, enough to stop a run that would take an hour.
 """
 

@@ -76,6 +76,8 @@ IDLE = {"cable_slack": "the border cables carry no load in the fit"}
 IDLE_SHARE = 0.01  # a part pulling less than 1 % of its nominal tension carries nothing
 Choice = tuple[str, "str | None", "float | None", str]  # mounting, orientation, span, bed
 EXPLAINS = 0.15  # explained: scored RMS mismatch below 15 % on every column (`measured.scored`)
+# The search's size: its sweeps and time on the bundled paper test are recorded in
+# benchmarks/measurements.md#fit-paper-test
 MAX_EVALUATIONS = 15  # least-squares steps for a retained choice (each: 1 + free sweeps)
 SCREEN_STEPS = 2  # Gauss-Newton steps of every discrete choice on the coarse net first
 SCREEN_KEEP = 2  # choices searched on after the screen

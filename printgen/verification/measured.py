@@ -363,6 +363,7 @@ XTOL_SLACK = 1e-4  # slack known to 0.01 %
 # sweeps of a one-factor fit, at most: the bounded Brent search's evaluations (golden section
 # to XTOL_LOG over the stiffness range takes about 14; the parabolic steps fewer), plus the
 # nominal it is compared with, and the nominal on the band's coarse net when it has one
+# (benchmarks/measurements.md#fit-paper-test)
 FACTOR_EVALUATIONS = 20
 AT_BOUND = 0.01  # a result this close to a range end (fraction of the range) is "at the bound"
 
