@@ -184,13 +184,13 @@ def test_the_estimate_counts_the_fit_s_sweeps_and_refuses_up_front():
     d = load_design(EXAMPLES / "paper_1_40" / "design.json", scale=40, prototype=p)
     m = Measurement("paper", LEVELS, {"strain_mid": np.array([np.nan, 0.05, 0.105])},
                     {"strain_mid": "mid"})
-    plan = fit_plan(m, "multi", 0.3)
+    plan = fit_plan(d, m, "multi", 0.3)
     planned = planned_sweeps(len(all_choices(0.3)))
     assert plan.sweeps == planned["coarse"] + planned["fine"] and plan.levels == 4
     work = Work(parts=False, fit=True, model_follows=False, fit_plan=plan)
     est = estimate(p, d, cores=2, work=work, variants=8)
     assert sum(s.name.startswith("fit") for s in est.sweeps) == plan.sweeps
-    one = fit_plan(m, "stiffness", 0.3)
+    one = fit_plan(d, m, "stiffness", 0.3)
     cheaper = estimate(p, d, cores=2, variants=8,
                        work=Work(parts=False, fit=True, model_follows=False, fit_plan=one))
     assert cheaper.seconds < est.seconds

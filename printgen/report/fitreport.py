@@ -38,10 +38,11 @@ def multi_fit_sections(rep: Report, fit: MultiFit) -> None:
                 f"{ident.sensitivity[k]:.3g}", _allowed(fit, k)]
                for k, (lo, hi, nom) in BOUNDS.items()])
     rep.table(["mounting", "panel-test orientation", "span", "bottom row", "best objective",
-               "net factor", "net slack", "cable slack"],
+               "net factor", "net slack", "cable slack", "found on"],
               [[m, o or "as profiled", "printed width" if s is None else f"{s * 1e3:g} mm",
                 b, f"{obj:.3g}", f"{p.net_factor:.3g}", f"{p.net_slack:.2%}",
-                f"{p.cable_slack:.2%}"] for (m, o, s, b), (p, obj) in fit.choices.items()])
+                f"{p.cable_slack:.2%}", fit.net_of((m, o, s, b))]
+               for (m, o, s, b), (p, obj) in fit.choices.items()])
     if fit.profiles:
         rep.table(["parameter", *[f"value {i + 1}" for i in range(len(
             next(iter(fit.profiles.values())).values))], "determined"],

@@ -35,18 +35,14 @@ from printgen.run.provenance import provenance_record
 from printgen.scaling.design_file import load_design
 from printgen.scaling.record import Design
 from printgen.scene.readings import design_units
-from printgen.verification.bands import (
-    COARSENINGS,
-    Band,
-    band_verdicts,
-    model_load_kw,
-)
+from printgen.verification.bands import Band, band_verdicts, model_load_kw
 from printgen.verification.fit import (
     MultiFit,
     all_choices,
     fit_levels,
     fit_measured,
     planned_sweeps,
+    screen_coarsen,
 )
 from printgen.verification.measured import (
     FACTOR_EVALUATIONS,
@@ -103,7 +99,7 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     d = load_design(design_path, scale=scale, prototype=p)
     m = read_measured(measured, design_units(d)) if measured is not None else None
     limit = DEFAULT_LIMIT_S if time_limit_s is None else time_limit_s
-    plan = fit_plan(m, fit, free_section(p)) if m is not None else None
+    plan = fit_plan(d, m, fit, free_section(p)) if m is not None else None
     est = check_budget(p, d, limit_s=limit, cores=sweep_cores(),
                        work=Work(parts=False, fit=m is not None, model_follows=False,
                                  fit_plan=plan))
@@ -151,13 +147,13 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
                      run)
 
 
-def fit_plan(m: Measurement, fit: str, section: float | None) -> FitPlan:
+def fit_plan(d: Design, m: Measurement, fit: str, section: float | None) -> FitPlan:
     """The sweeps the fit of `m` will run (`fit`: "multi" or a one-factor kind), for the
     run's estimate: their nets (mesh coarsening), counts and load levels."""
     levels = len(measured_path(m))
     if fit == "multi":
         plan = planned_sweeps(len(all_choices(section)))
-        return FitPlan(((COARSENINGS[0], plan["coarse"]), (1, plan["fine"])), levels,
+        return FitPlan(((screen_coarsen(d), plan["coarse"]), (1, plan["fine"])), levels,
                        parallel=True)
     # the Brent search on the band's net, the nominal, and the nominal on the band's coarse
     # net when it has one; the design's own net assumed, as for the band's variants

@@ -266,6 +266,8 @@ class MultiFit:
     profiles: dict[str, Profile] = field(default_factory=dict)
     sweeps: dict[str, int] = field(default_factory=dict)  # "coarse x2", "own net": sweeps run
     cpu_s: float = 0.0  # the sweeps' CPU over every process (bench fit)
+    searched: tuple[Choice, ...] = ()  # the choices searched on the design's own net (the
+    # others' objective is their screen's, on the coarse net)
 
     kind = "multi"
     at_bound = False  # the one-factor fit's flag; a multi fit says `explains` instead
@@ -279,6 +281,10 @@ class MultiFit:
         p = self.params
         return (f"fitted: net x {p.net_factor:.3g}, slack {p.net_slack:.1%} / "
                 f"{p.cable_slack:.1%}")
+
+    def net_of(self, c: Choice) -> str:
+        """Where choice `c`'s best objective was found: its search or the screen."""
+        return "own net" if c in self.searched or not self.searched else "coarse screen"
 
     def flat(self) -> list[str]:
         """The free parameters the data do not determine (their profile is flat)."""
@@ -296,7 +302,8 @@ class MultiFit:
                 "bounds": {k: {"low": lo, "high": hi, "nominal": nom}
                            for k, (lo, hi, nom) in BOUNDS.items()},
                 "choices": [{"mounting": k[0], "orientation": k[1], "span_m": k[2],
-                             "bed": k[3], "params": dataclasses.asdict(p), "objective": o}
+                             "bed": k[3], "params": dataclasses.asdict(p), "objective": o,
+                             "net": self.net_of(k)}
                             for k, (p, o) in self.choices.items()],
                 "identifiability": {"singular_values": ident.singular_values,
                                     "directions": ident.directions,
@@ -411,9 +418,8 @@ def _fit(d: Design, m: Measurement, lv: np.ndarray, coarsen: int, load_kw: dict 
     nominal = runs.one(Params(), coarsen)
     bases = [Params(mounting=c[0], orientation=c[1], span=c[2], bed=c[3]) for c in picked]
     best: dict[Choice, tuple[Params, float]] = {}
-    coarse = coarsen * screen_coarsen(d) if len(bases) > SCREEN_KEEP else coarsen
-    if coarse != coarsen:  # 1. the screen, every choice at once on the coarse net
-        best = _screen(runs, bases, idx, coarse)
+    if len(bases) > SCREEN_KEEP:  # 1. the screen, every choice at once on the coarse net
+        best = _screen(runs, bases, idx, coarsen * screen_coarsen(d))
         keep = sorted(best, key=lambda c: best[c][1])[:SCREEN_KEEP]
         starts = [best[c][0] for c in keep]
     else:
@@ -436,7 +442,7 @@ def _fit(d: Design, m: Measurement, lv: np.ndarray, coarsen: int, load_kw: dict 
     sweeps = {("own net" if k == coarsen else f"coarse x{k // coarsen}"): n
               for k, n in sorted(runs.count.items())}
     return MultiFit(params, before, after, pred, best, ident, sum(runs.count.values()), ok,
-                    edge, idle, profiles, sweeps, runs.cpu_s)
+                    edge, idle, profiles, sweeps, runs.cpu_s, tuple(s.choice for s in starts))
 
 
 def explained(before: list, after: list, params: Params) -> bool:
