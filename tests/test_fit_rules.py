@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import EXAMPLES
+from conftest import EXAMPLES, coarse_design_1_40
 from proto_files import REALISTIC
 
 from printgen.cli import main
@@ -238,3 +238,22 @@ def test_the_multi_fit_of_the_papers_test_says_what_the_data_determine(tmp_path)
     timings = json.loads((out / "timings.json").read_text())["timings_s"]
     assert fit["evaluations"] <= timings["estimate_fit_sweeps"]
     assert "Scoring:" in (out / "report.html").read_text()
+
+
+PATH_AGREE = 1e-6  # strain: the solver's tolerance, far below any reading (1e-4 is 0.01 %)
+
+
+@pytest.mark.slow
+def test_sweeping_only_the_measured_levels_gives_the_fine_path_s_curves():
+    """The fit sweeps h/h_B = 0 and the measured levels only: an elastic net's state does not
+    depend on the path, and a long step is reached by sub-steps; at the ends of the ranges
+    (softest net, largest slacks, free section, both beds) the curves are the 0.1-step path's."""
+    d = coarse_design_1_40(2)
+    m = paper_like()
+    fine = np.union1d(np.round(np.arange(0.0, 1.0 + 1e-9, 0.1), 10), m.levels)
+    for p in (Params(net_factor=0.25, net_slack=0.03, cable_slack=0.03, span=0.3),
+              Params(net_factor=4.0, cable_slack=0.03, bed="held", orientation="long")):
+        short = fit_mod.trial(d, p, m, fit_mod.fit_levels(m)).curves["strain_mid"]
+        full = fit_mod.trial(d, p, m, fine).curves["strain_mid"]
+        assert not np.isnan(short).any()
+        np.testing.assert_allclose(short, full, atol=PATH_AGREE)
