@@ -171,12 +171,15 @@ def measured_record(m: Measurement, band: Band, fit: Fit | None, profile: str
     rec: dict[str, Any] = {"file": m.path, "levels": m.levels, "values": m.values,
                            "columns": m.columns, "predicted_nominal": nom,
                            "band_min": lo, "band_max": hi,
-                           "mismatch": mismatch(m, nom, lo, hi), "fit": None}
+                           "mismatch": mismatch(m, nom, lo, hi), "scoring": SCORING,
+                           "fit": None}
     if fit and fit.kind == "multi":
         rec["fit"] = {**fit.to_record(), "profile": profile}
     elif fit:
         rec["fit"] = {"kind": fit.kind, "value": fit.value, "at_bound": fit.at_bound,
                       "evaluations": fit.evaluations, "mismatch_nominal": fit.before,
                       "mismatch_fitted": fit.after, "predicted": fit.predicted,
+                      "not_improved": [{"column": c, "before": b, "after": a}
+                                       for c, b, a in fit.unimproved],
                       "sentence": fit_sentence(fit), "profile": profile}
     return rec
