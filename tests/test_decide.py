@@ -1,0 +1,106 @@
+"""The three-valued verdict from the model's and the prototype's bands
+(printgen.verification.decide): PASS, FAIL and UNDECIDED on constructed bands, the deciding
+variant and the cheapest test it names, the variants the lab's data exclude, the record."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from printgen.report.jsonout import dumps
+from printgen.verification.bands import Band
+from printgen.verification.compare import METRICS, TOLERANCE
+from printgen.verification.decide import decide, excluded_by_data
+from printgen.verification.measured import Measurement
+from printgen.verification.variants import TESTS, Variant, cheapest_test
+
+LEVELS = np.array([0.0, 0.5, 1.0])
+PROTO = {k: np.array([0.0, 0.4, 1.0]) for k in METRICS}  # peak 1: mismatches read directly
+
+
+def band(nominal: float, variants: dict[str, tuple[float, str, float, str]]) -> Band:
+    """A model band whose nominal is `nominal` x the prototype, each variant `factor` x it
+    (label -> (factor, question, weight, excluded))."""
+    curves = {label: {k: f * c for k, c in PROTO.items()}
+              for label, (f, *_rest) in variants.items()}
+    info = {label: Variant(label, question=q, weight=w, excluded=x)
+            for label, (_, q, w, x) in variants.items()}
+    return Band(LEVELS, {k: nominal * c for k, c in PROTO.items()}, curves,
+                {k: "" for k in curves}, [], 1, {}, info=info)
+
+
+def test_a_band_inside_the_tolerance_passes():
+    d = decide(PROTO, band(1.0, {"a bit soft": (1.1, "lateral mounting", 0.5, "")}))
+    assert d.verdict == "PASS" and d.deciding == [] and d.test == "" and d.sentence() == ""
+    assert all(m.worst == pytest.approx(0.1) for m in d.metrics)
+
+
+def test_a_band_outside_the_tolerance_fails():
+    d = decide(PROTO, band(2.0, {"softer": (2.2, "lateral mounting", 0.5, "")}))
+    assert d.verdict == "FAIL"
+    assert all(m.best == pytest.approx(1.0) for m in d.metrics)  # 2x at the peak: 100 % off
+
+
+def test_a_band_that_straddles_the_tolerance_is_undecided_and_names_what_decides():
+    d = decide(PROTO, band(1.0, {"eyelets": (1.6, "lateral mounting", 0.5, ""),
+                                 "normal pressure": (1.05, "pressure direction", 0.5, "")}))
+    assert d.verdict == "UNDECIDED"
+    assert d.deciding == ["eyelets"]  # the one whose move alone crosses the 25 %
+    assert d.questions == ["lateral mounting"]
+    assert d.test == TESTS["lateral mounting"]
+    text = d.sentence()
+    assert "eyelets" in text and TESTS["lateral mounting"] in text
+    assert f"{TOLERANCE:.0%} tolerance" in text
+
+
+def test_an_excluded_variant_does_not_decide():
+    d = decide(PROTO, band(1.0, {"squeezed": (1.6, "mounting span", 0.5, "sags visibly")}))
+    assert d.verdict == "PASS"
+
+
+def test_the_prototype_band_counts_too():
+    proto = Band(LEVELS, PROTO, {"slack": {k: 1.5 * c for k, c in PROTO.items()}}, {"slack": ""},
+                 [], 1, {}, info={"slack": Variant("slack", question="prototype initial slack",
+                                                   weight=1.0, spread="range")})
+    d = decide(PROTO, band(1.0, {}), proto)
+    assert d.verdict == "UNDECIDED" and d.deciding == ["slack"]
+    assert d.test == TESTS["prototype initial slack"]
+
+
+def test_the_cheapest_test_is_the_first_listed():
+    assert cheapest_test(["modulus", "lateral mounting"]) == TESTS["lateral mounting"]
+    assert cheapest_test(["cable modulus"]) == TESTS["modulus"]
+    assert "orientation" not in TESTS and "long diagonal" in TESTS["panel-test orientation"]
+
+
+def test_variants_the_data_contradict_are_named_with_the_numbers():
+    b = band(1.0, {"slack": (3.0, "initial slack", 1.0, ""),
+                   "bed": (1.1, "bottom edge", 0.5, "")})
+    # the mid-height sensor read below 0.5 % at h/h_B = 0.5 and 2.0 % at 1.0 (a value the
+    # nominal, 1 %, misses by more than 25 % of the peak: it excludes nothing)
+    m = Measurement("t", np.array([0.5, 1.0]),
+                    {"strain_mid": np.array([np.nan, 0.02])},
+                    {"strain_mid": "mid_height_elongation_pct"},
+                    {"strain_mid": np.array([0.005, np.nan])})
+    model = band(0.01, {"slack": (0.03, "initial slack", 1.0, ""),
+                        "bed": (0.011, "bottom edge", 0.5, "")})
+    out = excluded_by_data(model, m)
+    assert list(out) == ["slack"]  # 1.2 % at 0.5 against < 0.5 %; the bed stays
+    assert "1.2 % predicted, < 0.5 % measured" in out["slack"]
+    assert "h/h_B = 0.5" in out["slack"]
+    # a value the nominal agrees with excludes a variant that misses it
+    m2 = Measurement("t", np.array([1.0]), {"strain_mid": np.array([0.01])},
+                     {"strain_mid": "mid_height_elongation_pct"})
+    assert "3 % predicted, 1 % measured" in excluded_by_data(model, m2)["slack"]
+    assert excluded_by_data(b, Measurement("t", np.array([1.0]), {}, {})) == {}
+
+
+def test_the_decision_record_is_json_ready():
+    d = decide(PROTO, band(1.0, {"eyelets": (1.6, "lateral mounting", 0.5, "")}))
+    rec = json.loads(dumps(d.to_record()))
+    assert rec["verdict"] == "UNDECIDED" and rec["cheapest_test"] == d.test
+    assert rec["deciding_variants"] == ["eyelets"]
+    assert {m["metric"] for m in rec["metrics"]} == set(METRICS)
+    assert all(m["status"] == "UNDECIDED" for m in rec["metrics"])
