@@ -78,7 +78,8 @@ def decide(proto: dict[str, np.ndarray], model: Band, prototype: Band | None = N
     -> (k,), at the band's levels) and its band `prototype` (None: the curves alone)."""
     mlo, mhi = model.central()
     plo, phi = prototype.central() if prototype is not None else (proto, proto)
-    out, effects = [], {}
+    out: list[MetricDecision] = []
+    effects: dict[str, float] = {}
     for key in METRICS:
         p, m = np.asarray(proto[key], float), model.nominal[key]
         peak = float(np.nanmax(np.abs(p))) if np.any(~np.isnan(p)) else 0.0
