@@ -117,3 +117,12 @@ def test_an_excluded_variant_leaves_the_central_interval_but_stays_in_the_envelo
         assert cut.envelope()[1]["strain_mid"][2] == 20.0  # still in the envelope
         assert cut.weighted() == ["soft"]
     assert synthetic_band(data={"far": "x"}).excluded == {"far": "excluded by the data: x"}
+
+
+def test_near_zero_the_effects_combine_as_differences():
+    # at the first level the nominal is 1 % of its peak: two variants reading 100x it would
+    # combine to 10 000x as ratios; as differences they give 1 + 99 + 99
+    nominal = np.array([0.01, 1.0])
+    parts = [Contribution(q, np.array([1.0, 1.0]), 0.5) for q in ("a", "b")]
+    lo, hi = central_interval(nominal, parts, (0.1, 1.0))
+    assert hi[0] == pytest.approx(1.99, abs=EXACT)

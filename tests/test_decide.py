@@ -104,3 +104,17 @@ def test_the_decision_record_is_json_ready():
     assert rec["deciding_variants"] == ["eyelets"]
     assert {m["metric"] for m in rec["metrics"]} == set(METRICS)
     assert all(m["status"] == "UNDECIDED" for m in rec["metrics"])
+
+
+def test_the_prototype_band_reads_its_law_otherwise_only_with_a_law():
+    from conftest import EXAMPLES
+
+    from printgen.inputs.prototype import load_prototype
+    from printgen.verification.variants import prototype_variants
+
+    real = prototype_variants(load_prototype(EXAMPLES / "realistic_barrier.toml"))
+    simple = prototype_variants(load_prototype(EXAMPLES / "simple_barrier.toml"))
+    assert [v.question for v in real] == ["prototype initial slack",
+                                          "prototype panel-test orientation"]
+    assert real[1].excluded and real[0].spread == "range"
+    assert [v.question for v in simple] == ["prototype initial slack"]

@@ -12,7 +12,7 @@ import numpy as np
 from printgen.report.html import Report
 from printgen.report.report import fmt_value, unit_of
 from printgen.verification.bands import Band, BandVerdict, band_verdicts
-from printgen.verification.central import QUANTILES, RANGE_POINTS
+from printgen.verification.central import QUANTILES, RANGE_POINTS, RATIO_FLOOR
 from printgen.verification.compare import METRICS, Deformation
 from printgen.verification.measured import Fit, Measurement, mismatch
 from printgen.verification.preprint import SHAPE_LEVELS, Verification
@@ -76,7 +76,8 @@ def band_sections(rep: Report, v: Verification, band: Band) -> None:
 CENTRAL_TEXT = (
     f"The central interval is {QUANTILES[0]:.0%} to {QUANTILES[1]:.0%} of the weighted "
     "combinations of the variants: each variant's change from the nominal (a ratio where every "
-    "weighted curve is positive at that level, else a difference) is an independent "
+    f"weighted curve is positive at that level and the nominal reaches {RATIO_FLOOR:.0%} of "
+    "its peak, else a difference) is an independent "
     "contribution; the answers of one question are exclusive, each with its weight (the "
     "nominal the rest), a range uniform between the nominal and its end (taken at "
     f"{RANGE_POINTS} points); the contributions add (first order: the combinations are not "

@@ -4,8 +4,10 @@ contributions, each question's answers weighted as its variants state
 
 Definition (stated in the report): at each load level, a variant's effect is its change from
 the nominal curve, as a ratio (log) where the nominal and every weighted variant are positive
-(deformations that scale, so that two effects that each halve the reading give a quarter,
-never a negative reading), else as a difference. The answers of one question are exclusive
+and the nominal reaches `RATIO_FLOOR` of its peak (deformations that scale, so that two effects
+that each halve the reading give a quarter, never a negative reading), else as a difference
+(near zero a ratio means nothing: two variants that each read 100 times a vanishing nominal
+would combine to 10 000 times it). The answers of one question are exclusive
 (one of them is the truth: its weight, the nominal the rest); a range is uniform between the
 nominal and its end (`RANGE_POINTS` equal parts). Questions are independent and their effects
 add (first order: the combinations are not run). The central interval is [q10, q90] of that
@@ -24,6 +26,7 @@ import numpy as np
 
 QUANTILES = (0.1, 0.9)  # the central interval: 10 % to 90 % of the weighted combinations
 RANGE_POINTS = 5  # a range's uniform spread, taken at the midpoints of 5 equal parts
+RATIO_FLOOR = 0.1  # effects combine as ratios where the nominal is >= 10 % of its peak
 POINTS_MAX = 4096  # combinations kept per level (more are merged into equal-weight bins)
 
 
@@ -98,12 +101,13 @@ def central_interval(nominal: np.ndarray, parts: list[Contribution],
     combination (its weight goes to the nominal there)."""
     nominal = np.asarray(nominal, float)
     lo, hi = np.full(nominal.shape, np.nan), np.full(nominal.shape, np.nan)
+    peak = float(np.nanmax(np.abs(nominal))) if np.any(~np.isnan(nominal)) else 0.0
     for i, n in enumerate(nominal):
         if np.isnan(n):
             continue
         here = [(float(c.curve[i]), c) for c in parts if c.weight > 0 and
                 not np.isnan(c.curve[i])]
-        ratio = n > 0 and all(x > 0 for x, _ in here)
+        ratio = n >= RATIO_FLOOR * peak and n > 0 and all(x > 0 for x, _ in here)
         by_q: dict[str, list[tuple[float, float, str]]] = {}
         for x, c in here:
             delta = np.log(x / n) if ratio else x - n

@@ -308,8 +308,8 @@ def squeezed_slack(width: float, span: float, height: float) -> str:
 
 def prototype_variants(p: Prototype) -> list[Variant]:
     """The variants of the prototype's net: its initial slack (0 to `SLACK_MAX`, as the
-    printed net's) and its panel law read along the other diagonal (shown, no weight: the
-    reference states the diagonal its panel was loaded along)."""
+    printed net's) and, when it has a panel law, the law read along the other diagonal
+    (shown, no weight: the reference states the diagonal its panel was loaded along)."""
     out = [Variant(f"prototype initial slack {SLACK_MAX:.0%}", "prototype net hung with 0 to "
                    "1 % slack (printgen; no as-built sag stated)", slack=SLACK_MAX,
                    effort=SLOWEST, question="prototype initial slack", weight=1.0,
@@ -319,5 +319,5 @@ def prototype_variants(p: Prototype) -> list[Variant]:
                     SceneOptions(orientation=o), question="prototype panel-test orientation",
                     excluded="stated by the reference (section 4): the prototype's 1.33 m "
                     "panel was loaded along the water-drop's long axis")
-            for o in ORIENTATIONS if o != PROTOTYPE_ORIENTATION]
+            for o in ORIENTATIONS if o != PROTOTYPE_ORIENTATION and p.net.panel_law is not None]
     return out
