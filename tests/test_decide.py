@@ -118,3 +118,44 @@ def test_the_prototype_band_reads_its_law_otherwise_only_with_a_law():
                                           "prototype panel-test orientation"]
     assert real[1].excluded and real[0].spread == "range"
     assert [v.question for v in simple] == ["prototype initial slack"]
+
+
+def fake_verification(d):
+    """What the summary and the band's record read of a verification, with decision `d`."""
+    from types import SimpleNamespace
+
+    deformation = SimpleNamespace(values=PROTO)
+    return SimpleNamespace(verdict=d.verdict, headline=d.sentence(), mismatches=[], ok=True,
+                           sensors=None, sensors_to_blame=False, runnable=True, flow=None,
+                           decision=d, prototype=SimpleNamespace(deformation=deformation),
+                           prototype_band=None)
+
+
+def test_undecided_gets_the_cheapest_test_as_its_next_step(monkeypatch):
+    from printgen.report import summary as summary_module
+    from printgen.report.records import CheckRecords, RunRecords
+    from printgen.report.summary import NEXT_UNDECIDED, summarize, summary_html
+
+    b = band(1.0, {"eyelets": (1.6, "lateral mounting", 0.5, "")})
+    v = fake_verification(decide(PROTO, b))
+    monkeypatch.setattr(summary_module, "band_verdicts", lambda values, band: [])
+    monkeypatch.setattr(summary_module, "chosen_parts", lambda design, plan=None: [])
+    s = summarize(RunRecords("t", None, steps={"verification": CheckRecords(v, b, 40.0)}))
+    assert s.verdict == "UNDECIDED" and s.next == NEXT_UNDECIDED.format(test=v.decision.test)
+    assert '<span class="undecided">UNDECIDED</span>' in summary_html(s)
+
+
+def test_the_band_record_has_the_central_interval_weights_and_exclusions():
+    from printgen.report.uncertainty import band_record
+
+    b = band(1.0, {"eyelets": (1.6, "lateral mounting", 0.5, ""),
+                   "squeezed": (9.0, "mounting span", 0.0, "sags visibly")})
+    rec = json.loads(dumps(band_record(fake_verification(decide(PROTO, b)), b)))
+    assert rec["central_max"]["strain_mid"][-1] == pytest.approx(1.6)
+    assert rec["max"]["strain_mid"][-1] == pytest.approx(9.0)  # the envelope keeps it
+    assert "10% to 90%" in rec["central_definition"]
+    assert rec["weights"]["squeezed"] == {"question": "mounting span", "weight": 0.0,
+                                          "spread": "answer", "weight_source": "",
+                                          "excluded": "sags visibly"}
+    assert rec["weights"]["eyelets"]["weight"] == 0.5 and rec["prototype"] is None
+    assert rec["at"]["1"]["strain_mid"]["central_max"] == pytest.approx(1.6)
