@@ -14,7 +14,7 @@ from printgen.verification.bands import Band
 from printgen.verification.compare import METRICS, TOLERANCE
 from printgen.verification.decide import decide, excluded_by_data
 from printgen.verification.measured import Measurement
-from printgen.verification.variants import TESTS, Variant, cheapest_test
+from printgen.verification.variants import READING, TESTS, Variant, cheapest_test
 
 LEVELS = np.array([0.0, 0.5, 1.0])
 PROTO = {k: np.array([0.0, 0.4, 1.0]) for k in METRICS}  # peak 1: mismatches read directly
@@ -72,7 +72,7 @@ def test_the_prototype_band_counts_too():
 def test_the_cheapest_test_is_the_first_listed():
     assert cheapest_test(["modulus", "lateral mounting"]) == TESTS["lateral mounting"]
     assert cheapest_test(["cable modulus"]) == TESTS["modulus"]
-    assert "orientation" not in TESTS and "long diagonal" in TESTS["panel-test orientation"]
+    assert "long diagonal" in TESTS[READING]
 
 
 def test_variants_the_data_contradict_are_named_with_the_numbers():
@@ -159,3 +159,27 @@ def test_the_band_record_has_the_central_interval_weights_and_exclusions():
                                           "excluded": "sags visibly"}
     assert rec["weights"]["eyelets"]["weight"] == 0.5 and rec["prototype"] is None
     assert rec["at"]["1"]["strain_mid"]["central_max"] == pytest.approx(1.6)
+
+
+def test_the_readings_of_one_panel_law_are_one_question_weighted_evenly():
+    from conftest import EXAMPLES
+
+    from printgen.inputs.prototype import load_prototype
+    from printgen.scaling.design_file import load_design
+    from printgen.verification.preprint import free_section
+    from printgen.verification.variants import model_variants
+
+    p = load_prototype(EXAMPLES / "realistic_barrier.toml")
+    d = load_design(EXAMPLES / "paper_1_40" / "design.json", scale=40.0, prototype=p)
+    variants, _ = model_variants(d, "walls", free_section(p))
+    readings = [v for v in variants if v.question == READING]
+    assert len(readings) >= 2
+    assert all(v.weight == pytest.approx(1 / (len(readings) + 1)) for v in readings)
+    by_q: dict[str, float] = {}
+    for v in variants:
+        if not v.excluded and v.spread == "answer":
+            by_q[v.question] = by_q.get(v.question, 0.0) + v.weight
+    assert all(0 < w <= 1 for w in by_q.values())  # every question's answers leave room
+    assert all(v.weight_source for v in variants if not v.excluded)  # every weight argued
+    squeezed = [v for v in variants if v.question == "mounting span"]
+    assert squeezed and all("sag of about" in v.excluded for v in squeezed)

@@ -33,6 +33,7 @@ Variants of design `d` (`model_variants`):
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -58,6 +59,10 @@ SAME = 1e-9  # relative change below which an alternative equals the nominal (no
 # lab installs a barrier whose elongation it measures
 VISIBLE_SLACK = 0.03
 EVEN = "not stated by the source: every answer equally likely"
+# the panel law's tested net, its diagonal and the strand law behind it are readings of one
+# measured law: exclusive answers of one question (never combined: two softer readings of the
+# same test would make a net softer than either), each weighted evenly with the nominal reading
+READING = "panel-law reading"
 # effort ranks: the sweeps measured longest run first (initial slack is a mechanism until
 # its strands tighten; then the mounting span, another mounting, the derived law, the
 # normal pressure; the rest are quick)
@@ -98,12 +103,9 @@ TESTS = {
     "prototype initial slack": "state the prototype's initial slack (its as-built sag)",
     "pressure direction": "photograph the film on the net at full head (does it lie on the "
                           "deformed net?)",
-    "panel-test orientation": "print `printgen testpieces` and load the panel along its long "
-                              "diagonal",
-    "panel law's tested net": "print `printgen testpieces` and load the panel as the profile's "
-                              "source did",
-    "strand law": "print `printgen testpieces`, load the panel and compare with `printgen "
-                  "panel`",
+    READING: "print `printgen testpieces` and load the panel along its long diagonal (and its "
+             "short one), then compare with `printgen panel`: which reading of the panel law "
+             "the printed net follows",
     "modulus": "tensile-test coupons of the printed material and run `printgen calibrate` "
                "(it writes the modulus and its SD)",
 }
@@ -147,7 +149,16 @@ def model_variants(d: Design, mounting: str | None = None, free_section: float |
                        effort=SLOWEST, question="initial slack", weight=1.0, spread="range",
                        weight_source=SLACK_RANGE))
     out += _model_form_variants(d, free_section, notes, nominal)
-    return out, notes
+    return _shared_evenly(out, READING), notes
+
+
+def _shared_evenly(variants: list[Variant], question: str) -> list[Variant]:
+    """`variants` with the answers of `question` weighted evenly with its nominal answer
+    (each 1 / (answers + 1); an excluded answer is no answer), their argument saying so."""
+    n = sum(v.question == question and not v.excluded for v in variants)
+    return [dataclasses.replace(v, weight=1 / (n + 1), weight_source=f"{v.weight_source}; "
+                                f"{n} other readings and the nominal's: {EVEN}")
+            if v.question == question and not v.excluded else v for v in variants]
 
 
 SLACK_RANGE = ("uniform from 0 to 1 %: no value is preferred within the range (its effect "
@@ -219,9 +230,9 @@ def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
         return []
     return [Variant(f"{mat.name} panel law: tested net = the design's net",
                     f"{mat.name} profile [measured.panel_law] conditions",
-                    SceneOptions(net_factor=ratio), question="panel law's tested net",
-                    weight=0.5, weight_source="the profile's tested net is an assumption "
-                    "where its source does not give it: " + EVEN)]
+                    SceneOptions(net_factor=ratio), question=READING,
+                    weight_source="the profile's tested net is an assumption where its "
+                    "source does not give it")]
 
 
 def _orientation_variants(d: Design) -> list[Variant]:
@@ -230,8 +241,8 @@ def _orientation_variants(d: Design) -> list[Variant]:
     recorded = recorded_orientation(load_material(d.net.material).panel_law)
     return [Variant(f"panel test along the {o} diagonal",
                     f"panel-test orientation not stated (profile: {recorded})",
-                    SceneOptions(orientation=o), question="panel-test orientation",
-                    weight=1 / len(ORIENTATIONS), weight_source=EVEN)
+                    SceneOptions(orientation=o), question=READING,
+                    weight_source="the source does not state the diagonal")
             for o in ORIENTATIONS if o != recorded]
 
 
@@ -252,8 +263,8 @@ def _model_form_variants(d: Design, free_section: float | None, notes: list[str]
         out.append(Variant("strand law from the virtual panel test", "printgen panel: the "
                            "strand law whose simulated panel test reproduces the profile's "
                            "(nominal: diamond formula)", SceneOptions(net_law="derived"),
-                           effort=MEDIUM, question="strand law", weight=0.5,
-                           weight_source="two readings of the same panel law: " + EVEN))
+                           effort=MEDIUM, question=READING,
+                           weight_source="two models of the strands behind the same law"))
     if d.cables:
         out.append(Variant("bottom row held on the bed", "the film's foot seals on the bed "
                            "under the full head (nominal: the bottom cable free between its "
