@@ -156,8 +156,9 @@ def _shared_evenly(variants: list[Variant], question: str) -> list[Variant]:
     """`variants` with the answers of `question` weighted evenly with its nominal answer
     (each 1 / (answers + 1); an excluded answer is no answer), their argument saying so."""
     n = sum(v.question == question and not v.excluded for v in variants)
-    return [dataclasses.replace(v, weight=1 / (n + 1), weight_source=f"{v.weight_source}; "
-                                f"{n} other readings and the nominal's: {EVEN}")
+    return [dataclasses.replace(v, weight=1 / (n + 1), weight_source=f"{v.weight_source}: "
+                                f"one of {n + 1} readings of the law (the nominal's and {n} "
+                                "variants), weighted evenly")
             if v.question == question and not v.excluded else v for v in variants]
 
 
@@ -256,7 +257,8 @@ def _model_form_variants(d: Design, free_section: float | None, notes: list[str]
                    "the net (nominal: along the flow, reference section 3)",
                    SceneOptions(pressure="normal"), effort=QUICKER,
                    question="pressure direction", weight=0.5,
-                   weight_source="two models of the film's force, neither measured: " + EVEN)]
+                   weight_source="two models of the film's force, neither measured: "
+                   "weighted evenly")]
     out += _routing_variants(d, mounting, notes) if d.cables else []
     law = load_material(d.net.material).panel_law
     if law is not None and law.has_geometry:
