@@ -14,7 +14,7 @@ from printgen.verification.bands import Band
 from printgen.verification.compare import METRICS, TOLERANCE
 from printgen.verification.decide import decide, excluded_by_data
 from printgen.verification.measured import Measurement
-from printgen.verification.variants import READING, TESTS, Variant, cheapest_test
+from printgen.verification.variants import READING, TESTS, Variant, cheapest_test, settling_tests
 
 LEVELS = np.array([0.0, 0.5, 1.0])
 PROTO = {k: np.array([0.0, 0.4, 1.0]) for k in METRICS}  # peak 1: mismatches read directly
@@ -71,6 +71,8 @@ def test_the_prototype_band_counts_too():
 
 def test_the_cheapest_test_is_the_first_listed():
     assert cheapest_test(["modulus", "lateral mounting"]) == TESTS["lateral mounting"]
+    assert settling_tests(["modulus", "cable modulus", "initial slack", "new one"]) == [
+        TESTS["initial slack"], TESTS["modulus"], "find out new one"]
     assert cheapest_test(["cable modulus"]) == TESTS["modulus"]
     assert "long diagonal" in TESTS[READING]
 
@@ -101,7 +103,7 @@ def test_the_decision_record_is_json_ready():
     d = decide(PROTO, band(1.0, {"eyelets": (1.6, "lateral mounting", 0.5, "")}))
     rec = json.loads(dumps(d.to_record()))
     assert rec["verdict"] == "UNDECIDED" and rec["cheapest_test"] == d.test
-    assert rec["deciding_variants"] == ["eyelets"]
+    assert rec["deciding_variants"] == ["eyelets"] and rec["tests"] == [d.test]
     assert {m["metric"] for m in rec["metrics"]} == set(METRICS)
     assert all(m["status"] == "UNDECIDED" for m in rec["metrics"])
 

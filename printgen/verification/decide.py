@@ -17,7 +17,7 @@ import numpy as np
 from printgen.verification.bands import Band
 from printgen.verification.compare import METRICS, TOLERANCE
 from printgen.verification.measured import Measurement
-from printgen.verification.variants import cheapest_test
+from printgen.verification.variants import settling_tests
 
 VERDICTS = ("PASS", "FAIL", "UNDECIDED")
 
@@ -38,14 +38,19 @@ class MetricDecision:
 @dataclass(frozen=True)
 class Decision:
     """The verdict of the bands: per quantity, overall, and for UNDECIDED the deciding
-    variants, their questions and the cheapest test that settles them."""
+    variants, their questions and the tests that settle them, cheapest first (`test`)."""
 
     verdict: str
     metrics: list[MetricDecision]
     deciding: list[str]
     questions: list[str]
-    test: str
+    tests: list[str]
     tolerance: float = TOLERANCE
+
+    @property
+    def test(self) -> str:
+        """The cheapest test that settles a deciding question ("" when none decides)."""
+        return self.tests[0] if self.tests else ""
 
     def sentence(self) -> str:
         """The verdict's sentence for UNDECIDED (empty otherwise)."""
@@ -57,12 +62,13 @@ class Decision:
                 f"{self.tolerance:.0%} tolerance on "
                 f"{len(open_)} of {len(self.metrics)} quantities ({', '.join(open_)}); it "
                 f"turns on {'; '.join(self.deciding)} ({', '.join(self.questions)}); the "
-                f"cheapest test that settles it: {self.test}")
+                f"cheapest test that settles it: {self.test}"
+                + (f" (then: {'; '.join(self.tests[1:])})" if len(self.tests) > 1 else ""))
 
     def to_record(self) -> dict[str, Any]:
         return {"verdict": self.verdict, "tolerance": self.tolerance,
                 "deciding_variants": self.deciding, "deciding_questions": self.questions,
-                "cheapest_test": self.test,
+                "cheapest_test": self.test, "tests": self.tests,
                 "metrics": [{"metric": m.metric, "status": m.status,
                              "worst_mismatch": m.worst, "best_mismatch": m.best,
                              "deciding_variants": m.deciding} for m in self.metrics]}
@@ -100,8 +106,7 @@ def decide(proto: dict[str, np.ndarray], model: Band, prototype: Band | None = N
         labels = []
     info = {**model.info, **(prototype.info if prototype is not None else {})}
     questions = list(dict.fromkeys(info[x].question or x for x in labels))
-    return Decision(verdict, out, labels, questions, cheapest_test(questions) if labels else "",
-                    tolerance)
+    return Decision(verdict, out, labels, questions, settling_tests(questions), tolerance)
 
 
 def _deciding(key: str, p: np.ndarray, m: np.ndarray, peak: float, model: Band,

@@ -111,14 +111,21 @@ TESTS = {
 }
 
 
+def settling_tests(questions: list[str]) -> list[str]:
+    """The tests of `TESTS` that settle `questions`, cheapest first (one per test; a question
+    not listed: "find out" it, last)."""
+    def test(q: str) -> str:
+        return TESTS.get(q, TESTS["modulus"] if q.endswith("modulus") else f"find out {q}")
+
+    order = list(TESTS.values())
+    found = dict.fromkeys(test(q) for q in questions)
+    return sorted(found, key=lambda t: order.index(t) if t in order else len(order))
+
+
 def cheapest_test(questions: list[str]) -> str:
-    """The cheapest test of `TESTS` that settles one of `questions` (their own order when
-    none is listed)."""
-    for q in TESTS:
-        if q in questions:
-            return TESTS[q]
-    return TESTS["modulus"] if any(q.endswith("modulus") for q in questions) else (
-        f"find out {questions[0]}" if questions else "")
+    """The cheapest test of `TESTS` that settles one of `questions` ("" for none)."""
+    found = settling_tests(questions)
+    return found[0] if found else ""
 
 
 def model_variants(d: Design, mounting: str | None = None, free_section: float | None = None
