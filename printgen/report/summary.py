@@ -103,7 +103,7 @@ def summarize(run: RunRecords, next_step: str = "") -> Summary:
                 if b.levels > 0}  # none where nothing deforms
         ratios = [m.ratio_high for m in v.mismatches if not m.ok]
         nxt = NEXT_PASS if v.ok else (NEXT_STIFF if ratios and min(ratios) < 1 else NEXT_SOFT)
-        if v.decision is not None and v.verdict == "UNDECIDED":
+        if v.verdict == "UNDECIDED" and v.decision is not None:
             nxt = NEXT_UNDECIDED.format(test=v.decision.test)
         if v.sensors is not None:
             sensors = v.sensors.text()
