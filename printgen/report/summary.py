@@ -181,7 +181,7 @@ def summary_html(s: Summary) -> str:
     lines += [f"<p><b>Warning:</b> {e(w)}</p>" for w in s.warnings]
     if s.band:
         lines.append("<p><b>Uncertainty band</b> (where the prototype lies against the "
-                     "model's band):</p><ul>" + "".join(
+                     "envelope of the model's variants):</p><ul>" + "".join(
                          f"<li>{e(METRICS[k].split(' (')[0])}: {e(t)}</li>"
                          for k, t in s.band.items()) + "</ul>")
     parts = "; ".join(
