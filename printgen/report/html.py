@@ -19,6 +19,7 @@ th, td { border: 1px solid #ccc; padding: .25em .6em; text-align: right; }
 th { background: #eef5f0; } td.t { text-align: left; } td:first-child, th:first-child { text-align: left; }
 .pass { color: #fff; background: #2a6; padding: .1em .5em; border-radius: .3em; }
 .fail { color: #fff; background: #c33; padding: .1em .5em; border-radius: .3em; }
+.undecided { color: #fff; background: #c80; padding: .1em .5em; border-radius: .3em; }
 .note { color: #555; font-size: .9em; }
 figure { margin: 1em 0; } figcaption { color: #555; font-size: .9em; }
 img { max-width: 100%; }
@@ -80,8 +81,11 @@ class Report:
         attr = f' class="{cls}"' if cls else ""
         self.blocks.append(f"<p{attr}>{html.escape(text)}</p>")
 
-    def verdict(self, ok: bool, text: str) -> None:
-        tag = '<span class="pass">PASS</span>' if ok else '<span class="fail">FAIL</span>'
+    def verdict(self, ok: bool | str, text: str) -> None:
+        """A verdict line: `ok` True/False (PASS/FAIL) or the verdict's word (PASS, FAIL,
+        UNDECIDED)."""
+        word = ok if isinstance(ok, str) else ("PASS" if ok else "FAIL")
+        tag = f'<span class="{word.lower()}">{html.escape(word)}</span>'
         self.blocks.append(f"<p>{tag} {html.escape(text)}</p>")
 
     def table(self, columns: list[str], rows: list[list[str]]) -> None:

@@ -26,6 +26,8 @@ NEXT_STIFF = ("Change the net before printing: the model is too stiff. Try a sof
               "design search the net (--objective deformation), then make again.")
 NEXT_SOFT = ("Change the net before printing: the model is too soft. Try a stiffer material or "
              "more passes (printgen select), or printgen design, then make again.")
+NEXT_UNDECIDED = ("Settle what decides before printing: {test}; then verify again (printgen "
+                  "verify --design, with the answer in the prototype file or the profile).")
 NEXT_NONE = "Run make with the verification step to get the verdict before printing."
 NEXT_FLUME = ("Change the scale or the flume before printing: {fix}. Then make again at that "
               "scale (the parts are selected anew for it).")
@@ -101,6 +103,8 @@ def summarize(run: RunRecords, next_step: str = "") -> Summary:
                 if b.levels > 0}  # none where nothing deforms
         ratios = [m.ratio_high for m in v.mismatches if not m.ok]
         nxt = NEXT_PASS if v.ok else (NEXT_STIFF if ratios and min(ratios) < 1 else NEXT_SOFT)
+        if v.verdict == "UNDECIDED" and v.decision is not None:
+            nxt = NEXT_UNDECIDED.format(test=v.decision.test)
         if v.sensors is not None:
             sensors = v.sensors.text()
             if v.sensors_to_blame:  # the net is similar: the sensors, not the material
@@ -171,14 +175,13 @@ def summary_html(s: Summary) -> str:
     from printgen.parts.gcode.estimate import duration
 
     e = html.escape
-    ok = s.verdict == "PASS"
-    tag = ("pass" if ok else "fail") if s.verdict != "not run" else "note"
+    tag = s.verdict.lower() if s.verdict in ("PASS", "FAIL", "UNDECIDED") else "note"
     reason = "<br>".join(e(x) for x in (s.reason or "the verification was not run").split("\n"))
     lines = [f'<p class="verdict"><span class="{tag}">{e(s.verdict)}</span> {reason}</p>']
     lines += [f"<p><b>Warning:</b> {e(w)}</p>" for w in s.warnings]
     if s.band:
         lines.append("<p><b>Uncertainty band</b> (where the prototype lies against the "
-                     "model's band):</p><ul>" + "".join(
+                     "envelope of the model's variants):</p><ul>" + "".join(
                          f"<li>{e(METRICS[k].split(' (')[0])}: {e(t)}</li>"
                          for k, t in s.band.items()) + "</ul>")
     parts = "; ".join(

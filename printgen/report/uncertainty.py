@@ -12,6 +12,7 @@ import numpy as np
 from printgen.report.html import Report
 from printgen.report.report import fmt_value, unit_of
 from printgen.verification.bands import Band, BandVerdict, band_verdicts
+from printgen.verification.central import QUANTILES, RANGE_POINTS, RATIO_FLOOR
 from printgen.verification.compare import METRICS, Deformation
 from printgen.verification.measured import SCORING, Fit, Measurement, mismatch
 from printgen.verification.preprint import SHAPE_LEVELS, Verification
@@ -33,28 +34,35 @@ def band_sections(rep: Report, v: Verification, band: Band) -> None:
             "variant's change added to the nominal curves")
     tried = ", ".join(f"x{k}: {c:.1%}" for k, c in band.refinement.items()) or "none"
     rep.paragraph(f"The model is swept for its nominal inputs and for each uncertain input moved "
-                  f"alone: {runs}. The band is the min/max envelope of those curves (one input "
+                  f"alone: {runs}. The envelope is the min/max of those curves (one input "
                   f"at a time; combined extremes are not run). Variants ran on {mesh}: the "
                   f"coarsest net whose nominal curves move by less than 1 % of their peak "
                   f"(refinement test, largest change: {tried}).")
+    rep.paragraph(CENTRAL_TEXT)
+    _weights_table(rep, band, "model")
+    if v.prototype_band is not None:
+        _weights_table(rep, v.prototype_band, "prototype")
+    _decision_lines(rep, v)
     for note in band.notes:
         rep.paragraph(f"Not in the band: {note}.", "note")
     for label, lv in band.failed.items():
         rep.verdict(False, f"{label}: no converged state at h/h_B = "
                            f"{', '.join(f'{x:g}' for x in lv)}; left out of the band there")
     lo, hi = band.envelope()
+    clo, chi = band.central()
     p = v.prototype.deformation.values
     verdicts = {b.metric: b for b in band_verdicts(p, band)}
     start = {b.metric: b for b in band_verdicts(p, band, from_start=True)}
     idx = [_at(band.levels, x) for x in SHOW_LEVELS]
     rows = []
     for key in METRICS:
-        cells = [("-" if i is None else f"{fmt_value(key, p[key][i])} (band "
+        cells = [("-" if i is None else f"{fmt_value(key, p[key][i])} (central "
+                  f"{fmt_value(key, clo[key][i])} to {fmt_value(key, chi[key][i])}; envelope "
                   f"{fmt_value(key, lo[key][i])} to {fmt_value(key, hi[key][i])})")
                  for i in idx]
         rows.append([f"{METRICS[key]} ({unit_of(key)})", *cells, verdicts[key].text,
                      start[key].text])
-    rep.table(["quantity: prototype (model band min to max)",
+    rep.table(["quantity: prototype (model central interval; envelope min to max)",
                *(f"h/h_B = {x:g}" for x in SHOW_LEVELS), "verdict", "counted from h/h_B = 0"],
               rows)
     negative = [METRICS[k].split(" (")[0] for k in METRICS
@@ -65,18 +73,67 @@ def band_sections(rep: Report, v: Verification, band: Band) -> None:
                       "that as a negative elongation (a computed reading, not an error).", "note")
 
 
+CENTRAL_TEXT = (
+    f"The central interval is {QUANTILES[0]:.0%} to {QUANTILES[1]:.0%} of the weighted "
+    "combinations of the variants: each variant's change from the nominal (a ratio where every "
+    f"weighted curve is positive at that level and the nominal reaches {RATIO_FLOOR:.0%} of "
+    "its peak, else a difference) is an independent "
+    "contribution; the answers of one question are exclusive, each with its weight (the "
+    "nominal the rest), a range uniform between the nominal and its end (taken at "
+    f"{RANGE_POINTS} points); the contributions add (first order: the combinations are not "
+    "run), and the interval always holds the nominal. A variant with a reason to be excluded "
+    "shows in the envelope only. The three-valued verdict compares the model's central "
+    "interval with the prototype's: PASS when every pair within them keeps every quantity "
+    "within the tolerance, FAIL when none does, UNDECIDED when they straddle it.")
+
+
+def _weights_table(rep: Report, band: Band, who: str) -> None:
+    """Each variant's question, weight and its argument, or why it carries none."""
+    excluded = band.excluded
+    rows = [[label, info.question, ("excluded" if label in excluded else
+             f"uniform to it, weight {info.weight:g}" if info.spread == "range" else
+             f"{info.weight:.2g}"), excluded.get(label, info.weight_source)]
+            for label, info in band.info.items() if label in band.variants]
+    if rows:
+        rep.table([f"{who} variant", "question", "weight", "why (or why excluded)"], rows)
+
+
+def _decision_lines(rep: Report, v: Verification) -> None:
+    """The bands' verdict per quantity, and for UNDECIDED what decides and the test."""
+    d = v.decision
+    if d is None:
+        return
+    for m in d.metrics:
+        turns = f"; turns on {', '.join(m.deciding)}" if m.deciding else ""
+        rep.verdict(m.status, f"{METRICS[m.metric].split(' (')[0]}: mismatch within the central "
+                              f"bands {m.best:.0%} to {m.worst:.0%} of the prototype's peak "
+                              f"(tolerance {d.tolerance:.0%}){turns}")
+    if d.verdict == "UNDECIDED":
+        rep.paragraph(f"Cheapest test that settles it: {d.test}.")
+
+
 def band_record(v: Verification, band: Band) -> dict[str, Any]:
     """The band in report.json: every curve's min/max (absolute and from h/h_B = 0), the
-    variants and notes, the refinement test, and the verdicts."""
+    central interval (`central_definition`), the variants with their weights and notes, the
+    refinement test, the verdicts, and the prototype's band."""
     lo, hi = band.envelope()
     lo0, hi0 = band.envelope(from_start=True)
+    clo, chi = band.central()
     p = v.prototype.deformation.values
     at = {f"{x:g}": {key: {"min": lo[key][i], "max": hi[key][i], "nominal": band.nominal[key][i],
+                           "central_min": clo[key][i], "central_max": chi[key][i],
                            "prototype": p[key][i]} for key in METRICS}
           for x in SHOW_LEVELS if (i := _at(band.levels, x)) is not None}
+    pb = v.prototype_band
     return {
         "levels": band.levels, "nominal": band.nominal, "min": lo, "max": hi,
         "min_from_start": lo0, "max_from_start": hi0, "at": at,
+        "central_min": clo, "central_max": chi, "central_definition": CENTRAL_TEXT,
+        "weights": weights_record(band),
+        "prototype": None if pb is None else {
+            "central_min": pb.central()[0], "central_max": pb.central()[1],
+            "min": pb.envelope()[0], "max": pb.envelope()[1], "weights": weights_record(pb),
+            "variant_curves": pb.variants, "not_converged": pb.failed},
         "variants": band.sources, "variant_curves": band.variants, "notes": band.notes,
         "coarsen": band.coarsen, "refinement_change": {str(k): c for k, c in
                                                        band.refinement.items()},
@@ -84,6 +141,16 @@ def band_record(v: Verification, band: Band) -> dict[str, Any]:
         "verdicts": [_verdict(b) for b in band_verdicts(p, band)],
         "verdicts_from_start": [_verdict(b) for b in band_verdicts(p, band, from_start=True)],
     }  # its wall time (band.seconds) goes to the run's timings
+
+
+def weights_record(band: Band) -> dict[str, dict[str, Any]]:
+    """label -> its question, weight, spread, the weight's argument, and the reason it is
+    excluded ("" when it carries its weight)."""
+    excluded = band.excluded
+    return {label: {"question": i.question, "weight": 0.0 if label in excluded else i.weight,
+                    "spread": i.spread, "weight_source": i.weight_source,
+                    "excluded": excluded.get(label, "")}
+            for label, i in band.info.items() if label in band.variants}
 
 
 def _verdict(b: BandVerdict) -> dict[str, Any]:

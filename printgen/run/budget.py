@@ -253,6 +253,11 @@ def sweeps(p: Prototype, d: Design, *, proto_factor: float = 1.0, model_factor: 
         out.append(one("prototype, sensors scaled", prototype_nodes(p, proto_factor), "pooled"))
     n_band = band_variants(p, d) if variants is None else variants
     out += [one("band variant", m_nodes, "band")] * n_band
+    if n_band:  # the prototype's own band
+        from printgen.verification.variants import prototype_variants
+
+        out += [one("prototype band variant", prototype_nodes(p, proto_factor), "pooled")
+                ] * len(prototype_variants(p))
     if work.fit:
         plan = work.fit_plan or default_fit()
         group = "fit" if plan.parallel else "serial"

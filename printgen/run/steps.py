@@ -358,14 +358,15 @@ def verification_sweeps(prototype: Prototype, design: Design,
 def solver_work(v: Verification, band: Band) -> dict[str, Any]:
     """What the solver did over the whole verification (`printgen.run.budget.counted_work`):
     the nominal sweeps of every load case (and of the prototype with the sensors scaled), the
-    band's refinement test and variants."""
+    band's refinement test and variants, and the prototype's band."""
     from printgen.run.budget import counted_work
 
     cases = [c for c in v.by_load.values() if c.spec != v.load.get("spec")]  # not v's own
     nominal = [r for c in [v, *cases] for r in (c.model, c.prototype)]
     if v.loaded_prototype is not None:  # the prototype with the sensors scaled (sensors.py)
         nominal.append(v.loaded_prototype)
-    return counted_work([*(r.work() for r in nominal), *band.work])
+    theirs = v.prototype_band.work if v.prototype_band is not None else []
+    return counted_work([*(r.work() for r in nominal), *band.work, *theirs])
 
 
 def verification_records(v: Verification, band: Band, scale: float

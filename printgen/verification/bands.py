@@ -30,10 +30,11 @@ from printgen.inputs.prototype import Prototype
 from printgen.scaling.record import Design
 from printgen.scene.options import SceneOptions, build_scene
 from printgen.trace import span
+from printgen.verification.central import Contribution, central_interval
 from printgen.verification.compare import METRICS
 from printgen.verification.preprint import Run, load_keywords, sweep
 from printgen.verification.sensors import scene_sensor_force
-from printgen.verification.variants import Variant, model_variants
+from printgen.verification.variants import Variant, model_variants, prototype_variants
 
 COARSENINGS = (2, 3)  # mesh multipliers tried in turn for the variant sweeps
 REFINE_TOL = 0.01  # a coarser net is used when no nominal curve moves by more than 1 % of its peak
@@ -81,6 +82,38 @@ class Band:
     mounting: str | None = None  # the nominal run's mounting, kept by every variant
     work: list[dict[str, Any]] = field(default_factory=list)  # Run.work() of every sweep run
     sensor_force: float | None = None  # N per sensor wire of the nominal run, kept by every variant
+    info: dict[str, Variant] = field(default_factory=dict)  # label -> its variant (weights)
+    data_excluded: dict[str, str] = field(default_factory=dict)  # label -> the data's reason
+
+    @property
+    def excluded(self) -> dict[str, str]:
+        """label -> why the variant carries no weight: its own reason (the material, the
+        geometry), or the lab's data (`printgen.verification.measured.excluded_by_data`)."""
+        out = {k: v.excluded for k, v in self.info.items() if v.excluded}
+        for k, r in self.data_excluded.items():
+            out[k] = "; ".join(x for x in (out.get(k, ""), f"excluded by the data: {r}") if x)
+        return out
+
+    def weighted(self) -> list[str]:
+        """The labels of the variants that carry weight in the central interval."""
+        out = self.excluded
+        return [k for k, v in self.info.items() if k in self.variants and k not in out
+                and v.weight > 0]
+
+    def central(self, *, from_start: bool = False
+                ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+        """(lo, hi) of the central interval per metric (`printgen.verification.central`:
+        the weighted variants combined, 10 % to 90 %); `from_start` as in `envelope`."""
+        def shifted(c: np.ndarray) -> np.ndarray:
+            return c - (c[0] if from_start else 0.0)
+
+        lo, hi = {}, {}
+        for key in METRICS:
+            parts = [Contribution(self.info[k].question or k, shifted(self.variants[k][key]),
+                                  self.info[k].weight, self.info[k].spread)
+                     for k in self.weighted()]
+            lo[key], hi[key] = central_interval(shifted(self.nominal[key]), parts)
+        return lo, hi
 
     def envelope(self, *, from_start: bool = False
                  ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
@@ -195,7 +228,36 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
         if r.failed:
             failed[v.label] = sorted(r.failed)
     return Band(lv, nom, out, {v.label: v.source for v in variants}, list(notes or []), k,
-                change, time.perf_counter() - t0, failed, mounting, work, force)
+                change, time.perf_counter() - t0, failed, mounting, work, force,
+                {v.label: v for v in variants})
+
+
+def run_prototype_variant(p: Prototype, v: Variant, lv: np.ndarray, load_kw: dict | None = None
+                          ) -> Run:
+    """Sweep the prototype with variant `v` (a worker job: module-level, picklable)."""
+    return sweep(build_scene(p, v.options), lv, slack=v.slack, **(load_kw or {}))
+
+
+def prototype_jobs(p: Prototype, nominal: Run, load_kw: dict | None = None) -> list[tuple]:
+    """(run_prototype_variant, args, kwargs) of every prototype variant, at the levels and
+    with the mounting of its `nominal` run."""
+    mounting = getattr(nominal.scene, "mounting", None)
+    lv = nominal.deformation.levels
+    return [(run_prototype_variant, (p, dataclasses.replace(v, options=dataclasses.replace(
+        v.options, mounting=mounting)), lv, load_kw), {}) for v in prototype_variants(p)]
+
+
+def prototype_band(p: Prototype, nominal: Run, runs: list[Run]) -> Band:
+    """The prototype's band: its `nominal` run and the `runs` of `prototype_jobs` (same
+    order), on its own net."""
+    variants = prototype_variants(p)
+    out = {v.label: curves(r) for v, r in zip(variants, runs, strict=True)}
+    failed = {v.label: sorted(r.failed) for v, r in zip(variants, runs, strict=True)
+              if r.failed}
+    return Band(nominal.deformation.levels, curves(nominal), out,
+                {v.label: v.source for v in variants}, [], 1, {}, 0.0, failed,
+                getattr(nominal.scene, "mounting", None), [r.work() for r in runs], None,
+                {v.label: v for v in variants})
 
 
 SIGNIFICANT = 0.1  # levels where the prototype is below 10 % of its peak carry no verdict

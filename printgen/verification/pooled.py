@@ -25,8 +25,17 @@ from printgen.inputs.prototype import Prototype
 from printgen.scaling.record import Design
 from printgen.scene.options import SceneOptions
 from printgen.trace import span
-from printgen.verification.bands import COARSENINGS, Band, meshable, model_band, run_variant
+from printgen.verification.bands import (
+    COARSENINGS,
+    Band,
+    meshable,
+    model_band,
+    prototype_band,
+    prototype_jobs,
+    run_variant,
+)
 from printgen.verification.cases import case_plan, other_cases, with_cases
+from printgen.verification.decide import decide
 from printgen.verification.preprint import Verification, steel_counterexample, verify_plan
 from printgen.verification.sensors import scene_sensor_force
 from printgen.verification.variants import Variant
@@ -37,9 +46,11 @@ def verify_with_band(p: Prototype, d: Design, *, load: str | LoadCase | None = N
                      meanwhile: Callable[[], object] | None = None,
                      loads: tuple[str, ...] = ()) -> tuple[Verification, Band]:
     """`verify(p, d, load=load, counterexample=...)` and the model's uncertainty band around
-    its model run (`model_band`), on one pool, with the nominal sweeps of each other load
-    case of `loads` (`with_cases`; queued behind the band's variants); `meanwhile` is called
-    here once the first sweeps have started (this process then only waits)."""
+    its model run (`model_band`), the prototype's (`prototype_band`, kept on the
+    verification with the bands' three-valued verdict, `decide`), on one pool, with the
+    nominal sweeps of each other load case of `loads` (`with_cases`; queued behind the band's
+    variants); `meanwhile` is called here once the first sweeps have started (this process
+    then only waits)."""
     plan = verify_plan(p, d, load=load)
     base = Variant(options=SceneOptions(mounting=plan.ms.mounting,
                                         sensor_force=scene_sensor_force(plan.ms)))
@@ -62,9 +73,15 @@ def verify_with_band(p: Prototype, d: Design, *, load: str | LoadCase | None = N
         with span("verify: nominal sweeps"):
             model, proto = collect(pair)
             v = plan.verified(model, proto, None, collect(loaded)[0] if loaded else None)
+        # the prototype's variants queue before the model's: they are few and quick
+        theirs = [pool.submit(fn, *args, **kw) for fn, args, kw
+                  in prototype_jobs(p, v.prototype, plan.kw_p)]
         with span("verify: band"):
             band = model_band(d, v.model, load_kw=plan.kw_m, free_section=free_section,
                               ahead=ahead, then=queue_cases)
+            pband = prototype_band(p, v.prototype, collect(theirs))
+            v = dataclasses.replace(v, decision=decide(v.prototype.deformation.values, band,
+                                                       pband), prototype_band=pband)
         if ce is not None:
             v = dataclasses.replace(v, counterexample=collect([ce])[0])
         runs = {spec: tuple(collect(f)) for spec, f in cases.items()}

@@ -49,7 +49,9 @@ from printgen.verification.sensors import (
 )
 
 if TYPE_CHECKING:  # pragma: no cover
+    from printgen.verification.bands import Band
     from printgen.verification.cases import CaseRuns
+    from printgen.verification.decide import Decision
 
 LEVEL_STEP = 0.05  # relative loading step of the sweep: at most 0.05, fine enough for every curve
 PATH_CUTS = 2  # halvings tried before a load level is reported as not converged
@@ -181,6 +183,8 @@ class Verification:
     flow: FlowCheck | None = None
     sensors: SensorCheck | None = None  # the sensors' share of the load (and its check)
     loaded_prototype: Run | None = None  # the prototype swept with sensors scaled (sensors)
+    decision: Decision | None = None  # the bands' three-valued verdict (decide.decide)
+    prototype_band: Band | None = None  # the prototype's variants (bands.prototype_band)
 
     @property
     def ok(self) -> bool:
@@ -196,8 +200,15 @@ class Verification:
 
     @property
     def verdict(self) -> str:
-        """PASS when the model deforms like the prototype and the flume can run the test."""
-        return "PASS" if self.ok and self.runnable else "FAIL"
+        """FAIL when the flume cannot run the test; else the bands' verdict (`decision`:
+        PASS, FAIL or UNDECIDED when the model's and the prototype's central bands straddle
+        the tolerance); without bands, PASS when the nominal model deforms like the
+        prototype."""
+        if not self.runnable:
+            return "FAIL"
+        if self.decision is not None:
+            return self.decision.verdict
+        return "PASS" if self.ok else "FAIL"
 
     @property
     def compared(self) -> int:
@@ -226,7 +237,10 @@ class Verification:
         if self.sensors_to_blame:
             assert self.sensors is not None
             return [*flume, self.sensors.text()]
-        return flume + headlines(self.mismatches)
+        own = headlines(self.mismatches)
+        if self.runnable and self.decision is not None and self.decision.sentence():
+            return [self.decision.sentence(), *(f"with the nominal inputs: {x}" for x in own)]
+        return flume + own
 
     @property
     def headline(self) -> str:
@@ -260,6 +274,7 @@ class Verification:
             "deformed_shape": self.model.shape_record(),
             "load": self.load,
             "sensors": None if self.sensors is None else self.sensors.to_record(),
+            "decision": None if self.decision is None else self.decision.to_record(),
             "by_load": {name: c.to_record() for name, c in self.by_load.items()},
             "assumptions": {who: [dict(zip(("what", "value", "source"), a, strict=True))
                                   for a in run.scene.assumptions] for who, run in runs},
