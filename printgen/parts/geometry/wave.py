@@ -28,29 +28,16 @@ import numpy as np
 from printgen.barrier.graph import NetGraph
 from printgen.errors import GeometryError
 from printgen.parts.geometry.lattice import EDGE_TOL_MM
-from printgen.scaling.record import NetDesign, Wave
+from printgen.scaling.record import NetDesign, Wave, check_net_wave
+
+__all__ = ["CHORD_TOL_MM", "WavedAreas", "WavedStrand", "check_net_wave", "crossing_tangent",
+           "node_colours", "node_tangents", "strand_colours", "wave_length", "waved_areas",
+           "waved_strand", "waved_strands"]
 
 # A polyline stays within 0.01 mm of the wave: 1/40 of a 0.4 mm nozzle, ten times finer than
 # the 0.1 mm the printers place a bead to; the eyelet circles use the same tolerance
 # (`printgen.parts.gcode.toolpath.CHORD_TOL_MM`).
 CHORD_TOL_MM = 0.01
-
-
-def check_net_wave(net: NetDesign, where: str = "net") -> None:
-    """GeometryError naming the limit when `net.wave` cannot be printed on its mesh: the
-    curved pattern's limits (`curved.check_wave_mm`), for the strands up the net and, in a
-    square net, across it (their chord is the other side)."""
-    if net.wave is None:
-        return
-    from printgen.barrier.patterns.curved import check_wave_mm
-
-    w, s = net.wave, net.strand
-    check_wave_mm(net.pattern, w.amplitude_mm, w.half_waves, s.bead_width_mm, s.beads_across,
-                  net.mesh_x_mm, net.mesh_y_mm, f"{where} wave")
-    if net.pattern == "square" and net.mesh_x_mm != net.mesh_y_mm:
-        check_wave_mm(net.pattern, w.amplitude_mm, w.half_waves, s.bead_width_mm,
-                      s.beads_across, net.mesh_y_mm, net.mesh_x_mm,
-                      f"{where} wave (strands across)")
 
 
 def wave_length(chord_mm: float, wave: Wave) -> float:
@@ -162,18 +149,27 @@ def node_colours(g: NetGraph) -> np.ndarray:
     return colour
 
 
+def waved_strand(g: NetGraph, nodes: np.ndarray, wave: Wave,
+                 colour: np.ndarray | None) -> WavedStrand:
+    """The waved centre line through the graph's `nodes` (a strand, either way along it;
+    `colour`: `node_colours(g)` for an odd number of half-waves, else None)."""
+    pts = g.nodes_mm[nodes]
+    d = pts[-1] - pts[0]
+    u = d / float(np.hypot(*d))
+    signs = np.ones(len(nodes) - 1) if colour is None else colour[nodes[:-1]]
+    return WavedStrand(pts[0].astype(float), u, np.array([-u[1], u[0]]), (pts - pts[0]) @ u,
+                       wave, signs)
+
+
+def strand_colours(g: NetGraph, wave: Wave) -> np.ndarray | None:
+    """The node colours the wave's phase needs (`node_colours`; None for even n)."""
+    return node_colours(g) if wave.half_waves % 2 else None
+
+
 def waved_strands(g: NetGraph, wave: Wave) -> list[WavedStrand]:
-    """The waved centre line of each of the graph's strands (node indices, first to last)."""
-    colour = node_colours(g) if wave.half_waves % 2 else None
-    out = []
-    for s in g.strands:
-        pts = g.nodes_mm[s]
-        d = pts[-1] - pts[0]
-        u = d / float(np.hypot(*d))
-        signs = np.ones(len(s) - 1) if colour is None else colour[s[:-1]]
-        out.append(WavedStrand(pts[0].astype(float), u, np.array([-u[1], u[0]]),
-                               (pts - pts[0]) @ u, wave, signs))
-    return out
+    """The waved centre line of each of the graph's strands (first node to last)."""
+    colour = strand_colours(g, wave)
+    return [waved_strand(g, s, wave, colour) for s in g.strands]
 
 
 def node_tangents(g: NetGraph, wave: Wave) -> dict[int, list[np.ndarray]]:
