@@ -75,8 +75,8 @@ class NetDesign:
 
 def check_net_wave(net: NetDesign, where: str = "net") -> None:
     """GeometryError naming the limit when `net.wave` cannot be printed on its mesh: the
-    curved pattern's limits (`curved.check_wave_mm`), for the strands up the net and, in a
-    square net, across it (their chord is the other side)."""
+    curved pattern's limits (`curved.check_wave_mm`; a square net's mesh is square, so its
+    strands up and across have the same chord and spacing)."""
     if net.wave is None:
         return
     from printgen.barrier.patterns.curved import check_wave_mm
@@ -84,10 +84,6 @@ def check_net_wave(net: NetDesign, where: str = "net") -> None:
     w, s = net.wave, net.strand
     check_wave_mm(net.pattern, w.amplitude_mm, w.half_waves, s.bead_width_mm, s.beads_across,
                   net.mesh_x_mm, net.mesh_y_mm, f"{where} wave")
-    if net.pattern == "square" and net.mesh_x_mm != net.mesh_y_mm:
-        check_wave_mm(net.pattern, w.amplitude_mm, w.half_waves, s.bead_width_mm,
-                      s.beads_across, net.mesh_y_mm, net.mesh_x_mm,
-                      f"{where} wave (strands across)")
 
 
 CABLE_SIDES = ("top", "bottom", "left", "right")  # a cable's name: the net side it borders
