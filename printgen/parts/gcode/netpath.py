@@ -33,6 +33,7 @@ straight moves.
 from __future__ import annotations
 
 import itertools
+from collections.abc import Callable
 
 import numpy as np
 
@@ -306,7 +307,7 @@ class _Waved:
         return self.ws.polyline(a, c, off)
 
 
-def _line_maker(net: NetDesign, g: NetGraph):
+def _line_maker(net: NetDesign, g: NetGraph) -> Callable[[np.ndarray], _Straight | _Waved]:
     """nodes -> the strand's centre line (`_Straight`, or `_Waved` for a net with a wave)."""
     if net.wave is None:
         return lambda s: _Straight(g.nodes_mm[s], g)
