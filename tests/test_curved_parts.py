@@ -17,7 +17,7 @@ from conftest import EXAMPLES, reference_design_1_40, require_shared, require_to
 from numpy.testing import assert_allclose
 
 from printgen.barrier.patterns.curved import MIN_RADIUS_BEADS, chord, spacing
-from printgen.errors import InputError
+from printgen.errors import GeometryError, InputError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
 from printgen.parts.gcode import net_toolpath, net_volume_budget, read_gcode, write_gcode
@@ -254,6 +254,26 @@ def _placement(tp, g):
     lo, hi = tp.bounds_mm()[:, :2]
     centre = (lo + hi) / 2
     return rot, centre - rot @ (np.array(g.size_mm) / 2)
+
+
+@pytest.mark.parametrize(("wave", "message"), [
+    (Wave(1.0, 5), "printable minimum of 1 bead width"),  # the pattern's limit
+    (Wave(2.5, 1), "swings its centre line 0.437 mm past the panel edge"),  # the frame's
+])
+def test_unprintable_waves_fail_before_any_part_is_written(wave, message, tmp_path):
+    """A net built in code (not read from a file) meets the same limits in the mesh and the
+    G-code: the frame's too (2.5 mm passes the pattern's band check, 5.6 < 8.55 mm, but
+    swings the strands at the edge out of the 1.2 mm frame)."""
+    from printgen.parts.geometry.solid import net_solid
+
+    net = _reduced(wave)
+    printer, style, material = _setup(net)
+    out = tmp_path / "net.gcode"
+    with pytest.raises(GeometryError, match=message):
+        write_gcode(out, net_toolpath(net, printer, style, material), printer, material)
+    with pytest.raises(GeometryError, match=message):
+        net_solid(net)
+    assert not out.exists()
 
 
 def _checker(path, *args):

@@ -59,6 +59,7 @@ from printgen.parts.geometry.attach import CORNER_EXTRA_RINGS, Attachment, Hole,
 from printgen.parts.geometry.lattice import crossing_direction, crossing_sin, end_sin
 from printgen.parts.geometry.wave import (
     WavedStrand,
+    check_inside,
     crossing_tangent,
     node_tangents,
     strand_colours,
@@ -74,6 +75,7 @@ def net_toolpath(net: NetDesign, printer: Printer, style: PrintStyle, material: 
     """Toolpath of the whole net, one layer per pass (see the module docstring)."""
     check_net_wave(net)
     g = net.graph()
+    check_inside(net, g)
     hs = [] if attachment is None else holes(net, g, attachment)
     angle, centre = check_part("net", net, printer, style,
                                reach_mm=max((h.outer_r_mm for h in hs), default=0.0))

@@ -38,7 +38,7 @@ from printgen.parts.geometry.lattice import (
     parallel_spacing,
     strand_ends,
 )
-from printgen.parts.geometry.wave import check_net_wave, waved_areas, waved_strands
+from printgen.parts.geometry.wave import check_inside, check_net_wave, waved_areas, waved_strands
 from printgen.scaling.record import CableDesign, NetDesign
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -76,6 +76,7 @@ def _graph(net: NetDesign) -> NetGraph:
         raise GeometryError(f"net border {bw:g} mm wide reaches the first strand crossings "
                             f"{first:g} mm from the edge (strand {w:g} mm); use a "
                             f"border narrower than {2 * (first - w):.3g} mm or a larger mesh")
+    check_inside(net, g)
     return g
 
 

@@ -30,9 +30,9 @@ from printgen.errors import GeometryError
 from printgen.parts.geometry.lattice import EDGE_TOL_MM
 from printgen.scaling.record import NetDesign, Wave, check_net_wave
 
-__all__ = ["CHORD_TOL_MM", "WavedAreas", "WavedStrand", "check_net_wave", "crossing_tangent",
-           "node_colours", "node_tangents", "strand_colours", "wave_length", "waved_areas",
-           "waved_strand", "waved_strands"]
+__all__ = ["CHORD_TOL_MM", "WavedAreas", "WavedStrand", "check_inside", "check_net_wave",
+           "crossing_tangent", "node_colours", "node_tangents", "strand_colours", "wave_length",
+           "waved_areas", "waved_strand", "waved_strands"]
 
 # A polyline stays within 0.01 mm of the wave: 1/40 of a 0.4 mm nozzle, ten times finer than
 # the 0.1 mm the printers place a bead to; the eyelet circles use the same tolerance
@@ -170,6 +170,27 @@ def waved_strands(g: NetGraph, wave: Wave) -> list[WavedStrand]:
     """The waved centre line of each of the graph's strands (first node to last)."""
     colour = strand_colours(g, wave)
     return [waved_strand(g, s, wave, colour) for s in g.strands]
+
+
+def check_inside(net: NetDesign, g: NetGraph) -> None:
+    """GeometryError when a waved strand's band leaves the net: past the outer edge of the
+    border frame (centred on the panel edge, `border_width_mm` wide) - near an edge the wave
+    may swing a strand toward it."""
+    if net.wave is None:
+        return
+    reach = (net.border_width_mm - net.strand.width_mm) / 2  # band edge within the frame
+    sx, sy = g.size_mm
+    worst = 0.0
+    for ws in waved_strands(g, net.wave):
+        p = ws.polyline(0.0, ws.length)
+        worst = max(worst, float(np.max(-p[:, 0])), float(np.max(p[:, 0] - sx)),
+                    float(np.max(-p[:, 1])), float(np.max(p[:, 1] - sy)))
+    if worst > reach + CHORD_TOL_MM:
+        raise GeometryError(
+            f"net wave: a strand's wave ({net.wave.amplitude_mm:g} mm amplitude) swings its "
+            f"centre line {worst:.3g} mm past the panel edge, beyond the {reach:.3g} mm the "
+            f"{net.border_width_mm:g} mm border frame holds its {net.strand.width_mm:g} mm "
+            "band in; use a smaller amplitude or a wider border")
 
 
 def node_tangents(g: NetGraph, wave: Wave) -> dict[int, list[np.ndarray]]:
