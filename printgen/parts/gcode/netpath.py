@@ -68,6 +68,9 @@ from printgen.parts.geometry.wave import (
 )
 from printgen.scaling.record import NetDesign, Section, check_net_wave
 
+EXIT_TOL_MM = 1e-4  # a waved bead's reduced flow ends where its line leaves the border, to
+# 0.1 um: a bead 0.6 mm wide then misplaces 6e-5 mm^2 per end (the mesh's own round-off)
+
 
 def net_toolpath(net: NetDesign, printer: Printer, style: PrintStyle, material: Material, *,
                  crossing_flow_factor: float | None = None,
@@ -279,12 +282,29 @@ class _Waved:
         return _trim(h, sec, abs(off)) * self.ws.frame(self.length if at_end else 0.0)[2]
 
     def exit(self, h: Hole, at_end: bool, off: float, bw: float) -> float:
-        """t from the end node to the last point of the bead's line (in its first segment)
-        inside the ring's disc or the frame band on the node's edge: a waved end may run
-        along the frame at a slant and turn away from it, which the end tangent alone does
-        not see."""
+        """t from the end node to where the bead's line (in its first segment) last leaves
+        the ring's disc or the frame band on the node's edge, to EXIT_TOL_MM: a waved end may
+        run along the frame at a slant and turn away from it, which the end tangent alone
+        does not see."""
         seg = (self.ws.t_nodes[-2], self.length) if at_end else (0.0, self.ws.t_nodes[1])
         t = self.ws.samples(float(seg[0]), float(seg[1]), off)
+        dist = (self.length - t) if at_end else t
+        inside = self._inside(h, t, off, bw)
+        if not inside.any():
+            return 0.0
+        j = int(np.flatnonzero(inside)[np.argmax(dist[inside])])
+        k = j - 1 if at_end else j + 1  # the next sample away from the node
+        if not 0 <= k < len(t):
+            return float(dist[j])  # inside to the segment's far end
+        lo, hi = float(dist[j]), float(dist[k])
+        while hi - lo > EXIT_TOL_MM:  # bisect the crossing between the last inside sample
+            mid = (lo + hi) / 2       # and the next one
+            at = np.array([self.length - mid if at_end else mid])
+            lo, hi = (mid, hi) if self._inside(h, at, off, bw)[0] else (lo, mid)
+        return (lo + hi) / 2
+
+    def _inside(self, h: Hole, t: np.ndarray, off: float, bw: float) -> np.ndarray:
+        """Whether the bead's line at t lies in the ring's disc or the node's frame band."""
         p = self.ws.points(t, off)
         sx, sy = self.g.size_mm
         x, y = h.centre_mm
@@ -293,8 +313,7 @@ class _Waved:
                                      (np.isclose(y, 0.0), 1, 0.0), (np.isclose(y, sy), 1, sy)):
             if on_edge:
                 inside |= np.abs(p[:, coord] - edge) <= bw / 2
-        dist = (self.length - t) if at_end else t
-        return float(dist[inside].max()) if inside.any() else 0.0
+        return inside
 
     def crossings(self, off: float, sec: Section) -> list[tuple[float, float, float, float]]:
         out = []
