@@ -13,12 +13,20 @@ from pathlib import Path
 from typing import Any
 
 from printgen.barrier.patterns import get_pattern
-from printgen.errors import InputError
+from printgen.errors import GeometryError, InputError
 from printgen.inputs.profiles import profile_name
 from printgen.inputs.prototype import MIN_MODEL_MESH_MM, Prototype
 from printgen.inputs.schema import Field, check_value, parse_data, positive, shown
 from printgen.outputs.files import read_input_text
-from printgen.scaling.record import CABLE_SIDES, CableDesign, Design, NetDesign, Section
+from printgen.scaling.record import (
+    CABLE_SIDES,
+    CableDesign,
+    Design,
+    NetDesign,
+    Section,
+    Wave,
+    check_net_wave,
+)
 
 DESIGN_LIMIT_BYTES = 16 << 20  # a design.json is ~2 kB, a report.json holding one < 1 MB
 
@@ -37,6 +45,8 @@ NET = {"width_mm": positive("width_mm", MM_MAX, 1.0, si=False),
 SECTION = {"bead_width_mm": positive("bead_width_mm", 10.0, 0.05, si=False),
            "beads_across": Field("beads_across", int, lo=1, hi=1000),
            "layer_heights_mm": Field("layer_heights_mm", list, items=float, max_items=1000)}
+WAVE = {"amplitude_mm": positive("amplitude_mm", 100.0, 0.01, si=False),
+        "half_waves": Field("half_waves", int, lo=1, hi=100)}
 LAYER = positive("layer_heights_mm", 5.0, 0.01, si=False)
 CABLE_NAME = Field("name", str, choices=CABLE_SIDES)
 CABLE = {"length_mm": positive("length_mm", MM_MAX, 1.0, si=False),
@@ -84,6 +94,8 @@ def design_from_dict(data: Any, where: str = "design") -> Design:
         net[key] = profile_name(net[key], f"{where}.net.{key}")
     if "pattern" in net:
         net["pattern"] = get_pattern(str(net["pattern"])).name
+    if net.get("wave") is not None:  # absent or null: straight strands
+        net["wave"] = Wave(**_fields(Wave, net["wave"], f"{where}.net.wave", WAVE))
     if not isinstance(kw["cables"], list):
         raise InputError(f"{where}.cables must be a list of cables")
     cables: list[CableDesign] = []
@@ -98,8 +110,19 @@ def design_from_dict(data: Any, where: str = "design") -> Design:
         for key in ("material", "print_style"):
             ckw[key] = profile_name(ckw[key], f"{where}.cables[{i}].{key}")
         cables.append(CableDesign(**ckw))
-    return Design(scale=kw["scale"], printer=profile_name(kw["printer"], f"{where}.printer"),
-                  net=NetDesign(**net), cables=tuple(cables))
+    design = Design(scale=kw["scale"], printer=profile_name(kw["printer"], f"{where}.printer"),
+                    net=NetDesign(**net), cables=tuple(cables))
+    _check_wave(design.net, f"{where}.net")
+    return design
+
+
+def _check_wave(net: NetDesign, where: str) -> None:
+    """InputError when the net's wave cannot be printed on its mesh: the curved pattern's
+    limits (`printgen.scaling.record.check_net_wave`), the limit named."""
+    try:
+        check_net_wave(net, where)
+    except GeometryError as exc:
+        raise InputError(str(exc)) from exc
 
 
 def load_design(path: str | Path, *, scale: float | None = None,

@@ -40,9 +40,19 @@ class Section:
 
 
 @dataclass(frozen=True)
+class Wave:
+    """The in-plane wave of every strand between two junctions a chord L apart (mm):
+    y = amplitude_mm sin(half_waves pi x / L) (`printgen.barrier.patterns.curved`)."""
+
+    amplitude_mm: float
+    half_waves: int
+
+
+@dataclass(frozen=True)
 class NetDesign:
     """A printed net: panel size, mesh diagonals (x across, y up), strand section, border
-    frame, and its pattern (`printgen.barrier.patterns`; a design file without one: diamond)."""
+    frame, its pattern (`printgen.barrier.patterns`; a design file without one: diamond) and
+    the strands' wave (None: straight strands; a design file without one: straight)."""
 
     material: str
     print_style: str
@@ -53,6 +63,7 @@ class NetDesign:
     strand: Section
     border_width_mm: float
     pattern: str = "diamond"
+    wave: Wave | None = None
 
     def graph(self) -> NetGraph:
         """The net's centre-line graph (mm), built by its pattern."""
@@ -60,6 +71,19 @@ class NetDesign:
 
         return get_pattern(self.pattern).graph(self.width_mm, self.height_mm, self.mesh_x_mm,
                                                self.mesh_y_mm)
+
+
+def check_net_wave(net: NetDesign, where: str = "net") -> None:
+    """GeometryError naming the limit when `net.wave` cannot be printed on its mesh: the
+    curved pattern's limits (`curved.check_wave_mm`; a square net's mesh is square, so its
+    strands up and across have the same chord and spacing)."""
+    if net.wave is None:
+        return
+    from printgen.barrier.patterns.curved import check_wave_mm
+
+    w, s = net.wave, net.strand
+    check_wave_mm(net.pattern, w.amplitude_mm, w.half_waves, s.bead_width_mm, s.beads_across,
+                  net.mesh_x_mm, net.mesh_y_mm, f"{where} wave")
 
 
 CABLE_SIDES = ("top", "bottom", "left", "right")  # a cable's name: the net side it borders
@@ -88,7 +112,12 @@ class Design:
     cables: tuple[CableDesign, ...]
 
     def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
+        """The record; a net of straight strands has no `wave` key (the files written before
+        nets could be curved, byte for byte)."""
+        rec = asdict(self)
+        if self.net.wave is None:
+            del rec["net"]["wave"]
+        return rec
 
     @classmethod
     def from_record(cls, rec: Any, *, where: str = "design record") -> Design:

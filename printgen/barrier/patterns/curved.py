@@ -98,35 +98,46 @@ def min_radius_mm(s: CurvedStrands, chord_mm: float) -> float:
 def check_wave(layout: str, s: CurvedStrands, mesh_x_mm: float, mesh_y_mm: float | None,
                where: str = "curved net") -> None:
     """GeometryError naming the limit when the wave cannot be printed on this mesh (mm)."""
+    check_wave_mm(layout, s.amplitude_mm, s.half_waves, s.bead_width_mm, s.beads_across,
+                  mesh_x_mm, mesh_y_mm, where)
+
+
+def check_wave_mm(layout: str, amplitude_mm: float, half_waves: int, bead_width_mm: float,
+                  beads_across: int, mesh_x_mm: float, mesh_y_mm: float | None,
+                  where: str = "curved net") -> None:
+    """`check_wave` of the wave's geometry alone (mm; the printed parts check their design's
+    wave with it, no material needed): the strands along the load (chord from the mesh
+    across `mesh_x_mm` and up `mesh_y_mm`)."""
     if layout not in LAYOUTS:
         raise GeometryError(f"{where}: layout {layout!r} is not one of {', '.join(LAYOUTS)}")
     mesh_y = mesh_x_mm if mesh_y_mm is None else mesh_y_mm
     get_pattern(layout).check_mesh(mesh_x_mm, mesh_y, where)
-    if not (s.half_waves >= 1 and s.amplitude_mm > 0):
+    if not (half_waves >= 1 and amplitude_mm > 0):
         raise GeometryError(f"{where}: a curved strand needs amplitude > 0 mm and at least one "
-                            f"half-wave, got {s.amplitude_mm:g} mm and {s.half_waves}; for "
+                            f"half-wave, got {amplitude_mm:g} mm and {half_waves}; for "
                             f"straight strands use pattern {layout!r}")
+    width_mm = bead_width_mm * beads_across
     length = chord(layout, mesh_y, mesh_x_mm)
-    radius = min_radius_mm(s, length)
-    inner = radius - (s.width_mm - s.bead_width_mm) / 2
-    limit = MIN_RADIUS_BEADS * s.bead_width_mm
+    k = half_waves * math.pi / length
+    radius = 1.0 / (amplitude_mm * k * k)
+    inner = radius - (width_mm - bead_width_mm) / 2
+    limit = MIN_RADIUS_BEADS * bead_width_mm
     if inner < limit:
-        k = s.half_waves * math.pi / length
-        most = 1.0 / (k * k * (limit + (s.width_mm - s.bead_width_mm) / 2))
+        most = 1.0 / (k * k * (limit + (width_mm - bead_width_mm) / 2))
         raise GeometryError(
-            f"{where}: the wave's tightest bend ({s.amplitude_mm:g} mm amplitude, "
-            f"{s.half_waves} half-waves over a {length:.3g} mm chord) puts the innermost bead "
+            f"{where}: the wave's tightest bend ({amplitude_mm:g} mm amplitude, "
+            f"{half_waves} half-waves over a {length:.3g} mm chord) puts the innermost bead "
             f"on a {inner:.3g} mm radius, below the printable minimum of {MIN_RADIUS_BEADS:g} "
             f"bead width ({limit:g} mm); use an amplitude of at most {most:.3g} mm, fewer "
             "half-waves or a larger mesh")
     gap = spacing(layout, mesh_y, mesh_x_mm)
-    band = 2 * s.amplitude_mm + s.width_mm
+    band = 2 * amplitude_mm + width_mm
     if band > gap:
         raise GeometryError(
-            f"{where}: the wave sweeps a band of {band:.3g} mm (2 x {s.amplitude_mm:g} mm "
-            f"amplitude + {s.width_mm:g} mm strand width), wider than the {gap:.3g} mm between "
+            f"{where}: the wave sweeps a band of {band:.3g} mm (2 x {amplitude_mm:g} mm "
+            f"amplitude + {width_mm:g} mm strand width), wider than the {gap:.3g} mm between "
             f"parallel strands of this mesh: neighbouring strands would fuse; use an amplitude "
-            f"of at most {(gap - s.width_mm) / 2:.3g} mm or a larger mesh")
+            f"of at most {(gap - width_mm) / 2:.3g} mm or a larger mesh")
 
 
 def curve_strains(excess: float, top: float = TOP_STRAIN) -> np.ndarray:

@@ -19,11 +19,21 @@ that bead itself meets them (an offset bead meets a crossing strand o cot(theta)
 centre line's crossing point, and its end corner nearer the centre line meets the hole
 first). Between strands the nozzle travels
 along the inner border bead (over printed material, so the writer does not retract there).
+
+A net with a wave (`NetDesign.wave`) lays each bead along its strand's waved centre line
+(`printgen.parts.geometry.wave`), offset along the wave's normal, as a fine polyline of G1
+moves within the wave's chord tolerance; the same spans as above, each at the tangents where
+it lies (a crossing strand's tangent at the junction, the strand's end tangent at a hole),
+measured along the chord. Polylines, not G2/G3 arcs: a sinusoid is no arc (arcs would need a
+biarc fit, with its own tolerance), firmware may lack arc support or split arcs into its own
+segments, and every reader of the G-code here (the read-back, the shared checker) reads
+straight moves.
 """
 
 from __future__ import annotations
 
 import itertools
+from collections.abc import Callable
 
 import numpy as np
 
@@ -47,14 +57,28 @@ from printgen.parts.gcode.toolpath import (
 )
 from printgen.parts.geometry.attach import CORNER_EXTRA_RINGS, Attachment, Hole, holes
 from printgen.parts.geometry.lattice import crossing_direction, crossing_sin, end_sin
-from printgen.scaling.record import NetDesign, Section
+from printgen.parts.geometry.wave import (
+    WavedStrand,
+    check_inside,
+    crossing_tangent,
+    node_tangents,
+    strand_colours,
+    waved_areas,
+    waved_strand,
+)
+from printgen.scaling.record import NetDesign, Section, check_net_wave
+
+EXIT_TOL_MM = 1e-4  # a waved bead's reduced flow ends where its line leaves the border, to
+# 0.1 um: a bead 0.6 mm wide then misplaces 6e-5 mm^2 per end (the mesh's own round-off)
 
 
 def net_toolpath(net: NetDesign, printer: Printer, style: PrintStyle, material: Material, *,
                  crossing_flow_factor: float | None = None,
                  attachment: Attachment | None = None) -> Toolpath:
     """Toolpath of the whole net, one layer per pass (see the module docstring)."""
+    check_net_wave(net)
     g = net.graph()
+    check_inside(net, g)
     hs = [] if attachment is None else holes(net, g, attachment)
     angle, centre = check_part("net", net, printer, style,
                                reach_mm=max((h.outer_r_mm for h in hs), default=0.0))
@@ -72,6 +96,7 @@ def net_toolpath(net: NetDesign, printer: Printer, style: PrintStyle, material: 
     fams = _strands_by_family(g)
     rings = _border_rings(net, g, hs) if hs else _plain_border(net, g)
     by_node = {h.node: h for h in hs}
+    line = _line_maker(net, g)
     for k, (h, v) in enumerate(zip(heights, layer_speeds, strict=True)):
         zk = float(round(z[k], 6))
         for ring, kind in rings:
@@ -85,12 +110,12 @@ def net_toolpath(net: NetDesign, printer: Printer, style: PrintStyle, material: 
             for n, s in enumerate(fams[fam]):
                 s = s if n % 2 == 0 else s[::-1]
                 ends = (by_node.get(int(s[0])), by_node.get(int(s[-1])))
-                beads = _strand_beads(g.nodes_mm[s], sec, g, f_cross, f, ends,
-                                      net.border_width_mm)
+                beads = _strand_beads(line(s), sec, f_cross, f, ends, net.border_width_mm)
                 if comb is not None and b.pos is not None and b.pos[2] == zk:
-                    b.travel(comb.route(b.part_xy(), beads[0][0][0]), zk, k, travel, COMB)
-                for p0, p1, fl in itertools.chain.from_iterable(beads):
-                    b.line(p0, p1, zk, sec.bead_width_mm, h, v, fl, k, kind, travel)
+                    b.travel(comb.route(b.part_xy(), beads[0][0][0][0]), zk, k, travel, COMB)
+                for pts, fl in itertools.chain.from_iterable(beads):
+                    for p0, p1 in itertools.pairwise(pts):
+                        b.line(p0, p1, zk, sec.bead_width_mm, h, v, fl, k, kind, travel)
     return b.toolpath([float(round(x, 6)) for x in z], "net")
 
 
@@ -192,52 +217,166 @@ def _sin_crossing(g: NetGraph) -> float:
     return crossing_sin(g)  # sin of the angle between the two families, any pattern
 
 
-def _strand_beads(pts: np.ndarray, sec: Section, g: NetGraph, f_cross: float, f_end: float,
+class _Straight:
+    """A straight strand's centre line through its nodes `pts`, in t (mm along it from the
+    first node); a bead's offset is a vector across it."""
+
+    def __init__(self, pts: np.ndarray, g: NetGraph) -> None:
+        self.pts, self.g = pts, g
+        d = pts[-1] - pts[0]
+        self.d = d
+        self.u = d / float(np.hypot(*d))
+        self.length = float(np.dot(pts[-1] - pts[0], self.u))
+
+    def offsets(self, sec: Section) -> list[np.ndarray]:
+        return _bead_offsets(sec, self.d)
+
+    @staticmethod
+    def size(off: np.ndarray) -> float:
+        return float(np.hypot(*off))
+
+    def trim(self, h: Hole | None, at_end: bool, sec: Section, off: np.ndarray) -> float:
+        """t from the end node to where the bead stops at the hole `h` (`_trim`)."""
+        return _trim(h, sec, self.size(off))
+
+    def exit(self, h: Hole, at_end: bool, off: np.ndarray, bw: float) -> float:
+        """t from the end node to where the bead leaves the ring and frame (`_border_exit`)."""
+        return _border_exit(h, self.g, -self.u if at_end else self.u, off, bw)
+
+    def crossings(self, off: np.ndarray, sec: Section) -> list[tuple[float, float, float, float]]:
+        """(t, shift, half span, dt per mm along the bead) of each junction: the offset
+        bead meets the crossing strand at t - shift (an offset line meets it o cot(theta)
+        off the centre line's crossing point)."""
+        half = _crossing_half_span(sec, self.g)
+        v = crossing_direction(self.g, self.u)  # the other family's direction (any pattern)
+        shift = _cross2(off, v) / _cross2(self.u, v)
+        return [(float(np.dot(p - self.pts[0], self.u)), shift, half, 1.0)
+                for p in self.pts[1:-1]]
+
+    def piece(self, a: float, c: float, off: np.ndarray) -> np.ndarray:
+        p00 = self.pts[0] + off
+        return np.array([p00 + self.u * a, p00 + self.u * c])
+
+
+class _Waved:
+    """A waved strand's centre line (`WavedStrand`), in t along its chord; a bead's offset
+    is a signed distance along the wave's normal."""
+
+    def __init__(self, ws: WavedStrand, nodes: np.ndarray, g: NetGraph,
+                 tangents: dict[int, list[np.ndarray]]) -> None:
+        self.ws, self.nodes, self.g, self.tangents = ws, nodes, g, tangents
+        self.length = ws.length
+
+    @staticmethod
+    def offsets(sec: Section) -> list[float]:
+        n = sec.beads_across
+        return [(j - (n - 1) / 2) * sec.bead_width_mm for j in range(n)]
+
+    @staticmethod
+    def size(off: float) -> float:
+        return abs(off)
+
+    def trim(self, h: Hole | None, at_end: bool, sec: Section, off: float) -> float:
+        """`_trim` along the end tangent (the hole is within a few bead widths of the node,
+        where the wave is straight: no curvature at a junction), as t."""
+        return _trim(h, sec, abs(off)) * self.ws.frame(self.length if at_end else 0.0)[2]
+
+    def exit(self, h: Hole, at_end: bool, off: float, bw: float) -> float:
+        """t from the end node to where the bead's line (in its first segment) last leaves
+        the ring's disc or the frame band on the node's edge, to EXIT_TOL_MM: a waved end may
+        run along the frame at a slant and turn away from it, which the end tangent alone
+        does not see."""
+        seg = (self.ws.t_nodes[-2], self.length) if at_end else (0.0, self.ws.t_nodes[1])
+        t = self.ws.samples(float(seg[0]), float(seg[1]), off)
+        dist = (self.length - t) if at_end else t
+        inside = self._inside(h, t, off, bw)
+        if not inside.any():
+            return 0.0
+        j = int(np.flatnonzero(inside)[np.argmax(dist[inside])])
+        k = j - 1 if at_end else j + 1  # the next sample away from the node
+        if not 0 <= k < len(t):
+            return float(dist[j])  # inside to the segment's far end
+        lo, hi = float(dist[j]), float(dist[k])
+        while hi - lo > EXIT_TOL_MM:  # bisect the crossing between the last inside sample
+            mid = (lo + hi) / 2       # and the next one
+            at = np.array([self.length - mid if at_end else mid])
+            lo, hi = (mid, hi) if self._inside(h, at, off, bw)[0] else (lo, mid)
+        return (lo + hi) / 2
+
+    def _inside(self, h: Hole, t: np.ndarray, off: float, bw: float) -> np.ndarray:
+        """Whether the bead's line at t lies in the ring's disc or the node's frame band."""
+        p = self.ws.points(t, off)
+        sx, sy = self.g.size_mm
+        x, y = h.centre_mm
+        inside = np.hypot(*(p - h.centre_mm).T) <= h.outer_r_mm
+        for on_edge, coord, edge in ((np.isclose(x, 0.0), 0, 0.0), (np.isclose(x, sx), 0, sx),
+                                     (np.isclose(y, 0.0), 1, 0.0), (np.isclose(y, sy), 1, sy)):
+            if on_edge:
+                inside |= np.abs(p[:, coord] - edge) <= bw / 2
+        return inside
+
+    def crossings(self, off: float, sec: Section) -> list[tuple[float, float, float, float]]:
+        out = []
+        for node, t in zip(self.nodes[1:-1], self.ws.t_nodes[1:-1], strict=True):
+            tangent, normal, c = self.ws.frame(float(t))
+            v = crossing_tangent(self.tangents[int(node)], tangent)
+            sin = _cross2(tangent, v)
+            out.append((float(t), _cross2(off * normal, v) / sin, sec.width_mm / 2 / abs(sin), c))
+        return out
+
+    def piece(self, a: float, c: float, off: float) -> np.ndarray:
+        return self.ws.polyline(a, c, off)
+
+
+def _line_maker(net: NetDesign, g: NetGraph) -> Callable[[np.ndarray], _Straight | _Waved]:
+    """nodes -> the strand's centre line (`_Straight`, or `_Waved` for a net with a wave)."""
+    if net.wave is None:
+        return lambda s: _Straight(g.nodes_mm[s], g)
+    wave = net.wave
+    colour, tangents = strand_colours(g, wave), node_tangents(g, wave)
+    return lambda s: _Waved(waved_strand(g, s, wave, colour), s, g, tangents)
+
+
+def _strand_beads(line, sec: Section, f_cross: float, f_end: float,
                   ends: tuple[Hole | None, Hole | None], bw: float):
-    """Pieces (p0, p1, flow) of each bead of one strand, beads side by side laid there and
+    """Pieces (points, flow) of each bead of one strand, beads side by side laid there and
     back (serpentine): `f_cross` where the bead lies over a crossing strand, `f_end` where it
     lies over the border frame or a ring at an end with a hole (it stops at the hole)."""
-    d = pts[-1] - pts[0]
-    u = d / float(np.hypot(*d))
     out = []
-    for j, off in enumerate(_bead_offsets(sec, d)):
-        pieces = _bead_pieces(pts, u, off, sec, g, f_cross, f_end, ends, bw)
+    for j, off in enumerate(line.offsets(sec)):
+        pieces = [(line.piece(a, c, off), fl)
+                  for a, c, fl in _bead_pieces(line, off, sec, f_cross, f_end, ends, bw)]
         if j % 2:
-            pieces = [(p1, p0, fl) for p0, p1, fl in reversed(pieces)]
+            pieces = [(pts[::-1], fl) for pts, fl in reversed(pieces)]
         out.append(pieces)
     return out
 
 
-def _bead_pieces(pts: np.ndarray, u: np.ndarray, off: np.ndarray, sec: Section, g: NetGraph,
-                 f_cross: float, f_end: float, ends: tuple[Hole | None, Hole | None], bw: float):
-    """Straight pieces (p0, p1, flow) of the bead at lateral offset `off` from the strand's
-    centre line, in t (mm along the strand from pts[0]); see `_strand_beads`."""
+def _bead_pieces(line, off, sec: Section, f_cross: float, f_end: float,
+                 ends: tuple[Hole | None, Hole | None], bw: float):
+    """Spans (t0, t1, flow) of the bead at offset `off` from the strand's centre line, in t
+    (mm along the strand's chord from its first node); see `_strand_beads`."""
     start, end = ends
-    length = float(np.dot(pts[-1] - pts[0], u))
-    o = float(np.hypot(*off))
-    t0 = _trim(start, sec, o)
-    t1 = length - _trim(end, sec, o)
+    length = line.length
     spans = []
     if f_cross < 1.0:
-        half = _crossing_half_span(sec, g)
-        v = crossing_direction(g, u)  # the other family's direction (any pattern)
-        shift = _cross2(off, v) / _cross2(u, v)  # the offset line meets each crossing here
-        spans += [(t - shift - half, t - shift + half, f_cross)
-                  for t in (float(np.dot(p - pts[0], u)) for p in pts[1:-1])]
+        spans += [(t - c * shift - c * half, t - c * shift + c * half, f_cross)
+                  for t, shift, half, c in line.crossings(off, sec)]
+    t0 = line.trim(start, False, sec, off)
+    t1 = length - line.trim(end, True, sec, off)
     if start is not None:
-        spans.append((t0, _border_exit(start, g, u, off, bw), f_end))
+        spans.append((t0, line.exit(start, False, off, bw), f_end))
     if end is not None:
-        spans.append((length - _border_exit(end, g, -u, off, bw), t1, f_end))
+        spans.append((length - line.exit(end, True, off, bw), t1, f_end))
     cuts = sorted({t0, t1, *(min(max(c, t0), t1) for lo, hi, _ in spans for c in (lo, hi))})
-    p00 = pts[0] + off
-    out: list[tuple[np.ndarray, np.ndarray, float]] = []
+    out: list[tuple[float, float, float]] = []
     for a, c in itertools.pairwise(cuts):
         mid = (a + c) / 2
         fl = min([fl for lo, hi, fl in spans if lo <= mid <= hi], default=1.0)
         if out and out[-1][2] == fl:
-            out[-1] = (out[-1][0], p00 + u * c, fl)
+            out[-1] = (out[-1][0], c, fl)
         else:
-            out.append((p00 + u * a, p00 + u * c, fl))
+            out.append((a, c, fl))
     return out
 
 
@@ -287,9 +426,13 @@ def net_volume_budget(net: NetDesign, style: PrintStyle, *,
     t = sec.thickness_mm
     w = sec.width_mm
     size = np.array(g.size_mm)
+    border = 2 * (size[0] + size[1]) * net.border_width_mm
+    if net.wave is not None:  # the same terms along the waved centre lines
+        wa = waved_areas(net, g)
+        return VolumeBudget((wa.strands + border) * t, wa.crossings * t, wa.ends * t, f,
+                            wa.crossing_count)
     strand_len = sum(float(np.hypot(*(g.nodes_mm[s[-1]] - g.nodes_mm[s[0]]))) for s in g.strands)
     n_cross = sum(len(s) - 2 for s in g.strands) // 2
-    border = 2 * (size[0] + size[1]) * net.border_width_mm
     nominal = (strand_len * w + border) * t
     crossing = n_cross * w * w / _sin_crossing(g) * t
     # strand ends inside the frame, each at its angle to the border edge it meets

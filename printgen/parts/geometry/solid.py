@@ -3,7 +3,8 @@ extruded to the section thickness (manifold3d), checked after every operation.
 
 Net: every strand of the `NetGraph` (the diamond's diagonals, the square's strands up and
 across) as one straight band of the strand width from
-border to border (rigid junctions where the bands cross), plus the border frame of
+border to border (rigid junctions where the bands cross) - or, with the design's wave, a band
+along the strand's waved centre line (`printgen.parts.geometry.wave`) - plus the border frame of
 `border_width_mm` centred on the panel edge, which the border cables thread along - the same
 layout the direct G-code lays. With an `Attachment` (`printgen.parts.geometry.attach`) a
 loop is centred on every edge node, through which the cable strip threads, and an eyelet on
@@ -37,6 +38,7 @@ from printgen.parts.geometry.lattice import (
     parallel_spacing,
     strand_ends,
 )
+from printgen.parts.geometry.wave import check_inside, check_net_wave, waved_areas, waved_strands
 from printgen.scaling.record import CableDesign, NetDesign
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -55,6 +57,7 @@ def _graph(net: NetDesign) -> NetGraph:
     check_positive_mm(net.strand.width_mm, "net strand width")
     check_positive_mm(net.strand.thickness_mm, "net strand thickness")
     check_positive_mm(net.border_width_mm, "net border width")
+    check_net_wave(net)
     g = net.graph()
     a, b = g.mesh_mm
     w, bw = net.strand.width_mm, net.border_width_mm
@@ -73,6 +76,7 @@ def _graph(net: NetDesign) -> NetGraph:
         raise GeometryError(f"net border {bw:g} mm wide reaches the first strand crossings "
                             f"{first:g} mm from the edge (strand {w:g} mm); use a "
                             f"border narrower than {2 * (first - w):.3g} mm or a larger mesh")
+    check_inside(net, g)
     return g
 
 
@@ -97,6 +101,11 @@ def net_outline(net: NetDesign, attachment: Attachment | None = None):
 def _strand_bands(net: NetDesign, g: NetGraph) -> list:
     from shapely.geometry import LineString
 
+    if net.wave is not None:
+        lines = waved_strands(g, net.wave)
+        return [LineString(ws.polyline(0.0, ws.length)).buffer(net.strand.width_mm / 2,
+                                                               cap_style="flat")
+                for ws in lines]
     return [LineString(g.nodes_mm[[s[0], s[-1]]]).buffer(net.strand.width_mm / 2,
                                                           cap_style="flat")
             for s in g.strands]
@@ -117,17 +126,23 @@ def analytic_net_area(net: NetDesign, attachment: Attachment | None = None) -> f
     Strand lengths x width, less one rhombus w^2 / sin(theta) per crossing (theta between
     the crossing strands: `lattice.crossing_sin`) and, per strand end, the w x (bw/2) /
     sin(phi) inside the frame (phi: strand vs the edge it meets, `lattice.end_sin`), plus
-    the frame 2 bw (sx + sy). Each ring adds its disc less the frame and strands already
-    inside it (a polar-grid integral of numpy point tests) and removes its hole.
+    the frame 2 bw (sx + sy). A waved net: the same terms along the waved centre lines
+    (`wave.waved_areas`: arc lengths in closed form, the tangents' angles at the crossings,
+    the ends' arcs inside the frame). Each ring adds its disc less the frame and strands
+    already inside it (a polar-grid integral of numpy point tests) and removes its hole.
     """
     g = _graph(net)
     sx, sy = g.size_mm
     w, bw = net.strand.width_mm, net.border_width_mm
-    ends = strand_ends(g).reshape(-1, 2)
-    length = float(np.hypot(*(ends[1::2] - ends[::2]).T).sum())
-    n_cross = sum(len(s) - 2 for s in g.strands) // 2
-    area = (length * w - n_cross * w * w / crossing_sin(g)
-            - float(np.sum(bw / 2 / end_sin(g))) * w + 2 * bw * (sx + sy))
+    if net.wave is not None:
+        wa = waved_areas(net, g)
+        area = wa.strands - wa.crossings - wa.ends + 2 * bw * (sx + sy)
+    else:
+        ends = strand_ends(g).reshape(-1, 2)
+        length = float(np.hypot(*(ends[1::2] - ends[::2]).T).sum())
+        n_cross = sum(len(s) - 2 for s in g.strands) // 2
+        area = (length * w - n_cross * w * w / crossing_sin(g)
+                - float(np.sum(bw / 2 / end_sin(g))) * w + 2 * bw * (sx + sy))
     if attachment is not None:
         for h in holes(net, g, attachment):
             area += np.pi * (h.outer_r_mm**2 - h.hole_r_mm**2) - _base_in_disc(net, g, h)
@@ -143,7 +158,11 @@ def _base_in_disc(net: NetDesign, g: NetGraph, h: Hole) -> float:
     outer = (x >= -half) & (x <= sx + half) & (y >= -half) & (y <= sy + half)
     inner = (x > half) & (x < sx - half) & (y > half) & (y < sy - half)
     inside = outer & ~inner
-    for s in _strands_near(g, h.centre_mm, h.outer_r_mm + net.strand.width_mm):
+    sway = 0.0 if net.wave is None else net.wave.amplitude_mm  # a wave strays this off its chord
+    waved = {} if net.wave is None else {
+        (int(s[0]), int(s[-1])): ws for s, ws in zip(g.strands, waved_strands(g, net.wave),
+                                                   strict=True)}
+    for s in _strands_near(g, h.centre_mm, h.outer_r_mm + net.strand.width_mm + sway):
         p0, p1 = g.nodes_mm[s[0]], g.nodes_mm[s[-1]]
         d = p1 - p0
         length = float(np.hypot(*d))
@@ -151,6 +170,11 @@ def _base_in_disc(net: NetDesign, g: NetGraph, h: Hole) -> float:
         rx, ry = x - p0[0], y - p0[1]
         along = rx * u[0] + ry * u[1]
         across = np.abs(rx * -u[1] + ry * u[0])
+        if net.wave is not None:
+            # off the waved centre line: its offset along the normal, to first order in the
+            # distance (the wave is straight at the junction a ring sits on: no curvature)
+            wy, slope = waved[int(s[0]), int(s[-1])].shape(np.clip(along, 0.0, length))
+            across = np.abs(rx * -u[1] + ry * u[0] - wy) / np.sqrt(1 + slope * slope)
         inside |= (along >= 0) & (along <= length) & (across <= net.strand.width_mm / 2)
     return float(np.sum(cell * inside))
 
