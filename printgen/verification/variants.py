@@ -13,7 +13,8 @@ Variants of design `d` (`model_variants`):
 - the panel law's geometry assumption: the law's tested net (strand and mesh recorded in the
   profile, an assumption when the source does not give it) against the alternative that the
   tested panel had the design's own strands and mesh (the law used without rescaling);
-- the panel law read along each mesh diagonal its profile does not record;
+- the panel law read along each mesh diagonal but the nominal reading (the one the material
+  can produce, `printgen.scaling.reading`), with why it fails a check when it does (`excluded`);
 - the mounting in the flume, each of the scene's `MOUNTINGS` but the nominal;
 - initial slack of the printed net, 0 to `SLACK_MAX` (0 is the nominal);
 - the model-form options (`printgen.scene.forms`, `printgen.scene.mount`): the water's force
@@ -28,10 +29,11 @@ from dataclasses import dataclass, field
 
 from printgen.barrier.patterns import get_pattern
 from printgen.inputs.materials import Material, load_material
+from printgen.scaling.reading import chosen_orientation, panel_axes, panel_reading
 from printgen.scaling.record import Design
 from printgen.scaling.section import area_m2
 from printgen.scene.options import SceneOptions, build_scene
-from printgen.scene.scenes import MOUNTINGS, ORIENTATIONS, TESTED_PATTERN, recorded_orientation
+from printgen.scene.scenes import MOUNTINGS, TESTED_PATTERN, recorded_orientation
 from printgen.units import MM
 
 SLACK_MAX = 0.01  # initial slack of the printed net, upper end of the range (0-1 %)
@@ -47,13 +49,15 @@ class Variant:
     """One uncertain input of the printed model moved from its nominal value: `label`,
     `source` (why, for the report), the scene `options` it changes, the relative initial
     `slack` of every strand and cable of its solver net, its `effort` rank (higher: started
-    earlier)."""
+    earlier); `excluded`: why it is a reading the material cannot produce ("" when it can),
+    kept to be shown apart, never as a central value."""
 
     label: str = "nominal"
     source: str = ""
     options: SceneOptions = field(default_factory=SceneOptions)
     slack: float = 0.0
     effort: int = 0
+    excluded: str = ""  # why the variant contradicts the material or the test ("": it does not)
 
 
 def model_variants(d: Design, mounting: str | None = None, free_section: float | None = None
@@ -130,8 +134,9 @@ def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
     """The panel law used without the rescaling from its (assumed) tested net to the design's."""
     mat = load_material(d.net.material)
     law, n = mat.panel_law, d.net
-    tested = get_pattern(TESTED_PATTERN).membrane_factor(law.mesh_along_load,
-                                                         law.mesh_across_load) * (
+    along, across = panel_axes(law.mesh_along_load, law.mesh_across_load,
+                               chosen_orientation(mat) or recorded_orientation(law))
+    tested = get_pattern(TESTED_PATTERN).membrane_factor(along, across) * (
         law.strand_width * law.strand_thickness)
     design = get_pattern(n.pattern).membrane_factor(n.mesh_y_mm * MM, n.mesh_x_mm * MM) * \
         area_m2(n.strand)
@@ -146,13 +151,24 @@ def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
 
 
 def _orientation_variants(d: Design) -> list[Variant]:
-    """The panel law read along each mesh diagonal its profile does not record (the paper
-    does not say which diagonal its printed panels were loaded along)."""
-    recorded = recorded_orientation(load_material(d.net.material).panel_law)
-    return [Variant(f"panel test along the {o} diagonal",
-                    f"panel-test orientation not stated (profile: {recorded})",
-                    SceneOptions(orientation=o))
-            for o in ORIENTATIONS if o != recorded]
+    """The panel law read along each mesh diagonal but the nominal reading (the one the
+    material can produce, `printgen.scaling.reading`; the paper does not say which diagonal
+    its printed panels were loaded along); a reading that fails a check carries why."""
+    reading = panel_reading(load_material(d.net.material))
+    if reading is None:
+        return []
+    out = []
+    for c in reading.checks:
+        if c.orientation == reading.orientation:
+            continue
+        why = "; ".join(c.reasons())
+        out.append(Variant(f"panel test along the {c.orientation} diagonal",
+                           f"panel-test orientation not stated (nominal: {reading.orientation}"
+                           f", chosen by consistency; profile records {reading.recorded}); "
+                           + c.summary(), SceneOptions(orientation=c.orientation),
+                           excluded=f"a reading the material cannot produce: {why}"
+                           if why else ""))
+    return out
 
 
 def _model_form_variants(d: Design, free_section: float | None, notes: list[str],
