@@ -27,6 +27,8 @@ from printgen.run.options import RunOptions
 from printgen.run.provenance import provenance_record
 from printgen.scaling.design_file import load_design
 from printgen.scaling.record import Design
+from printgen.scaling.selection import design_net
+from printgen.scaling.similitude import scale_targets
 from printgen.scene.readings import design_units
 from printgen.verification.bands import Band, band_verdicts, model_load_kw
 from printgen.verification.fit import MultiFit, fit_levels, fit_measured
@@ -102,6 +104,8 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
         text = "" if one.at_bound or one.worsened else _profile_text(d, one, Path(measured).name)
         result = one
     run = RunRecords(f"printgen verify: {p.name} at 1:{d.scale:g}", d)
+    # the design's net scored like select's candidates: its stiffness across and up the barrier
+    run.steps["design_net"] = design_net(p, scale_targets(p, d.scale), d.net, d.printer)
     run.steps["verification"] = CheckRecords(v, band, d.scale, nested=False)
     if m is not None:
         run.steps["measured"] = MeasuredRecords(m, band, result, text)
