@@ -243,7 +243,7 @@ def panel_reading(mat: Material) -> Reading | None:
     if law is None or not law.has_geometry:
         return None
     (lo, hi), source = modulus_range(mat)
-    return _reading(mat.name, law, lo, hi, source, mat.failure_stress()[0])
+    return choose_reading(mat.name, law, lo, hi, source, mat.failure_stress()[0])
 
 
 def chosen_orientation(mat: Material) -> str | None:
@@ -253,8 +253,12 @@ def chosen_orientation(mat: Material) -> str | None:
 
 
 @lru_cache(maxsize=32)
-def _reading(name: str, law: PanelLaw, lo: float, hi: float, source: str,
-             strength: float) -> Reading:
+def choose_reading(name: str, law: PanelLaw, lo: float, hi: float, source: str,
+                   strength: float) -> Reading:
+    """The reading of `law` (material `name`, a printed strand's plausible modulus `lo`-`hi`
+    Pa from `source`, tensile strength Pa): each diagonal checked, the first passing one
+    chosen, the profile's recorded one first; the recorded one, marked inconsistent and
+    logged, when none passes."""
     checks = tuple(check_reading(law, o, (lo, hi), source, strength) for o in ORIENTATIONS)
     recorded = recorded_orientation(law)
     order = sorted(checks, key=lambda c: c.orientation != recorded)
