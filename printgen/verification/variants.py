@@ -134,12 +134,13 @@ def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
     """The panel law used without the rescaling from its (assumed) tested net to the design's."""
     mat = load_material(d.net.material)
     law, n = mat.panel_law, d.net
-    along, across = panel_axes(law.mesh_along_load, law.mesh_across_load,
-                               chosen_orientation(mat) or recorded_orientation(law))
-    tested = get_pattern(TESTED_PATTERN).membrane_factor(along, across) * (
+    # the panel loaded along the diagonal of the nominal reading, of either net
+    o = chosen_orientation(mat) or recorded_orientation(law)
+    tested = get_pattern(TESTED_PATTERN).membrane_factor(
+        *panel_axes(law.mesh_along_load, law.mesh_across_load, o)) * (
         law.strand_width * law.strand_thickness)
-    design = get_pattern(n.pattern).membrane_factor(n.mesh_y_mm * MM, n.mesh_x_mm * MM) * \
-        area_m2(n.strand)
+    design = get_pattern(n.pattern).membrane_factor(
+        *panel_axes(n.mesh_x_mm * MM, n.mesh_y_mm * MM, o)) * area_m2(n.strand)
     ratio = tested / design
     if abs(ratio - 1) < SAME:
         notes.append(f"{mat.name} panel law: the design's net is the tested net the profile "
