@@ -75,10 +75,23 @@ def panel_axes(mesh_a: float, mesh_b: float, orientation: str) -> tuple[float, f
     return (lo, hi) if orientation == "short" else (hi, lo)
 
 
+def tested_net(law: PanelLaw) -> tuple[float, float, float, float]:
+    """(strand width, strand thickness, mesh along the load, mesh across it) m of the net a
+    panel law was tested on; GeometryError when its profile does not record them."""
+    w, t, a, b = (law.strand_width, law.strand_thickness, law.mesh_along_load,
+                  law.mesh_across_load)
+    if w is None or t is None or a is None or b is None:
+        raise GeometryError(f"panel law ({law.source}) records no tested net: give "
+                            "strand_width_mm, strand_thickness_mm, mesh_along_load_mm and "
+                            "mesh_across_load_mm in its [measured.panel_law]")
+    return w, t, a, b
+
+
 def recorded_orientation(law: PanelLaw) -> str:
     """The diagonal a measured panel law was loaded along, as its profile records the meshes:
     "short" when the mesh along the load is the shorter one, else "long"."""
-    return "short" if law.mesh_along_load <= law.mesh_across_load else "long"
+    _, _, along, across = tested_net(law)
+    return "short" if along <= across else "long"
 
 
 @dataclass(frozen=True)
@@ -273,10 +286,11 @@ def choose_reading(name: str, law: PanelLaw, lo: float, hi: float, source: str,
 def check_reading(law: PanelLaw, orientation: str, plausible: tuple[float, float],
                   source: str, strength: float) -> ReadingCheck:
     """The three checks of `law` read along its tested net's `orientation` diagonal."""
-    along, across = panel_axes(law.mesh_along_load, law.mesh_across_load, orientation)
+    w, t, a, b = tested_net(law)
+    along, across = panel_axes(a, b, orientation)
     pattern = get_pattern(TESTED_PATTERN)
     slopes = tuple(k * law.panel_length for k in law.kappas)
-    area = law.strand_width * law.strand_thickness
+    area = w * t
     ea = slopes[0] / pattern.membrane_factor(along, across)
     eps = law_strains(law.knee_strains)
     top = max(law.knee_strains) if law.knee_strains else float(eps[-1])

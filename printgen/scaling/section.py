@@ -14,7 +14,12 @@ import math
 from printgen.barrier.patterns import get_pattern
 from printgen.inputs.materials import Material
 from printgen.scaling.panel_test import TESTED_PATTERN
-from printgen.scaling.reading import chosen_orientation, panel_axes
+from printgen.scaling.reading import (
+    chosen_orientation,
+    panel_axes,
+    recorded_orientation,
+    tested_net,
+)
 from printgen.scaling.record import Section
 from printgen.units import MM
 
@@ -44,12 +49,13 @@ def net_membrane_law(material: Material, section: Section, mesh_along: float,
     net = get_pattern(pattern)
     law = material.panel_law
     if law is not None and law.has_geometry:
-        along, across = panel_axes(law.mesh_along_load, law.mesh_across_load,
-                                   orientation or chosen_orientation(material) or "short")
+        w, t, a, b = tested_net(law)
+        along, across = panel_axes(a, b, orientation or chosen_orientation(material)
+                                   or recorded_orientation(law))
         knees, slopes = membrane_law_between(
             law.knee_strains, tuple(k * law.panel_length for k in law.kappas),
             (TESTED_PATTERN, along, across), (pattern, mesh_along, mesh_across))
-        ratio = area_m2(section) / (law.strand_width * law.strand_thickness)
+        ratio = area_m2(section) / (w * t)
         return knees, tuple(s * ratio for s in slopes), "measured panel law"
     factor = net.membrane_factor(mesh_along, mesh_across) * area_m2(section)
     modulus, source = material.modulus()

@@ -86,13 +86,12 @@ class Candidate:
     @property
     def error_across(self) -> float | None:
         """Printed / target membrane stiffness across the barrier, minus 1 (nets)."""
-        return None if self.stiffness_across is None else (
-            self.stiffness_across / self.target_across - 1)
+        return _ratio(self.stiffness_across, self.target_across)
 
     @property
     def error_up(self) -> float | None:
         """Printed / target membrane stiffness up the barrier, minus 1 (nets)."""
-        return None if self.stiffness_up is None else self.stiffness_up / self.target_up - 1
+        return _ratio(self.stiffness_up, self.target_up)
 
     def direction_text(self) -> str:
         """'+521 % across, +182 % up' (nets); '' for cables."""
@@ -132,6 +131,11 @@ class Candidate:
         return (f"Candidate({self.material} {s.width_mm:g} x {s.thickness_mm:g} mm, "
                 f"{s.passes} passes, stiffness {off} of target, SF "
                 f"{self.safety_factor:.2g}, {state})")
+
+
+def _ratio(got: float | None, want: float | None) -> float | None:
+    """got / want - 1, None when either is not given."""
+    return None if got is None or want is None else got / want - 1
 
 
 @dataclass(frozen=True)

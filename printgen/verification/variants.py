@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 
 from printgen.barrier.patterns import get_pattern
 from printgen.inputs.materials import Material, load_material
-from printgen.scaling.reading import chosen_orientation, panel_axes, panel_reading
+from printgen.scaling.reading import chosen_orientation, panel_axes, panel_reading, tested_net
 from printgen.scaling.record import Design
 from printgen.scaling.section import area_m2
 from printgen.scene.options import SceneOptions, build_scene
@@ -134,11 +134,12 @@ def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
     """The panel law used without the rescaling from its (assumed) tested net to the design's."""
     mat = load_material(d.net.material)
     law, n = mat.panel_law, d.net
+    if law is None:
+        return []
+    w, t, a, b = tested_net(law)
     # the panel loaded along the diagonal of the nominal reading, of either net
     o = chosen_orientation(mat) or recorded_orientation(law)
-    tested = get_pattern(TESTED_PATTERN).membrane_factor(
-        *panel_axes(law.mesh_along_load, law.mesh_across_load, o)) * (
-        law.strand_width * law.strand_thickness)
+    tested = get_pattern(TESTED_PATTERN).membrane_factor(*panel_axes(a, b, o)) * (w * t)
     design = get_pattern(n.pattern).membrane_factor(
         *panel_axes(n.mesh_x_mm * MM, n.mesh_y_mm * MM, o)) * area_m2(n.strand)
     ratio = tested / design
