@@ -193,3 +193,21 @@ def test_select_records_and_shows_both_directions():
         worse = max((c.error_across, c.error_up), key=lambda e: abs(math.log1p(e)))
         assert c.error == pytest.approx(worse, rel=EXACT)
     assert " across" in s.net_rationale and " up " in s.net_rationale
+
+
+def test_design_search_screens_both_directions():
+    """`design`'s screen scores the paper's net as select does: 6.2x the target across and
+    2.8x up; its single small-strain error is the worse (across)."""
+    from printgen.search.screen import screen_point
+    from printgen.search.space import NetPoint, SearchSpace, search_context
+
+    p = load_prototype(REALISTIC)
+    t = scale_targets(p, 40)
+    ctx = search_context(p, t, SearchSpace(("tpe",), (1,), (3,), (20.6, 20.6), (9.4, 9.4)))
+    s = screen_point(ctx, NetPoint(0, "tpe", 1, 3, 32, 21, 20.6, 9.4, 2))
+    assert 1 + s.error_across == pytest.approx(6.2, rel=STATED)
+    assert 1 + s.error_up == pytest.approx(2.8, rel=STATED)
+    assert s.error_small == s.error_across
+    rec = s.to_record()
+    assert rec["stiffness_error_across"] == s.error_across
+    assert rec["stiffness_error_up"] == s.error_up
