@@ -22,7 +22,7 @@ from printgen.inputs.laws import piecewise_linear
 from printgen.inputs.materials import Material, load_material, material_names
 from printgen.inputs.printers import Printer, PrintStyle, check_pass, load_print_style, load_printer
 from printgen.inputs.prototype import Prototype
-from printgen.scaling.reading import PROTOTYPE_ORIENTATION, panel_axes
+from printgen.scaling.reading import PROTOTYPE_ORIENTATION, panel_axes, panel_reading
 from printgen.scaling.record import NetDesign, Section
 from printgen.scaling.section import (
     area_m2,
@@ -368,7 +368,8 @@ def select(p: Prototype, t: ScaledTargets, *, printer: str | None = None,
                                 f"{printer_obj.key}: {nets[0].reasons[0]}")
     mesh_x, mesh_y = model_mesh(p, t)
     return Selection(tuple(cables), tuple(nets), _rationale(cables, "cable"),
-                     _rationale(nets, "net") + _per_material(nets), printer_obj.key,
+                     _rationale(nets, "net") + _per_material(nets) + _readings(mats),
+                     printer_obj.key,
                      net_style.key, cable_style.key,
                      mesh_text(printed_pattern(p), mesh_x / MM, mesh_y / MM))
 
@@ -393,6 +394,12 @@ def _per_material(ranked: list[Candidate]) -> str:
             f"({hit.direction_text()}).")
     return out + (f" It rests on a datasheet modulus: {CALIBRATE_FIRST}."
                   if hit.modulus_source == "datasheet" else "")
+
+
+def _readings(mats: list[Material]) -> str:
+    """Sentences: how each material's panel law is read (`printgen.scaling.reading`)."""
+    readings = [r for r in map(panel_reading, mats) if r is not None]
+    return "".join(f" {r.why()}." for r in readings)
 
 
 def _rank(cands: list[Candidate]) -> list[Candidate]:
@@ -430,7 +437,8 @@ def _rationale(ranked: list[Candidate], what: str) -> str:
              f"only a DATASHEET modulus (printed parts are often 2x softer): {CALIBRATE_FIRST}")
     others = [c for c in ranked[1:] if c.feasible and c.material != best.material]
     vs = (f" The best other material, {others[0].material_name}, scores {others[0].score:.3f} "
-          f"against {best.score:.3f} ({others[0].error:+.1%})." if others else "")
+          f"against {best.score:.3f} ({others[0].direction_text() or f'{others[0].error:+.1%}'})."
+          if others else "")
     return (f"{best.material_name}, {layout}: {fit}, based on {basis} "
             f"({best.modulus_source}). Its equal-area diameter breaks Pi3 (d / h_B) by "
             f"{best.pi3_deviation:+.0%}: the section is an equivalent one that keeps the "
