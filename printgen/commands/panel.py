@@ -50,20 +50,9 @@ def run(args: argparse.Namespace) -> int:
             c.print(f"[bold yellow]the pin-jointed net is a mechanism here[/]: "
                     f"{dp.curve.hold_share:.0%} of the clamp force is the solver's hold, not "
                     "the strands; a printed panel's force comes from its rigid junctions")
-    _print_reading(c, args.design)
+    r = runs[0].reading if runs else None
+    if r is not None:  # how the material's panel law is read (printgen.scaling.reading)
+        c.print(f"[bold]Panel-law reading:[/] {r.why()}")
+        for check in r.checks:
+            c.print(f"  {check.summary()}")
     return 0
-
-
-def _print_reading(c, design: Path) -> None:
-    """How the material's panel law is read (printgen.scaling.reading): each diagonal's checks
-    and the one chosen."""
-    from printgen.inputs.materials import load_material
-    from printgen.scaling.design_file import load_design
-    from printgen.scaling.reading import panel_reading
-
-    r = panel_reading(load_material(load_design(design).net.material))
-    if r is None:
-        return
-    c.print(f"[bold]Panel-law reading:[/] {r.why()}")
-    for check in r.checks:
-        c.print(f"  {check.summary()}")
