@@ -163,18 +163,18 @@ class ReadingCheck:
             out.append(f"the simulated {self.mode} panel test is a mechanism over the law's "
                        f"range (its meshes lie along the load only at {self.lockup:.0%}): its "
                        f"strands carry {a:.1%}-{b:.1%} of the measured force")
-        elif not self.test_ok:
+        elif not self.test_ok and self.window is not None:
             out.append(f"the simulated {self.mode} panel test misses the law by "
                        f"{self.test_error:.0%} (tolerance {REPRODUCE_TOL:.0%}) from "
-                       f"{self.window[0]:.0%} strain" if self.window else "")
+                       f"{self.window[0]:.0%} strain")
         return tuple(out)
 
     def summary(self) -> str:
         """One line: the three checks' numbers."""
         lo, hi = self.modulus_range
+        start = f" from {self.window[0]:.0%}" if self.window is not None else ""
         test = ("not run" if self.test_note else "mechanism" if self.test_error is None
-                else f"{self.test_error:.1%} off from {self.window[0]:.0%}" if self.window
-                else "")
+                else f"{self.test_error:.1%} off{start}")
         return (f"{self.orientation} diagonal ({self.along / MM:g} mm along the load, "
                 f"{self.mode}): strand E {self.modulus / 1e6:.3g} MPa (plausible "
                 f"{lo / 1e6:.3g}-{hi / 1e6:.3g}), stress {self.stress / 1e6:.3g} MPa at "
