@@ -266,8 +266,9 @@ def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
     applies the other options): its pattern's net with the material's (measured) law, printed
     border frame, cables of the measured modulus, mounted by `mounting`, and the three sensor
     wires pulling `sensor_force` N along themselves ([flume] sensor_force_n). `orientation`
-    ("short", "long"): the mesh diagonal the material's panel test loaded (None: the one its
-    profile records); `load`: the load case its assumptions state (default hydrostatic)."""
+    ("short", "long"): the mesh diagonal the material's panel test loaded (None: the reading
+    its material can produce, `printgen.scaling.reading`); `load`: the load case its
+    assumptions state (default hydrostatic)."""
     n = d.net
     pattern = get_pattern(n.pattern)
     g = n.graph()
