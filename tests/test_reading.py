@@ -100,3 +100,18 @@ def test_report_json_states_the_reading_and_its_checks():
     assert by["short"]["strand_stress_mpa"] > by["short"]["tensile_strength_mpa"]
     assert by["long"]["passes"] and not by["short"]["passes"]
     assert by["long"]["plausible_modulus_mpa"] == [5.0, 250.0]
+
+
+def test_the_border_frame_is_printed_like_the_strands():
+    """The printed border frame of the paper's net takes the strand modulus the consistent
+    reading implies (14 MPa), not the filament's 0.24 GPa datasheet; that datasheet value is a
+    band variant."""
+    from printgen.scene.scenes import frame_modulus
+    from printgen.verification.variants import _frame_variant
+
+    tpe = load_material("tpe")
+    e, source = frame_modulus(tpe, None)
+    assert e == pytest.approx(14e6, rel=STATED) and "long diagonal" in source
+    assert frame_modulus(tpe, "short")[0] == pytest.approx(0.33e9, rel=STATED)
+    (v,) = _frame_variant(load_design(PAPER))
+    assert v.options.frame_factor == pytest.approx(tpe.datasheet_modulus / e, rel=1e-12)

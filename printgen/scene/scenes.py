@@ -274,7 +274,7 @@ def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
     g = n.graph()
     mat = load_material(n.material)
     net_law, how = model_net_law(mat, n, orientation)
-    e, e_src = mat.modulus()
+    e, e_src = frame_modulus(mat, orientation)
     border_ea = e * n.border_width_mm * n.strand.thickness_mm * MM * MM
     cable_law, rows = None, []
     if d.cables:
@@ -302,6 +302,20 @@ def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
             f"profile materials/{n.material} [measured.panel_law] and [datasheet]; printgen "
             "docs: physics, the reading of a panel law"))
     return _finish(s, rows, force=sensor_force, load=load, model=True)
+
+
+def frame_modulus(mat, orientation: str | None) -> tuple[float, str]:
+    """(E Pa, its source) of the printed border frame, a strip of the net's material printed
+    as its strands are: the measured printed modulus when the profile has one; else, with a
+    panel law, the strand modulus its reading implies (the reading the material can produce,
+    or `orientation`): a printed strand's modulus, where the datasheet's is the filament's;
+    else the datasheet's."""
+    e, source = mat.modulus()
+    reading = panel_reading(mat)
+    if source == "measured" or reading is None:
+        return e, source
+    check = reading.check(orientation or reading.orientation)
+    return check.modulus, f"implied by the panel law read along its {check.orientation} diagonal"
 
 
 def model_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:

@@ -13,6 +13,8 @@ Variants of design `d` (`model_variants`):
 - the panel law's geometry assumption: the law's tested net (strand and mesh recorded in the
   profile, an assumption when the source does not give it) against the alternative that the
   tested panel had the design's own strands and mesh (the law used without rescaling);
+- the printed border frame at its filament's datasheet modulus, when the nominal takes the
+  strand modulus the panel law's reading implies;
 - the panel law read along each mesh diagonal but the nominal reading (the one the material
   can produce, `printgen.scaling.reading`), with why it fails a check when it does (`excluded`);
 - the mounting in the flume, each of the scene's `MOUNTINGS` but the nominal;
@@ -33,7 +35,12 @@ from printgen.scaling.reading import chosen_orientation, panel_axes, panel_readi
 from printgen.scaling.record import Design
 from printgen.scaling.section import area_m2
 from printgen.scene.options import SceneOptions, build_scene
-from printgen.scene.scenes import MOUNTINGS, TESTED_PATTERN, recorded_orientation
+from printgen.scene.scenes import (
+    MOUNTINGS,
+    TESTED_PATTERN,
+    frame_modulus,
+    recorded_orientation,
+)
 from printgen.units import MM
 
 SLACK_MAX = 0.01  # initial slack of the printed net, upper end of the range (0-1 %)
@@ -74,6 +81,7 @@ def model_variants(d: Design, mounting: str | None = None, free_section: float |
     if panel is not None and panel.has_geometry:
         out += _panel_geometry_variant(d, notes)
         out += _orientation_variants(d)
+        out += _frame_variant(d)
     opts = MOUNTINGS if d.cables else ()  # no border cables: bed and banks only
     nominal = mounting or (opts[0] if opts else None)
     out += [Variant(f"mounting: {m}", f"flume mounting option (nominal: {nominal})",
@@ -171,6 +179,20 @@ def _orientation_variants(d: Design) -> list[Variant]:
                            excluded=f"a reading the material cannot produce: {why}"
                            if why else ""))
     return out
+
+
+def _frame_variant(d: Design) -> list[Variant]:
+    """The printed border frame at the filament's datasheet modulus instead of the strand
+    modulus the panel law's reading implies (the nominal, `scene.scenes.frame_modulus`)."""
+    mat = load_material(d.net.material)
+    e, source = frame_modulus(mat, None)
+    if source in ("measured", "datasheet") or abs(mat.datasheet_modulus / e - 1) < SAME:
+        return []
+    return [Variant(f"{mat.name} border frame at the datasheet modulus",
+                    f"{mat.name} datasheet E = {mat.datasheet_modulus / 1e9:.3g} GPa, the "
+                    f"filament's (nominal: {e / 1e6:.3g} MPa, the printed strands' from the "
+                    "panel law's reading)",
+                    SceneOptions(frame_factor=mat.datasheet_modulus / e))]
 
 
 def _model_form_variants(d: Design, free_section: float | None, notes: list[str],
