@@ -9,7 +9,14 @@ from conftest import coarse_design_1_40
 
 from printgen.scene.forms import slackened
 from printgen.solver import Law
-from printgen.verification.fit import BOUNDS, Params, at_bounds, fit_measured, predict
+from printgen.verification.fit import (
+    BOUNDS,
+    Params,
+    at_bounds,
+    fit_measured,
+    planned_sweeps,
+    predict,
+)
 from printgen.verification.measured import Measurement
 
 COARSE = 2  # the 1:40 net with a 2x coarser mesh (distinct top and mid rows): fast sweeps
@@ -45,6 +52,8 @@ def test_a_synthetic_measurement_is_recovered():
     assert fit.params.net_factor == pytest.approx(known.net_factor, rel=RECOVER)
     assert fit.params.net_slack == pytest.approx(known.net_slack, rel=RECOVER)
     assert max(mm.rms_rel for mm in fit.after) < max(mm.rms_rel for mm in fit.before)
+    # the run's estimate counts the sweeps the fit may run: never fewer than it ran
+    assert fit.evaluations <= sum(planned_sweeps(1, 2).values())
 
 
 @pytest.mark.slow

@@ -1,4 +1,4 @@
-"""`printgen bench solver|sweeps|gcode|parts|design|make|figures|timeline --out DIR`: run a
+"""`printgen bench solver|sweeps|gcode|parts|design|make|figures|timeline|fit --out DIR`: run a
 benchmark of benchmarks/ (a source checkout) and write its JSON/PNG into DIR. An installed wheel has
 no benchmarks/: there the command is not offered (argparse lists the commands that are)."""
 
@@ -12,7 +12,8 @@ from pathlib import Path
 from printgen.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[2]
-BENCHES = ("solver", "sweeps", "gcode", "parts", "design", "make", "figures", "timeline")
+BENCHES = ("solver", "sweeps", "gcode", "parts", "design", "make", "figures", "timeline",
+           "fit")
 
 
 def available() -> bool:

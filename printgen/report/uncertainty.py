@@ -13,7 +13,7 @@ from printgen.report.html import Report
 from printgen.report.report import fmt_value, unit_of
 from printgen.verification.bands import Band, BandVerdict, band_verdicts
 from printgen.verification.compare import METRICS, Deformation
-from printgen.verification.measured import Fit, Measurement, mismatch
+from printgen.verification.measured import SCORING, Fit, Measurement, mismatch
 from printgen.verification.preprint import SHAPE_LEVELS, Verification
 
 SHOW_LEVELS = SHAPE_LEVELS  # relative loadings shown in the tables and summaries
@@ -109,13 +109,13 @@ def measured_sections(rep: Report, m: Measurement, band: Band, fit: Fit | None,
     before = mismatch(m, nom, lo, hi)
     after = {mm.metric: mm for mm in fit.after} if fit else {}
     rep.paragraph("Measured values are taken as the sensors read them, counted from h/h_B = 0, "
-                  "and compared with the predicted curves counted from there.")
+                  f"and compared with the predicted curves counted from there. Scored {SCORING}.")
     rows = [[mm.column, str(mm.points), f"{mm.inside} of {mm.points}", _fmt(mm),
              f"{mm.rms_rel:.0%}"] + ([_fmt(after[mm.metric]), f"{after[mm.metric].rms_rel:.0%}"]
                                      if fit else []) for mm in before]
-    cols = ["column", "points", "inside the band", "RMS mismatch (nominal)", "of measured peak"]
+    cols = ["column", "points", "inside the band", "RMS mismatch (nominal)", "scored"]
     if fit:
-        cols += [f"RMS, fitted {fit.kind}", "of measured peak"]
+        cols += [f"RMS, fitted {fit.kind}", "scored"]
     rep.table(cols, rows)
     if fit:
         rep.paragraph(fit_sentence(fit))
@@ -127,7 +127,7 @@ def measured_sections(rep: Report, m: Measurement, band: Band, fit: Fit | None,
                "triangles: 'below' bounds) on the predicted band (orange: model nominal, shaded: "
                "band; thin lines: each variant), with the prototype (black line), all counted "
                "from h/h_B = 0; dashed: fitted.", "measured")
-    if profile and not (fit and fit.at_bound):
+    if profile:
         rep.paragraph("To feed it back, save this in a profile folder of your own as "
                       "materials/<name>.toml, add the folder to $PRINTGEN_PROFILES, and name "
                       "it as the net's material:")
@@ -149,10 +149,17 @@ def fit_sentence(fit: Fit) -> str:
             "what this factor can explain." if fit.at_bound else "")
     worse = "; ".join(f"{col} {before:.1%} -> {after:.1%}"
                       for col, before, after in fit.worsened)
+    flat = "; ".join(f"{col} {before:.1%} -> {after:.1%}"
+                     for col, before, after in fit.unimproved if (col, before, after)
+                     not in fit.worsened)
     if worse:
-        edge += (f" It fits some columns at the price of others (RMS of the measured peak, "
-                 f"nominal -> fitted: {worse}): this one factor does not explain the test, so "
-                 "no profile is written (--fit multi tries several).")
+        edge += (f" It fits some columns at the price of others (scored RMS, nominal -> "
+                 f"fitted: {worse}): this one factor does not explain the test, so no profile "
+                 "is written (--fit multi tries several).")
+    elif flat:
+        edge += (f" It does not improve every measured column (scored RMS, nominal -> fitted: "
+                 f"{flat}): this one factor does not explain the test, so no profile is "
+                 "written (--fit multi tries several).")
     return (f"The printed net behaved like a model with {what} (one-factor fit, "
             f"{fit.evaluations} solver sweeps).{edge}")
 
@@ -164,12 +171,15 @@ def measured_record(m: Measurement, band: Band, fit: Fit | None, profile: str
     rec: dict[str, Any] = {"file": m.path, "levels": m.levels, "values": m.values,
                            "columns": m.columns, "predicted_nominal": nom,
                            "band_min": lo, "band_max": hi,
-                           "mismatch": mismatch(m, nom, lo, hi), "fit": None}
+                           "mismatch": mismatch(m, nom, lo, hi), "scoring": SCORING,
+                           "fit": None}
     if fit and fit.kind == "multi":
         rec["fit"] = {**fit.to_record(), "profile": profile}
     elif fit:
         rec["fit"] = {"kind": fit.kind, "value": fit.value, "at_bound": fit.at_bound,
                       "evaluations": fit.evaluations, "mismatch_nominal": fit.before,
                       "mismatch_fitted": fit.after, "predicted": fit.predicted,
+                      "not_improved": [{"column": c, "before": b, "after": a}
+                                       for c, b, a in fit.unimproved],
                       "sentence": fit_sentence(fit), "profile": profile}
     return rec

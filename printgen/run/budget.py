@@ -15,8 +15,10 @@ core that many iterations of ITERATION_S + ITERATION_S_PER_UNKNOWN x its unknown
 node). The run counts the same work (`counted_work`, report.json "verification" ->
 "solver_work" against "size" -> "solver_work"); tests/test_budget.py checks the prediction
 against the count on both examples and `printgen bench make` (benchmarks/bench_make.py)
-measures the constants, the estimate against the measured time and the CPU. The parts' steps
-(meshes, slicer profiles, G-code, previews) have constants of their own. The estimate is meant
+measures the constants, the estimate against the measured time and the CPU. `verify
+--measured` adds its fit's sweeps as the fit plans them (`FitPlan`: every sweep it may run, on
+its nets, over its levels; `printgen bench fit` measures them). The parts' steps (meshes,
+slicer profiles, G-code, previews) have constants of their own. The estimate is meant
 to be right within a factor of about two, enough to stop a run that would take an hour.
 """
 
@@ -73,10 +75,6 @@ MESH_S_PER_SEGMENT = 1e-4  # meshes step per model net segment
 CABLE_PARTS_S = 1.3  # the four cables: meshes, 3MF, plate, slicer profiles, G-code
 CABLE_PART_S = CABLE_PARTS_S / 4  # one cable
 FIXED_S = 2.0  # start-up, planning, the net's parts and slicer profile, the report
-# verify --measured: the fit's bounded Brent search runs this many sweeps of the model on the
-# band's net (coarsened COARSENED_BY each way, so about COARSENED_BY^2 fewer nodes)
-FIT_SWEEPS = 20
-COARSENED_BY = 2
 BASE_MEMORY_B = 150e6  # Python, numpy, scipy and the geometry libraries
 MEMORY_B_PER_NODE = 20e3  # sparse factor, path results kept per level (1998 nodes: +39 MB)
 COARSEN_MAX = 1000.0  # search bound for the mesh factor that fits
@@ -98,7 +96,8 @@ class SweepWork:
     """One predicted sweep: its net's unknowns, load levels and Newton iterations; `group`:
     "nominal" (the prototype and model pair of a load case), "band" (the variants) and
     "pooled" (the refinement test's sweep), all on one pool on the sweep cores; "serial":
-    alone, after them (a fit's search)."""
+    alone, after them (a one-factor fit's search); "fit": after them, shared on the sweep
+    cores (the multi-parameter fit's batches)."""
 
     name: str
     unknowns: int
@@ -182,6 +181,23 @@ def sweep_cores() -> int:
 
 
 @dataclass(frozen=True)
+class FitPlan:
+    """The sweeps of a measured test's fit (verify --measured), as the fit plans them
+    (`printgen.verification.fit.planned_sweeps`, `measured.FACTOR_EVALUATIONS`): `runs`,
+    (mesh coarsening of the design's net, sweeps) pairs; `levels`, the load levels of each
+    sweep (h / h_B = 0 and the measured ones); `parallel`: run in batches on the sweep cores
+    (the multi-parameter fit) or one after the other (the one-factor search)."""
+
+    runs: tuple[tuple[int, int], ...]
+    levels: int
+    parallel: bool = False
+
+    @property
+    def sweeps(self) -> int:
+        return sum(n for _, n in self.runs)
+
+
+@dataclass(frozen=True)
 class Work:
     """What a command runs: `sweep` the verification, `parts` the printable files (make),
     `fit` a measured test's fit (verify --measured); `cases`: the load cases swept (make
@@ -192,6 +208,15 @@ class Work:
     fit: bool = False
     model_follows: bool = True  # the model's mesh is the prototype's scaled (not a design's)
     cases: int = 1
+    fit_plan: FitPlan | None = None  # the fit's sweeps (with `fit`; None: `default_fit`)
+
+
+def default_fit() -> FitPlan:
+    """A one-factor fit of a measurement not yet read: its search's sweeps on the design's
+    net over every sweep level (the most a test can measure)."""
+    from printgen.verification.measured import FACTOR_EVALUATIONS
+
+    return FitPlan(((1, FACTOR_EVALUATIONS + 2),), LEVELS)
 
 
 MAKE = Work()
@@ -229,7 +254,12 @@ def sweeps(p: Prototype, d: Design, *, proto_factor: float = 1.0, model_factor: 
     n_band = band_variants(p, d) if variants is None else variants
     out += [one("band variant", m_nodes, "band")] * n_band
     if work.fit:
-        out += [one("fit", m_nodes / COARSENED_BY**2, "serial")] * FIT_SWEEPS
+        plan = work.fit_plan or default_fit()
+        group = "fit" if plan.parallel else "serial"
+        for k, n in plan.runs:
+            nodes = model_nodes(d, model_factor * k)
+            out += [SweepWork(f"fit x{k}" if k > 1 else "fit", round(3 * nodes), plan.levels,
+                              plan.levels * iterations_per_level(kind, 3 * nodes), group)] * n
     return tuple(out)
 
 
@@ -258,12 +288,13 @@ def verification_seconds(work: tuple[SweepWork, ...], cores: int) -> tuple[float
     c = max(1, min(cores, 2))
     nominal = [s.seconds for s in work if s.group == "nominal"]
     band = [s.seconds for s in work if s.group == "band"]
-    jobs = [s.seconds for s in work if s.group != "serial"] + (
+    jobs = [s.seconds for s in work if s.group not in ("serial", "fit")] + (
         [COUNTEREXAMPLE_S] if nominal else [])
     serial = sum(s.seconds for s in work if s.group == "serial")
+    fit = [s.seconds for s in work if s.group == "fit"]  # after the band, in batches
     chain = (nominal[1] if len(nominal) > 1 else 0.0) + max(band, default=0.0)
-    wall = max(_shared(jobs, c), chain) + serial
-    return VERIFY_REPORT_S + wall, VERIFY_REPORT_S + sum(jobs) + serial
+    wall = max(_shared(jobs, c), chain) + serial + _shared(fit, c)
+    return VERIFY_REPORT_S + wall, VERIFY_REPORT_S + sum(jobs) + serial + sum(fit)
 
 
 def _shared(jobs: list[float], cores: int) -> float:
@@ -325,9 +356,30 @@ def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
                        speed=speed)
     which = ("the default, about a minute of make on 2 cores" if limit_s == DEFAULT_LIMIT_S
              else "from --time-limit")
-    raise InputError(f"this run is too big: {est.summary()}; the limit is {limit_s:g} s "
+    fit = _fit_share(est) if work.fit else ""
+    if fit and work.fit_plan is not None and work.fit_plan.parallel:
+        fix += (f"; or fit one factor of the net (--fit stiffness), a search of at most "
+                f"{default_fit().sweeps} sweeps")
+    raise InputError(f"this run is too big: {est.summary()}{fit}; the limit is {limit_s:g} s "
                      f"({which}). Raise it with --time-limit "
                      f"{math.ceil(est.seconds * 1.5 / 60) * 60:g}, or {fix}")
+
+
+def fit_estimate(est: Estimate) -> float:
+    """Seconds of the measured test's fit in `est` (on this machine): its sweeps' CPU, shared
+    out on the sweep cores when the fit runs in batches."""
+    fit = [s for s in est.sweeps if s.name.startswith("fit")]
+    if not fit:
+        return 0.0
+    c = max(1, min(est.cores, 2)) if fit[0].group == "fit" else 1
+    return est.speed * sum(s.seconds for s in fit) / c
+
+
+def _fit_share(est: Estimate) -> str:
+    """The fit's part of an estimate, as words: its sweeps and their time."""
+    n = sum(1 for s in est.sweeps if s.name.startswith("fit"))
+    return (f", of which the measured test's fit: {n} sweeps, about "
+            f"{fit_estimate(est):.0f} s") if n else ""
 
 
 def prototype_sweep_s(p: Prototype) -> float:

@@ -22,7 +22,14 @@ from printgen.outputs import TIMINGS, check_destination, staged_dir
 from printgen.report.build import build_report, report_files
 from printgen.report.jsonout import dumps
 from printgen.report.records import CheckRecords, MeasuredRecords, RunRecords
-from printgen.run.budget import DEFAULT_LIMIT_S, Work, check_budget, sweep_cores
+from printgen.run.budget import (
+    DEFAULT_LIMIT_S,
+    FitPlan,
+    Work,
+    check_budget,
+    fit_estimate,
+    sweep_cores,
+)
 from printgen.run.options import RunOptions
 from printgen.run.provenance import provenance_record
 from printgen.scaling.design_file import load_design
@@ -31,12 +38,21 @@ from printgen.scaling.selection import design_net
 from printgen.scaling.similitude import scale_targets
 from printgen.scene.readings import design_units
 from printgen.verification.bands import Band, band_verdicts, model_load_kw
-from printgen.verification.fit import MultiFit, fit_levels, fit_measured
+from printgen.verification.fit import (
+    MultiFit,
+    all_choices,
+    fit_levels,
+    fit_measured,
+    planned_sweeps,
+    screen_coarsen,
+)
 from printgen.verification.measured import (
+    FACTOR_EVALUATIONS,
     Fit,
     Measurement,
     fit_factor,
     fitted_profile,
+    measured_path,
     model_predictor,
     read_measured,
 )
@@ -85,13 +101,16 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     d = load_design(design_path, scale=scale, prototype=p)
     m = read_measured(measured, design_units(d)) if measured is not None else None
     limit = DEFAULT_LIMIT_S if time_limit_s is None else time_limit_s
-    check_budget(p, d, limit_s=limit, cores=sweep_cores(),
-                 work=Work(parts=False, fit=m is not None, model_follows=False))
+    plan = fit_plan(d, m, fit, free_section(p)) if m is not None else None
+    est = check_budget(p, d, limit_s=limit, cores=sweep_cores(),
+                       work=Work(parts=False, fit=m is not None, model_follows=False,
+                                 fit_plan=plan))
     load_kw = model_load_kw(p, d, load)
     say("verification (prototype and model load sweeps) and its uncertainty band (model "
         "variants)")
     v, band = verify_with_band(p, d, load=load, free_section=free_section(p))
     result, text = None, ""
+    t_fit, cpu_fit = time.perf_counter(), time.process_time()
     if m is not None and fit == "multi":
         say(f"multi-parameter fit of the printed net to {Path(measured).name}")
         result = fit_measured(d, m, fit_levels(m), load_kw=load_kw, free_section=free_section(p))
@@ -99,10 +118,13 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     elif m is not None:
         say(f"fit of the net's {fit} to {Path(measured).name}")
         one = fit_factor(m, model_predictor(d, band, m, fit, load_kw=load_kw), fit)
-        # a factor at the end of its range, or one that fits a column worse, explains
-        # nothing: no profile to feed back
-        text = "" if one.at_bound or one.worsened else _profile_text(d, one, Path(measured).name)
+        # a factor at the end of its range, or one that does not improve every measured
+        # column, explains nothing: no profile to feed back
+        text = _profile_text(d, one, Path(measured).name) if one.writes_profile else ""
         result = one
+    fit_s = time.perf_counter() - t_fit
+    # the fit's CPU: its sweeps' in the workers (multi), else this process's (one factor)
+    fit_cpu = result.cpu_s if isinstance(result, MultiFit) else time.process_time() - cpu_fit
     run = RunRecords(f"printgen verify: {p.name} at 1:{d.scale:g}", d)
     # the design's net scored like select's candidates: its stiffness across and up the barrier
     run.steps["design_net"] = design_net(p, scale_targets(p, d.scale), d.net, d.printer)
@@ -116,7 +138,10 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     files.update({k: b.decode("utf-8") for k, b in report_files(run, rep, figures=False).items()})
     if text:
         files[fitted_name(d)] = text
-    timings = {"total": time.perf_counter() - t0, "band": band.seconds}
+    timings = {"total": time.perf_counter() - t0, "band": band.seconds,
+               "estimate": est.seconds, "estimate_speed_factor": est.speed,
+               **({"fit": fit_s, "fit_cpu": fit_cpu, "estimate_fit_sweeps": plan.sweeps,
+                   "estimate_fit": fit_estimate(est)} if plan else {})}
     files[TIMINGS] = dumps({"timings_s": timings})
     meta = provenance_record(options.command, prototype=prototype,
                              files={"design_file": design_path, "measured": measured},
@@ -124,6 +149,20 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     written = _write(out, files, force, inputs, meta)
     return VerifyRun(p, d, v, band, m, result, text, {**record, "timings_s": timings}, written,
                      run)
+
+
+def fit_plan(d: Design, m: Measurement, fit: str, section: float | None) -> FitPlan:
+    """The sweeps the fit of `m` will run (`fit`: "multi" or a one-factor kind), for the
+    run's estimate: their nets (mesh coarsening), counts and load levels."""
+    levels = len(measured_path(m))
+    if fit == "multi":
+        plan = planned_sweeps(len(all_choices(section)))
+        return FitPlan(((screen_coarsen(d), plan["coarse"]), (1, plan["fine"])), levels,
+                       parallel=True)
+    # the Brent search on the band's net, the nominal, and the nominal on the band's coarse
+    # net when it has one; the design's own net assumed, as for the band's variants
+    # (printgen.run.budget: a run whose band coarsens is estimated high)
+    return FitPlan(((1, FACTOR_EVALUATIONS + 2),), levels, parallel=False)
 
 
 def _multi_profile_text(d: Design, fit: MultiFit, source: str) -> str:

@@ -269,7 +269,9 @@ def _check_stretching(p: Path, data: dict[str, np.ndarray], line_numbers: list[i
 @dataclass(frozen=True)
 class Mismatch:
     """Measured vs predicted for one column: RMS of the difference (model units), and the
-    same relative to the measured peak; inside : points within the predicted band."""
+    RMS of the scored misses (`scored`: a value's over the column's measured peak, a bound's
+    excess over the bound); inside : points within the predicted band; bounds : how many of
+    the `points` are bounds ('<x'), the rest are measured values."""
 
     metric: str
     column: str
@@ -277,6 +279,33 @@ class Mismatch:
     rms_rel: float
     points: int
     inside: int
+    bounds: int = 0
+
+    @property
+    def values(self) -> int:
+        """Measured values (not bounds) the column compares."""
+        return self.points - self.bounds
+
+
+SCORING = ("relative mismatch: a measured value's miss over its column's measured peak; a "
+           "bound's excess over the bound itself (a prediction 3.4 x its '< 0.5 %' bound "
+           "misses by 240 %, not by its small share of the column's peak)")
+
+
+def scored(m: Measurement, key: str, pred: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Every point of column `key` against `pred` (values, then bounds): (the miss in the
+    model's units, the scored miss of SCORING); NaN where `pred` is NaN. A bound counts by its
+    excess only, over the bound: a breach of an onset bound weighs as the breach it is."""
+    meas, cap = m.values[key], m.bound(key)
+    ok, capped = ~np.isnan(meas), ~np.isnan(cap)
+    peak = float(np.abs(meas[ok]).max()) if ok.any() else 0.0
+    miss = meas[ok] - pred[ok]
+    excess = np.maximum(pred[capped] - cap[capped], 0.0)
+    excess = np.where(np.isnan(pred[capped]), np.nan, excess)
+    # a bound of zero or below has no scale of its own: its column's peak, else 1
+    scale = np.where(cap[capped] > 0, cap[capped], peak if peak > 0 else 1.0)
+    rel = np.concatenate([miss / peak if peak > 0 else miss, excess / scale])
+    return np.concatenate([miss, excess]), rel
 
 
 def mismatch(m: Measurement, predicted: dict[str, np.ndarray],
@@ -288,24 +317,41 @@ def mismatch(m: Measurement, predicted: dict[str, np.ndarray],
     for key, col in m.columns.items():
         meas, pred, cap = m.values[key], predicted[key], m.bound(key)
         ok = ~np.isnan(meas) & ~np.isnan(pred)
-        capped = ~np.isnan(cap) & ~np.isnan(pred)  # a bound counts by its excess only
-        diff = np.concatenate([meas[ok] - pred[ok], np.maximum(pred[capped] - cap[capped], 0)])
-        rms = float(np.sqrt(np.mean(diff**2))) if diff.size else math.nan
-        peak = float(np.abs(meas[ok]).max()) if ok.any() else (
-            float(np.abs(cap[capped]).max()) if capped.any() else 0.0)  # bounds only: their scale
+        capped = ~np.isnan(cap) & ~np.isnan(pred)
+        diff, rel = scored(m, key, pred)
+        keep = ~np.isnan(rel)
+        rms = float(np.sqrt(np.mean(diff[keep]**2))) if keep.any() else math.nan
+        rms_rel = float(np.sqrt(np.mean(rel[keep]**2))) if keep.any() else math.nan
         inside = 0
         if lo is not None and hi is not None:
             inside = int(np.sum((meas[ok] >= lo[key][ok] - 1e-12)
                                 & (meas[ok] <= hi[key][ok] + 1e-12)))
-        out.append(Mismatch(key, col, rms, rms / peak if peak > 0 else math.nan,
-                            int(ok.sum() + capped.sum()), inside))
+        out.append(Mismatch(key, col, rms, rms_rel, int(ok.sum() + capped.sum()), inside,
+                            int(capped.sum())))
     return out
 
 
 def objective(m: Measurement, predicted: dict[str, np.ndarray]) -> float:
-    """Mean over columns of the squared RMS mismatch relative to each column's measured peak
-    (columns of different units weigh the same)."""
+    """Mean over columns of the squared RMS of the scored misses (`scored`: columns of
+    different units weigh the same, a bound by its breach)."""
     return float(np.nanmean([mm.rms_rel**2 for mm in mismatch(m, predicted)]))
+
+
+def not_improved(before: list[Mismatch], after: list[Mismatch]
+                 ) -> list[tuple[str, float, float]]:
+    """(column, scored RMS before, after) of every column a fit does not improve: one with
+    measured values whose mismatch does not fall (by more than WORSE_TOL), or one whose
+    mismatch grows (a bound it breaks more). A fit that leaves a measured column as it was, or
+    buys one column with another, explains neither: no profile is written from it."""
+    out = []
+    for b, a in zip(before, after, strict=True):
+        if a.points == 0 or math.isnan(a.rms_rel) or math.isnan(b.rms_rel):
+            continue
+        worse = a.rms_rel > b.rms_rel * (1 + WORSE_TOL)
+        flat = a.values > 0 and b.rms_rel > 0 and a.rms_rel > b.rms_rel * (1 - WORSE_TOL)
+        if worse or flat:
+            out.append((a.column, b.rms_rel, a.rms_rel))
+    return out
 
 
 Predictor = Callable[[float], dict[str, np.ndarray]]
@@ -314,6 +360,11 @@ STIFFNESS_RANGE = (0.2, 5.0)  # net stiffness factors searched: a printed net 5x
 SLACK_RANGE = (0.0, 0.03)  # initial slack searched: 3 % sags visibly, a lab would see it
 XTOL_LOG = 0.005  # stiffness factor known to 0.5 % (bounded Brent on log factor)
 XTOL_SLACK = 1e-4  # slack known to 0.01 %
+# sweeps of a one-factor fit, at most: the bounded Brent search's evaluations (golden section
+# to XTOL_LOG over the stiffness range takes about 14; the parabolic steps fewer), plus the
+# nominal it is compared with, and the nominal on the band's coarse net when it has one
+# (benchmarks/measurements.md#fit-paper-test)
+FACTOR_EVALUATIONS = 20
 AT_BOUND = 0.01  # a result this close to a range end (fraction of the range) is "at the bound"
 
 
@@ -337,12 +388,23 @@ class Fit:
 
     @property
     def worsened(self) -> list[tuple[str, float, float]]:
-        """(column, RMS before, after, of the measured peak) of every column with measured
+        """(column, scored RMS before, after) of every column with measured
         values that the fitted factor fits worse than the nominal: a factor that buys one
         column with another explains neither, and its profile is not written."""
         return [(a.column, b.rms_rel, a.rms_rel) for b, a in zip(self.before, self.after,
                                                                  strict=True)
                 if a.points > 0 and a.rms_rel > b.rms_rel * (1 + WORSE_TOL)]
+
+    @property
+    def unimproved(self) -> list[tuple[str, float, float]]:
+        """`not_improved`: the columns the fitted factor leaves unimproved or worsens."""
+        return not_improved(self.before, self.after)
+
+    @property
+    def writes_profile(self) -> bool:
+        """A profile is fed back only from a factor inside its range that improves every
+        measured column (`not_improved`)."""
+        return not self.at_bound and not self.unimproved
 
 
 def fit_factor(m: Measurement, predict: Predictor, kind: str = "stiffness") -> Fit:
@@ -366,7 +428,8 @@ def fit_factor(m: Measurement, predict: Predictor, kind: str = "stiffness") -> F
     else:
         (lo, hi), to_value, nominal, xtol = SLACK_RANGE, float, 0.0, XTOL_SLACK
     res = minimize_scalar(lambda x: objective(m, curves_at(to_value(x))), bounds=(lo, hi),
-                          method="bounded", options={"xatol": xtol})
+                          method="bounded", options={"xatol": xtol,
+                                                     "maxiter": FACTOR_EVALUATIONS})
     value = to_value(float(res.x))
     edge = AT_BOUND * (hi - lo)
     return Fit(kind, value, mismatch(m, curves_at(nominal)), mismatch(m, curves_at(value)),
@@ -402,14 +465,15 @@ def model_predictor(d: Design, band: Band, m: Measurement, kind: str = "stiffnes
     """`predict(value)` for `fit_factor`: the printed model swept with the net's stiffness
     times `value` (or `value` initial slack) up to the highest measured level, on the band's
     solver net (a coarse net adds its change to the nominal curves, as the band does), counted
-    from h / h_B = 0 and interpolated at the measured levels."""
-    top = float(m.levels.max())
-    above = np.flatnonzero(band.levels >= top - 1e-9)
-    n = int(above[0]) + 1 if above.size else len(band.levels)
-    lv, k = band.levels[:n], band.coarsen
+    from h / h_B = 0 at the measured levels. Each sweep solves only h / h_B = 0 and the
+    measured levels (`measured_path`): the solver's states do not depend on the path (an
+    elastic net; a level it cannot reach in one step it reaches by sub-steps)."""
+    lv, k = measured_path(m), band.coarsen
     nominal = Variant(options=SceneOptions(mounting=band.mounting,
                                            sensor_force=band.sensor_force))
     base = curves(run_variant(d, nominal, lv, k, load_kw)) if k > 1 else None
+    band_nominal = {key: np.interp(lv, band.levels, band.nominal[key]) for key in m.values
+                    } if k > 1 else {}
 
     def predict(value: float) -> dict[str, np.ndarray]:
         if kind == "stiffness":
@@ -420,8 +484,14 @@ def model_predictor(d: Design, band: Band, m: Measurement, kind: str = "stiffnes
         c = curves(run_variant(d, v, lv, k, load_kw))
         out = {}
         for key in m.values:
-            y = c[key] if base is None else band.nominal[key][:n] + c[key] - base[key]
+            y = c[key] if base is None else band_nominal[key] + c[key] - base[key]
             out[key] = np.interp(m.levels, lv, y - y[0])
         return out
 
     return predict
+
+
+def measured_path(m: Measurement) -> np.ndarray:
+    """The load path a fit's sweep solves: h / h_B = 0 (the sensors' zero) and every measured
+    level, in order."""
+    return np.union1d([0.0], m.levels)
