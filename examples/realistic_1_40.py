@@ -32,16 +32,19 @@ def run() -> Verification:
     half = p.levels >= 0.5
     for key in ("strain_bottom", "strain_top", "deflection"):
         assert np.all(np.diff(p.values[key][half]) > 0), key
-    for key in ("strain_bottom", "strain_top", "deflection", "lowering"):
+    for key in ("strain_bottom", "strain_top", "deflection"):
         assert np.all(np.diff(m.values[key][half]) > 0), key
     # the prototype's top centre lowers to ~0.12 of its height near h/h_B = 0.8, then rises a
-    # little as the net (panel law along the meshes' long axis) bulges downstream
+    # little as the net (panel law along the meshes' long axis) bulges downstream; the model's
+    # soft net (select's pick, both barrier directions weighed) peaks between 0.8 and 0.95 too
     assert 0.08 < p.values["lowering"].max() < 0.16
+    assert 0.8 <= m.levels[int(np.argmax(m.values["lowering"]))] <= 0.95
     # the 1 N sensor wires pull along themselves: no deflection before the water arrives
     assert abs(m.values["deflection"][0]) < 0.01 and p.values["deflection"][0] == 0.0
     # prototype at overflow: a flexible barrier, mid-height deflection 10-30 % of its width
     assert 0.10 < p.values["deflection"][-1] < 0.30
-    # the model's net is stiffer than the target (selection: +325 % at small strain)
+    # the model's net is stiffer than the target across the barrier (selection: +80 % across,
+    # -18 % up at small strain), and the three 1 N sensors pull on it
     dm = next(mm for mm in v.mismatches if mm.metric == "deflection")
     assert dm.ratio_high < 1.0
     return v

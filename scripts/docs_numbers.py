@@ -41,6 +41,12 @@ def _net(r: dict[str, Any], passes: int) -> dict[str, Any]:
                 and c["section"]["beads_across"] == 1 and c["section"]["passes"] == passes)
 
 
+def _both(rec: dict[str, Any]) -> str:
+    """'+80 % across, -18 % up': a net's stiffness error in both barrier directions."""
+    return (f"{100 * rec['stiffness_error_across']:+.0f} % across, "
+            f"{100 * rec['stiffness_error_up']:+.0f} % up")
+
+
 def _at_1(r: dict[str, Any], quantity: str, which: str) -> float:
     """The compared quantity at h / h_B = 1 (the model's nominal or the prototype's)."""
     return r["verification"]["bands"]["at"]["1"][quantity][which]
@@ -85,6 +91,12 @@ NUMBERS: dict[str, Callable[[dict[str, Any]], str]] = {
     "paper_net_error": lambda r: f"{100 * _net(r, 3)['error_low_strain']:+.0f} %",
     "paper_net_error_high": lambda r: f"{100 * _net(r, 3)['error_high_strain']:+.0f} %",
     "net_error_high": lambda r: f"{100 * _net(r, 2)['error_high_strain']:+.0f} %",
+    "paper_net_stiffness_across": lambda r: f"{_net(r, 3)['stiffness_across']:.0f} N/m",
+    "paper_net_stiffness_up": lambda r: f"{_net(r, 3)['stiffness_up']:.1f} N/m",
+    "paper_net_across": lambda r: f"{1 + _net(r, 3)['stiffness_error_across']:.1f}x",
+    "paper_net_up": lambda r: f"{1 + _net(r, 3)['stiffness_error_up']:.1f}x",
+    "net_errors": lambda r: _both(_part(r, "net")),
+    "tpe_net_errors": lambda r: _both(_net(r, 2)),
     "deflection_model": lambda r: f"{_at_1(r, 'deflection', 'nominal'):.3f}",
     "deflection_prototype": lambda r: f"{_at_1(r, 'deflection', 'prototype'):.3f}",
     "strain_mid_model": lambda r: f"{100 * _at_1(r, 'strain_mid', 'nominal'):.1f} %",

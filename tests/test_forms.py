@@ -42,7 +42,7 @@ def test_derived_law_along_the_short_diagonal_uses_the_blocked_test():
     """A free pin-jointed panel along the 9.4 mm diagonal is a mechanism (issue 25, panel.py):
     the derivation falls back to the blocked test and says so."""
     d = load_design(PAPER)
-    _, how = derived_net_law(load_material("tpe"), d.net, None)
+    _, how = derived_net_law(load_material("tpe"), d.net, "short")
     assert "blocked" in how and "9.4 mm (short)" in how
 
 

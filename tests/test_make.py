@@ -48,7 +48,11 @@ def test_report_json_schema(made):
     # the steel counter-example: steel at 1:40 deflects far less than the prototype
     defl = ver["counterexample"]["deflection"]
     assert defl["1:40, steel E"] < 0.5 * defl["prototype (lambda = 1)"]
-    assert rec["design"]["net"]["material"] == "tpe"
+    # weighed across and up the barrier, with TPE's law read along its long diagonal, the
+    # soft TPU 85A is the closest net at the paper's mesh (TPE: +325 % across, +93 % up)
+    assert rec["design"]["net"]["material"] == "tpu-85a"
+    best = rec["selection"]["net"]["ranked"][0]
+    assert best["stiffness_error_across"] > 0 > best["stiffness_error_up"]
     assert rec["selection"]["cable"]["ranked"][0]["material"] == "petg"
     READBACK = 0.02  # issue 5: G-code deposits the designed volume within 2 %
     for part in rec["gcode"].values():

@@ -50,7 +50,9 @@ def test_orientation_reads_the_panel_law_along_the_chosen_diagonal():
     d = load_design(HERE / "design.json", scale=40)
     short, long_ = (build_scene(d, SceneOptions(orientation=o)).laws[0]
                     for o in ("short", "long"))
-    assert build_scene(d).laws[0] == short  # the TPE profile records the short diagonal
+    # the nominal is the reading the material can produce (printgen.scaling.reading): the
+    # long diagonal, though the TPE profile records the short one
+    assert build_scene(d).laws[0] == long_
     sin_s, sin_l = 4.7 / np.hypot(4.7, 10.3), 10.3 / np.hypot(4.7, 10.3)
     # strand EA = kappa L a_across / (2 sin^3): the two readings differ by this ratio
     ratio = (9.4 / sin_l**3) / (20.6 / sin_s**3)

@@ -3,20 +3,22 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 from proto_files import REALISTIC, SIMPLE, write_variant
 
-from printgen.barrier.patterns.diamond import diamond_factor
+from printgen.barrier.patterns.diamond import diamond_factor, diamond_sin
 from printgen.errors import PrintabilityError
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_printer
 from printgen.inputs.profiles import list_profiles
 from printgen.inputs.prototype import load_prototype
+from printgen.scaling.design_file import load_design
 from printgen.scaling.record import Section
 from printgen.scaling.section import area_m2, net_membrane_law
-from printgen.scaling.selection import SCORE_DIGITS, select
+from printgen.scaling.selection import SCORE_DIGITS, design_net, select, target_net_laws
 from printgen.scaling.similitude import scale_targets
 
 EXACT = 1e-12  # closed-form arithmetic, round-off only
@@ -85,7 +87,13 @@ def test_net_law_scales_with_strand_area_and_geometry():
     k1 = net_membrane_law(tpe, Section(0.6, 1, (0.35, 0.30, 0.30)), 9.4e-3, 20.6e-3)
     k2 = net_membrane_law(tpe, Section(0.6, 2, (0.35, 0.30, 0.30)), 9.4e-3, 20.6e-3)
     np.testing.assert_allclose(np.array(k2[1]) / np.array(k1[1]), 2.0, rtol=EXACT)
-    assert k1[0] == (0.40,)
+    # TPE's law is read along the long (20.6 mm) diagonal: loaded along it, the tested net
+    # keeps its knee; loaded along the short one its strands strain sin^2 ratio less per unit
+    # panel strain, so the knee moves up by that ratio
+    along = net_membrane_law(tpe, Section(0.6, 1, (0.35, 0.30, 0.30)), 20.6e-3, 9.4e-3)
+    assert along[0] == pytest.approx((0.40,), rel=EXACT)
+    ratio = diamond_sin(20.6e-3, 9.4e-3) ** 2 / diamond_sin(9.4e-3, 20.6e-3) ** 2
+    assert k1[0] == pytest.approx((0.40 * ratio,), rel=EXACT)
     petg = load_material("petg")
     sec = Section(0.6, 1, (0.35,))
     _, slopes, _ = net_membrane_law(petg, sec, 9.4e-3, 20.6e-3)
@@ -93,11 +101,17 @@ def test_net_law_scales_with_strand_area_and_geometry():
                                       rel=EXACT)
 
 
-def test_simple_barrier_gets_a_net_within_ten_percent():
+def test_simple_barrier_gets_a_net_within_a_third_alike_both_ways():
+    """A square net of square meshes is as stiff across as up, printed and prototype alike, so
+    both directions' errors agree. TPE, read along the diagonal its material can produce, is
+    about 23x softer than the short reading made it and no longer matches; the best net
+    at the scaled mesh is TPU within a third (printgen design also searches the mesh)."""
     p = load_prototype(SIMPLE)
     s = select(p, scale_targets(p, 40))
     assert s.cables == () and "no border cables" in s.cable_rationale
-    assert abs(s.net[0].error) < 0.10  # a soft polymer can match a scaled 100 GPa square net
+    best = s.net[0]
+    assert best.error_across == pytest.approx(best.error_up, rel=EXACT)
+    assert abs(best.error) < 0.35  # the stiff polymer closest to a scaled 100 GPa square net
 
 
 def test_printer_with_a_fine_nozzle_rejects_wide_layers(tmp_path):
@@ -140,3 +154,60 @@ def test_a_selection_prints_in_a_few_lines():
     text = repr(select(p, scale_targets(p, 40)))
     assert len(text.splitlines()) == 3 and len(text) < 600
     assert "net (" in text and "cables (" in text and "stiffness" in text
+
+
+PAPER_DESIGN = Path(__file__).parents[1] / "examples" / "paper_1_40" / "design.json"
+STATED = 0.01  # the ratios below as stated to 2-3 significant figures (6.2x, 143x)
+
+
+def test_paper_net_is_compared_across_and_up_under_each_reading():
+    """The paper's printed net (the tested net itself) against the realistic prototype at 1:40:
+    under the long reading (the nominal) 6.2x the target across and 2.8x up; under the short
+    one 143x and 65x. The prototype's law is across (its panel loaded along the 630 mm axis),
+    its target up 10.5x lower; the printed mesh is more elongated (2.19 against 1.8), hence
+    the two directions differ by 2.2x."""
+    p = load_prototype(REALISTIC)
+    t = scale_targets(p, 40)
+    d = load_design(PAPER_DESIGN, scale=40, prototype=p)
+    c = design_net(p, t, d.net, d.printer)
+    assert c.stiffness_across / c.target_across == pytest.approx(6.2, rel=STATED)
+    assert c.stiffness_up / c.target_up == pytest.approx(2.8, rel=STATED)
+    rec = c.to_record()
+    assert rec["stiffness_error_across"] == pytest.approx(c.error_across, rel=EXACT)
+    assert rec["stiffness_error_up"] == pytest.approx(c.error_up, rel=EXACT)
+    want = target_net_laws(p, t)
+    tpe, sec = load_material("tpe"), d.net.strand
+    short = {k: net_membrane_law(tpe, sec, *m, orientation="short")[1][0] / want[k][1][0]
+             for k, m in (("across", (20.6e-3, 9.4e-3)), ("up", (9.4e-3, 20.6e-3)))}
+    assert short["across"] == pytest.approx(143, rel=STATED)
+    assert short["up"] == pytest.approx(65, rel=STATED)
+
+
+def test_select_records_and_shows_both_directions():
+    p = load_prototype(REALISTIC)
+    s = select(p, scale_targets(p, 40), materials=("tpe", "tpu-85a"))
+    for c in s.net:
+        rec = c.to_record()
+        assert {"stiffness_error_across", "stiffness_error_up"} <= set(rec)
+        # the single-number error is the worse of the two directions
+        worse = max((c.error_across, c.error_up), key=lambda e: abs(math.log1p(e)))
+        assert c.error == pytest.approx(worse, rel=EXACT)
+    assert " across" in s.net_rationale and " up " in s.net_rationale
+
+
+def test_design_search_screens_both_directions():
+    """`design`'s screen scores the paper's net as select does: 6.2x the target across and
+    2.8x up; its single small-strain error is the worse (across)."""
+    from printgen.search.screen import screen_point
+    from printgen.search.space import NetPoint, SearchSpace, search_context
+
+    p = load_prototype(REALISTIC)
+    t = scale_targets(p, 40)
+    ctx = search_context(p, t, SearchSpace(("tpe",), (1,), (3,), (20.6, 20.6), (9.4, 9.4)))
+    s = screen_point(ctx, NetPoint(0, "tpe", 1, 3, 32, 21, 20.6, 9.4, 2))
+    assert 1 + s.error_across == pytest.approx(6.2, rel=STATED)
+    assert 1 + s.error_up == pytest.approx(2.8, rel=STATED)
+    assert s.error_small == s.error_across
+    rec = s.to_record()
+    assert rec["stiffness_error_across"] == s.error_across
+    assert rec["stiffness_error_up"] == s.error_up

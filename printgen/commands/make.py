@@ -89,11 +89,13 @@ class Progress:
         self.status.update(f"{label} ...{self.estimate}")
 
 
-def _net_error(ctx) -> float:
-    """The printed net's small-strain stiffness error: the design file's own net with
-    --design, else the selection's choice."""
+def _net_error(ctx) -> str:
+    """The printed net's small-strain stiffness error across and up the barrier: the design
+    file's own net with --design, else the selection's choice."""
     own = ctx.record.get("design_net")
-    return own["error"] if own else ctx.selection.net[0].error
+    if own:
+        return f"{own['stiffness_error_across']:+.0%} across, {own['stiffness_error_up']:+.0%} up"
+    return ctx.selection.net[0].direction_text()
 
 
 def show_summary(ctx, out: Path, seconds: float) -> None:
@@ -101,7 +103,7 @@ def show_summary(ctx, out: Path, seconds: float) -> None:
     d = ctx.design
     rows = [["net", (f"{d.net.material.upper()} {d.net.strand.width_mm:g} x "
              f"{d.net.strand.thickness_mm:g} mm, {d.net.strand.passes} passes"),
-             f"{_net_error(ctx):+.0%} (small strain)"]]
+             f"{_net_error(ctx)} (small strain)"]]
     if ctx.selection.cables:
         cab = ctx.selection.cables[0]
         rows.append(["cables", (f"{cab.material_name} {cab.section.width_mm:g} x "

@@ -65,4 +65,9 @@ def run(args: argparse.Namespace) -> int:
             c.print(f"[bold yellow]the pin-jointed net is a mechanism here[/]: "
                     f"{dp.curve.hold_share:.0%} of the clamp force is the solver's hold, not "
                     "the strands; a printed panel's force comes from its rigid junctions")
+    reading = runs[0].reading if runs else None
+    if reading is not None:  # how the material's panel law is read (printgen.scaling.reading)
+        c.print(f"[bold]Panel-law reading:[/] {reading.why()}")
+        for check in reading.checks:
+            c.print(f"  {check.summary()}")
     return 0

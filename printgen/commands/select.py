@@ -70,26 +70,31 @@ def show_selection(s: Selection, limit: int | None) -> None:
         if not cands:
             continue
         rows = [_row(i + 1, c) for i, c in enumerate(cands[:limit])]
-        cols = ["#", "material", "E source", "section mm", "passes", f"stiffness {unit}",
+        stiff = f"stiffness {unit}" + (" across / up" if what == "net" else "")
+        cols = ["#", "material", "E source", "section mm", "passes", stiff,
                 "error", "Pi3", "SF", "score", "printable"]
         name = f"{what} ({s.net_mesh})" if what == "net" and s.net_mesh else what
-        out.print(table(f"{name}: target {cands[0].target:.4g} {unit} "
+        target = (f"{cands[0].target_across:.4g} across, {cands[0].target_up:.4g} up"
+                  if cands[0].target_across is not None else f"{cands[0].target:.4g}")
+        out.print(table(f"{name}: target {target} {unit} "
                         f"({len(cands)} candidates, best first)", cols, rows))
         best = cands[0]
         if best.feasible and abs(best.error) > STIFFNESS_WARN:
-            out.print(f"[bold red]Warning:[/] the best {what} candidate is {best.error:+.0%} off "
-                      "its stiffness target: the model will not deform like the prototype; "
-                      "printgen design searches mesh and strand too.")
+            out.print(f"[bold red]Warning:[/] the best {what} candidate is "
+                      f"{best.direction_text() or f'{best.error:+.0%}'} off its stiffness "
+                      "target: the model will not deform like the prototype; printgen design "
+                      "searches mesh and strand too.")
         out.print(f"[bold]Choice:[/] {why}\n")
 
 
 def _row(rank: int, c: Candidate) -> list[str]:
     s = c.section
     err = f"{c.error:+.1%}"
-    if c.component == "net":
-        err += f" (rms {c.error_rms:.2f})"
+    if c.component == "net":  # both barrier directions, never one number
+        err = f"{c.direction_text()} (rms {c.error_rms:.2f})"
     source = "panel law" if "panel law" in c.modulus_source else c.modulus_source.split()[0]
     return [str(rank), c.material_name, source, f"{s.width_mm:g} x {s.thickness_mm:g}",
-            str(s.passes), fmt(c.stiffness), err, f"{c.pi3_deviation:+.0%}",
+            str(s.passes), fmt(c.stiffness) if c.stiffness_across is None else
+            f"{fmt(c.stiffness_across)} / {fmt(c.stiffness_up)}", err, f"{c.pi3_deviation:+.0%}",
             f"{c.safety_factor:.1f}", f"{c.score:.3f}", "yes" if c.feasible else "NO: "
             + c.reasons[0][:48]]

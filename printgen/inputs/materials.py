@@ -46,6 +46,12 @@ PANEL_LAW = [
     positive("strand_thickness_mm", 100.0, required=False),
     positive("mesh_along_load_mm", 1e4, required=False),
     positive("mesh_across_load_mm", 1e4, required=False),
+    # How the source held the panel between its clamps: "free" (a tensile test of a printed
+    # panel, its sides unsupported) or "blocked" (transverse displacement held, as the
+    # prototype's 1.33 m panel); the reading of the law is checked against that test.
+    Field("test_mode", str, choices=("free", "blocked"), required=False, default="free",
+          help="free: the panel's sides unsupported between the clamps (a plain tensile "
+               "test); blocked: its transverse displacement held"),
     *PROVENANCE,
 ]
 DATASHEET = [
@@ -57,6 +63,11 @@ DATASHEET = [
           help="how the modulus was read off the datasheet when it is not a tensile modulus"),
     positive("elongation_at_break_percent", 5000.0, required=False, si=False),
     Field("shore_hardness_a", float, lo=0.0, hi=100.0, required=False, si=False),
+    Field("plausible_modulus_gpa", list, required=False, default=[],
+          help="[low, high] modulus a printed strand of this material can have (GPa): the "
+               "range a panel law's reading is checked against"),
+    Field("plausible_modulus_source", str, required=False, default="",
+          help="where the plausible modulus range comes from"),
 ]
 PRINT = [
     Field("source", str, required=False, default="",
@@ -119,6 +130,7 @@ class PanelLaw:
     strand_thickness: float | None = None  # m
     mesh_along_load: float | None = None  # m, mesh diagonal along the load
     mesh_across_load: float | None = None  # m
+    test_mode: str = "free"  # "free" or "blocked" between the clamps, as the source ran it
 
     @property
     def has_geometry(self) -> bool:
@@ -157,6 +169,8 @@ class Datasheet:
     modulus_basis: str = ""
     elongation_at_break_percent: float | None = None
     shore_hardness_a: float | None = None
+    plausible_modulus: tuple[float, float] | None = None  # Pa, a printed strand's (low, high)
+    plausible_modulus_source: str = ""
 
 
 @dataclass(frozen=True)
@@ -218,7 +232,9 @@ def load_material(name: str) -> Material:
         description=top["description"],
         files=tuple(files),
         sheet=Datasheet(sheet["test_standard"], sheet["modulus_basis"],
-                        sheet["elongation_at_break_percent"], sheet["shore_hardness_a"]),
+                        sheet["elongation_at_break_percent"], sheet["shore_hardness_a"],
+                        _modulus_range(sheet["plausible_modulus_gpa"], where),
+                        sheet["plausible_modulus_source"]),
     )
 
 
@@ -248,7 +264,19 @@ def _panel_law(raw: dict | None, where: str) -> PanelLaw | None:
         raise ProfileError(f"{loc}: knee strains must increase from 0 and kappas be > 0")
     return PanelLaw(tuple(knees), tuple(kappas), t["panel_length"], t["panel_width"],
                     t["source"], t["conditions"], t["strand_width"], t["strand_thickness"],
-                    t["mesh_along_load"], t["mesh_across_load"])
+                    t["mesh_along_load"], t["mesh_across_load"], t["test_mode"])
+
+
+def _modulus_range(raw: list, where: str) -> tuple[float, float] | None:
+    """[low, high] GPa of [datasheet] plausible_modulus_gpa in Pa, or None when not given."""
+    if not raw:
+        return None
+    key = "plausible_modulus_gpa"
+    values = [_number(v, f"{where} [datasheet]", key) for v in raw]
+    if len(values) != 2 or not 0 < values[0] < values[1]:
+        raise ProfileError(f"{where} [datasheet]: {key} = {raw!r} must be [low, high] with "
+                           "0 < low < high (GPa)")
+    return values[0] * 1e9, values[1] * 1e9
 
 
 def _number(v: object, where: str, key: str) -> float:

@@ -238,5 +238,11 @@ class RunRecords:
         rec = {} if self.plan is None else self.plan.to_record()
         if self.plan is None:
             rec["design"] = self.design.to_dict()
+        from printgen.inputs.materials import load_material
+        from printgen.scaling.reading import panel_reading
+
+        reading = panel_reading(load_material(self.design.net.material))
+        if reading is not None:  # which reading of the net's panel law, its checks and why
+            rec["panel_law_reading"] = reading.to_record()
         rec.update(self.records(self.steps))
         return rec

@@ -45,7 +45,7 @@ def design_sections(rep: Report, proto: Prototype, t: ScaledTargets, sel: Select
             continue
         rep.heading(f"Selection: {what.lower()}")
         rep.paragraph(why)
-        unit = "E*A, N" if what == "Border cables" else "initial membrane, N/m"
+        unit = "E*A, N" if what == "Border cables" else "initial membrane across / up, N/m"
         rep.table(["#", "material", "E source", "section (mm)", "passes", f"stiffness ({unit})",
                    f"target ({unit})", "stiffness error", "Pi3 deviation", "safety factor (-)"],
                   [_row(i + 1, c) for i, c in enumerate(cands[:SHOW])])
@@ -66,8 +66,10 @@ def design_sections(rep: Report, proto: Prototype, t: ScaledTargets, sel: Select
     rep.table(["part", "material", "size (mm)", "section"], rows)
     if design_file:
         own = "" if own_net is None else (
-            f" Its net's initial membrane stiffness: {own_net.stiffness:.4g} N/m against the "
-            f"target {own_net.target:.4g} N/m ({own_net.error:+.0%}), safety factor "
+            f" Its net's initial membrane stiffness: {own_net.stiffness_across:.4g} N/m across "
+            f"the barrier against the target {own_net.target_across:.4g} N/m "
+            f"({own_net.error_across:+.0%}), {own_net.stiffness_up:.4g} N/m up it against "
+            f"{own_net.target_up:.4g} N/m ({own_net.error_up:+.0%}), safety factor "
             f"{own_net.safety_factor:.2f}.")
         rep.paragraph(f"The printed parts are the design of {design_file} "
                       f"(printgen design), not the selection's choice above.{own}")
@@ -87,8 +89,18 @@ def _same_stiffness(cands: tuple[Candidate, ...] | list[Candidate]) -> str:
 def _row(rank: int, c: Candidate) -> list[str]:
     s = c.section
     return [str(rank), c.material_name, c.modulus_source, f"{s.width_mm:g} x {s.thickness_mm:g}",
-            str(s.passes), f"{c.stiffness:.4g}", f"{c.target:.4g}", f"{c.error:+.1%}",
+            str(s.passes), *_stiffness_cells(c),
             f"{c.pi3_deviation:+.0%}", f"{c.safety_factor:.1f}"]
+
+
+def _stiffness_cells(c: Candidate) -> list[str]:
+    """Stiffness, target and error cells: across / up for a net (never one number), E*A for a
+    cable."""
+    if c.stiffness_across is None:
+        return [f"{c.stiffness:.4g}", f"{c.target:.4g}", f"{c.error:+.1%}"]
+    return [f"{c.stiffness_across:.4g} / {c.stiffness_up:.4g}",
+            f"{c.target_across:.4g} / {c.target_up:.4g}",
+            f"{c.error_across:+.1%} / {c.error_up:+.1%}"]
 
 
 def verification_sections(rep: Report, v: Verification | None, ce: CounterExample | None,

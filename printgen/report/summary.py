@@ -112,7 +112,8 @@ def summarize(run: RunRecords, next_step: str = "") -> Summary:
                                           share=v.sensors.threshold)
         if not v.runnable and v.flow is not None:  # a new scale changes the parts too
             nxt = NEXT_FLUME.format(fix=v.flow.fix)
-    return Summary(verdict, reason, band, chosen_parts(run.design, run.plan),
+    return Summary(verdict, reason, band, chosen_parts(run.design, run.plan,
+                                                       run.steps.get("design_net")),
                    next_step or nxt, print_totals(gcode) if gcode else None,
                    _warnings(run), sensors)
 
@@ -127,17 +128,21 @@ def _warnings(run: RunRecords) -> list[str]:
     return [w for w in t.warnings if w not in stated]
 
 
-def chosen_parts(design: Design, plan: PlanRecords | None = None) -> list[dict[str, Any]]:
+def chosen_parts(design: Design, plan: PlanRecords | None = None,
+                 own_net: Candidate | None = None) -> list[dict[str, Any]]:
     """The net and the border cables as chosen: material, section, passes, stiffness error
-    (the selection's candidate of the same section; a design file's net: its own)."""
+    (the selection's candidate of the same section; a design file's net: its own, `own_net`
+    when there is no plan)."""
     sel = None if plan is None else plan.selection
     net = design.net
     pick = plan.own_net if plan is not None and plan.own_net is not None else (
-        None if sel is None else _same_section(sel.net, net.material, net.strand))
+        own_net if sel is None else _same_section(sel.net, net.material, net.strand))
     out = [{"part": "net", "material": net.material.upper(),
             "section": (f"strand {_mm(net.strand)}, "
                         + mesh_text(net.pattern, net.mesh_x_mm, net.mesh_y_mm)),
-            "stiffness_error": None if pick is None else pick.error}]
+            "stiffness_error": None if pick is None else pick.error,
+            "stiffness_error_across": None if pick is None else pick.error_across,
+            "stiffness_error_up": None if pick is None else pick.error_up}]
     if design.cables:
         c = design.cables[0]
         pick = None if sel is None else _same_section(sel.cables, c.material, c.section)
@@ -170,6 +175,16 @@ def _same_section(ranked: tuple[Candidate, ...], material: str, s: Section
     return None
 
 
+def _stiffness_text(part: dict[str, Any]) -> str:
+    """', stiffness +521% across, +182% up off target' (a net: both barrier directions)."""
+    if part.get("stiffness_error_across") is not None:
+        return (f", stiffness {part['stiffness_error_across']:+.0%} across and "
+                f"{part['stiffness_error_up']:+.0%} up off target")
+    if part["stiffness_error"] is None:
+        return ""
+    return f", stiffness {part['stiffness_error']:+.0%} off target"
+
+
 def summary_html(s: Summary) -> str:
     """The summary box (HTML)."""
     from printgen.parts.gcode.estimate import duration
@@ -186,8 +201,7 @@ def summary_html(s: Summary) -> str:
                          for k, t in s.band.items()) + "</ul>")
     parts = "; ".join(
         f"{e(p['part'])}: {e(p['material'])}, {e(p['section'])}"
-        + ("" if p["stiffness_error"] is None else
-           f", stiffness {p['stiffness_error']:+.0%} off target") for p in s.parts)
+        + _stiffness_text(p) for p in s.parts)
     lines.append(f"<p><b>Chosen:</b> {parts}</p>")
     if s.sensors:
         lines.append(f"<p><b>Sensors:</b> {e(s.sensors)}</p>")

@@ -8,7 +8,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from printgen.errors import InputError
+from printgen.inputs.materials import load_material
 from printgen.scaling.design_file import load_design
+from printgen.scaling.reading import Reading, panel_reading
 from printgen.scene.panel import MODES, DesignPanel, curved_panel, design_panel, panel_lockup
 from printgen.scene.scenes import ORIENTATIONS
 
@@ -17,11 +19,13 @@ __all__ = ["MODES", "ORIENTATIONS", "PanelRun", "panel_tests", "wave_of"]
 
 @dataclass(frozen=True)
 class PanelRun:
-    """One simulated panel test: the test and its curve (`panel`) and the panel strain at
-    which the strands lie along the load (`lockup`, a fraction)."""
+    """One simulated panel test: the test and its curve (`panel`), the panel strain at
+    which the strands lie along the load (`lockup`, a fraction) and how the material's panel
+    law is read (`reading`: each diagonal's checks and the one chosen; None without one)."""
 
     panel: DesignPanel
     lockup: float
+    reading: Reading | None = None
 
 
 def wave_of(amplitude_mm: float | None, half_waves: int | None) -> tuple[float, int] | None:
@@ -41,8 +45,9 @@ def panel_tests(design_path: str | Path, orientations: tuple[str, ...] | None = 
     both diagonals), clamped `mode` (free or blocked); `wave` (amplitude mm, half-waves): its
     net printed with curved strands instead (`scene.panel.curved_panel`)."""
     d = load_design(design_path)
+    reading = panel_reading(load_material(d.net.material))
     runs = []
     for o in orientations or ORIENTATIONS:
         dp = design_panel(d, o, mode) if wave is None else curved_panel(d, o, *wave, mode)
-        runs.append(PanelRun(dp, panel_lockup(dp.test)))
+        runs.append(PanelRun(dp, panel_lockup(dp.test), reading))
     return runs

@@ -176,7 +176,8 @@ def series_row(r: SearchResult) -> dict:
     return {"scale": r.scale, "chosen": s.to_record(),
             "mismatch_rms": None if v is None else v.mismatch,
             "select_mismatch_rms": None if r.select_score is None else r.select_score.mismatch,
-            "error_small_strain": s.error_small, "d_pi2": s.d_pi2, "d_pi3": s.d_pi3,
+            "error_small_strain": s.error_small, "stiffness_error_across": s.error_across,
+            "stiffness_error_up": s.error_up, "d_pi2": s.d_pi2, "d_pi3": s.d_pi3,
             "print_time_s": s.print_time_s, "binding_constraints": list(r.binding)}
 
 

@@ -35,6 +35,8 @@ from printgen.run.options import RunOptions
 from printgen.run.provenance import provenance_record
 from printgen.scaling.design_file import load_design
 from printgen.scaling.record import Design
+from printgen.scaling.selection import design_net
+from printgen.scaling.similitude import scale_targets
 from printgen.scene.readings import design_units
 from printgen.verification.bands import Band, band_verdicts, model_load_kw
 from printgen.verification.decide import decide, excluded_by_data
@@ -130,6 +132,8 @@ def verify_design(prototype: str | Path, scale: float, design_path: str | Path,
     # the fit's CPU: its sweeps' in the workers (multi), else this process's (one factor)
     fit_cpu = result.cpu_s if isinstance(result, MultiFit) else time.process_time() - cpu_fit
     run = RunRecords(f"printgen verify: {p.name} at 1:{d.scale:g}", d)
+    # the design's net scored like select's candidates: its stiffness across and up the barrier
+    run.steps["design_net"] = design_net(p, scale_targets(p, d.scale), d.net, d.printer)
     run.steps["verification"] = CheckRecords(v, band, d.scale, nested=False)
     if m is not None:
         run.steps["measured"] = MeasuredRecords(m, band, result, text)

@@ -22,8 +22,14 @@ from printgen.inputs.laws import piecewise_linear
 from printgen.inputs.materials import Material, load_material, material_names
 from printgen.inputs.printers import Printer, PrintStyle, check_pass, load_print_style, load_printer
 from printgen.inputs.prototype import Prototype
+from printgen.scaling.reading import PROTOTYPE_ORIENTATION, panel_axes, panel_reading
 from printgen.scaling.record import NetDesign, Section
-from printgen.scaling.section import area_m2, equal_area_diameter, net_membrane_law
+from printgen.scaling.section import (
+    area_m2,
+    equal_area_diameter,
+    membrane_law_between,
+    net_membrane_law,
+)
 from printgen.scaling.similitude import ScaledTargets
 from printgen.units import MM, G
 
@@ -70,6 +76,28 @@ class Candidate:
     speed_mm_per_s: float
     reasons: tuple[str, ...]
     score: float
+    # nets: initial membrane stiffness (N/m) of the printed net and of the target loaded across
+    # the barrier (along x) and up it (along z); None for cables
+    stiffness_across: float | None = None
+    stiffness_up: float | None = None
+    target_across: float | None = None
+    target_up: float | None = None
+
+    @property
+    def error_across(self) -> float | None:
+        """Printed / target membrane stiffness across the barrier, minus 1 (nets)."""
+        return _ratio(self.stiffness_across, self.target_across)
+
+    @property
+    def error_up(self) -> float | None:
+        """Printed / target membrane stiffness up the barrier, minus 1 (nets)."""
+        return _ratio(self.stiffness_up, self.target_up)
+
+    def direction_text(self) -> str:
+        """'+521 % across, +182 % up' (nets); '' for cables."""
+        if self.error_across is None or self.error_up is None:
+            return ""
+        return f"{self.error_across:+.0%} across, {self.error_up:+.0%} up"
 
     def to_record(self) -> dict:
         """JSON-ready record of this candidate (stable keys)."""
@@ -86,6 +114,9 @@ class Candidate:
             "peak_force_n": self.peak_force, "safety_factor": self.safety_factor,
             "speed_mm_per_s": self.speed_mm_per_s, "feasible": self.feasible,
             "reasons": list(self.reasons), "score": self.score,
+            "stiffness_across": self.stiffness_across, "stiffness_up": self.stiffness_up,
+            "target_across": self.target_across, "target_up": self.target_up,
+            "stiffness_error_across": self.error_across, "stiffness_error_up": self.error_up,
         }
 
     @property
@@ -96,9 +127,15 @@ class Candidate:
         """One line (a notebook prints it): material, section, stiffness error, printable."""
         s = self.section
         state = "printable" if self.feasible else f"not printable: {self.reasons[0]}"
+        off = self.direction_text() or f"{self.error:+.0%}"
         return (f"Candidate({self.material} {s.width_mm:g} x {s.thickness_mm:g} mm, "
-                f"{s.passes} passes, stiffness {self.error:+.0%} of target, SF "
+                f"{s.passes} passes, stiffness {off} of target, SF "
                 f"{self.safety_factor:.2g}, {state})")
+
+
+def _ratio(got: float | None, want: float | None) -> float | None:
+    """got / want - 1, None when either is not given."""
+    return None if got is None or want is None else got / want - 1
 
 
 @dataclass(frozen=True)
@@ -206,17 +243,33 @@ def cable_candidate(t: ScaledTargets, m: Material, sec: Section, printer: Printe
                      force, sf, speed, tuple(reasons), score)
 
 
-def target_net_law(p: Prototype, t: ScaledTargets) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """(knee strains, membrane slopes N/m) of the model net's target force-per-width law.
+def target_net_laws(p: Prototype, t: ScaledTargets
+                    ) -> dict[str, tuple[tuple[float, ...], tuple[float, ...]]]:
+    """(knee strains, membrane slopes N/m) of the model net's target force-per-width law loaded
+    across the barrier ("across", along x) and up it ("up", along z).
 
-    From the prototype's panel law (kappa * L_p scaled by lambda^-2), else from its strand E*A
-    and mesh geometry (its pattern's `membrane_factor`).
+    From the prototype's panel law (kappa * L_p scaled by lambda^-2), read along the diagonal
+    its source loaded (PROTOTYPE_ORIENTATION) and carried to each direction through its
+    strands (`membrane_law_between`); else from its strand E*A and mesh geometry (its
+    pattern's `membrane_factor`).
     """
-    if p.net.panel_law is not None:
-        knees, kappas = p.net.panel_law[0], p.net.panel_law[1]
-        return tuple(knees), tuple(t[f"membrane_{i}"] for i in range(len(kappas)))
-    factor = get_pattern(p.net.pattern).membrane_factor(t["mesh_y"], t["mesh_x"])
-    return (), (t["strand_ea"] * factor,)
+    net = get_pattern(p.net.pattern)
+    ax, ay = t["mesh_x"], t["mesh_y"]
+    if p.net.panel_law is None:
+        return {"across": ((), (t["strand_ea"] * net.membrane_factor(ax, ay),)),
+                "up": ((), (t["strand_ea"] * net.membrane_factor(ay, ax),))}
+    knees, kappas = tuple(p.net.panel_law[0]), p.net.panel_law[1]
+    slopes = tuple(t[f"membrane_{i}"] for i in range(len(kappas)))
+    tested = (p.net.pattern, *panel_axes(ax, ay, PROTOTYPE_ORIENTATION))
+    return {"across": membrane_law_between(knees, slopes, tested, (p.net.pattern, ax, ay)),
+            "up": membrane_law_between(knees, slopes, tested, (p.net.pattern, ay, ax))}
+
+
+def target_net_law(p: Prototype, t: ScaledTargets) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """(knee strains, membrane slopes N/m) of the model net's target law loaded up the barrier
+    (along z, the printed net's `net_membrane_law(..., mesh_y, mesh_x)`): `target_net_laws`'s
+    "up"."""
+    return target_net_laws(p, t)["up"]
 
 
 def model_mesh(p: Prototype, t: ScaledTargets) -> tuple[float, float]:
@@ -235,30 +288,37 @@ def net_candidate(p: Prototype, t: ScaledTargets, m: Material, sec: Section,
                   printer: Printer, *, mesh: tuple[float, float] | None = None,
                   pattern: str | None = None) -> Candidate:
     """Score one net candidate: its membrane law (the printed pattern's geometry) against the
-    target law; `mesh` (mesh_x, mesh_y in m, default `model_mesh`) and `pattern` (default
-    `printed_pattern`) of a given design's net."""
+    target law in both barrier directions, across and up (RMS log error over both); `mesh`
+    (mesh_x, mesh_y in m, default `model_mesh`) and `pattern` (default `printed_pattern`) of a
+    given design's net."""
     mesh_x, mesh_y = mesh or model_mesh(p, t)
     pattern = pattern or printed_pattern(p)
-    knees, slopes, source = net_membrane_law(m, sec, mesh_y, mesh_x, pattern)
-    t_knees, t_slopes = target_net_law(p, t)
-    got = piecewise_linear(NET_STRAINS, knees, slopes)
-    want = piecewise_linear(NET_STRAINS, t_knees, t_slopes)
-    log_ratio = np.log(got / want)
-    low, high = (float(np.interp(s, NET_STRAINS, got / want) - 1) for s in CHECK_STRAINS)
+    dirs = {"across": (mesh_x, mesh_y), "up": (mesh_y, mesh_x)}
+    laws = {k: net_membrane_law(m, sec, *dirs[k], pattern) for k in dirs}
+    want_laws = target_net_laws(p, t)
+    ratios = {k: piecewise_linear(NET_STRAINS, *laws[k][:2])
+              / piecewise_linear(NET_STRAINS, *want_laws[k]) for k in dirs}
+    # the worse direction at small strain is the one the single-number fields report
+    worse = max(dirs, key=lambda k: abs(math.log(ratios[k][0])))
+    low, high = (float(np.interp(s, NET_STRAINS, ratios[worse]) - 1) for s in CHECK_STRAINS)
     speed, reasons = print_limits(sec, m, printer, f"net {m.name} strand "
                                   f"{sec.width_mm:g}x{sec.thickness_mm:g} mm")
     force = peak_strand_force(t, mesh_x, mesh_y, pattern)
     sf = m.failure_stress()[0] * area_m2(sec) / force
     if sf < MIN_SAFETY_FACTOR:
         reasons.append(f"safety factor {sf:.2f} below {MIN_SAFETY_FACTOR} at {force:.3g} N")
-    rms = float(np.sqrt(np.mean(log_ratio**2)))
+    # both directions weigh alike: the barrier spans the flume across and holds the water up
+    rms = float(np.sqrt(np.mean(np.log(np.concatenate(list(ratios.values()))) ** 2)))
     modulus, mod_source = m.modulus()
+    source = laws["up"][2]
     measured = "measured" if source == "measured panel law" else mod_source
     score = rms + DATASHEET_PENALTY * (measured == "datasheet") + PASS_PENALTY * sec.passes
-    return Candidate("net", m.key, m.name, modulus, source, sec, slopes[0], t_slopes[0],
-                     float(got[0] / want[0] - 1), low, high, rms,
+    got, want = laws[worse][1][0], want_laws[worse][1][0]
+    return Candidate("net", m.key, m.name, modulus, source, sec, got, want,
+                     float(ratios[worse][0] - 1), low, high, rms,
                      equal_area_diameter(sec) / t["strand_d"] - 1, force, sf, speed,
-                     tuple(reasons), score)
+                     tuple(reasons), score, laws["across"][1][0], laws["up"][1][0],
+                     want_laws["across"][1][0], want_laws["up"][1][0])
 
 
 def design_net(p: Prototype, t: ScaledTargets, net: NetDesign, printer: str) -> Candidate:
@@ -308,7 +368,8 @@ def select(p: Prototype, t: ScaledTargets, *, printer: str | None = None,
                                 f"{printer_obj.key}: {nets[0].reasons[0]}")
     mesh_x, mesh_y = model_mesh(p, t)
     return Selection(tuple(cables), tuple(nets), _rationale(cables, "cable"),
-                     _rationale(nets, "net") + _per_material(nets), printer_obj.key,
+                     _rationale(nets, "net") + _per_material(nets) + _readings(mats),
+                     printer_obj.key,
                      net_style.key, cable_style.key,
                      mesh_text(printed_pattern(p), mesh_x / MM, mesh_y / MM))
 
@@ -320,8 +381,9 @@ def _per_material(ranked: list[Candidate]) -> str:
     for c in ranked:
         if c.feasible:
             best.setdefault(c.material_name, c)
-    parts = [f"{name} {c.section.width_mm:g} x {c.section.thickness_mm:g} mm ({c.error:+.0%}, "
-             f"SF {c.safety_factor:.1f})" for name, c in best.items()]
+    parts = [f"{name} {c.section.width_mm:g} x {c.section.thickness_mm:g} mm "
+             f"({c.direction_text() or f'{c.error:+.0%}'}, SF {c.safety_factor:.1f})"
+             for name, c in best.items()]
     out = " Best net per material: " + "; ".join(parts) + "."
     hit = next((c for c in ranked if c.feasible and abs(c.error) <= NET_ON_TARGET), None)
     if hit is None:
@@ -329,9 +391,15 @@ def _per_material(ranked: list[Candidate]) -> str:
                       "prototype mesh; printgen design also searches the mesh.")
     out += (f" First within +-{NET_ON_TARGET:.0%} at SF >= {MIN_SAFETY_FACTOR}: "
             f"{hit.material_name} {hit.section.width_mm:g} x {hit.section.thickness_mm:g} mm "
-            f"({hit.error:+.0%}).")
+            f"({hit.direction_text()}).")
     return out + (f" It rests on a datasheet modulus: {CALIBRATE_FIRST}."
                   if hit.modulus_source == "datasheet" else "")
+
+
+def _readings(mats: list[Material]) -> str:
+    """Sentences: how each material's panel law is read (`printgen.scaling.reading`)."""
+    readings = [r for r in map(panel_reading, mats) if r is not None]
+    return "".join(f" {r.why()}." for r in readings)
 
 
 def _rank(cands: list[Candidate]) -> list[Candidate]:
@@ -359,15 +427,18 @@ def _rationale(ranked: list[Candidate], what: str) -> str:
         fit = (f"E*A = {best.stiffness:.4g} N against the target {best.target:.4g} N "
                f"({best.error:+.1%})")
     else:
-        fit = (f"membrane stiffness {best.stiffness:.4g} N/m against {best.target:.4g} N/m at "
-               f"small strain ({best.error:+.1%}), {best.error_low:+.0%} at "
+        fit = (f"membrane stiffness at small strain {best.stiffness_across:.4g} N/m across "
+               f"the barrier against {best.target_across:.4g} N/m ({best.error_across:+.1%}) "
+               f"and {best.stiffness_up:.4g} N/m up it against {best.target_up:.4g} N/m "
+               f"({best.error_up:+.1%}); in the worse direction {best.error_low:+.0%} at "
                f"{CHECK_STRAINS[0]:.0%} and {best.error_high:+.0%} at {CHECK_STRAINS[1]:.0%} "
-               f"strain (RMS log error {best.error_rms:.2f} over 1-40 %)")
+               f"strain (RMS log error {best.error_rms:.2f} over 1-40 %, both directions)")
     basis = ("a measured printed value" if "measured" in best.modulus_source else
              f"only a DATASHEET modulus (printed parts are often 2x softer): {CALIBRATE_FIRST}")
     others = [c for c in ranked[1:] if c.feasible and c.material != best.material]
     vs = (f" The best other material, {others[0].material_name}, scores {others[0].score:.3f} "
-          f"against {best.score:.3f} ({others[0].error:+.1%})." if others else "")
+          f"against {best.score:.3f} ({others[0].direction_text() or f'{others[0].error:+.1%}'})."
+          if others else "")
     return (f"{best.material_name}, {layout}: {fit}, based on {basis} "
             f"({best.modulus_source}). Its equal-area diameter breaks Pi3 (d / h_B) by "
             f"{best.pi3_deviation:+.0%}: the section is an equivalent one that keeps the "

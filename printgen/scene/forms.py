@@ -30,6 +30,7 @@ import numpy as np
 
 from printgen.barrier.patterns import get_pattern
 from printgen.inputs.materials import load_material
+from printgen.scaling.reading import panel_reading
 from printgen.scaling.record import Design
 from printgen.scaling.section import area_m2
 from printgen.scene.panel import PanelTest, derive_law, law_strains, simulate
@@ -67,14 +68,16 @@ def _derived(knees: tuple[float, ...], slopes: tuple[float, ...], along: float, 
 
 def derived_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
     """The design's strand law derived from the virtual panel test of `mat`'s panel law, read
-    along `orientation` (None: the diagonal its profile records), rescaled from the tested
-    strand section to the design's; and how it was found. GeometryError-free: a material
-    without a panel law of recorded geometry keeps the formula (`model_net_law`)."""
+    along `orientation` (None: the reading it can produce, `printgen.scaling.reading`),
+    rescaled from the tested strand section to the design's; and how it was found.
+    GeometryError-free: a material without a panel law of recorded geometry keeps the formula
+    (`model_net_law`)."""
     law = mat.panel_law
     if law is None or not law.has_geometry:
         return model_net_law(mat, n, orientation)
-    if orientation is None:
-        orientation = recorded_orientation(law)
+    if orientation is None:  # the reading the material can produce
+        reading = panel_reading(mat)
+        orientation = reading.orientation if reading is not None else recorded_orientation(law)
     along, across = panel_axes(law.mesh_along_load, law.mesh_across_load, orientation)
     width = law.panel_width or law.panel_length
     strand, mode, err = _derived(tuple(law.knee_strains),

@@ -35,8 +35,9 @@ class SceneOptions:
 
     mounting : one of MOUNTINGS (None: the prototype file's [flume] lateral for the prototype,
     the first of MOUNTINGS for a design); orientation : the mesh diagonal the panel law is
-    read along ("short", "long"; None: the profile's for a design, PROTOTYPE_ORIENTATION for
-    the prototype); load : the load case the assumptions state (None: hydrostatic);
+    read along ("short", "long"; None: for a design the reading its material can produce,
+    `printgen.scaling.reading`; PROTOTYPE_ORIENTATION for the prototype); load : the load
+    case the assumptions state (None: hydrostatic);
     pressure : one of PRESSURES; net_law : one of NET_LAWS; bed : one of BEDS; routing : one of
     ROUTINGS; span : m between the lateral supports (None: the printed width);
     net_factor, frame_factor, cable_factor : multipliers on the force laws of the net's

@@ -41,9 +41,17 @@ from printgen.barrier.graph import NetGraph
 from printgen.barrier.loads import FLOW, LoadCase, get_load
 from printgen.barrier.patterns import AS_DRAWN, get_pattern, mesh_text
 from printgen.errors import GeometryError
-from printgen.inputs.materials import PanelLaw, load_material
+from printgen.inputs.materials import load_material
 from printgen.inputs.prototype import LATERAL, Prototype
 from printgen.inputs.prototype import SENSOR_FORCE_N as PAPER_SENSOR_N
+from printgen.scaling.panel_test import TESTED_PATTERN
+from printgen.scaling.reading import (
+    ORIENTATIONS,
+    PROTOTYPE_ORIENTATION,
+    panel_axes,
+    panel_reading,
+    recorded_orientation,
+)
 from printgen.scaling.record import Design
 from printgen.scaling.section import area_m2, net_membrane_law
 from printgen.scene.rows import mid_levels, to_edges
@@ -54,22 +62,19 @@ from printgen.units import MM, RHO_WATER, G
 SENSOR_FORCE_N = PAPER_SENSOR_N
 MID_UPPER = "mid_upper"  # the mid-height sensor's wire on the row above h/2 (when between rows)
 SENSOR_EXIT = 0.1  # the potentiometer stands this fraction of the width beyond the right edge
-__all__ = ["FLOW"]  # the flow direction, defined with the load cases (printgen.barrier.loads)
+__all__ = ["FLOW", "ORIENTATIONS", "PROTOTYPE_ORIENTATION", "TESTED_PATTERN",  # re-exported
+           "recorded_orientation"]  # FLOW: the flow direction (printgen.barrier.loads)
 MOUNTINGS = LATERAL  # lateral mounting in the flume ([flume] lateral), the default first
-# Panel-test orientation: the diagonal of the mesh its panel test loaded, the one
-# a panel law is read along. The prototype's 1.33 m panel was loaded along the water-drop's
-# long axis; the printed nets' orientation is not stated, and their profile (TPE) records the
-# short diagonal, whose strand modulus matches the datasheet (see `panel_strand_law`).
-ORIENTATIONS = ("short", "long")
+# Panel-test orientation (ORIENTATIONS): the diagonal of the mesh its panel test loaded, the one
+# a panel law is read along. The prototype's is stated by its source (PROTOTYPE_ORIENTATION);
+# a printed net's is chosen by physical consistency (`printgen.scaling.reading`).
 # Direction of the water's force on a node: along the flow (the reference's section 3), or
 # normal to the deformed net (the film lies on the net: `printgen.scene.pressure`).
 PRESSURES = ("flow", "normal")
-PROTOTYPE_ORIENTATION = "long"
 # Stiffness holding each free node where it is when its strands carry no load (N/m), as a
 # fraction of rho g A* (the rate at which a node's hydrostatic load grows per metre of head):
 # it scales like every stiffness (lambda^-2), so prototype and model get the same share.
 HOLD_FRACTION = 1e-3
-TESTED_PATTERN = "diamond"  # the pattern of the nets the material profiles' panel laws tested
 
 Assumption = tuple[str, str, str]  # (what, value, source)
 
@@ -136,22 +141,6 @@ class BarrierScene:
     # (node, weight) at the centre of each row the mid-height sensor is read from: the
     # deflection at mid-height is interpolated between them as the reading is (empty: `centre`)
     mid_centres: tuple[tuple[int, float], ...] = ()
-
-
-def recorded_orientation(law: PanelLaw) -> str:
-    """The diagonal a measured panel law was loaded along, as its profile records the meshes:
-    "short" when the mesh along the load is the shorter one, else "long"."""
-    return "short" if law.mesh_along_load <= law.mesh_across_load else "long"
-
-
-def panel_axes(mesh_a: float, mesh_b: float, orientation: str) -> tuple[float, float]:
-    """(along, across) the load of a panel test on a mesh with diagonals a and b, loaded along
-    its `orientation` ("short" or "long") diagonal."""
-    if orientation not in ORIENTATIONS:
-        raise GeometryError(f"panel-test orientation {orientation!r} is not one of "
-                            f"{', '.join(ORIENTATIONS)}")
-    lo, hi = sorted((mesh_a, mesh_b))
-    return (lo, hi) if orientation == "short" else (hi, lo)
 
 
 def _net_arrays(g: NetGraph, to_m: float
@@ -248,7 +237,9 @@ def prototype_scene(p: Prototype, *, mounting: str | None = None,
         law_text = ("panel law " + ", ".join(f"{k / 1e3:g}" for k in kappas) + " kN/m/m"
                     + (" (knees " + ", ".join(f"{k:.0%}" for k in knees) + ")" if knees else "")
                     + f" of a panel loaded along the {along / MM:g} mm ({orientation}) "
-                    "diagonal, transverse displacement blocked, turned into a strand law")
+                    "diagonal, transverse displacement blocked, turned into a strand law"
+                    + (" (the diagonal and the test mode the source states: no reading to "
+                       "choose)" if orientation == PROTOTYPE_ORIENTATION else ""))
     else:
         net_law = linear(p.net.strand_modulus * math.pi / 4 * p.net.strand_diameter**2)
         law_text = (f"linear strands E = {p.net.strand_modulus / 1e9:g} GPa, "
@@ -275,14 +266,15 @@ def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
     applies the other options): its pattern's net with the material's (measured) law, printed
     border frame, cables of the measured modulus, mounted by `mounting`, and the three sensor
     wires pulling `sensor_force` N along themselves ([flume] sensor_force_n). `orientation`
-    ("short", "long"): the mesh diagonal the material's panel test loaded (None: the one its
-    profile records); `load`: the load case its assumptions state (default hydrostatic)."""
+    ("short", "long"): the mesh diagonal the material's panel test loaded (None: the reading
+    its material can produce, `printgen.scaling.reading`); `load`: the load case its
+    assumptions state (default hydrostatic)."""
     n = d.net
     pattern = get_pattern(n.pattern)
     g = n.graph()
     mat = load_material(n.material)
     net_law, how = model_net_law(mat, n, orientation)
-    e, e_src = mat.modulus()
+    e, e_src = frame_modulus(mat, orientation)
     border_ea = e * n.border_width_mm * n.strand.thickness_mm * MM * MM
     cable_law, rows = None, []
     if d.cables:
@@ -303,19 +295,43 @@ def model_scene(d: Design, *, mounting: str = MOUNTINGS[0],
              f"({e_src})" + (", on the edge rows (the prototype's edge strands)"
                              if pattern.edge_strands else "")),
              f"design; profile materials/{n.material}"), *rows]
+    reading = panel_reading(mat) if orientation is None else None
+    if reading is not None:
+        rows.insert(2, ("panel-law reading", reading.why() + ". " + "; ".join(
+            c.summary() for c in reading.checks),
+            f"profile materials/{n.material} [measured.panel_law] and [datasheet]; printgen "
+            "docs: physics, the reading of a panel law"))
     return _finish(s, rows, force=sensor_force, load=load, model=True)
+
+
+def frame_modulus(mat, orientation: str | None) -> tuple[float, str]:
+    """(E Pa, its source) of the printed border frame, a strip of the net's material printed
+    as its strands are: the measured printed modulus when the profile has one; else, with a
+    panel law, the strand modulus its reading implies (the reading the material can produce,
+    or `orientation`): a printed strand's modulus, where the datasheet's is the filament's;
+    else the datasheet's."""
+    e, source = mat.modulus()
+    reading = panel_reading(mat)
+    if source == "measured" or reading is None:
+        return e, source
+    check = reading.check(orientation or reading.orientation)
+    return check.modulus, f"implied by the panel law read along its {check.orientation} diagonal"
 
 
 def model_net_law(mat, n, orientation: str | None) -> tuple[Law, str]:
     """The printed net's strand law and how it was found: a panel law with its tested net is
-    read along the tested net's `orientation` diagonal (a strand law of the tested strands,
-    rescaled to the design's strand section); otherwise the membrane law of the design."""
+    read along the tested net's `orientation` diagonal (None: the reading the material can
+    produce, `printgen.scaling.reading`): a strand law of the tested strands, rescaled to the
+    design's strand section; otherwise the membrane law of the design."""
     law = mat.panel_law
-    if law is None or not law.has_geometry or orientation is None:
+    if law is None or not law.has_geometry:
         knees, slopes, how = net_membrane_law(mat, n.strand, n.mesh_y_mm * MM, n.mesh_x_mm * MM,
                                               n.pattern)
         law_of = get_pattern(n.pattern).strand_law
         return law_of(knees, slopes, n.mesh_y_mm * MM, n.mesh_x_mm * MM), how
+    if orientation is None:  # the reading the material can produce
+        reading = panel_reading(mat)
+        orientation = reading.orientation if reading is not None else recorded_orientation(law)
     along, across = panel_axes(law.mesh_along_load, law.mesh_across_load, orientation)
     tested = get_pattern(TESTED_PATTERN).strand_law(
         law.knee_strains, tuple(k * law.panel_length for k in law.kappas), along, across)

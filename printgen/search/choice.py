@@ -118,8 +118,9 @@ def choice_reasons(res: SearchResult) -> list[str]:
                    f"({len(res.screened)} screened): RMS log error {s.error_rms_log:.3f} over "
                    "1-40 % strain (not verified by the solver: --objective deformation does)")
     on = near_target(s)
-    out.append(f"membrane stiffness {s.membrane_n_per_m:.4g} N/m at small strain against the "
-               f"target {s.target_n_per_m:.4g} N/m ({s.error_small:+.0%}): "
+    out.append(f"membrane stiffness at small strain {s.error_across:+.0%} off the target "
+               f"across the barrier and {s.error_up:+.0%} up it (worse: "
+               f"{s.membrane_n_per_m:.4g} N/m against {s.target_n_per_m:.4g} N/m): "
                f"{'within' if on else 'outside'} +-{SMALL_STRAIN_TOLERANCE:.0%}")
     if res.closest is not None and res.binding:
         c = res.screened[res.closest]

@@ -18,7 +18,8 @@ from printgen.search.space import space_record
 
 # Columns of the candidate table (candidates.json), in order.
 COLUMNS = ("index", "material", "beads_across", "layers", "mesh_x_mm", "mesh_y_mm",
-           "border_beads", "membrane_n_per_m", "error_small_strain", "error_rms_log", "score",
+           "border_beads", "membrane_n_per_m", "error_small_strain", "stiffness_error_across",
+           "stiffness_error_up", "error_rms_log", "score",
            "safety_factor", "speed_mm_per_s", "opening_mm", "d_pi2", "d_pi3", "print_time_s",
            "feasible", "violations")
 

@@ -27,7 +27,7 @@ from printgen.scaling.selection import (
     NET_STRAINS,
     peak_strand_force,
     print_limits,
-    target_net_law,
+    target_net_laws,
 )
 from printgen.search.space import NetPoint, SearchContext
 from printgen.units import MM
@@ -48,9 +48,9 @@ class Screened:
     point: NetPoint
     law_source: str
     datasheet: bool
-    membrane_n_per_m: float  # small-strain membrane stiffness
+    membrane_n_per_m: float  # small-strain membrane stiffness, in the worse direction
     target_n_per_m: float
-    error_small: float
+    error_small: float  # in the worse of the two directions below (by |log|)
     error_rms_log: float
     score: float
     peak_force_n: float
@@ -61,6 +61,8 @@ class Screened:
     d_pi3: float
     print_time_s: float
     violations: tuple[tuple[str, str], ...]
+    error_across: float = 0.0  # small-strain membrane stiffness / target - 1, across the barrier
+    error_up: float = 0.0  # ... up the barrier
 
     @property
     def feasible(self) -> bool:
@@ -76,6 +78,7 @@ class Screened:
             "law_source": self.law_source, "datasheet": self.datasheet,
             "membrane_n_per_m": self.membrane_n_per_m, "target_n_per_m": self.target_n_per_m,
             "error_small_strain": self.error_small, "error_rms_log": self.error_rms_log,
+            "stiffness_error_across": self.error_across, "stiffness_error_up": self.error_up,
             "score": self.score, "peak_force_n": self.peak_force_n,
             "safety_factor": self.safety_factor, "speed_mm_per_s": self.speed_mm_per_s,
             "opening_mm": self.opening_mm, "d_pi2": self.d_pi2, "d_pi3": self.d_pi3,
@@ -130,13 +133,12 @@ def across_law(knees: tuple[float, ...], slopes: tuple[float, ...], mesh_along: 
 
 
 def target_curve(ctx: SearchContext) -> tuple[float, np.ndarray]:
-    """(small-strain target slope N/m, target force per width N/m at NET_STRAINS along the
-    load, then across it: the prototype's law and its diamond geometry)."""
-    p = ctx.prototype
-    knees, slopes = target_net_law(p, ctx.targets)
-    k2, s2 = across_law(knees, slopes, p.net.mesh_y, p.net.mesh_x)
-    return slopes[0], np.concatenate([piecewise_linear(NET_STRAINS, knees, slopes),
-                                      piecewise_linear(NET_STRAINS, k2, s2)])
+    """(small-strain target slope N/m up the barrier, target force per width N/m at
+    NET_STRAINS up the barrier, then across it: the prototype's law read along the diagonal
+    its source loaded, `target_net_laws`)."""
+    laws = target_net_laws(ctx.prototype, ctx.targets)
+    return laws["up"][1][0], np.concatenate([piecewise_linear(NET_STRAINS, *laws["up"]),
+                                             piecewise_linear(NET_STRAINS, *laws["across"])])
 
 
 def screen_point(ctx: SearchContext, point: NetPoint,
@@ -171,11 +173,15 @@ def screen_point(ctx: SearchContext, point: NetPoint,
                                       f"{MIN_OPENING_MM:g} mm; use a larger mesh or a thinner "
                                       "strand")))
     dx, dy = ax / t["mesh_x"] - 1, ay / t["mesh_y"] - 1
-    return Screened(point, source, datasheet, slopes[0], t_slope, slopes[0] / t_slope - 1, rms,
+    # both directions at the first strain, on every law's first segment: the small-strain ratio
+    up, across = float(ratio[0] - 1), float(ratio[len(NET_STRAINS)] - 1)
+    worse = up if abs(math.log1p(up)) >= abs(math.log1p(across)) else across
+    slope = slopes[0] if worse is up else s2[0]
+    return Screened(point, source, datasheet, slope, slope / (1 + worse), worse, rms,
                     rms + DATASHEET_PENALTY * datasheet, force, sf, speed, opening,
                     dx if abs(dx) >= abs(dy) else dy,
                     equal_area_diameter(sec) / t["strand_d"] - 1,
-                    print_time_s(ctx, point, sec, speed), tuple(violations))
+                    print_time_s(ctx, point, sec, speed), tuple(violations), across, up)
 
 
 def screen_batch(ctx: SearchContext, points: list[NetPoint]) -> list[Screened]:

@@ -22,7 +22,10 @@ Variants of design `d` (`model_variants`):
 - the panel law's geometry assumption: the law's tested net (strand and mesh recorded in the
   profile, an assumption when the source does not give it) against the alternative that the
   tested panel had the design's own strands and mesh (the law used without rescaling);
-- the panel law read along each mesh diagonal its profile does not record;
+- the printed border frame at its filament's datasheet modulus, when the nominal takes the
+  strand modulus the panel law's reading implies;
+- the panel law read along each mesh diagonal but the nominal reading (the one the material
+  can produce, `printgen.scaling.reading`), with why it fails a check when it does (`excluded`);
 - the mounting in the flume, each of the scene's `MOUNTINGS` but the nominal;
 - initial slack of the printed net, 0 to `SLACK_MAX` (0 is the nominal);
 - the model-form options (`printgen.scene.forms`, `printgen.scene.mount`): the water's force
@@ -40,6 +43,7 @@ from dataclasses import dataclass, field
 from printgen.barrier.patterns import get_pattern
 from printgen.inputs.materials import Material, load_material
 from printgen.inputs.prototype import Prototype
+from printgen.scaling.reading import chosen_orientation, panel_axes, panel_reading, tested_net
 from printgen.scaling.record import Design
 from printgen.scaling.section import area_m2
 from printgen.scene.options import SceneOptions, build_scene
@@ -48,6 +52,7 @@ from printgen.scene.scenes import (
     ORIENTATIONS,
     PROTOTYPE_ORIENTATION,
     TESTED_PATTERN,
+    frame_modulus,
     recorded_orientation,
 )
 from printgen.units import MM
@@ -74,7 +79,8 @@ class Variant:
     """One uncertain input of the printed model moved from its nominal value: `label`,
     `source` (why, for the report), the scene `options` it changes, the relative initial
     `slack` of every strand and cable of its solver net, its `effort` rank (higher: started
-    earlier)."""
+    earlier); `excluded`: why it is a reading the material cannot produce ("" when it can),
+    kept to be shown apart, never as a central value."""
 
     label: str = "nominal"
     source: str = ""
@@ -142,6 +148,7 @@ def model_variants(d: Design, mounting: str | None = None, free_section: float |
     if panel is not None and panel.has_geometry:
         out += _panel_geometry_variant(d, notes)
         out += _orientation_variants(d)
+        out += _frame_variant(d)
     opts = MOUNTINGS if d.cables else ()  # no border cables: bed and banks only
     nominal = mounting or (opts[0] if opts else None)
     out += [Variant(f"mounting: {m}", f"flume mounting option (nominal: {nominal})",
@@ -226,11 +233,14 @@ def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
     """The panel law used without the rescaling from its (assumed) tested net to the design's."""
     mat = load_material(d.net.material)
     law, n = mat.panel_law, d.net
-    tested = get_pattern(TESTED_PATTERN).membrane_factor(law.mesh_along_load,
-                                                         law.mesh_across_load) * (
-        law.strand_width * law.strand_thickness)
-    design = get_pattern(n.pattern).membrane_factor(n.mesh_y_mm * MM, n.mesh_x_mm * MM) * \
-        area_m2(n.strand)
+    if law is None:
+        return []
+    w, t, a, b = tested_net(law)
+    # the panel loaded along the diagonal of the nominal reading, of either net
+    o = chosen_orientation(mat) or recorded_orientation(law)
+    tested = get_pattern(TESTED_PATTERN).membrane_factor(*panel_axes(a, b, o)) * (w * t)
+    design = get_pattern(n.pattern).membrane_factor(
+        *panel_axes(n.mesh_x_mm * MM, n.mesh_y_mm * MM, o)) * area_m2(n.strand)
     ratio = tested / design
     if abs(ratio - 1) < SAME:
         notes.append(f"{mat.name} panel law: the design's net is the tested net the profile "
@@ -244,14 +254,43 @@ def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
 
 
 def _orientation_variants(d: Design) -> list[Variant]:
-    """The panel law read along each mesh diagonal its profile does not record (the paper
-    does not say which diagonal its printed panels were loaded along)."""
-    recorded = recorded_orientation(load_material(d.net.material).panel_law)
-    return [Variant(f"panel test along the {o} diagonal",
-                    f"panel-test orientation not stated (profile: {recorded})",
-                    SceneOptions(orientation=o), question=READING,
-                    weight_source="the source does not state the diagonal")
-            for o in ORIENTATIONS if o != recorded]
+    """The panel law read along each mesh diagonal but the nominal reading (the one the
+    material can produce, `printgen.scaling.reading`; the paper does not say which diagonal
+    its printed panels were loaded along); a reading that fails a check carries why."""
+    reading = panel_reading(load_material(d.net.material))
+    if reading is None:
+        return []
+    out = []
+    for c in reading.checks:
+        if c.orientation == reading.orientation:
+            continue
+        why = "; ".join(c.reasons())
+        out.append(Variant(f"panel test along the {c.orientation} diagonal",
+                           f"panel-test orientation not stated (nominal: {reading.orientation}"
+                           f", chosen by consistency; profile records {reading.recorded}); "
+                           + c.summary(), SceneOptions(orientation=c.orientation),
+                           question=READING, weight_source="the source does not state the "
+                           "diagonal", excluded=f"a reading the material cannot produce: {why}"
+                           if why else ""))
+    return out
+
+
+def _frame_variant(d: Design) -> list[Variant]:
+    """The printed border frame at the filament's datasheet modulus instead of the strand
+    modulus the panel law's reading implies (the nominal, `scene.scenes.frame_modulus`)."""
+    mat = load_material(d.net.material)
+    e, source = frame_modulus(mat, None)
+    if source in ("measured", "datasheet") or abs(mat.datasheet_modulus / e - 1) < SAME:
+        return []
+    return [Variant(f"{mat.name} border frame at the datasheet modulus",
+                    f"{mat.name} datasheet E = {mat.datasheet_modulus / 1e9:.3g} GPa, the "
+                    f"filament's (nominal: {e / 1e6:.3g} MPa, the printed strands' from the "
+                    "panel law's reading)",
+                    SceneOptions(frame_factor=mat.datasheet_modulus / e),
+                    question="border frame modulus",
+                    excluded="the frame is printed from the same filament as the strands, whose "
+                    f"modulus the panel law's consistent reading gives ({e / 1e6:.3g} MPa); the "
+                    "datasheet's is a generic value that reading contradicts")]
 
 
 def _model_form_variants(d: Design, free_section: float | None, notes: list[str],
