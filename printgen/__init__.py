@@ -24,8 +24,6 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-__version__ = "0.1.0"
-
 VERBS = ("targets", "select", "plan", "make", "verify", "verify_design", "calibrate",
          "search_nets", "series", "panel", "testpieces", "examples", "example", "init")
 __all__ = [
@@ -47,6 +45,7 @@ __all__ = [
 ]
 
 if TYPE_CHECKING:
+    __version__: str
     from printgen.run.api import (
         calibrate,
         example,
@@ -66,6 +65,10 @@ if TYPE_CHECKING:
 
 
 def __getattr__(name: str) -> Any:
+    if name == "__version__":  # from git or the package's metadata (`printgen.version`)
+        from printgen.version import version
+
+        return version()
     if name in VERBS:
         from printgen.run import api
 
@@ -74,4 +77,4 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
-    return sorted([*globals(), *VERBS])
+    return sorted([*globals(), *VERBS, "__version__"])
