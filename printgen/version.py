@@ -1,6 +1,7 @@
 """printgen's version, from git: setuptools-scm names it from `git describe` (the last tag, the
-commits since and the commit, `0.1.dev594+g5267b93`; a tree with uncommitted edits adds the
-date), so a manifest tells which code made its folder. An installed wheel carries the version
+commits since and the commit: `0.1.1.dev594+g5267b93`, counted from the first commit and the
+last release `FALLBACK` while no tag is set; a tree with uncommitted edits adds the date), so a
+manifest tells which code made its folder. An installed wheel carries the version
 it was built with in its metadata; a git checkout (an editable install, a clone on PYTHONPATH)
 is asked now, when setuptools-scm is installed (the `test` extra), since its metadata names the
 commit it was installed at; a source tree with neither is `FALLBACK`, as its build is."""
@@ -13,7 +14,9 @@ from importlib.metadata import PackageNotFoundError
 from importlib.metadata import version as dist_version
 from pathlib import Path
 
-FALLBACK = "0+unknown"  # no git, no metadata: [tool.setuptools_scm] fallback_version
+# [tool.setuptools_scm] fallback_version: the version of a source tree without git (and the base
+# of the count while the repository has no tag): the last release, CHANGELOG.md's
+FALLBACK = "0.1.0"
 ROOT = Path(__file__).resolve().parents[1]  # a checkout's root; site-packages when installed
 
 
@@ -34,7 +37,7 @@ def checkout_version(root: Path) -> str | None:
     except ImportError:
         return None
     try:
-        return str(get_version(root=str(root)))
+        return str(get_version(root=str(root), fallback_version=FALLBACK))  # as the build
     except (LookupError, OSError, ValueError, subprocess.SubprocessError):
         return None  # no git on PATH, a repository git refuses to read
 
