@@ -18,12 +18,18 @@ trap 'rm -rf "$tmp"' EXIT
 fail() { echo "test_wheel: $*" >&2; exit 1; }
 
 # 1. The wheel, built from a copy of the clone's files (tracked and new, not ignored), so that
-# a stale build/ folder cannot leak into it.
+# a stale build/ folder cannot leak into it. The copy has no .git: it is given the clone's
+# version (setuptools-scm's, from git), which the installed `printgen --version` must show.
+"$py" -c 'import setuptools_scm' 2>/dev/null \
+  || fail "setuptools-scm is not installed in $py (pip install -e '.[all,test]')"
+version=$(cd "$clone" && "$py" -m setuptools_scm 2>/dev/null) \
+  || fail "setuptools-scm cannot name this clone's version (is it a git checkout?)"
 mkdir "$tmp/src"
 git ls-files -z --cached --others --exclude-standard \
   | while IFS= read -r -d '' f; do [[ -e $f ]] && printf '%s\0' "$f"; done \
   | xargs -0 cp --parents -t "$tmp/src"
-"$py" -m pip wheel -q --no-deps --no-build-isolation --no-index -w "$tmp/dist" "$tmp/src" \
+SETUPTOOLS_SCM_PRETEND_VERSION_FOR_PRINTGEN=$version \
+  "$py" -m pip wheel -q --no-deps --no-build-isolation --no-index -w "$tmp/dist" "$tmp/src" \
   >"$tmp/build.log" 2>&1 || { cat "$tmp/build.log" >&2; fail "building the wheel failed"; }
 wheel=$(ls "$tmp"/dist/printgen-*.whl)
 built=$SECONDS
@@ -52,7 +58,8 @@ unset PYTHONPATH PRINTGEN_PROFILES
 pg="$tmp/venv/bin/printgen"
 where=$("$tmp/venv/bin/python" -c 'import printgen; print(printgen.__file__)')
 [[ $where == "$site"/* ]] || fail "printgen imports from $where, not from the wheel in $site"
-"$pg" --version
+[[ $("$pg" --version) == "printgen $version" ]] \
+  || fail "the wheel says $("$pg" --version), not the clone's version $version"
 "$pg" profiles list >profiles.txt || { cat profiles.txt; fail "profiles list failed"; }
 grep -q petg profiles.txt && grep -q generic-350 profiles.txt \
   || { cat profiles.txt; fail "profiles list lacks the bundled profiles"; }

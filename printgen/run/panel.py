@@ -7,6 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from printgen.outputs.display import Shown, Summary
 from printgen.scaling.design_file import load_design
 from printgen.scene.panel import MODES, DesignPanel, design_panel, panel_lockup
 from printgen.scene.scenes import ORIENTATIONS
@@ -14,13 +15,21 @@ from printgen.scene.scenes import ORIENTATIONS
 __all__ = ["MODES", "ORIENTATIONS", "PanelRun", "panel_tests"]
 
 
-@dataclass(frozen=True)
-class PanelRun:
+@dataclass(frozen=True, repr=False)
+class PanelRun(Shown):
     """One simulated panel test: the test and its curve (`panel`) and the panel strain at
     which the strands lie along the load (`lockup`, a fraction)."""
 
     panel: DesignPanel
     lockup: float
+
+    def summary(self) -> Summary:
+        t = self.panel.test
+        return Summary(f"PanelRun: {self.panel.orientation} diagonal, sides {t.mode}",
+                       (("mesh along x across", f"{t.mesh_along * 1e3:.3g} x "
+                                                f"{t.mesh_across * 1e3:.3g} mm"),
+                        ("panel", f"{t.length * 1e3:.3g} mm long, {t.width * 1e3:.3g} mm wide"),
+                        ("strands along the load at", f"{self.lockup:.1%} strain")))
 
 
 def panel_tests(design_path: str | Path, orientations: tuple[str, ...] | None = None,
