@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # printgen as a user installs it: build the wheel from this clone, install it into a
-# fresh venv outside the clone, and from an empty folder run profiles list, example, make,
-# check and calibrate --inherits petg on a generated export; then the same profile lookup
-# through the clone's editable install. scripts/test.sh runs it before the suite.
+# fresh venv outside the clone, and from an empty folder run --version, profiles list, example,
+# the example notebook, make, check and calibrate --inherits petg on a generated export; then
+# the same profile lookup through the clone's editable install. scripts/test.sh runs it before the suite.
 # The fresh venv gets no dependencies of its own (pip --no-deps --no-index): a .pth file puts the
 # clone's .venv site-packages after its own (what --system-site-packages does for the system
 # Python), so the check is fast and needs no network. Only the wheel's printgen is importable
@@ -35,6 +35,7 @@ wheel=$(ls "$tmp"/dist/printgen-*.whl)
 built=$SECONDS
 for f in printgen/profiles/materials/petg.toml printgen/profiles/printers/generic-350.toml \
          printgen/examples/realistic_barrier.toml printgen/examples/paper_1_40/measured.csv \
+         printgen/examples/realistic_1_40.ipynb \
          printgen/py.typed printgen/solver/py.typed; do
   unzip -l "$wheel" "$f" >/dev/null || fail "$f missing from $(basename "$wheel")"
 done
@@ -68,6 +69,18 @@ if "$pg" bench make --out b >bench.txt 2>&1; then fail "bench is offered by the 
 cmp -s proto.toml "$clone/examples/realistic_barrier.toml" || fail "example realistic differs"
 "$pg" example paper_1_40 --out paper >/dev/null || fail "example paper_1_40 --out failed"
 cmp -s paper/design.json "$clone/examples/paper_1_40/design.json" || fail "example paper_1_40 differs"
+# the example notebook, written by the wheel and run by its Python (nbclient, a python3 kernel
+# started with this venv's interpreter: the wheel's printgen), from this folder
+"$pg" example notebook >/dev/null || fail "example notebook failed"
+cmp -s realistic_1_40.ipynb "$clone/examples/realistic_1_40.ipynb" || fail "the notebook differs"
+"$tmp/venv/bin/python" - <<'EOF' || fail "the example notebook failed to run from the wheel"
+import nbclient, nbformat
+nb = nbformat.read("realistic_1_40.ipynb", as_version=4)
+nbclient.NotebookClient(nb, timeout=600, kernel_name="python3").execute()
+errors = [o for c in nb.cells if c.cell_type == "code" for o in c.outputs
+          if o.output_type == "error"]
+assert not errors, errors
+EOF
 "$pg" make proto.toml --scale 40 --out o >make.txt 2>&1 || { cat make.txt; fail "make failed"; }
 "$pg" check o
 grep -q '"solver_backend"' o/manifest.json || fail "manifest.json records no solver backend"
@@ -98,6 +111,6 @@ else
   echo "test_wheel: the editable check skipped: $py imports printgen from $editable"
 fi
 echo "test_wheel: $(basename "$wheel") ($(unzip -Z1 "$wheel" | wc -l) files) installed outside" \
-     "the clone: profiles, example, make, check, calibrate OK in $((SECONDS - start)) s" \
+     "the clone: profiles, example, notebook, make, check, calibrate OK in $((SECONDS - start)) s" \
      "(build $((built - start)) s, venv and install $((installed - built)) s, commands" \
      "$((SECONDS - installed)) s)"

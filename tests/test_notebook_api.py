@@ -149,3 +149,50 @@ def _coupons(folder):
         paths.append(folder / f"coupon{i}.csv")
         paths[-1].write_text("Load (N),Extension (mm)\n" + "\n".join(rows) + "\n")
     return paths
+
+
+GUARD_SCRIPT = '''
+import math, os
+import printgen.executor.start as start
+from printgen.executor.local import run_jobs
+start.start_method = lambda plat=None: "spawn"  # as on macOS and Windows
+print(run_jobs([(math.sqrt, (4.0,), {}), (math.sqrt, (9.0,), {})]))
+'''
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("how", ["unguarded", "serial", "guarded"])
+def test_the_main_guard_message_is_true(tmp_path, how):
+    """A script without `if __name__ == "__main__":` is refused before its workers start, by a
+    message naming the script, the start method and both ways out; each way out works: the
+    guard (the spawned workers run the script again, its calls skipped) or PRINTGEN_SERIAL=1
+    (no worker at all)."""
+    import os
+    import subprocess
+    import textwrap
+
+    from conftest import ROOT
+
+    from printgen.executor.start import cores
+
+    if cores() < 2:
+        pytest.skip("one core: printgen starts no worker")
+    body = GUARD_SCRIPT
+    if how == "guarded":
+        body = 'if __name__ == "__main__":\n' + textwrap.indent(body, "    ")
+    script = tmp_path / "my_run.py"
+    script.write_text(body)
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    env.pop("PRINTGEN_SERIAL", None)
+    if how == "serial":
+        env["PRINTGEN_SERIAL"] = "1"
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                          env=env, timeout=300)
+    if how == "unguarded":
+        assert done.returncode == 1 and not done.stdout
+        for words in ("my_run.py runs printgen's parallel work", "(spawn: how workers start on "
+                      "macOS and Windows)", 'if __name__ == "__main__":',
+                      "Python API section of docs/user-guide.md", "PRINTGEN_SERIAL=1"):
+            assert words in done.stderr, (words, done.stderr)
+    else:
+        assert done.returncode == 0 and done.stdout.strip() == "[2.0, 3.0]", done.stderr

@@ -86,8 +86,8 @@ def test_example_folder_is_copied_whole(tmp_path, capsys):
 
 def test_unknown_example_exits_2(capsys):
     assert main(["example", "nope"]) == 2
-    assert ("no example named 'nope'; examples: realistic, simple, calibration, paper_1_40"
-            in capsys.readouterr().err)
+    assert ("no example named 'nope'; examples: realistic, simple, calibration, paper_1_40, "
+            "notebook" in capsys.readouterr().err)
 
 
 def test_version(capsys):
