@@ -34,8 +34,6 @@ def _record(args: argparse.Namespace) -> dict:
 def _written(ex: Example, args: argparse.Namespace) -> Path | None:
     """The file a one-file example was written into (FILE; the notebook's default name
     without one), or None when it is printed or copied (--out)."""
-    if args.file is not None and args.out is not None:
-        raise InputError("give FILE or --out DIR, not both")
     if args.file is None and (ex.name != NOTEBOOK[0] or args.out is not None):
         return None
     return write_example(ex, args.file or NOTEBOOK[1])
@@ -54,6 +52,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.file is not None and args.out is not None:  # before --out copies anything
+        raise InputError("give FILE or --out DIR, not both")
     if args.json:
         emit_json(_record(args))
         return 0
