@@ -11,8 +11,6 @@ import sys
 from pathlib import Path
 
 from printgen.commands.common import add_json_arg, emit_json
-from printgen.errors import InputError
-from printgen.inputs.examples import NOTEBOOK, Example, write_example
 from printgen.run import api
 
 
@@ -21,22 +19,20 @@ def _record(args: argparse.Namespace) -> dict:
     (copied ones with --out) and, for a single prototype file, its text."""
     if args.name is None:
         return {"examples": {name: path.name for name, path in api.examples().items()}}
-    ex = api.example(args.name, out=args.out)
+    ex, written = _example(args)
     rec: dict = {"name": ex.name, "source": ex.path.name, "files": [str(f) for f in ex.files]}
-    written = _written(ex, args)
-    if written is not None:
-        rec["files"] = [str(written)]
-    elif args.out is None and not ex.is_folder:
+    if not written and args.out is None and not ex.is_folder:
         rec["text"] = ex.path.read_text("utf-8")
     return rec
 
 
-def _written(ex: Example, args: argparse.Namespace) -> Path | None:
-    """The file a one-file example was written into (FILE; the notebook's default name
-    without one), or None when it is printed or copied (--out)."""
-    if args.file is None and (ex.name != NOTEBOOK[0] or args.out is not None):
-        return None
-    return write_example(ex, args.file or NOTEBOOK[1])
+def _example(args: argparse.Namespace) -> tuple[api.Example, bool]:
+    """The example asked, copied (--out) or written into FILE (the notebook: its default
+    name without FILE), and whether it was written into a file."""
+    ex = api.example(args.name, out=args.out, file=args.file)
+    if args.file is None and args.out is None and ex.default_file is not None:
+        ex = api.example(args.name, file=ex.default_file)
+    return ex, args.file is not None or ex.default_file is not None and args.out is None
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -44,7 +40,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("name", nargs="?", help="which example (none: list them)")
     p.add_argument("file", nargs="?", type=Path,
                    help="write a one-file example (a prototype, the notebook) into this new "
-                        f"file instead of printing it (the notebook's default: {NOTEBOOK[1]})")
+                        "file instead of printing it (the notebook: by default into its own "
+                        "name here)")
     p.add_argument("--out", "-o", type=Path, metavar="DIR",
                    help="copy the example's files into DIR (a new folder) instead of printing")
     add_json_arg(p)
@@ -52,8 +49,6 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.file is not None and args.out is not None:  # before --out copies anything
-        raise InputError("give FILE or --out DIR, not both")
     if args.json:
         emit_json(_record(args))
         return 0
@@ -61,10 +56,9 @@ def run(args: argparse.Namespace) -> int:
         for name, path in api.examples().items():
             print(f"{name}\t{path.name}")
         return 0
-    ex = api.example(args.name, out=args.out)
-    written = _written(ex, args)
-    if written is not None:
-        print(written)
+    ex, written = _example(args)
+    if written:
+        print(ex.files[0])
         return 0
     if args.out is not None or ex.is_folder:
         for f in ex.files:

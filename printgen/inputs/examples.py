@@ -33,6 +33,12 @@ class Example:
         """A folder of data files, not one prototype file."""
         return self.path.is_dir()
 
+    @property
+    def default_file(self) -> str | None:
+        """The file `printgen example NAME` writes without FILE (the notebook's name), or
+        None: the example is printed."""
+        return NOTEBOOK[1] if self.name == NOTEBOOK[0] else None
+
 
 def examples() -> dict[str, Path]:
     """Example name -> its TOML file or its folder of data files; InputError when none is
@@ -53,10 +59,14 @@ def example_files(folder: Path) -> list[Path]:
     return sorted(f for f in folder.iterdir() if f.suffix in DATA_SUFFIXES and f.is_file())
 
 
-def example(name: str, out: str | Path | None = None) -> Example:
+def example(name: str, out: str | Path | None = None, *,
+            file: str | Path | None = None) -> Example:
     """The example `name` (its file name, with or without .toml and `SUFFIX`, also names it);
-    with `out`, its files copied into that new folder (`copy_example`). InputError naming the
-    examples when there is none of that name."""
+    with `out`, its files copied into that new folder (`copy_example`); with `file`, a one-file
+    example written into that new file (`write_example`). InputError naming the examples when
+    there is none of that name, or for `out` and `file` both."""
+    if out is not None and file is not None:  # before anything is copied
+        raise InputError("give FILE or --out DIR, not both")
     found = examples()
     key = name.lower().removesuffix(".toml").removesuffix(SUFFIX)
     if key not in found:
@@ -65,7 +75,10 @@ def example(name: str, out: str | Path | None = None) -> Example:
     files = example_files(path) if path.is_dir() else [path]
     if out is not None:
         files = copy_example(path, Path(out))
-    return Example(key, path, tuple(files))
+    ex = Example(key, path, tuple(files))
+    if file is not None:
+        return Example(key, path, (write_example(ex, file),))
+    return ex
 
 
 def write_example(ex: Example, file: str | Path) -> Path:
