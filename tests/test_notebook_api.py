@@ -34,6 +34,23 @@ def shows_short(result: object, *words: str) -> str:
     return text
 
 
+def test_every_public_name_resolves_and_import_stays_light():
+    """`import printgen` loads no numpy, matplotlib, pandas or setuptools-scm: each public
+    name is imported when first used."""
+    import subprocess
+
+    from conftest import ROOT
+
+    code = ("import sys, printgen; print(sorted(m for m in ('numpy', 'matplotlib', 'pandas', "
+            "'setuptools_scm') if m in sys.modules))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=ROOT, check=True)
+    assert done.stdout.strip() == "[]"
+    assert {"plot_curves", "plot_net", "__version__"} <= set(printgen.__all__)
+    assert all(getattr(printgen, name, None) is not None for name in printgen.__all__)
+    assert {"plot_curves", "plot_net"} <= set(dir(printgen))
+
+
 def test_summary_is_cut_and_escaped():
     s = Summary("T <1:40>", tuple((f"row {i}", "x" * 80) for i in range(100)), "PASS")
     assert len(s.text()) == MAX_REPR_CHARS and s.text().endswith("...")
