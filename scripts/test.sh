@@ -11,6 +11,12 @@ if ! .venv/bin/python -c "import cadquery, pytest, nbclient, setuptools_scm" 2>/
     || { cat .venv/setup-test.log >&2; echo "test: installing the test and cad extras failed" >&2
          exit 1; }
 fi
+# The documentation site's strict build (tests/test_docs.py) needs the `docs` extra, outside `all`.
+if ! .venv/bin/python -c "import mkdocs, material, mkdocstrings_handlers.python" 2>/dev/null; then
+  .venv/bin/python -m pip install -q -e ".[all,docs]" >.venv/setup-docs.log 2>&1 \
+    || { cat .venv/setup-docs.log >&2; echo "test: installing the docs extra failed" >&2; exit 1; }
+fi
+export PRINTGEN_REQUIRE_DOCS=1   # the site's build fails, not skips, when MkDocs is missing
 # The wheel, installed outside the clone and used from an empty folder: what a user installs.
 bash scripts/test_wheel.sh
 export PRINTGEN_REQUIRE_SLICERS=1   # slicer tests fail, not skip, when a slicer is missing

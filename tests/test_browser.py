@@ -24,6 +24,7 @@ from conftest import ROOT, require_tool
 from proto_files import REALISTIC
 
 import printgen.run.make as make_mod
+from printgen.report import pdf
 from printgen.run.options import RunOptions
 
 ARTIFACTS = ROOT / "artifacts"
@@ -154,6 +155,9 @@ window.addEventListener("load", function () {
 </script>"""
 UNIT = re.compile(r"\(([^()]+)\)$")  # an axis label ends with its unit in parentheses
 MIN_PDF_PAGES = 5  # the 1:40 report prints on well over five A4/Letter pages
+A4_PT = (595.28, 841.89)  # 210 x 297 mm in PDF points (1/72 in)
+LETTER_PT = (612.0, 792.0)  # 8.5 x 11 in
+PAGE_TOL_PT = 1.0  # Chromium rounds the page to whole device pixels: well under a point
 CSV_TOL = 1e-7  # the CSV files keep 8 significant digits
 CSV_ZERO = 1e-6  # ... and write values below labfiles.NOISE as 0
 # file names a report may mention: an output file, or a file of the package (README, examples)
@@ -227,6 +231,10 @@ def test_report_pdf_has_pages_and_text(printed):
     assert len(reader.pages) >= MIN_PDF_PAGES
     first = reader.pages[0].extract_text()
     assert "Summary" in first and "FAIL" in first
+    box = reader.pages[0].mediabox  # A4 by default: 210 x 297 mm
+    assert abs(float(box.width) - A4_PT[0]) < PAGE_TOL_PT
+    assert abs(float(box.height) - A4_PT[1]) < PAGE_TOL_PT
+    assert not list(out.glob(".*print*")), "the printed copy of report.html is left behind"
 
 
 @pytest.mark.slow
@@ -236,10 +244,38 @@ def test_make_pdf_writes_report_pdf_into_the_folder_and_its_manifest(tmp_path):
     require_tool("chromium")
     pypdf = pytest.importorskip("pypdf")
     out = tmp_path / "out"
-    ctx = make_mod.make(REALISTIC, 40, out, steps=[], options=RunOptions(pdf=True))
+    ctx = make_mod.make(REALISTIC, 40, out, steps=[],
+                        options=RunOptions(pdf=True, paper="letter"))
     assert "report.pdf" in json.loads((out / "manifest.json").read_text())["files"]
     assert "report.pdf" in ctx.record["files"] and "pdf_skipped" not in ctx.record
-    assert len(pypdf.PdfReader(out / "report.pdf").pages) >= 1
+    pages = pypdf.PdfReader(out / "report.pdf").pages
+    assert len(pages) >= 1
+    box = pages[0].mediabox  # --paper letter: 8.5 x 11 in
+    assert abs(float(box.width) - LETTER_PT[0]) < PAGE_TOL_PT
+    assert abs(float(box.height) - LETTER_PT[1]) < PAGE_TOL_PT
+
+
+def test_paged_names_the_page_size_in_the_head():
+    html = "<html><head><title>t</title></head><body>x</body></html>"
+    assert "@page { size: A4; }</style></head>" in pdf.paged(html, "a4")
+    assert "size: letter" in pdf.paged(html, "letter")
+    with pytest.raises(ValueError, match="a4, letter"):
+        pdf.paged(html, "a3")
+
+
+@pytest.mark.parametrize("platform", ["win32", "darwin"])
+def test_browser_found_where_the_installer_puts_it(platform, tmp_path, monkeypatch):
+    """On Windows and macOS Chrome and Edge are seldom on the PATH: their install folders are
+    searched after it (here: a fake executable where the second candidate would be)."""
+    monkeypatch.delenv("PRINTGEN_CHROMIUM", raising=False)
+    monkeypatch.setenv("PATH", str(tmp_path / "empty"))
+    fake = tmp_path / "Edge" / "msedge"
+    fake.parent.mkdir()
+    fake.write_text("")
+    monkeypatch.setitem(pdf.INSTALLED, platform, (str(tmp_path / "Chrome" / "chrome"),
+                                                  str(fake)))
+    assert pdf.browser(platform) == str(fake)
+    assert pdf.browser("linux") is None  # nothing on the PATH, no install folders searched
 
 
 def _read_csv(path) -> dict[str, list[float]]:

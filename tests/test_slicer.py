@@ -37,7 +37,9 @@ def _setup(design, part):
 
 
 def _ini(text: str) -> dict[str, str]:
-    return dict(ln.split(" = ", 1) for ln in text.splitlines() if ln and not ln.startswith("#"))
+    """The settings of an .ini (the preset names, *_settings_id, left out)."""
+    return dict(ln.split(" = ", 1) for ln in text.splitlines()
+                if ln and not ln.startswith("#") and "_settings_id = " not in ln)
 
 
 def test_ini_follows_the_measured_rules(design_1_40):

@@ -139,7 +139,8 @@ def run_options(args: argparse.Namespace) -> RunOptions:
     itself; what the command does not give keeps the record's default."""
     from printgen.run.options import RunOptions
 
-    given = {"printer": "printer", "step": "step", "pdf": "pdf", "design_file": "design",
+    given = {"printer": "printer", "step": "step", "pdf": "pdf", "paper": "paper",
+             "design_file": "design",
              "time_limit_s": "time_limit", "force": "force", "scheduler": "scheduler",
              "workers": "workers", "serial": "serial"}
     kw = {field: getattr(args, arg) for field, arg in given.items()

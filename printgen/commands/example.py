@@ -36,7 +36,8 @@ def _example(args: argparse.Namespace) -> tuple[api.Example, bool]:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("example", help="print a bundled example prototype (TOML) to stdout")
+    p = sub.add_parser("example", help="print or write a bundled example (a prototype, the "
+                                          "notebook), or copy an example folder")
     p.add_argument("name", nargs="?", help="which example (none: list them)")
     p.add_argument("file", nargs="?", type=Path,
                    help="write a one-file example (a prototype, the notebook) into this new "

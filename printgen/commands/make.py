@@ -23,6 +23,7 @@ from printgen.commands.common import (
     seconds,
     table,
 )
+from printgen.report.pdf import PAPERS
 from printgen.run import api
 from printgen.run.budget import DEFAULT_LIMIT_S
 from printgen.run.make import json_output
@@ -48,8 +49,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--force", action="store_true",
                    help="replace --out even when it holds files printgen did not write")
     p.add_argument("--pdf", action="store_true",
-                   help="also print report.pdf with headless Chromium (skipped, with one line, "
-                        "when Chromium is not installed)")
+                   help="also print report.pdf with a headless Chrome, Edge or Chromium "
+                        "(skipped, with one line, when none is installed)")
+    p.add_argument("--paper", choices=sorted(PAPERS), default=None,
+                   help="report.pdf's page size (default: a4)")
     add_json_arg(p)
     p.set_defaults(func=run)
 

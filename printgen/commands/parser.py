@@ -47,7 +47,7 @@ def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
     parser.add_argument("--version", action=_Version, nargs=0,
-                        help="show printgen's version (from git) and exit")
+                        help="show printgen's version, from git, and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     words = [a for a in argv or [] if not a.startswith("-") or a in ("-h", "--help")]

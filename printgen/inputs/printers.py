@@ -141,3 +141,12 @@ def check_pass(printer: Printer, bead_width_mm: float, layer_height_mm: float,
             f"{where}: layer height {layer_height_mm:.3g} mm exceeds {printer.max_layer_mm:.3g} mm "
             f"({MAX_LAYER_FRACTION} x nozzle {noz:g} mm); lower layer_height_mm in the print "
             "style or use a larger nozzle")
+
+
+def nozzle_range_mm(printer: Printer, bead_width_mm: float,
+                    layer_heights_mm: tuple[float, ...] | list[float]) -> tuple[float, float]:
+    """(smallest, largest) nozzle diameter in mm that `check_pass` accepts for these beads and
+    layers with this printer's bead factors: a layer at most MAX_LAYER_FRACTION x the nozzle,
+    a bead between min_bead_factor and max_bead_factor x it."""
+    lo = max(max(layer_heights_mm) / MAX_LAYER_FRACTION, bead_width_mm / printer.max_bead_factor)
+    return lo, bead_width_mm / printer.min_bead_factor

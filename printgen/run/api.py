@@ -234,12 +234,13 @@ def init(path: str | Path, *, force: bool = False) -> Path:
 
 
 def panel(design_file: str | Path, *, orientations: Sequence[str] | None = None,
-          mode: str = "free") -> list[PanelRun]:
+          mode: str = "free", wave: tuple[float, int] | None = None) -> list[PanelRun]:
     """The simulated tensile test of the design's printed net panel along each diagonal of
-    `orientations` (default: both), its sides `mode` free or blocked (`printgen panel`)."""
+    `orientations` (default: both), its sides `mode` free or blocked (`printgen panel`);
+    `wave` (amplitude mm, half-waves between junctions): the net with curved strands."""
     from printgen.run.panel import panel_tests
 
-    return panel_tests(design_file, tuple(orientations) if orientations else None, mode)
+    return panel_tests(design_file, tuple(orientations) if orientations else None, mode, wave)
 
 
 def testpieces(design_file: str | Path, out: str | Path, *, orientation: str = "short",

@@ -227,7 +227,7 @@ def report_pdf(ctx: MakeContext, stage: Path, progress: Callable[[str], None] | 
 
     if progress:
         progress("report.pdf (headless Chromium)")
-    skipped = print_pdf(stage / "report.html", stage / "report.pdf")
+    skipped = print_pdf(stage / "report.html", stage / "report.pdf", ctx.options.paper)
     if skipped:
         log.warning("%s", skipped)
         ctx.record["pdf_skipped"] = skipped

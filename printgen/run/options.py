@@ -27,6 +27,7 @@ class RunOptions:
     printer : printer profile (None: the prototype's [model] choice)
     step : `make` also writes STEP
     pdf : `make` also prints report.pdf
+    paper : report.pdf's page size (a key of `printgen.report.pdf.PAPERS`)
     design_file : `make` prints this design.json instead of the selection's choice
     time_limit_s : refuse runs estimated longer (s); None: each pipeline's default
     force : replace a folder printgen did not write
@@ -42,6 +43,7 @@ class RunOptions:
     printer: str | None = None
     step: bool = False
     pdf: bool = False
+    paper: str = "a4"
     design_file: str | Path | None = None
     time_limit_s: float | None = None
     force: bool = False
@@ -53,7 +55,7 @@ class RunOptions:
     def to_record(self) -> dict[str, Any]:
         """The options as JSON-ready data (paths as text, tuples as lists)."""
         return {"load": self.load, "loads": list(self.loads), "printer": self.printer,
-                "step": self.step, "pdf": self.pdf,
+                "step": self.step, "pdf": self.pdf, "paper": self.paper,
                 "design_file": None if self.design_file is None else str(self.design_file),
                 "time_limit_s": self.time_limit_s, "force": self.force,
                 "command": None if self.command is None else list(self.command),

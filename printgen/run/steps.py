@@ -121,35 +121,56 @@ def kit_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
 
 
 def slicer_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
-    """PrusaSlicer .ini for every part and CuraEngine settings for the cables."""
-    from printgen.parts.slicer.cura import cura_cfg_text
-    from printgen.parts.slicer.prusa import prusa_ini_text
+    """PrusaSlicer settings for every part (the whole config; its print and filament presets
+    alone, for the lab's own printer; all presets as one config bundle) and, for the cables,
+    CuraEngine settings, a Cura profile and its settings table."""
+    from printgen.parts.slicer.cura import (
+        cura_cfg_text,
+        cura_settings,
+        cura_table_csv,
+        curaprofile_bytes,
+    )
+    from printgen.parts.slicer.prusa import (
+        BUNDLE_FILE,
+        design_presets,
+        presets_ini_text,
+        prusa_bundle_text,
+    )
 
     d = ctx.design
     printer = load_printer(d.printer)
+    presets = design_presets(d, printer)
     written = []
     for kind, name, part in [("net", "net", d.net)] + [("cable", f"cable-{c.name}", c)
                                                        for c in d.cables]:
-        mat, style = load_material(part.material), load_print_style(part.print_style)
-        ini = stage / f"{name}.prusa.ini"
-        ini.write_text(prusa_ini_text(kind, part, printer, style, mat))
-        written.append(ini.name)
+        files = {f"{name}.prusa.ini": presets_ini_text(presets[name]),
+                 f"{name}.prusa-print.ini": presets_ini_text(presets[name],
+                                                             ("print", "filament"))}
         if kind == "cable":
-            cfg = stage / f"{name}.cura.cfg"
-            cfg.write_text(cura_cfg_text(kind, part, printer, style, mat))
-            written.append(cfg.name)
+            mat, style = load_material(part.material), load_print_style(part.print_style)
+            files[f"{name}.cura.cfg"] = cura_cfg_text(kind, part, printer, style, mat)
+            s = cura_settings(kind, part, printer, style, mat)
+            files[f"{name}.cura-settings.csv"] = cura_table_csv(s)
+            (stage / f"{name}.curaprofile").write_bytes(curaprofile_bytes(name, s))
+            written.append(f"{name}.curaprofile")
+        for file, text in files.items():
+            (stage / file).write_text(text, encoding="utf-8")  # Cura's units hold a degree sign
+        written += list(files)
+    (stage / BUNDLE_FILE).write_text(prusa_bundle_text(list(presets.values())), encoding="utf-8")
+    written.append(BUNDLE_FILE)
     ctx.files += written
-    return {"slicer_profiles": written}
+    return {"slicer_profiles": sorted(written)}
 
 
 def parts_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     """Watertight meshes of every part: STL, a 3MF carrying its PrusaSlicer settings, and
     STEP when asked (--step, needs cadquery; the progress line names each part's STEP)."""
-    from printgen.parts.slicer.prusa import prusa_ini_text
+    from printgen.parts.slicer.prusa import design_presets, presets_ini_text
 
     d = ctx.design
     printer = load_printer(d.printer)
     parts = _mesh_parts(d, printer.hole_compensation_mm)
+    presets = design_presets(d, printer)
     rec: dict[str, MeshRecord | PlateRecord] = {}
     cables = []
     for k, (name, kind, part, solid, outline, analytic) in enumerate(parts, 1):
@@ -159,14 +180,13 @@ def parts_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
         if ctx.options.step and ctx.progress:
             ctx.progress(f"STEP {name} ({k} of {len(parts)})")
         mesh = _write_part(stage, name, kind, part, body, printer,
-                           outline if ctx.options.step else None, analytic(part))
+                           outline if ctx.options.step else None, analytic(part),
+                           presets_ini_text(presets[name]))
         rec[name] = mesh
         ctx.files += mesh.files
         ctx.volumes_mm3[name] = mesh.volume_mm3
     if cables:  # every cable on one plate: one print job, with the cables' settings
-        c = d.cables[0]
-        ini = prusa_ini_text("cable", c, printer, load_print_style(c.print_style),
-                             load_material(c.material))
+        ini = presets_ini_text(presets[f"cable-{d.cables[0].name}"])
         rec["cables-plate"] = _write_plate(stage, cables, printer, ini)
         ctx.files.append("cables-plate.3mf")
     return {"parts": rec}
@@ -194,16 +214,18 @@ def _mesh_parts(d: Design, comp: float) -> list[tuple]:
 
 
 def _write_part(stage: Path, name: str, kind: str, part, body, printer, outline,
-                expected: float) -> MeshRecord:
-    """Place `body` on the bed and write its STL, 3MF (and STEP from `outline` when given);
-    its record."""
+                expected: float, ini: str | None = None) -> MeshRecord:
+    """Place `body` on the bed and write its STL, 3MF carrying the PrusaSlicer settings `ini`
+    (None: the part's own, its presets named after it alone) and STEP from `outline` when
+    given; its record."""
     from printgen.parts.export import place_mesh, prusa_config_from_ini, stl_bytes, threemf_bytes
     from printgen.parts.slicer.prusa import prusa_ini_text
     from printgen.report.records import MeshRecord
 
-    mat, style = load_material(part.material), load_print_style(part.print_style)
+    if ini is None:
+        ini = prusa_ini_text(kind, part, printer, load_print_style(part.print_style),
+                             load_material(part.material))
     mesh, angle = place_mesh(body, printer, name)
-    ini = prusa_ini_text(kind, part, printer, style, mat)
     (stage / f"{name}.stl").write_bytes(stl_bytes(mesh))
     (stage / f"{name}.3mf").write_bytes(threemf_bytes([(name, mesh)],
                                                        prusa_config_from_ini(ini)))

@@ -315,6 +315,10 @@ class DesignPanel:
     law: Law
     curve: PanelCurve
     measured: np.ndarray | None
+    # curved strands (`curved_panel`): how they are made, and the law the strand curves give
+    # the net, read as this panel reads it (N/m at curve.strains)
+    strands: str = ""
+    expected: np.ndarray | None = None
 
 
 def design_panel(d: Design, orientation: str, mode: str = "free",
@@ -334,3 +338,51 @@ def design_panel(d: Design, orientation: str, mode: str = "free",
     # pattern's panel is not that test, and gets no measured column
     same_net = pl is not None and n.pattern == TESTED_PATTERN
     return DesignPanel(orientation, t, law, curve, pl.force_per_width(eps) if same_net else None)
+
+
+def curved_panel(d: Design, orientation: str, amplitude_mm: float, half_waves: int,
+                 mode: str = "blocked", points: int = STRAIN_POINTS) -> DesignPanel:
+    """The simulated panel test of design `d`'s net printed with curved strands (its layout,
+    section and material; the wave's `amplitude_mm` and `half_waves` between junctions,
+    `printgen.barrier.patterns.curved`), loaded along its `orientation` diagonal, with the
+    net law its strand curves give (the blocked, infinite net) to compare with. The panel is
+    PRINTED_PANEL long, or longer to hold two meshes; its strains reach 1.5 x the knee."""
+    from printgen.barrier.patterns.curved import (
+        CurvedStrands,
+        blocked_membrane,
+        check_wave,
+        membrane_law,
+        strand_law,
+        stress_law,
+    )
+
+    n = d.net
+    stress, how = stress_law(load_material(n.material))
+    s = CurvedStrands(amplitude_mm, half_waves, n.strand.bead_width_mm, n.strand.beads_across,
+                      n.strand.thickness_mm, stress, how)
+    check_wave(n.pattern, s, n.mesh_x_mm, n.mesh_y_mm, "--wave")
+    along, across = panel_axes(n.mesh_x_mm * MM, n.mesh_y_mm * MM, orientation)
+    size = (max(PRINTED_PANEL[0], 2 * along), max(PRINTED_PANEL[1], 2 * across))
+    t = PanelTest(along, across, size[0], size[1], mode, n.pattern)
+    law = strand_law(n.pattern, s, along, across)
+    m = membrane_law(n.pattern, s, along, across)
+    eps = law_strains((m.knee,), points)
+    curve = simulate(law, t, eps)
+    # the strand curves' net law is the blocked, infinite net's: the free panel is another test
+    expected = (blocked_membrane(n.pattern, s, along, across, eps) * edge_share(t)
+                if mode == "blocked" else None)
+    text = (f"curved strands: {amplitude_mm:g} mm amplitude, {half_waves} half-wave(s) per "
+            f"strand, excess length {m.excess:.2%}, in-plane width {s.width_mm:g} mm bends; "
+            f"net law low {m.low_slope:.4g} N/m, straightened {m.straight_slope:.4g} N/m, "
+            f"knee {m.knee:.1%}; stress law: {how}")
+    return DesignPanel(orientation, t, law, curve, None, text, expected)
+
+
+def edge_share(t: PanelTest) -> float:
+    """Loaded strands of the panel per those of as wide a strip of the infinite net: (nx + 1)
+    / nx for a pattern whose edge columns are strands (the square: nx meshes across hold nx + 1
+    strands along the load), 1 otherwise (the diamond's strands fill its width evenly)."""
+    if not get_pattern(t.pattern).edge_strands:
+        return 1.0
+    nx = round(lattice_size(t)[1] / t.mesh_across)
+    return (nx + 1) / nx

@@ -13,6 +13,11 @@ from printgen.barrier.graph import NetGraph
 from printgen.errors import InputError
 from printgen.solver import Law  # the one force-strain law type: strain knees, force slopes (N)
 
+# Patterns built from parameters, not entries of the registry: "curved" makes a curved-strand
+# net of a layout (square or diamond) and a wave. Not a [net] or [model] pattern choice: a design
+# does not record a wave, and meshes and G-code of curved strands are not built.
+FAMILIES = ("curved",)
+
 # Prototype patterns drawn as another (the prototype file's [net] pattern), said so in the
 # verification's assumptions.
 AS_DRAWN = {"water-drop": "diamond"}

@@ -4,14 +4,28 @@ it has no Arachne, see slicers.md section 3).
 CuraEngine's CLI does not evaluate fdmprinter.def.json formulas, so every derived setting is
 given explicitly, and extruder settings (material_diameter above all) must be passed again
 after `-e0` (`cura_engine_args` does both).
+
+For Cura's GUI the same settings, less the printer's (the Machine settings, the filament
+diameter, relative extrusion and the CLI-only ones), go in a `.curaprofile` (Preferences >
+Profiles > Import) and a settings table to type in. A .curaprofile is a zip of Cura
+instance containers; Cura 4.13's importer (CuraContainerRegistry.importProfile) takes one
+global `quality_changes` container, moves its per-extruder settings to the first extruder
+and re-targets its definition to the active printer's. Its quality_type is Cura's empty
+quality, "not_supported": the only type every printer accepts and always shows
+(MachineNode.getQualityChangesGroups); the profile sets every setting it needs.
 """
 
 from __future__ import annotations
 
+import csv
+import io
 import os
+import zipfile
+from functools import cache
+from importlib import resources
 from pathlib import Path
 
-from printgen.errors import PrintabilityError
+from printgen.errors import PrintabilityError, ProfileError
 from printgen.inputs.materials import Material
 from printgen.inputs.printers import Printer, PrintStyle
 from printgen.outputs import write_text
@@ -147,3 +161,58 @@ def cura_engine_args(settings: dict[str, str], stl: str | Path, out: str | Path,
     s = [a for k, v in settings.items() for a in ("-s", f"{k}={v}")]
     return ["CuraEngine", "slice", "-v", "-j", str(Path(definitions) / "fdmprinter.def.json"),
             *s, "-e0", *s, "-l", str(stl), "-o", str(out)]
+
+
+# Cura 4.13's formats (its resources/quality/*.inst.cfg; CuraApplication.SettingVersion)
+CURA_CONTAINER_VERSION = 4
+CURA_SETTING_VERSION = 19
+CURA_QUALITY_TYPE = "not_supported"  # Cura's empty quality: importable on every printer
+CURA_DEFINITION = "fdmprinter"  # the importer re-targets it to the active printer's
+ZIP_TIME = (2020, 1, 1, 0, 0, 0)  # fixed timestamp: reproducible archives
+TABLE_COLUMNS = ("setting", "category", "label", "value", "unit")
+
+
+@cache
+def cura_profile_keys() -> dict[str, tuple[str, str, str]]:
+    """Setting -> (category, label, unit) of the settings a Cura profile carries (from
+    cura_keys.tsv, in Cura's order of the file)."""
+    text = resources.files("printgen.parts.slicer").joinpath("cura_keys.tsv").read_text("utf-8")
+    rows = [ln.split("\t") for ln in text.splitlines() if ln and not ln.startswith("#")]
+    return {r[0]: (r[1], r[2], r[3]) for r in rows}
+
+
+def cura_profile_settings(settings: dict[str, str]) -> dict[str, str]:
+    """The settings of a GUI profile: those listed in cura_keys.tsv (every other one is the
+    printer's), switches written as Cura's own files write them (True / False)."""
+    keys = cura_profile_keys()
+    return {k: {"true": "True", "false": "False"}.get(v, v)
+            for k, v in settings.items() if k in keys}
+
+
+def curaprofile_bytes(name: str, settings: dict[str, str]) -> bytes:
+    """A .curaprofile (zip of one global quality_changes container) named `name`."""
+    values = cura_profile_settings(settings)
+    if "\n" in name or not name.strip():
+        raise ProfileError(f"Cura profile name {name!r} must be one non-empty line")
+    text = "\n".join([
+        "[general]", f"version = {CURA_CONTAINER_VERSION}", f"name = {name}",
+        f"definition = {CURA_DEFINITION}", "", "[metadata]", "type = quality_changes",
+        f"quality_type = {CURA_QUALITY_TYPE}", f"setting_version = {CURA_SETTING_VERSION}", "",
+        "[values]", *(f"{k} = {v}" for k, v in values.items())]) + "\n"
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
+        entry = "".join(c if c.isalnum() else "_" for c in name.lower())
+        z.writestr(zipfile.ZipInfo(entry, ZIP_TIME), text)
+    return buf.getvalue()
+
+
+def cura_table_csv(settings: dict[str, str]) -> str:
+    """The profile's settings as a table to type into Cura (setting, category, label, value,
+    unit), one header row."""
+    keys = cura_profile_keys()
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(TABLE_COLUMNS)
+    w.writerows((k, *keys[k][:2], v, keys[k][2])
+                for k, v in cura_profile_settings(settings).items())
+    return buf.getvalue()
