@@ -1,10 +1,10 @@
 """Build hook (the metadata is in pyproject.toml): the wheel ships the repository's top-level
-`profiles/` (the bundled material, printer and print profiles) and the example prototypes
-`examples/*.toml` with the example folders of data files (`examples/paper_1_40/`: the paper's
-printed design and its measured test) inside the package, as `printgen/profiles/` and
-`printgen/examples/`, where
-`printgen.inputs.profiles.bundled_dir` reads them with importlib.resources. An editable
-install reads them where they are kept, at the root of the checkout."""
+`profiles/` (the bundled material, printer and print profiles), the example prototypes
+`examples/*.toml`, the example notebook `examples/*.ipynb` and the example folders of data files
+(`examples/paper_1_40/`: the paper's printed design and its measured test) inside the package,
+as `printgen/profiles/` and `printgen/examples/`, where `printgen.inputs.profiles.bundled_dir`
+reads them with importlib.resources. An editable install reads them where they are kept, at the
+root of the checkout."""
 
 from pathlib import Path
 
@@ -12,7 +12,8 @@ from setuptools import setup
 from setuptools.command.build_py import build_py
 
 SHIPPED = {"profiles": ("*/*.toml",),  # folder -> the files copied from it
-           "examples": ("*.toml", "paper_1_40/*.json", "paper_1_40/*.csv", "calibration/*.toml")}
+           "examples": ("*.toml", "*.ipynb", "paper_1_40/*.json", "paper_1_40/*.csv",
+                        "calibration/*.toml")}
 
 
 class BuildWithData(build_py):

@@ -18,16 +18,25 @@ The public verbs (`printgen.run.api`), imported on first use so `import printgen
 - ``testpieces(design_file, out)`` -> the record of the test pieces written in `out`
 - ``examples()`` -> the bundled examples; ``example(name, out=None)`` -> `Example`
 - ``init(path)`` -> the prototype template written at `path`
+
+Plot helpers (`printgen.report.figures`, the `plot` extra), each returning a matplotlib Figure
+or drawing on the `ax` given:
+
+- ``plot_curves(result, ax=None, metric=None)``: prototype vs model against h/h_B
+- ``plot_net(design, ax=None)``: the printed net's strands
+
+Every result has a short repr and a notebook table; `Verification`, `make`'s and
+`verify_design`'s results give their curves as ``curves_table()`` (pandas, the `table` extra)
+or ``curve_rows()`` (dicts).
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-__version__ = "0.1.0"
-
 VERBS = ("targets", "select", "plan", "make", "verify", "verify_design", "calibrate",
          "search_nets", "series", "panel", "testpieces", "examples", "example", "init")
+PLOTS = ("plot_curves", "plot_net")  # printgen.report.figures
 __all__ = [
     "__version__",
     "calibrate",
@@ -37,6 +46,8 @@ __all__ = [
     "make",
     "panel",
     "plan",
+    "plot_curves",
+    "plot_net",
     "search_nets",
     "select",
     "series",
@@ -47,6 +58,8 @@ __all__ = [
 ]
 
 if TYPE_CHECKING:
+    __version__: str
+    from printgen.report.figures import plot_curves, plot_net
     from printgen.run.api import (
         calibrate,
         example,
@@ -66,12 +79,20 @@ if TYPE_CHECKING:
 
 
 def __getattr__(name: str) -> Any:
+    if name == "__version__":  # from git or the package's metadata (`printgen.version`)
+        from printgen.version import version
+
+        return version()
     if name in VERBS:
         from printgen.run import api
 
         return getattr(api, name)
+    if name in PLOTS:
+        from printgen.report import figures
+
+        return getattr(figures, name)
     raise AttributeError(f"module 'printgen' has no attribute {name!r}")
 
 
 def __dir__() -> list[str]:
-    return sorted([*globals(), *VERBS])
+    return sorted([*globals(), *VERBS, *PLOTS, "__version__"])

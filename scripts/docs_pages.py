@@ -125,10 +125,10 @@ def api_page() -> str:
            GENERATED.format(source="printgen.__all__ and the verbs' docstrings"), "",
            "The public verbs of `import printgen` (the names of `printgen.__all__`). Each "
            "returns the dataclasses the command line prints; the [user guide]"
-           "(user-guide.md#python-api) maps each command to its call. A script that runs "
-           "`make`, `verify` or a search keeps its calls under "
-           '`if __name__ == "__main__":` (the worker processes start by importing it on macOS '
-           "and Windows).", ""]
+           "(user-guide.md#python-api) maps each command to its call, and shows the results' "
+           "tables and the plot helpers in a notebook. A script that runs `make`, `verify` or a "
+           'search keeps its calls under `if __name__ == "__main__":` (on macOS and Windows '
+           "the worker processes start by running it again).", ""]
     for _, home in api_entries():
         out += [f"::: {home}", ""]
     return "\n".join(out)

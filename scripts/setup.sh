@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Set up printgen on a fresh Debian 12 machine: system slicers and chromium (when root), a venv
-# in .venv, and printgen with its extras. Safe to run again: it skips what is already there.
+# in .venv, and printgen with the `all` extra (every feature, no test tools: scripts/test.sh adds
+# the `test` extra). Safe to run again: it skips what is already there.
 # Usage: bash scripts/setup.sh [--with-slicers]
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -3,10 +3,13 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh --with-slicers
-# The STEP tests need cadquery (the `cad` extra, ~250 MB): the suite installs it, demo.sh does not.
-if ! .venv/bin/python -c "import cadquery" 2>/dev/null; then
-  .venv/bin/python -m pip install -q -e ".[all,cad]" >.venv/setup-cad.log 2>&1 \
-    || { cat .venv/setup-cad.log >&2; echo "test: installing the cad extra failed" >&2; exit 1; }
+# The test tools (the `test` extra: pytest, ruff, mypy, nbclient, setuptools-scm, ...) and
+# cadquery for the STEP tests (the `cad` extra, ~250 MB): the suite installs them, setup.sh (what
+# demo.sh runs) does not.
+if ! .venv/bin/python -c "import cadquery, pytest, nbclient, setuptools_scm" 2>/dev/null; then
+  .venv/bin/python -m pip install -q -e ".[all,test,cad]" >.venv/setup-test.log 2>&1 \
+    || { cat .venv/setup-test.log >&2; echo "test: installing the test and cad extras failed" >&2
+         exit 1; }
 fi
 # The documentation site's strict build (tests/test_docs.py) needs the `docs` extra, outside `all`.
 if ! .venv/bin/python -c "import mkdocs, material, mkdocstrings_handlers.python" 2>/dev/null; then

@@ -15,7 +15,7 @@ from conftest import ROOT
 # Rank of each part of printgen: a module may import only parts of equal or lower rank.
 RANK = {
     "solver": 0,  # the cable-net solver: numpy and scipy only, nothing else of printgen
-    "errors": 0, "units": 0, "outputs": 0, "executor": 0, "trace": 0,  # ground floor
+    "errors": 0, "units": 0, "outputs": 0, "executor": 0, "trace": 0, "version": 0,  # ground floor
     "inputs": 1,
     "barrier": 1,  # beside inputs: the net patterns and load cases, as data
     "calibrate": 2,  # tensile exports -> material profiles: feeds inputs, sits beside scaling

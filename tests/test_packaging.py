@@ -86,8 +86,8 @@ def test_example_folder_is_copied_whole(tmp_path, capsys):
 
 def test_unknown_example_exits_2(capsys):
     assert main(["example", "nope"]) == 2
-    assert ("no example named 'nope'; examples: realistic, simple, calibration, paper_1_40"
-            in capsys.readouterr().err)
+    assert ("no example named 'nope'; examples: realistic, simple, calibration, paper_1_40, "
+            "notebook" in capsys.readouterr().err)
 
 
 def test_version(capsys):
@@ -123,3 +123,20 @@ def test_example_and_init_take_json(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["text"].startswith("#")
     assert main(["init", str(tmp_path / "p.toml"), "--json"]) == 0
     assert json.loads(capsys.readouterr().out) == {"written": str(tmp_path / "p.toml")}
+
+
+def test_example_file_writes_a_one_file_example(tmp_path, capsys):
+    """`printgen example NAME FILE`: no shell redirect needed; never over a file, never for a
+    folder of files, never with --out too."""
+    proto = tmp_path / "proto.toml"
+    assert main(["example", "realistic", str(proto)]) == 0
+    assert proto.read_bytes() == (ROOT / "examples/realistic_barrier.toml").read_bytes()
+    assert capsys.readouterr().out.strip() == str(proto)
+    assert main(["example", "simple", str(proto)]) == 2
+    assert f"{proto} exists; name a new file" in capsys.readouterr().err
+    assert main(["example", "paper_1_40", str(tmp_path / "p.toml")]) == 2
+    assert "is a folder of files; copy it with `printgen example paper_1_40 --out DIR`" in \
+        capsys.readouterr().err
+    assert main(["example", "simple", str(tmp_path / "s.toml"), "--out", str(tmp_path / "o")]) == 2
+    assert "give FILE or --out DIR, not both" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["proto.toml"]

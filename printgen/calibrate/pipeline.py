@@ -40,6 +40,7 @@ from printgen.calibrate.specimen import (
 from printgen.calibrate.windows import machine_warning, window_warnings
 from printgen.errors import CalibrationError
 from printgen.inputs.profiles import profile_name
+from printgen.outputs.display import Shown, Summary
 
 log = logging.getLogger(__name__)
 
@@ -69,9 +70,9 @@ class PanelLawFit:
     panel_width: float | None  # m
 
 
-@dataclass(frozen=True)
-class Calibration:
-    """Everything measured for one material and specimen type."""
+@dataclass(frozen=True, repr=False)
+class Calibration(Shown):
+    """Everything measured for one material and specimen type (shown by its statistics)."""
 
     material: str
     kind: str
@@ -99,6 +100,24 @@ class Calibration:
     @property
     def strain_sources(self) -> tuple[str, ...]:
         return tuple(dict.fromkeys(s.strain_source for s in self.samples))
+
+    def summary(self) -> Summary:
+        """The modulus, strength and elongation (mean, sd, n) and the warnings."""
+        panel = self.kind == "panel"  # N/m per unit width, else Pa shown in MPa
+        unit, f = ("N/m", 1.0) if panel else ("MPa", 1e-6)
+
+        def stats(s: Stats | None, unit: str, f: float) -> str:
+            if s is None:
+                return "-"
+            sd = "" if s.sd is None else f" +- {s.sd * f:.3g}"
+            return f"{s.mean * f:.4g}{sd} {unit} (n = {s.n})"
+
+        rows = [("files", f"{len(self.files)} ({len(self.excluded)} left out)"),
+                ("modulus", stats(self.modulus, unit, f)),
+                ("strength", stats(self.strength, unit, f)),
+                ("elongation at break", stats(self.elongation, "%", 100.0))]
+        rows += [("warning", w) for w in self.warnings]
+        return Summary(f"Calibration: {self.material} ({self.kind})", tuple(rows))
 
 
 def calibrate(paths: Sequence[str | Path], *, material: str, options: FitOptions | None = None,

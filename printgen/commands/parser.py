@@ -8,6 +8,7 @@ import argparse
 import importlib
 import logging
 import re
+import sys
 from typing import NoReturn
 
 import printgen
@@ -27,6 +28,15 @@ class Parser(argparse.ArgumentParser):
         raise UsageError(f"{self.prog}: error: {message}; see `{self.prog} --help`")
 
 
+class _Version(argparse.Action):
+    """`--version`: the version is looked up only when asked (in a checkout it runs git)."""
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace,
+                 values: object, option_string: str | None = None) -> None:
+        sys.stdout.write(f"printgen {printgen.__version__}\n")  # stdout, as argparse's own
+        parser.exit()
+
+
 def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
     """The parser of every command, or with `argv` naming one (its first word that is not an
     option) of that command alone: the others' imports (scipy.optimize for calibrate, ...)
@@ -36,7 +46,8 @@ def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
         description="Stiffness-scaled, printable flexible-barrier models for flume experiments.",
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
-    parser.add_argument("--version", action="version", version=f"printgen {printgen.__version__}")
+    parser.add_argument("--version", action=_Version, nargs=0,
+                        help="show printgen's version, from git, and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     words = [a for a in argv or [] if not a.startswith("-") or a in ("-h", "--help")]

@@ -156,6 +156,10 @@ def watch_is_safe() -> Iterator[None]:
         yield
 
 
+# Why a start method runs the main script again in each worker (`start_method` picks them)
+RERUNS = {"spawn": "how workers start on macOS and Windows",
+          "forkserver": "how workers start on Linux from a process running threads, and on "
+                        "other Unix systems"}
 _GUARD = re.compile(r"""^\s*if\s+__name__\s*==\s*["']__main__["']\s*:""", re.MULTILINE)
 
 
@@ -179,7 +183,7 @@ def check_main_guard(method: str) -> None:
         return
     if not _GUARD.search(text):
         raise InputError(f"{path} runs printgen's parallel work, whose worker processes start "
-                         f"by running this script again ({method}: macOS and Windows start "
-                         "them so): put the script's calls under `if __name__ == \"__main__\":` "
-                         "(printgen docs: Python API), or set PRINTGEN_SERIAL=1 to run in one "
-                         "process")
+                         f"by running this script again ({method}: {RERUNS.get(method, method)})"
+                         ": put the script's calls under `if __name__ == \"__main__\":` (see "
+                         "the Python API section of docs/user-guide.md), or set "
+                         "PRINTGEN_SERIAL=1 to run in one process")

@@ -1,6 +1,7 @@
 """The bundled examples: example prototypes (`realistic_barrier.toml` is the example
-`realistic`) and example folders of data files (the paper's printed design and its measured
-test), from the package data or the checkout's examples/."""
+`realistic`), example folders of data files (the paper's printed design and its measured
+test) and the notebook that walks the 1:40 barrier through the Python API (`notebook`), from
+the package data or the checkout's examples/."""
 
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ from printgen.inputs.profiles import bundled_dir
 from printgen.outputs.files import write_bytes
 
 SUFFIX = "_barrier"  # realistic_barrier.toml is the example `realistic`
+NOTEBOOK = ("notebook", "realistic_1_40.ipynb")  # (its example name, its file)
 DATA_SUFFIXES = {".json", ".csv", ".toml"}  # what an example folder holds
 
 
@@ -31,6 +33,12 @@ class Example:
         """A folder of data files, not one prototype file."""
         return self.path.is_dir()
 
+    @property
+    def default_file(self) -> str | None:
+        """The file `printgen example NAME` writes without FILE (the notebook's name), or
+        None: the example is printed."""
+        return NOTEBOOK[1] if self.name == NOTEBOOK[0] else None
+
 
 def examples() -> dict[str, Path]:
     """Example name -> its TOML file or its folder of data files; InputError when none is
@@ -39,6 +47,8 @@ def examples() -> dict[str, Path]:
     files = sorted(root.glob("*.toml"))
     folders = sorted(d for d in root.glob("*") if d.is_dir() and example_files(d))
     found = {f.stem.removesuffix(SUFFIX): f for f in files} | {d.name: d for d in folders}
+    if (root / NOTEBOOK[1]).is_file():
+        found[NOTEBOOK[0]] = root / NOTEBOOK[1]
     if not found:
         raise InputError(f"no example prototypes in {root}; reinstall printgen")
     return found
@@ -49,10 +59,14 @@ def example_files(folder: Path) -> list[Path]:
     return sorted(f for f in folder.iterdir() if f.suffix in DATA_SUFFIXES and f.is_file())
 
 
-def example(name: str, out: str | Path | None = None) -> Example:
+def example(name: str, out: str | Path | None = None, *,
+            file: str | Path | None = None) -> Example:
     """The example `name` (its file name, with or without .toml and `SUFFIX`, also names it);
-    with `out`, its files copied into that new folder (`copy_example`). InputError naming the
-    examples when there is none of that name."""
+    with `out`, its files copied into that new folder (`copy_example`); with `file`, a one-file
+    example written into that new file (`write_example`). InputError naming the examples when
+    there is none of that name, or for `out` and `file` both."""
+    if out is not None and file is not None:  # before anything is copied
+        raise InputError("give FILE or --out DIR, not both")
     found = examples()
     key = name.lower().removesuffix(".toml").removesuffix(SUFFIX)
     if key not in found:
@@ -61,7 +75,22 @@ def example(name: str, out: str | Path | None = None) -> Example:
     files = example_files(path) if path.is_dir() else [path]
     if out is not None:
         files = copy_example(path, Path(out))
-    return Example(key, path, tuple(files))
+    ex = Example(key, path, tuple(files))
+    if file is not None:
+        return Example(key, path, (write_example(ex, file),))
+    return ex
+
+
+def write_example(ex: Example, file: str | Path) -> Path:
+    """The single-file example `ex` (a prototype, the notebook) written, byte for byte, into
+    the new file `file`; InputError for a folder of files or a `file` that exists."""
+    path = Path(file)
+    if ex.is_folder:
+        raise InputError(f"example {ex.name} is a folder of files; copy it with "
+                         f"`printgen example {ex.name} --out DIR`")
+    if path.exists() or path.is_symlink():
+        raise InputError(f"{path} exists; name a new file")
+    return write_bytes(path, ex.path.read_bytes())
 
 
 def copy_example(src: Path, out: Path) -> list[Path]:

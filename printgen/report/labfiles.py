@@ -22,20 +22,13 @@ from printgen.scene.readings import DEPTH_COLUMN, RAW_COLUMNS, flume_units
 from printgen.units import MM
 from printgen.verification.bands import Band
 from printgen.verification.compare import METRICS
-from printgen.verification.measured import COLUMNS, LEVEL_COLUMN
+from printgen.verification.measured import LEVEL_COLUMN
 from printgen.verification.preprint import Verification
+from printgen.verification.tables import CURVE_COLUMNS, curve_column, nearest
 
 DIGITS = 8  # significant digits of every number in the CSV files
 NOISE = 1e-6  # |value| below this (in the column's unit: %, mm, N, kN or -) is written as 0
 CURVES, READINGS, SHEET = "curves.csv", "expected-readings.csv", "measurement-sheet.csv"
-# METRICS key -> (CSV stem with its unit, factor from the record's unit)
-CURVE_COLUMNS = {key: (col, 100.0 if col.endswith("_pct") else 1.0)
-                 for col, (key, _) in COLUMNS.items()}
-
-
-def _levels_of(levels: np.ndarray, keep: np.ndarray) -> np.ndarray:
-    """Indices into `levels` of each value of `keep` (the band's levels are the sweep's)."""
-    return np.array([int(np.argmin(np.abs(levels - x))) for x in keep], dtype=int)
 
 
 def lab_record(v: Verification, band: Band, scale: float) -> dict[str, Any]:
@@ -43,8 +36,8 @@ def lab_record(v: Verification, band: Band, scale: float) -> dict[str, Any]:
     flume units at the band's levels; the record of report.json's "lab"."""
     units = flume_units(v.model.scene)
     lv = band.levels
-    ip = _levels_of(v.prototype.deformation.levels, lv)
-    im = _levels_of(v.model.deformation.levels, lv)
+    ip = nearest(v.prototype.deformation.levels, lv)
+    im = nearest(v.model.deformation.levels, lv)
     p, m = v.prototype.deformation, v.model.deformation
     lo, hi = band.envelope()
     lo0, hi0 = band.envelope(from_start=True)
@@ -108,7 +101,7 @@ def curves_csv(lab: dict[str, Any]) -> str:
     header, cols = [LEVEL_COLUMN], [c["levels"]]
     for key, (stem, f) in CURVE_COLUMNS.items():
         for who in ("prototype", "model", "band_min", "band_max"):
-            header.append(f"{stem.removesuffix('_pct')}_{who}" + ("_pct" if f != 1 else ""))
+            header.append(curve_column(stem, who))
             cols.append(np.asarray(c[key][who]) * f)
     for name, values in c["tension"].items():
         header.append(f"max_{name}")

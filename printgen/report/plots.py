@@ -86,20 +86,20 @@ def verification_figure(proto: Deformation, model: Deformation, scale: float,
     """Normalised deformations of prototype and model against relative loading, 2 x 3 panels;
     the model's uncertainty band (min/max envelope) shaded when given."""
     plt = _pyplot()
-    keys = [k for k in METRICS if _shows(proto.values[k]) or _shows(model.values[k])]
     fig, axes = plt.subplots(2, 3, figsize=(12, 6.6), constrained_layout=True)
-    lo, hi = band.envelope() if band is not None else ({}, {})
+    draw_verification(axes, proto, model, scale, band)
+    fig.suptitle(title)
+    return _png(fig)
+
+
+def draw_verification(axes, proto: Deformation, model: Deformation, scale: float,
+                      band: Band | None = None) -> None:
+    """The 2 x 3 `axes` of `verification_figure`: each curve that shows (`draw_metric`), then
+    the largest tensions at prototype scale."""
+    keys = [k for k in METRICS if _shows(proto.values[k]) or _shows(model.values[k])]
+    envelope = band.envelope() if band is not None else None
     for ax, key in zip(axes.flat, keys, strict=False):
-        label, f = AXIS[key]
-        if band is not None:
-            ax.fill_between(band.levels, lo[key] * f, hi[key] * f, color="C1", alpha=0.25,
-                            lw=0, label="model band")
-        ax.plot(proto.levels, proto.values[key] * f, "k-o", ms=3, label="prototype")
-        ax.plot(model.levels, model.values[key] * f, "C1-s", ms=3, label=f"model 1:{scale:g}")
-        ax.set_xlabel(LOADING)
-        ax.set_ylabel(label)
-        ax.set_title(METRICS[key].split(" (")[0], fontsize=10)
-        ax.grid(alpha=0.3)
+        draw_metric(ax, key, proto, model, scale, band, envelope)
     for ax in axes.flat[len(keys):-1]:
         ax.set_axis_off()
     ax = axes.flat[-1]
@@ -117,8 +117,24 @@ def verification_figure(proto: Deformation, model: Deformation, scale: float,
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
     axes.flat[0].legend(fontsize=8)
-    fig.suptitle(title)
-    return _png(fig)
+
+
+def draw_metric(ax, key: str, proto: Deformation, model: Deformation, scale: float,
+                band: Band | None = None, envelope: tuple[dict, dict] | None = None) -> None:
+    """Curve `key` (a METRICS key, strains in %) of prototype and model against relative
+    loading on `ax`, the band's min/max envelope shaded when given (`envelope`: the band's,
+    when already computed)."""
+    label, f = AXIS[key]
+    if band is not None:
+        lo, hi = envelope or band.envelope()
+        ax.fill_between(band.levels, lo[key] * f, hi[key] * f, color="C1", alpha=0.25,
+                        lw=0, label="model band")
+    ax.plot(proto.levels, proto.values[key] * f, "k-o", ms=3, label="prototype")
+    ax.plot(model.levels, model.values[key] * f, "C1-s", ms=3, label=f"model 1:{scale:g}")
+    ax.set_xlabel(LOADING)
+    ax.set_ylabel(label)
+    ax.set_title(METRICS[key].split(" (")[0], fontsize=10)
+    ax.grid(alpha=0.3)
 
 
 def _shows(curve: np.ndarray) -> bool:

@@ -215,12 +215,14 @@ def examples() -> dict[str, Path]:
     return _examples()
 
 
-def example(name: str, out: str | Path | None = None) -> Example:
+def example(name: str, out: str | Path | None = None, *,
+            file: str | Path | None = None) -> Example:
     """The bundled example `name` and its files, copied into the new folder `out` when
-    given (`printgen example NAME --out DIR`)."""
+    given (`printgen example NAME --out DIR`), or a one-file example (a prototype, the
+    notebook) written into the new `file` (`printgen example NAME FILE`)."""
     from printgen.inputs.examples import example as _example
 
-    return _example(name, out)
+    return _example(name, out, file=file)
 
 
 def init(path: str | Path, *, force: bool = False) -> Path:

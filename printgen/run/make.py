@@ -24,13 +24,14 @@ from pathlib import Path
 from typing import Any
 
 from printgen.barrier.loads import distinct_specs, get_load
-from printgen.errors import TimeLimitError
+from printgen.errors import InputError, TimeLimitError
 from printgen.executor.local import Helper, check_deadline, deadline, helper
 from printgen.executor.signals import signals_deferred
 from printgen.executor.start import cores, quiet_tracker, warm_up
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import MANIFEST, TIMINGS, check_destination, staged_dir
+from printgen.outputs.display import Shown, Summary
 from printgen.report.build import build_report, report_files
 from printgen.report.html import Report
 from printgen.report.jsonout import dumps
@@ -50,6 +51,7 @@ from printgen.run.provenance import (  # noqa: F401 (json_output, TIME_KEYS: use
     json_output,
     provenance,
 )
+from printgen.run.shown import make_summary
 from printgen.run.steps import (
     draw_figures,
     gcode_step,
@@ -67,6 +69,9 @@ from printgen.scaling.record import Design
 from printgen.scaling.selection import Selection, design_net, select
 from printgen.scaling.similitude import ScaledTargets, scale_targets
 from printgen.trace import span
+from printgen.verification.bands import Band
+from printgen.verification.preprint import Verification
+from printgen.verification.tables import CurveTable
 
 log = logging.getLogger(__name__)
 # what the workers' jobs import (the verification's sweeps, the report's figures): a fork
@@ -76,8 +81,8 @@ log = logging.getLogger(__name__)
 JOB_MODULES = ("printgen.run.steps", "printgen.verification.pooled", "printgen.report.plots")
 
 
-@dataclass
-class MakeContext:
+@dataclass(repr=False)
+class MakeContext(Shown, CurveTable):
     """What the steps share: inputs, the chosen design, the run's records (`records`: the
     plan's and each step's, as objects) and `record`, their records as report.json holds
     them (written by `make` only); `timings`, the run's wall-clock times (timings.json);
@@ -98,6 +103,16 @@ class MakeContext:
     helper: Helper | None = None  # the helper process of the run (`verification_ahead`)
     toolpaths: dict[str, Any] = field(default_factory=dict)  # per part, built once per run
     volumes_mm3: dict[str, float] = field(default_factory=dict)  # per part's mesh (parts step)
+
+    def summary(self) -> Summary:
+        return make_summary(self)
+
+    def curve_source(self) -> tuple[Verification, Band | None]:
+        """The run's verification and its band; InputError when the run checked nothing."""
+        check = self.records.check
+        if check is None:
+            raise InputError("this make run has no verification (its steps left it out)")
+        return check.verification, check.band
 
 
 Step = Callable[[MakeContext, Path], dict[str, Any]]  # its records, by report.json key

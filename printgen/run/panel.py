@@ -9,6 +9,7 @@ from pathlib import Path
 
 from printgen.errors import InputError
 from printgen.inputs.materials import load_material
+from printgen.outputs.display import Shown, Summary
 from printgen.scaling.design_file import load_design
 from printgen.scaling.reading import Reading, panel_reading
 from printgen.scene.panel import MODES, DesignPanel, curved_panel, design_panel, panel_lockup
@@ -17,8 +18,8 @@ from printgen.scene.scenes import ORIENTATIONS
 __all__ = ["MODES", "ORIENTATIONS", "PanelRun", "panel_tests", "wave_of"]
 
 
-@dataclass(frozen=True)
-class PanelRun:
+@dataclass(frozen=True, repr=False)
+class PanelRun(Shown):
     """One simulated panel test: the test and its curve (`panel`), the panel strain at
     which the strands lie along the load (`lockup`, a fraction) and how the material's panel
     law is read (`reading`: each diagonal's checks and the one chosen; None without one)."""
@@ -26,6 +27,14 @@ class PanelRun:
     panel: DesignPanel
     lockup: float
     reading: Reading | None = None
+
+    def summary(self) -> Summary:
+        t = self.panel.test
+        return Summary(f"PanelRun: {self.panel.orientation} diagonal, sides {t.mode}",
+                       (("mesh along x across", f"{t.mesh_along * 1e3:.3g} x "
+                                                f"{t.mesh_across * 1e3:.3g} mm"),
+                        ("panel", f"{t.length * 1e3:.3g} mm long, {t.width * 1e3:.3g} mm wide"),
+                        ("strands along the load at", f"{self.lockup:.1%} strain")))
 
 
 def wave_of(amplitude_mm: float | None, half_waves: int | None) -> tuple[float, int] | None:

@@ -27,10 +27,12 @@ from printgen.executor import open_runner
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import check_destination, write_folder
+from printgen.outputs.display import Shown, Summary
 from printgen.report.jsonout import dumps
 from printgen.run.budget import DESIGN_LIMIT_S, check_design_budget, run_cores
 from printgen.run.options import RunOptions
 from printgen.run.provenance import provenance_record
+from printgen.run.shown import design_summary
 from printgen.scaling.similitude import ScaledTargets, scale_targets
 from printgen.search.nets import (
     SearchResult,
@@ -96,14 +98,17 @@ class SearchOptions:
     level_step: float | None = None
 
 
-@dataclass
-class DesignRun:
+@dataclass(repr=False)
+class DesignRun(Shown):
     """The searches of one call, where they ran and what was written."""
 
     results: list[SearchResult]
     where: str
     record: dict = field(default_factory=dict)
     files: list[str] = field(default_factory=list)
+
+    def summary(self) -> Summary:
+        return design_summary(self)
 
 
 def space_for(p: Prototype, scale: float, o: SearchOptions) -> SearchSpace:

@@ -22,11 +22,13 @@ from printgen.executor import open_runner
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import TIMINGS, check_destination, write_folder
+from printgen.outputs.display import Shown, Summary
 from printgen.report.jsonout import dumps
 from printgen.report.series import series_csv, series_figure, series_report
 from printgen.run.budget import DEFAULT_LIMIT_S, check_series_budget, run_cores
 from printgen.run.options import RunOptions
 from printgen.run.provenance import provenance_record
+from printgen.run.shown import series_summary
 from printgen.scene.scenes import SENSOR_FORCE_N
 from printgen.verification.series import (
     LEVEL,
@@ -45,8 +47,8 @@ from printgen.verification.series_table import Series, summarise
 PARALLEL_FROM = 12  # cases from which the series runs on this machine's workers by default
 
 
-@dataclass
-class SeriesRun:
+@dataclass(repr=False)
+class SeriesRun(Shown):
     """What `printgen series` computed, where it ran and what it wrote."""
 
     series: Series
@@ -54,6 +56,9 @@ class SeriesRun:
     where: str
     record: dict = field(default_factory=dict)
     files: list[str] = field(default_factory=list)
+
+    def summary(self) -> Summary:
+        return series_summary(self)
 
 
 def run_series(prototype: str | Path | Prototype, scales: list[float], *,

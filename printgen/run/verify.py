@@ -20,6 +20,7 @@ from printgen.inputs.materials import load_material
 from printgen.inputs.profiles import profile_name, search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import TIMINGS, check_destination, staged_dir
+from printgen.outputs.display import Shown, Summary
 from printgen.report.build import build_report, report_files
 from printgen.report.jsonout import dumps
 from printgen.report.records import CheckRecords, MeasuredRecords, RunRecords
@@ -33,6 +34,7 @@ from printgen.run.budget import (
 )
 from printgen.run.options import RunOptions
 from printgen.run.provenance import provenance_record
+from printgen.run.shown import verify_summary
 from printgen.scaling.design_file import load_design
 from printgen.scaling.record import Design
 from printgen.scaling.selection import design_net
@@ -60,13 +62,14 @@ from printgen.verification.measured import (
 )
 from printgen.verification.pooled import verify_with_band
 from printgen.verification.preprint import Verification, free_section
+from printgen.verification.tables import CurveTable
 
 # what the workers' jobs import (the sweeps, the figures): a fork server imports them once
 JOB_MODULES = ("printgen.verification.pooled", "printgen.report.plots")
 
 
-@dataclass
-class VerifyRun:
+@dataclass(repr=False)
+class VerifyRun(Shown, CurveTable):
     """What `printgen verify` computed and wrote: `record` is report.json's with the run's
     timings under "timings_s" (`--json`'s output); `records`, the objects it came from."""
 
@@ -80,6 +83,12 @@ class VerifyRun:
     record: dict[str, Any]
     files: list[str]
     records: RunRecords | None = None
+
+    def summary(self) -> Summary:
+        return verify_summary(self)
+
+    def curve_source(self) -> tuple[Verification, Band | None]:
+        return self.verification, self.band
 
 
 def verify_design(prototype: str | Path, scale: float, design_path: str | Path,

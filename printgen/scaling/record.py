@@ -10,6 +10,8 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING, Any
 
+from printgen.outputs.display import Shown, Summary
+
 if TYPE_CHECKING:
     from printgen.barrier.graph import NetGraph
 
@@ -102,9 +104,10 @@ class CableDesign:
     eyelet_outer_mm: float
 
 
-@dataclass(frozen=True)
-class Design:
-    """A complete printable model at scale 1/lambda on one printer."""
+@dataclass(frozen=True, repr=False)
+class Design(Shown):
+    """A complete printable model at scale 1/lambda on one printer (shown by its net and
+    cables; `to_dict()` holds everything)."""
 
     scale: float
     printer: str
@@ -118,6 +121,17 @@ class Design:
         if self.net.wave is None:
             del rec["net"]["wave"]
         return rec
+
+    def summary(self) -> Summary:
+        n, s = self.net, self.net.strand
+        rows = [("printer", self.printer),
+                ("net", f"{n.material} {n.pattern}, {n.width_mm:g} x {n.height_mm:g} mm, mesh "
+                        f"{n.mesh_x_mm:g} x {n.mesh_y_mm:g} mm, strand {s.width_mm:g} x "
+                        f"{s.thickness_mm:g} mm ({s.passes} passes), print {n.print_style}")]
+        rows += [(f"{c.name} cable", f"{c.material}, {c.length_mm:g} mm, {c.section.width_mm:g} "
+                                     f"x {c.section.thickness_mm:g} mm ({c.section.passes} "
+                                     "passes)") for c in self.cables]
+        return Summary(f"Design at 1:{self.scale:g}", tuple(rows))
 
     @classmethod
     def from_record(cls, rec: Any, *, where: str = "design record") -> Design:

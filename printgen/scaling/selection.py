@@ -22,6 +22,7 @@ from printgen.inputs.laws import piecewise_linear
 from printgen.inputs.materials import Material, load_material, material_names
 from printgen.inputs.printers import Printer, PrintStyle, check_pass, load_print_style, load_printer
 from printgen.inputs.prototype import Prototype
+from printgen.outputs.display import Shown, Summary
 from printgen.scaling.reading import PROTOTYPE_ORIENTATION, panel_axes, panel_reading
 from printgen.scaling.record import NetDesign, Section
 from printgen.scaling.section import (
@@ -139,7 +140,7 @@ def _ratio(got: float | None, want: float | None) -> float | None:
 
 
 @dataclass(frozen=True)
-class Selection:
+class Selection(Shown):
     """Ranked candidates (best first) and the rationale for each winner."""
 
     cables: tuple[Candidate, ...]
@@ -162,6 +163,16 @@ class Selection:
         return (f"Selection(printer {self.printer!r}, {self.net_mesh or 'net'}\n"
                 f"  net ({len(self.net)} ranked): {self.net[0]!r}\n"
                 f"  cables ({len(self.cables)} ranked): {cable})")
+
+    def summary(self) -> Summary:
+        """The winners, how many were ranked and why (the notebook's table)."""
+        cable = repr(self.cables[0]) if self.cables else "none (no border cables)"
+        return Summary(f"Selection (printer {self.printer})",
+                       (("net", self.net_mesh or "-"),
+                        (f"net, best of {len(self.net)}", repr(self.net[0])),
+                        ("why", self.net_rationale),
+                        (f"cables, best of {len(self.cables)}", cable),
+                        ("why", self.cable_rationale)))
 
     def to_record(self) -> dict:
         """JSON-ready record of the ranked selection (stable keys)."""

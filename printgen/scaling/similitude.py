@@ -14,6 +14,7 @@ from typing import Any
 from printgen.barrier.patterns import get_pattern
 from printgen.errors import InputError
 from printgen.inputs.prototype import Prototype
+from printgen.outputs.display import Shown, Summary
 from printgen.scaling.flow import (  # noqa: F401 (RE_TURBULENT: also read from here)
     RE_TURBULENT,
     FlowCheck,
@@ -36,8 +37,8 @@ class TargetRow:
     model: float
 
 
-@dataclass(frozen=True)
-class ScaledTargets:
+@dataclass(frozen=True, repr=False)
+class ScaledTargets(Shown):
     """Targets of the model at 1/scale; `rows` keyed by `TargetRow.key` in `values`."""
 
     scale: float
@@ -57,6 +58,17 @@ class ScaledTargets:
         """Every warning of the targets: the model flow's (the flume's limits among them),
         then the printed mesh's."""
         return self.flow.warnings + self.mesh_warnings
+
+    def summary(self) -> Summary:
+        """Each target (model value, prototype value), the model flow and the warnings."""
+        f = self.flow
+        rows = [(r.label, f"{r.model:.4g} {r.unit} (prototype {r.prototype:.4g})")
+                for r in self.rows]
+        rows.append(("model flow", f"v = {f.velocity:.3g} m/s, Froude {f.froude:.2f}, "
+                                   f"Reynolds {f.reynolds:.3g}"))
+        rows += [("warning", w) for w in self.warnings]
+        return Summary(f"ScaledTargets: {self.prototype or 'prototype'} at 1:{self.scale:g}",
+                       tuple(rows))
 
     def to_record(self) -> dict:
         """JSON-ready record of the targets (stable keys)."""

@@ -24,6 +24,7 @@ from printgen.executor.local import (  # worker lifecycle: ground floor
     run_jobs,
 )
 from printgen.inputs.prototype import Prototype
+from printgen.outputs.display import Shown, Summary
 from printgen.scaling.record import Design
 from printgen.scaling.similitude import FlowCheck, scale_targets
 from printgen.scene.options import SceneOptions, build_scene
@@ -165,10 +166,11 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw: Any
                int((~net.fixed_dofs).sum()), time.process_time() - cpu0)
 
 
-@dataclass(frozen=True)
-class Verification:
+@dataclass(frozen=True, repr=False)
+class Verification(Shown):
     """Prototype vs printed model over the loading sweep; `flow`: the model flow at this
-    scale, with the limits of the flume that bind the verdict (None: not checked)."""
+    scale, with the limits of the flume that bind the verdict (None: not checked). Shown
+    (repr, notebook) by its verdict and mismatches; its curves by `curves_table`."""
 
     load_case: str
     prototype: Run
@@ -246,6 +248,25 @@ class Verification:
     def headline(self) -> str:
         """The verdict's sentences, one per line."""
         return "\n".join(self.headlines)
+
+    def summary(self) -> Summary:
+        from printgen.verification.tables import verification_summary
+
+        return verification_summary(self)
+
+    def curve_rows(self, band: Band | None = None) -> list[dict[str, float]]:
+        """The curves, one dict per relative loading (`printgen.verification.tables`)."""
+        from printgen.verification.tables import curve_rows
+
+        return curve_rows(self, band)
+
+    def curves_table(self, band: Band | None = None) -> Any:
+        """The curves as a pandas DataFrame (the `table` extra): one row per h / h_B,
+        strains in % (`_pct`), deflection and lowering normalised, tensions in N or kN, the
+        `band`'s min and max when given."""
+        from printgen.outputs.display import frame
+
+        return frame(self.curve_rows(band), "the verification curves")
 
     def to_record(self) -> dict[str, Any]:
         """Every number of the verification, JSON-ready."""
