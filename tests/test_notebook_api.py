@@ -67,7 +67,7 @@ def test_a_table_without_pandas_names_the_extra(monkeypatch):
 def test_targets_selection_and_design_show_short():
     t = shows_short(printgen.targets(REALISTIC, 40), "at 1:40", "border cable axial")
     assert "E*A: 706.9 N" in t  # the 24 mm steel cable's E*A / lambda^3, as the notebook asserts
-    shows_short(printgen.select(REALISTIC, 40), "generic-350", "tpe")
+    shows_short(printgen.select(REALISTIC, 40), "generic-350", "tpu-85a")
     shows_short(printgen.plan(REALISTIC, 40), "Design at 1:40", "top cable")
 
 
