@@ -127,6 +127,7 @@ class Estimate:
     verification_s: float = 0.0
     parts_s: float = 0.0
     speed: float = 1.0  # this machine's time over the reference machine's (printgen.run.speed)
+    advice_s: float = 0.0  # the advice's wall time, when the verdict is not PASS (`advice_seconds`)
 
     def summary(self) -> str:
         nets = ", ".join(f"{n.name} {n.nodes:,} nodes / {n.unknowns:,} unknowns"
@@ -299,8 +300,30 @@ def estimate(p: Prototype, d: Design, *, cores: int, sweep: bool = True,
     if work.parts and work.sweep and cores > 1:  # the verification in make's helper
         seconds = max(verify, parts, (verify_cpu + parts) / min(cores, 2))
     memory = BASE_MEMORY_B + sum(n.memory_b for n in nets)
-    return Estimate(nets, segments, speed * seconds, memory, cores, run, speed * verify,
-                    speed * parts, speed)
+    advice = advice_seconds(d, cores) if work.sweep else 0.0
+    return Estimate(nets, segments, speed * (seconds + advice), memory, cores, run,
+                    speed * verify, speed * parts, speed, speed * advice)
+
+
+def advice_seconds(d: Design, cores: int) -> float:
+    """Wall seconds of the advice of a run whose verdict is not PASS
+    (printgen.verification.advice), counted in every estimate since the verdict is not known
+    before: its screen (ADVICE_SCREEN nets at SCREEN_RATE per second), then at most ADVICE_NETS
+    sweeps of nets ADVICE_COARSEN times coarser, shared on the cores, and two sweeps of the
+    design's own net (the weaker sensors', a confirmation). Candidates are softer than select's
+    pick: their sweeps take SEARCH_VERIFY_FACTOR times its iterations."""
+    from printgen.search.space import SCREEN_RATE
+    from printgen.verification.advice import ADVICE_COARSEN, ADVICE_NETS, ADVICE_SCREEN
+
+    kind = "border cables" if d.cables else "free top"
+    nodes = model_nodes(d)
+
+    def one(n: float) -> float:
+        return SweepWork("advice", round(3 * n), LEVELS,
+                         LEVELS * iterations_per_level(kind, 3 * n)).seconds
+
+    nets = ADVICE_NETS * one(nodes / ADVICE_COARSEN**2) * SEARCH_VERIFY_FACTOR
+    return ADVICE_SCREEN / SCREEN_RATE + nets / max(1, min(cores, 2)) + 2 * one(nodes)
 
 
 def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
@@ -341,16 +364,18 @@ def prototype_sweep_s(p: Prototype) -> float:
 
 
 def check_design_budget(p: Prototype, screened: int, verified: int, *, limit_s: float,
-                        cores: int, speed: float | None = None) -> float:
-    """Seconds a design search takes on `cores`: `screened` nets at SCREEN_RATE per second
-    and `verified` solver verifications (a prototype and a model sweep each); InputError
-    naming both, the limit and the fixes when it passes `limit_s`, before any work."""
+                        cores: int, speed: float | None = None, prototypes: int = 1) -> float:
+    """Seconds a design search takes on `cores`: `screened` nets at SCREEN_RATE per second,
+    `verified` solver verifications (a model sweep each, against the prototype's sweep made
+    once per scale: `prototypes`); InputError naming both, the limit and the fixes when it
+    passes `limit_s`, before any work."""
     from printgen.search.space import SCREEN_RATE
 
     speed = _checked(limit_s, speed)
     c = max(1, cores)
-    one = 2 * prototype_sweep_s(p) * SEARCH_VERIFY_FACTOR  # a prototype and a model sweep
-    seconds = speed * (screened / SCREEN_RATE + verified * one) / c
+    one = prototype_sweep_s(p)
+    seconds = speed * (screened / SCREEN_RATE + verified * one * SEARCH_VERIFY_FACTOR
+                       + prototypes * one) / c
     if seconds > limit_s:
         _too_big(f"design search is too big: {screened:,} nets to screen and {verified} to "
                  f"verify with the solver, about {seconds:.0f} s on {c} cores", seconds,

@@ -259,7 +259,8 @@ def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
     keep(ctx, {"size": est})
     ctx.timings.setdefault("timings_s", {}).update(
         {"estimate": est.seconds, "estimate_verification": est.verification_s,
-         "estimate_parts": est.parts_s, "estimate_speed_factor": est.speed})
+         "estimate_parts": est.parts_s, "estimate_speed_factor": est.speed,
+         "estimate_advice": est.advice_s})
     return est
 
 

@@ -56,6 +56,9 @@ ADVICE_NETS = 4  # nets the advice sweeps with the solver at most (one pool batc
 # band's coarsening), about 4 x cheaper; a net that passes there is confirmed on its own
 ADVICE_COARSEN = 2
 ADVICE_MESHES = 6  # mesh counts screened each way, evenly spread over the search's range
+# nets the advice screens at most: 8 bundled materials x 2 beads x 5 layers x ADVICE_MESHES^2
+# (with the design's own border), under a second at SCREEN_RATE
+ADVICE_SCREEN = 8 * 2 * 5 * ADVICE_MESHES**2
 NEXT_DESIGN = "next-design.json"  # the verified net, as `printgen make --design` reads it
 
 
@@ -121,7 +124,7 @@ class Advice:
         return " ".join([text, *self.notes])
 
     def tried_text(self) -> str:
-        ok = next(t for t in self.tried if t.passes and t.what == self.change)
+        ok = next(t for t in reversed(self.tried) if t.passes and t.what == self.change)
         return (f"every quantity within tolerance, RMS mismatch {ok.mismatch:.3f} of the "
                 f"prototype's peak; {len(self.tried)} change(s) checked with the solver")
 
@@ -240,23 +243,18 @@ def advise(p: Prototype, d: Design, proto: Run, *, sensors_too_strong: bool,
     lv = proto.deformation.levels
     force = sensor_force(p)
     weaker = weaker_force(sensor_limit_n) if sensors_too_strong and sensor_limit_n else None
+    tried: list[Tried] = []
+    if weaker is not None:  # the cheapest change first, alone: it needs no new print
+        what = (f"keep the net and use weaker sensors: each wire pulling {weaker:.2g} N "
+                f"instead of {force:.3g} N")
+        tried.append(against(proto, _job(p, d, lv, weaker, 1, load), what, 1))
+        if tried[0].passes:
+            return Advice(what, None, weaker, "", tuple(tried), 0, time.perf_counter() - t0)
     ctx, screened, space = screen_nets(p, d)
     picks = best_pairs(screened)
     net_force = weaker if weaker is not None else force
-    jobs = [(_job, (p, candidate_design(ctx, s.point, d), lv, net_force, coarsen, load), {})
-            for s in picks]
-    sensor_what = (None if weaker is None else
-                   f"keep the net and use weaker sensors: each wire pulling {weaker:.2g} N "
-                   f"instead of {force:.3g} N")
-    if sensor_what is not None:  # the cheapest change first: it needs no new print
-        jobs.insert(0, (_job, (p, d, lv, weaker, 1, load), {}))
-    runs = run_jobs(jobs)
-    tried: list[Tried] = []
-    if sensor_what is not None:
-        tried.append(against(proto, runs.pop(0), sensor_what, 1))
-        if tried[0].passes:
-            return Advice(sensor_what, None, weaker, "", tuple(tried), len(screened),
-                          time.perf_counter() - t0)
+    runs = run_jobs([(_job, (p, candidate_design(ctx, s.point, d), lv, net_force, coarsen,
+                             load), {}) for s in picks])
     with_sensors = "" if weaker is None else f", with each sensor wire pulling {weaker:.2g} N"
     named = {id(s): f"print {describe(s)} instead{with_sensors}" for s in picks}
     nets = [against(proto, r, named[id(s)], coarsen) for s, r in zip(picks, runs, strict=True)]
