@@ -44,6 +44,9 @@ DESIGN_LIMIT_S = 600.0  # a design search runs minutes by nature; the limit stop
 # The search verifies its best candidates, soft nets close to the prototype's deformation: each
 # takes several times the Newton iterations of select's pick (measurements.md#design-verification)
 SEARCH_VERIFY_FACTOR = 6.0
+# The advice's candidates (printgen.verification.advice) are nets near the design's, not the
+# search's softest: 1.1 to 1.9 x its Newton iterations on the 1:40 example (134 against 153-254)
+ADVICE_SWEEP_FACTOR = 1.5
 LONG_RUN_S = 30.0  # runs estimated longer show their estimate and progress (make, on a terminal)
 LEVELS = 23  # load levels of a sweep (verify.levels(): 0 to 1.1 by 0.05; tests/test_budget.py)
 # Newton iterations (chord steps included) per load level, averaged over a run's sweeps (the
@@ -308,12 +311,13 @@ def estimate(p: Prototype, d: Design, *, cores: int, sweep: bool = True,
 def advice_seconds(d: Design, cores: int) -> float:
     """Wall seconds of the advice of a run whose verdict is not PASS
     (printgen.verification.advice), counted in every estimate since the verdict is not known
-    before: its screen (ADVICE_SCREEN nets at SCREEN_RATE per second), then at most ADVICE_NETS
-    sweeps of nets ADVICE_COARSEN times coarser, shared on the cores, and two sweeps of the
-    design's own net (the weaker sensors', a confirmation). Candidates are softer than select's
-    pick: their sweeps take SEARCH_VERIFY_FACTOR times its iterations."""
+    before: its screen (ADVICE_SCREEN nets at SCREEN_RATE per second), then at most
+    ADVICE_ROUNDS x ADVICE_NETS sweeps of nets on the band's net (the design's own on both
+    examples), shared on the cores, and two sweeps of the design's own net (the weaker
+    sensors', a confirmation). A candidate's sweep takes ADVICE_SWEEP_FACTOR times the
+    design's iterations."""
     from printgen.search.space import SCREEN_RATE
-    from printgen.verification.advice import ADVICE_COARSEN, ADVICE_NETS, ADVICE_SCREEN
+    from printgen.verification.advice import ADVICE_NETS, ADVICE_ROUNDS, ADVICE_SCREEN
 
     kind = "border cables" if d.cables else "free top"
     nodes = model_nodes(d)
@@ -322,7 +326,7 @@ def advice_seconds(d: Design, cores: int) -> float:
         return SweepWork("advice", round(3 * n), LEVELS,
                          LEVELS * iterations_per_level(kind, 3 * n)).seconds
 
-    nets = ADVICE_NETS * one(nodes / ADVICE_COARSEN**2) * SEARCH_VERIFY_FACTOR
+    nets = ADVICE_ROUNDS * ADVICE_NETS * one(nodes) * ADVICE_SWEEP_FACTOR
     return ADVICE_SCREEN / SCREEN_RATE + nets / max(1, min(cores, 2)) + 2 * one(nodes)
 
 

@@ -257,7 +257,7 @@ def advice_for(ctx: MakeContext, v: Verification, band: Band) -> Advice | None:
     fix, a capacity statement, needs no solve). Its wall time goes to the run's timings."""
     import dataclasses
 
-    from printgen.verification.advice import ADVICE_COARSEN, advise
+    from printgen.verification.advice import advise, direction
 
     if v.verdict == "PASS" or not v.runnable:
         return None
@@ -266,7 +266,8 @@ def advice_for(ctx: MakeContext, v: Verification, band: Band) -> Advice | None:
         a = advise(ctx.prototype, ctx.design, v.prototype,
                    sensors_too_strong=s is not None and s.too_strong,
                    sensor_limit_n=None if s is None else s.limit_n,
-                   coarsen=max(band.coarsen, ADVICE_COARSEN), load=ctx.options.load)
+                   coarsen=band.coarsen, load=ctx.options.load,
+                   way=direction(v.mismatches))
     ctx.timings.setdefault("timings_s", {})["advice"] = time.perf_counter() - t
     out = None if ctx.out is None else str(ctx.out)
     return dataclasses.replace(a, next=a.next_step(str(ctx.prototype.path),

@@ -9,10 +9,12 @@ The changes are tried cheapest first, every one re-checked with the solver befor
 2. the net: the design search's space at this scale (material x strand section x diamond mesh,
    `printgen.search.space`), on a sub-grid of ADVICE_MESHES meshes each way with the design's
    own border, screened by the analytic membrane law (`printgen.search.screen`); the printable
-   net of lowest membrane-law error of each material x section pair, the ADVICE_NETS best pairs,
+   net of lowest membrane-law error of each material x section pair, those on the side the
+   verdict asks for (softer when too stiff) spread in stiffness and bracketed (`bracketed`),
    are swept against the prototype's sweep the verification already made (never swept again),
    on the band's solver net (the coarsest whose nominal curves stay within the band's refinement
-   tolerance); a net that passes there is confirmed on its own net before it is named. When
+   tolerance: the design's own on both examples), warm-started level to level; a net that
+   passes on a coarser net is confirmed on its own before it is named. When
    the sensors are too strong the nets are tried with the weaker sensors (with the strong ones
    no net can match: the sensors' pull is not similar).
 
@@ -20,8 +22,12 @@ The flume's limits are not advised here: a flume that cannot run the test is a c
 statement needing no solve (the verdict's own fix). A candidate passes when every compared
 quantity is within tolerance over the levels both barriers reached: the nominal comparison of the
 verdict, not its band. The cost is bounded: one screen of a few thousand nets (about
-SCREEN_RATE per second) and at most ADVICE_NETS + 2 model sweeps (`printgen.run.budget` counts
-them).
+SCREEN_RATE per second) and at most ADVICE_ROUNDS x ADVICE_NETS + 2 model sweeps
+(`printgen.run.budget` counts them); past them the advice says what it tried and stops.
+
+A net whose pattern is not the search's diamond keeps its pattern and mesh and changes its
+strand (`same_mesh`): at a fixed pattern and mesh the membrane stiffness at small strain is
+proportional to the strand's E A, by which the strands are ranked.
 """
 
 from __future__ import annotations
@@ -29,6 +35,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -39,8 +46,14 @@ from printgen.errors import SolverError
 from printgen.executor.local import run_jobs
 from printgen.inputs.materials import load_material
 from printgen.inputs.prototype import Prototype
-from printgen.scaling.record import Design
-from printgen.scaling.selection import CALIBRATE_FIRST
+from printgen.scaling.record import Design, Section
+from printgen.scaling.section import area_m2
+from printgen.scaling.selection import (
+    CALIBRATE_FIRST,
+    MIN_SAFETY_FACTOR,
+    peak_strand_force,
+    print_limits,
+)
 from printgen.scaling.similitude import scale_targets
 from printgen.scene.options import SceneOptions, build_scene
 from printgen.scene.scenes import lateral_mounting
@@ -48,17 +61,17 @@ from printgen.search.choice import SMALL_STRAIN_TOLERANCE, binding_constraints, 
 from printgen.search.nets import candidate_design, design_point
 from printgen.search.screen import Screened, screen_batch
 from printgen.search.space import NetPoint, SearchContext, default_space, grid, search_context
+from printgen.units import MM
 from printgen.verification.compare import METRICS, Mismatch, compare, headlines
 from printgen.verification.preprint import Run, load_keywords, sensor_force, sweep
 
-ADVICE_NETS = 4  # nets the advice sweeps with the solver at most (one pool batch on 2 cores)
-# the nets are swept on a net this many times coarser (strands as many times stiffer: the
-# band's coarsening), about 4 x cheaper; a net that passes there is confirmed on its own
-ADVICE_COARSEN = 2
+ADVICE_NETS = 4  # nets the advice sweeps per round (one pool batch on 2 cores)
+ADVICE_ROUNDS = 2  # rounds: the spread over all candidates, then between the two that bracket
 ADVICE_MESHES = 6  # mesh counts screened each way, evenly spread over the search's range
 # nets the advice screens at most: 8 bundled materials x 2 beads x 5 layers x ADVICE_MESHES^2
 # (with the design's own border), under a second at SCREEN_RATE
 ADVICE_SCREEN = 8 * 2 * 5 * ADVICE_MESHES**2
+SEARCHED_PATTERN = "diamond"  # the design search's nets (`printgen.search.space`)
 NEXT_DESIGN = "next-design.json"  # the verified net, as `printgen make --design` reads it
 
 
@@ -133,7 +146,7 @@ class Advice:
                 "design_file": NEXT_DESIGN if self.design is not None else None,
                 "sensor_force_n": self.sensor_force_n, "reason": self.reason or None,
                 "tried": list(self.tried), "screened": self.screened,
-                "verified_at_most": ADVICE_NETS, "notes": list(self.notes),
+                "verified_at_most": ADVICE_NETS * ADVICE_ROUNDS, "notes": list(self.notes),
                 "definition": ("a change passes when every compared quantity is within "
                                "tolerance against the prototype's sweep (the nominal "
                                "comparison of the verdict, not its band); nets screened by "
@@ -220,25 +233,85 @@ def _spread(values: list[int]) -> set[int]:
     return {values[i] for i in picks}
 
 
-def best_pairs(screened: list[Screened]) -> list[Screened]:
-    """The printable net of lowest membrane-law error (across and up, 1-40 % strain) of each
-    material x section pair, the ADVICE_NETS best pairs, best first."""
+def best_pairs(screened: list[Screened], way: str = "", own_n_per_m: float = 0.0
+               ) -> list[Screened]:
+    """The nets the solver checks: the printable net of lowest membrane-law error (across and
+    up, 1-40 % strain) of each material x section pair; with `way` ("stiff": the design deforms
+    too little, "soft": too much), only the pairs softer (stiffer) than the design's
+    `own_n_per_m`, ADVICE_NETS of them spread evenly in log stiffness from the nearest to the
+    farthest (deformation falls as stiffness rises: the spread brackets the tolerance window,
+    and the farthest one tells whether any printable net reaches it); without, the ADVICE_NETS
+    pairs of lowest error."""
     best: dict[tuple, Screened] = {}
     for s in screened:
         if not s.feasible:
             continue
+        if way == "stiff" and not s.membrane_n_per_m < own_n_per_m:
+            continue
+        if way == "soft" and not s.membrane_n_per_m > own_n_per_m:
+            continue
         pair = (s.point.material, s.point.beads_across, s.point.layers)
         if pair not in best or s.error_rms_log < best[pair].error_rms_log:
             best[pair] = s
-    return sorted(best.values(), key=lambda s: (s.error_rms_log, s.point.index))[:ADVICE_NETS]
+    pool = list(best.values())
+    if not way:
+        return sorted(pool, key=lambda s: (s.error_rms_log, s.point.index))[:ADVICE_NETS]
+    pool.sort(key=lambda s: (abs(math.log(s.membrane_n_per_m / own_n_per_m)), s.point.index))
+    return pool
+
+
+def spread(n: int, k: int = ADVICE_NETS) -> list[int]:
+    """`k` indices of 0..n-1 spread evenly, both ends included (all when n <= k)."""
+    if n <= k:
+        return list(range(n))
+    return sorted({int(i) for i in np.linspace(0, n - 1, k).round()})
+
+
+def bracketed(n: int, way: str, check: Callable[[list[int]], list[Tried]]
+              ) -> tuple[list[int], list[Tried]]:
+    """Candidates 0..n-1 (ordered nearest to farthest from the design's stiffness) checked in
+    at most ADVICE_ROUNDS rounds of ADVICE_NETS: the first spread over all of them; when none
+    passes and one still errs only `way` next to one that no longer does, the second spread
+    between those two (deformation is monotone in the net's stiffness, so the window lies
+    there). Returns the indices checked, in order, and their results."""
+    idx = spread(n)
+    done = dict(zip(idx, check(idx), strict=True))
+    for _ in range(ADVICE_ROUNDS - 1):
+        if not way or any(t.passes for t in done.values()):
+            break
+        order = sorted(done)
+        same = [_ways(done[i]) == {way} for i in order]
+        inner: list[int] = []
+        for a, b, sa, sb in zip(order, order[1:], same, same[1:], strict=False):
+            if sa and not sb:
+                inner = list(range(a + 1, b))
+                break
+        if not inner:
+            break
+        picked = [inner[i] for i in spread(len(inner))]
+        done.update(zip(picked, check(picked), strict=True))
+    order = sorted(done)
+    return order, [done[i] for i in order]
+
+
+def direction(mismatches: list[Mismatch]) -> str:
+    """"stiff" when every quantity off is off because the model deforms too little, "soft"
+    when too much, "" when both or none."""
+    bad = [m for m in mismatches if not m.ok and math.isfinite(m.ratio_high)]
+    if bad and all(m.ratio_high < 1 for m in bad):
+        return "stiff"
+    if bad and all(m.ratio_high >= 1 for m in bad):
+        return "soft"
+    return ""
 
 
 def advise(p: Prototype, d: Design, proto: Run, *, sensors_too_strong: bool,
-           sensor_limit_n: float | None, coarsen: int = ADVICE_COARSEN,
-           load: str | LoadCase | None = None) -> Advice:
+           sensor_limit_n: float | None, coarsen: int = 1,
+           load: str | LoadCase | None = None, way: str = "") -> Advice:
     """The advice for design `d` that did not pass; `proto`: the verification's prototype
     sweep (compared levels only), shared by every change; `sensor_limit_n`: the largest sensor
-    force within the sensors' share; `coarsen`: the band's solver net."""
+    force within the sensors' share; `coarsen`: the band's solver net; `way`: the design's
+    error (`direction` of its mismatches)."""
     t0 = time.perf_counter()
     lv = proto.deformation.levels
     force = sensor_force(p)
@@ -250,14 +323,23 @@ def advise(p: Prototype, d: Design, proto: Run, *, sensors_too_strong: bool,
         tried.append(against(proto, _job(p, d, lv, weaker, 1, load), what, 1))
         if tried[0].passes:
             return Advice(what, None, weaker, "", tuple(tried), 0, time.perf_counter() - t0)
+    if d.net.pattern != SEARCHED_PATTERN:  # the search's nets would be another structure
+        return same_mesh(p, d, proto, tried, weaker, way, load, t0)
     ctx, screened, space = screen_nets(p, d)
-    picks = best_pairs(screened)
+    own = screen_batch(ctx, [design_point(ctx, d)])[0]
+    pool = best_pairs(screened, way, own.membrane_n_per_m)
     net_force = weaker if weaker is not None else force
-    runs = run_jobs([(_job, (p, candidate_design(ctx, s.point, d), lv, net_force, coarsen,
-                             load), {}) for s in picks])
     with_sensors = "" if weaker is None else f", with each sensor wire pulling {weaker:.2g} N"
-    named = {id(s): f"print {describe(s)} instead{with_sensors}" for s in picks}
-    nets = [against(proto, r, named[id(s)], coarsen) for s, r in zip(picks, runs, strict=True)]
+    named = {id(s): f"print {describe(s)} instead{with_sensors}" for s in pool}
+
+    def check(idx: list[int]) -> list[Tried]:
+        runs = run_jobs([(_job, (p, candidate_design(ctx, pool[i].point, d), lv, net_force,
+                                 coarsen, load), {}) for i in idx])
+        return [against(proto, r, named[id(pool[i])], coarsen)
+                for i, r in zip(idx, runs, strict=True)]
+
+    idx, nets = bracketed(len(pool), way, check)
+    picks = [pool[i] for i in idx]
     tried += nets
     passing = sorted((t.mismatch, i) for i, t in enumerate(nets) if t.passes)
     for _, i in passing[:1]:
@@ -272,13 +354,105 @@ def advise(p: Prototype, d: Design, proto: Run, *, sensors_too_strong: bool,
                   f"{CALIBRATE_FIRST}",) if s.datasheet else ())
         return Advice(named[id(s)], cand, weaker, "", tuple(tried), len(screened),
                       time.perf_counter() - t0, notes)
-    reason = why_none(screened, space, nets, picks, weaker is not None)
+    reason = why_none(screened, space, nets, picks, weaker is not None, way, own)
     return Advice("", None, None, reason, tuple(tried), len(screened),
                   time.perf_counter() - t0)
 
 
+@dataclass(frozen=True)
+class Strand:
+    """A strand for the design's own pattern and mesh: material, section, E A (N) and whether
+    its modulus is a datasheet value."""
+
+    material: str
+    section: Section
+    ea_n: float
+    datasheet: bool
+
+    def text(self, pattern: str) -> str:
+        n = len(self.section.layer_heights_mm)
+        return (f"{self.material.upper()} strand of {self.section.beads_across} bead(s) x {n} "
+                f"layer(s) on this design's {pattern} mesh")
+
+
+def strands(p: Prototype, d: Design) -> list[Strand]:
+    """Every printable strand of the search's materials and passes (`default_space`) that is
+    strong enough (safety factor >= MIN_SAFETY_FACTOR at the overflow strand force) on the
+    design's own pattern and mesh."""
+    t = scale_targets(p, d.scale)
+    space = default_space(p, t)
+    ctx = search_context(p, t, space, printer=d.printer)
+    names = dict.fromkeys((*space.materials, d.net.material))
+    force = peak_strand_force(t, d.net.mesh_x_mm * MM, d.net.mesh_y_mm * MM, d.net.pattern)
+    out = []
+    for name in names:
+        m = load_material(name)
+        e, source = m.modulus()
+        for beads in space.beads:
+            for layers in space.layers:
+                sec = Section(ctx.style.bead_width_mm, beads,
+                              tuple(ctx.style.layer_heights_mm(layers)))
+                _, reasons = print_limits(sec, m, ctx.printer, f"net {name}")
+                if reasons or m.failure_stress()[0] * area_m2(sec) < MIN_SAFETY_FACTOR * force:
+                    continue
+                out.append(Strand(name, sec, e * area_m2(sec), source == "datasheet"))
+    return out
+
+
+def same_mesh(p: Prototype, d: Design, proto: Run, tried: list[Tried], weaker: float | None,
+              way: str, load: str | LoadCase | None, t0: float) -> Advice:
+    """The advice for a net the design search does not hold (its pattern is not a diamond):
+    the design's own pattern and mesh with another strand. At a fixed pattern and mesh the
+    membrane stiffness at small strain is proportional to the strand's E A, so the strands
+    are ranked by it: with `way`, ADVICE_NETS of those softer (stiffer) than the design's,
+    spread evenly in log E A from the nearest to the farthest; without, the nearest."""
+    own = load_material(d.net.material).modulus()[0] * area_m2(d.net.strand)
+    pool = strands(p, d)
+    if way:
+        pool = [c for c in pool if (c.ea_n < own) == (way == "stiff") and c.ea_n != own]
+    pool.sort(key=lambda c: abs(math.log(c.ea_n / own)))
+    if not way:
+        pool = pool[:ADVICE_NETS]
+    force = weaker if weaker is not None else sensor_force(p)
+    extra = "" if weaker is None else f", with each sensor wire pulling {weaker:.2g} N"
+
+    def design_of(c: Strand) -> Design:
+        return dataclasses.replace(d, net=dataclasses.replace(d.net, material=c.material,
+                                                              strand=c.section))
+
+    def check(idx: list[int]) -> list[Tried]:
+        runs = run_jobs([(_job, (p, design_of(pool[i]), proto.deformation.levels, force, 1,
+                                 load), {}) for i in idx])
+        return [against(proto, r, f"print {pool[i].text(d.net.pattern)} instead{extra}", 1)
+                for i, r in zip(idx, runs, strict=True)]
+
+    idx, nets = bracketed(len(pool), way, check)
+    picks = [pool[i] for i in idx]
+    designs = [design_of(c) for c in picks]
+    tried = [*tried, *nets]
+    ok = sorted((t.mismatch, i) for i, t in enumerate(nets) if t.passes)
+    if ok:
+        i = ok[0][1]
+        notes = ((f"Its {picks[i].material.upper()} modulus is a DATASHEET value: "
+                  f"{CALIBRATE_FIRST}",) if picks[i].datasheet else ())
+        return Advice(nets[i].what, designs[i], weaker, "", tuple(tried), len(pool),
+                      time.perf_counter() - t0, notes)
+    scope = (f"the design search holds {SEARCHED_PATTERN} nets only, so only the strand of this "
+             f"{d.net.pattern} net was changed: of {len(pool)} printable, strong enough strands")
+    if not picks:
+        other = "softer" if way == "stiff" else "stiffer"
+        return Advice("", None, None, f"{scope}, none is {other} than this design's",
+                      tuple(tried), 0, time.perf_counter() - t0)
+    far, run = picks[-1], nets[-1]
+    reason = (f"{scope}, {len(picks)} were swept (the advice sweeps at most {ADVICE_ROUNDS} "
+              f"rounds of {ADVICE_NETS}) and none passes; the farthest, "
+              f"{far.text(d.net.pattern)} ({far.ea_n / own:.2g} x this design's E A), is: "
+              + _short(run.headline))
+    return Advice("", None, None, reason, tuple(tried), len(pool), time.perf_counter() - t0)
+
+
 def why_none(screened: list[Screened], space: Any, nets: list[Tried], picks: list[Screened],
-             weaker: bool) -> str:
+             weaker: bool, way: str = "", own: Screened | None = None) -> str:
     """The binding constraint when no change passes: no printable net, none near the target
     stiffness (how far the closest is), or the nearest ones verified and failing."""
     closest, binding = binding_constraints(screened, space)
@@ -288,6 +462,25 @@ def why_none(screened: list[Screened], space: Any, nets: list[Tried], picks: lis
     if closest is None:
         return scope + "none is printable: " + "; ".join(binding)
     c = next(s for s in screened if s.point.index == closest)
+    if way and own is not None and picks:  # the nets checked span one side of the design
+        far, run, ways = picks[-1], nets[-1], _ways(nets[-1])
+        most = "softest" if way == "stiff" else "stiffest"
+        ratio = far.membrane_n_per_m / own.membrane_n_per_m
+        named = (f"the {most} printable net the solver checked, {describe(far)} ({ratio:.2g} x "
+                 f"this design's membrane stiffness, {1 + far.error_small:.2g} x the target)")
+        if ways == {way}:
+            need = "soft" if way == "stiff" else "stiff"
+            return (scope + f"no printable net is {need} enough: {named}, is still too {way}: "
+                    + _short(run.headline))
+        if len(ways) == 2:
+            return (scope + f"{named} is too stiff in {_names(set(run.stiff))} and too soft in "
+                    f"{_names(set(run.soft))} at once: a softer or stiffer net moves both the "
+                    "same way, so no net stiffness fixes both (the border cables, the frame or "
+                    "the load path differ)")
+        return (scope + f"the {len(nets)} nets checked (the advice sweeps at most "
+                f"{ADVICE_NETS}) bracket the prototype, from too {way} to {named}, too "
+                f"{next(iter(ways))}, but none lies within tolerance; printgen design "
+                "(--objective deformation) searches between them")
     if binding:  # no printable net within the small-strain tolerance
         way = "soft" if c.error_small > 0 else "stiff"
         return (scope + f"no profile is {way} enough: the closest to the target, "
@@ -299,14 +492,22 @@ def why_none(screened: list[Screened], space: Any, nets: list[Tried], picks: lis
     out = (scope + f"the {len(nets)} of lowest membrane-law error (the advice sweeps at most "
            f"{ADVICE_NETS}) were swept{sensors} and none passes; the best, "
            f"{describe(best[1])}, still fails: " + _short(best[0].headline))
-    stiff = set.intersection(*(set(n.stiff) for n in nets)) if nets else set()
-    soft = set.intersection(*(set(n.soft) for n in nets)) if nets else set()
+    stiff, soft = set(best[0].stiff), set(best[0].soft)
     if stiff and soft:  # a softer net deforms more everywhere: it cannot fix both at once
-        out += (f"; every net swept is too stiff in {_names(stiff)} and too soft in "
-                f"{_names(soft)} at once: a softer or stiffer net moves both the same way, so "
-                "the net alone cannot fix them (the border cables, the frame or the load "
-                "path differ)")
+        out += (f"; it is too stiff in {_names(stiff)} and too soft in {_names(soft)} at "
+                "once: a softer or stiffer net moves both the same way, so no net stiffness "
+                "fixes both (the border cables, the frame or the load path differ)")
     return out
+
+
+def _ways(t: Tried) -> set[str]:
+    return {w for w, off in (("stiff", t.stiff), ("soft", t.soft)) if off}
+
+
+def _target(c: Screened) -> str:
+    """The printable net closest to the target membrane stiffness, as the screen rates it."""
+    return (f"the closest to the target membrane stiffness at small strain is {describe(c)} "
+            f"({c.error_small:+.0%})")
 
 
 def _short(headline: str) -> str:
