@@ -13,13 +13,23 @@ import json
 import pytest
 from conftest import EXAMPLES
 
+from printgen.inputs.prototype import FlumeSpec
 from printgen.report.jsonout import dumps
 from printgen.run.make import plan_run
 from printgen.run.options import RunOptions
 from printgen.run.search import SearchOptions, search_at_scales
 from printgen.scaling.design_file import load_design
 from printgen.verification import preprint
-from printgen.verification.advice import NEXT_DESIGN, advise, weaker_force
+from printgen.verification.advice import (
+    ADVICE_NETS,
+    ADVICE_ROUNDS,
+    NEXT_DESIGN,
+    advise,
+    bracketed,
+    direction,
+    spread,
+    weaker_force,
+)
 from printgen.verification.preprint import verify
 
 SIMPLE = EXAMPLES / "simple_barrier.toml"
@@ -30,6 +40,30 @@ def test_weaker_force_rounds_down_to_the_two_digits_shown():
     assert weaker_force(0.0318) == pytest.approx(0.031)
     assert weaker_force(0.529) == pytest.approx(0.52)
     assert weaker_force(2.0) == pytest.approx(2.0)
+
+
+def test_spread_takes_both_ends():
+    assert spread(3) == [0, 1, 2]
+    assert spread(10, 4) == [0, 3, 6, 9]
+
+
+def test_bracketing_sweeps_between_the_last_too_stiff_and_the_first_too_soft():
+    """Candidates 0..19 ordered softer and softer; 0..9 still too stiff, 11.. too soft, 10
+    passes: the first round (0, 6, 13, 19) brackets 6..13, the second finds 10 inside it."""
+    from printgen.verification.advice import Tried
+
+    seen: list[int] = []
+
+    def check(idx):
+        seen.extend(idx)
+        return [Tried(str(i), i == 10, 0.0, "", stiff=("m",) if i < 10 else (),
+                      soft=("m",) if i > 10 else ()) for i in idx]
+
+    order, tried = bracketed(20, "stiff", check)
+    assert seen[:ADVICE_NETS] == [0, 6, 13, 19]
+    assert all(6 < i < 13 for i in seen[ADVICE_NETS:]) and 10 in seen
+    assert len(seen) <= ADVICE_NETS * ADVICE_ROUNDS and order == sorted(seen)
+    assert any(t.passes for t in tried)
 
 
 @pytest.mark.slow
@@ -50,42 +84,59 @@ def test_a_verified_sensor_change_is_named_and_passes_when_applied(tmp_path):
     assert verify(dataclasses.replace(p, flume=flume), d).verdict == "PASS"
 
 
+def _quiet_sensors(p):
+    """The prototype with sensors that only read (0.01 N a wire), in a flume that runs any
+    test: the net alone decides the verdict."""
+    return dataclasses.replace(p, flume=FlumeSpec(width=100.0, max_discharge=1e3,
+                                                  free_section=None, froude_min=0.0,
+                                                  froude_max=100.0, sensor_force=0.01))
+
+
 @pytest.mark.slow
 def test_a_verified_net_is_written_as_a_design_file_that_passes(tmp_path):
-    """A constructed failure: the simple barrier at 1:40 printed in PETG (select's TPE pick
-    passes) is far too stiff; the advice names a net it verified and that net's design file,
-    loaded as make --design loads it, passes the verification again."""
-    ctx = plan_run(SIMPLE, 40)
-    p, d = ctx.prototype, ctx.design
+    """A constructed failure: the simple barrier at 1:100 with quiet sensors (select's TPU-85A
+    net then passes) printed in PETG is far too stiff; the advice names a strand it verified
+    and that design's file, loaded as make --design loads it, passes the verification again."""
+    ctx = plan_run(SIMPLE, 100)
+    p, d = _quiet_sensors(ctx.prototype), ctx.design
     stiff = dataclasses.replace(d, net=dataclasses.replace(d.net, material="petg"))
     v = verify(p, stiff)
-    assert v.verdict == "FAIL"
-    a = advise(p, stiff, v.prototype, sensors_too_strong=False, sensor_limit_n=None)
+    assert v.verdict == "FAIL" and direction(v.mismatches) == "stiff"
+    a = advise(p, stiff, v.prototype, sensors_too_strong=False, sensor_limit_n=None,
+               way="stiff")
     assert a.found, a.reason
     assert a.design is not None and any(t.passes for t in a.tried)
-    text = a.next_step(str(SIMPLE), 40, str(tmp_path / "o"))
+    assert len(a.tried) <= ADVICE_NETS * ADVICE_ROUNDS
+    text = a.next_step(str(SIMPLE), 100, str(tmp_path / "o"))
     assert f"--design {tmp_path / 'o'}/{NEXT_DESIGN}" in text and "verified" in text
+    assert a.change in text
     path = tmp_path / NEXT_DESIGN
     path.write_text(dumps(a.design.to_dict()))
-    again = load_design(path, scale=40, prototype=p)
+    again = load_design(path, scale=100, prototype=p)
     assert verify(p, again).verdict == "PASS"
 
 
 @pytest.mark.slow
-def test_no_change_states_the_binding_constraint():
-    """Only PSU in the prototype's [model] materials: no printable PSU net is anywhere near soft
-    enough, and the advice says so with how far the closest is, instead of a change."""
-    ctx = plan_run(SIMPLE, 40)
-    p, d = ctx.prototype, ctx.design
-    p = dataclasses.replace(p, model=dataclasses.replace(p.model, materials=("psu",)))
-    stiff = dataclasses.replace(d, net=dataclasses.replace(d.net, material="psu"))
-    v = verify(p, stiff)
-    assert v.verdict == "FAIL"
-    a = advise(p, stiff, v.prototype, sensors_too_strong=False, sensor_limit_n=None)
+def test_no_change_states_the_binding_constraint(tmp_path):
+    """A small diamond barrier whose [model] materials are PSU only, printed in PSU: far too
+    stiff, and no printable PSU net is soft enough; the advice says so, naming the softest net
+    it checked, instead of a change."""
+    toml = SIMPLE.read_text().replace('pattern = "square"', 'pattern = "diamond"')
+    for a, b in (("width_m = 12.0", "width_m = 6.0"), ("height_m = 4.0", "height_m = 2.0"),
+                 ("mesh_x_m = 0.2", "mesh_x_m = 0.4"), ("mesh_y_m = 0.2", "mesh_y_m = 0.4")):
+        toml = toml.replace(a, b)
+    path = tmp_path / "small-diamond.toml"
+    path.write_text(toml + '\n[model]\nmaterials = ["psu"]\n')
+    ctx = plan_run(path, 20)
+    p, d = _quiet_sensors(ctx.prototype), ctx.design
+    assert d.net.material == "psu" and d.net.pattern == "diamond"
+    v = verify(p, d)
+    assert v.verdict == "FAIL" and direction(v.mismatches) == "stiff"
+    a = advise(p, d, v.prototype, sensors_too_strong=False, sensor_limit_n=None, way="stiff")
     assert not a.found and a.design is None
-    assert "no profile is soft enough" in a.reason and "x the target membrane stiffness" \
-        in a.reason
-    assert a.next_step(str(SIMPLE), 40, None).startswith("No change printgen tried passes")
+    assert "no printable net is soft enough" in a.reason and "is still too stiff" in a.reason
+    assert "PSU" in a.reason
+    assert a.next_step(str(path), 20, None).startswith("No change printgen tried passes")
     assert json.loads(dumps(a.to_record()))["found"] is False
 
 

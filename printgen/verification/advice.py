@@ -444,10 +444,16 @@ def same_mesh(p: Prototype, d: Design, proto: Run, tried: list[Tried], weaker: f
         return Advice("", None, None, f"{scope}, none is {other} than this design's",
                       tuple(tried), 0, time.perf_counter() - t0)
     far, run = picks[-1], nets[-1]
-    reason = (f"{scope}, {len(picks)} were swept (the advice sweeps at most {ADVICE_ROUNDS} "
-              f"rounds of {ADVICE_NETS}) and none passes; the farthest, "
-              f"{far.text(d.net.pattern)} ({far.ea_n / own:.2g} x this design's E A), is: "
-              + _short(run.headline))
+    what = (f"the farthest, {far.text(d.net.pattern)} ({far.ea_n / own:.2g} x this design's "
+            "E A)")
+    if way and _ways(run) == {way}:
+        need = "soft" if way == "stiff" else "stiff"
+        reason = (f"{scope}, no printable strand is {need} enough: {what}, is still too {way}: "
+                  + _short(run.headline))
+    else:
+        reason = (f"{scope}, {len(picks)} were swept (the advice sweeps at most "
+                  f"{ADVICE_ROUNDS} rounds of {ADVICE_NETS}) and none passes; {what}: "
+                  + _short(run.headline))
     return Advice("", None, None, reason, tuple(tried), len(pool), time.perf_counter() - t0)
 
 
