@@ -88,6 +88,7 @@ def test_a_verified_sensor_change_is_named_and_passes_when_applied(tmp_path):
     text = a.next_step(str(SIMPLE), 100, str(tmp_path / "o"))
     assert f"sensor_force_n = {a.sensor_force_n:.2g}" in text
     assert f"printgen make {SIMPLE} -s 100" in text
+    assert "add a [flume] table" in text  # the example has none to set the force in
     assert p.flume is None  # the default sensors: the same as a flume table stating them
     assert verify(_quiet_sensors(p, a.sensor_force_n), d).verdict == "PASS"
 

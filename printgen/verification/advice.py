@@ -89,7 +89,8 @@ class Tried:
     soft: tuple[str, ...] = ()  # quantities off because it deforms more
 
     def to_record(self) -> dict[str, Any]:
-        return {"change": self.what, "passes": self.passes, "mismatch_rms": self.mismatch,
+        return {"change": self.what, "passes": self.passes,
+                "mismatch_rms": self.mismatch if math.isfinite(self.mismatch) else None,
                 "headline": self.headline, "solver_net_coarsened": self.coarsen,
                 "too_stiff": list(self.stiff), "too_soft": list(self.soft)}
 
@@ -111,6 +112,7 @@ class Advice:
     seconds: float = 0.0
     notes: tuple[str, ...] = field(default_factory=tuple)
     next: str = ""  # the "Next" line (`next_step`), set by the run that knows its files
+    flume_table: bool = True  # the prototype file has a [flume] table to set the force in
 
     @property
     def found(self) -> bool:
@@ -126,8 +128,11 @@ class Advice:
         cmd = f"printgen make {prototype_file} -s {scale:g}"
         steps = []
         if self.sensor_force_n is not None:
+            table = "" if self.flume_table else (
+                " (add a [flume] table with your flume's width_m, max_discharge_l_per_s, "
+                "froude_min and froude_max: the verdict then checks them too)")
             steps.append(f"set [flume] sensor_force_n = {self.sensor_force_n:.2g} in "
-                         f"{prototype_file}")
+                         f"{prototype_file}{table}")
         if self.design is not None:
             where = f"{out}/{NEXT_DESIGN}" if out else NEXT_DESIGN
             cmd += f" --design {where} --out {out}-next" if out else f" --design {where}"
@@ -306,6 +311,16 @@ def direction(mismatches: list[Mismatch]) -> str:
 
 
 def advise(p: Prototype, d: Design, proto: Run, *, sensors_too_strong: bool,
+           sensor_limit_n: float | None, coarsen: int = 1,
+           load: str | LoadCase | None = None, way: str = "") -> Advice:
+    """The advice for design `d` that did not pass (`_advise`), stating whether the prototype
+    file has a [flume] table to set a sensor force in."""
+    a = _advise(p, d, proto, sensors_too_strong=sensors_too_strong,
+                sensor_limit_n=sensor_limit_n, coarsen=coarsen, load=load, way=way)
+    return dataclasses.replace(a, flume_table=p.flume is not None)
+
+
+def _advise(p: Prototype, d: Design, proto: Run, *, sensors_too_strong: bool,
            sensor_limit_n: float | None, coarsen: int = 1,
            load: str | LoadCase | None = None, way: str = "") -> Advice:
     """The advice for design `d` that did not pass; `proto`: the verification's prototype
