@@ -487,8 +487,10 @@ def why_none(screened: list[Screened], space: Any, nets: list[Tried], picks: lis
         far, run, ways = picks[-1], nets[-1], _ways(nets[-1])
         most = "softest" if way == "stiff" else "stiffest"
         ratio = far.membrane_n_per_m / own.membrane_n_per_m
-        named = (f"the {most} printable net the solver checked, {describe(far)} ({ratio:.2g} x "
-                 f"this design's membrane stiffness, {1 + far.error_small:.2g} x the target)")
+        sensors = ", with weaker sensors," if weaker else ","
+        named = (f"the {most} printable net the solver checked{sensors} {describe(far)} "
+                 f"({ratio:.2g} x this design's membrane stiffness, {1 + far.error_small:.2g} x "
+                 "the target)")
         if ways == {way}:
             need = "soft" if way == "stiff" else "stiff"
             return (scope + f"no printable net is {need} enough: {named}, is still too {way}: "
