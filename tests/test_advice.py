@@ -160,3 +160,32 @@ def test_the_design_search_sweeps_the_prototype_once_per_scale(monkeypatch):
     assert len(proto) == 2  # one per scale
     verified = sum(len(r.verified) + 1 for r in run.results)  # and select's pick
     assert len(names) - len(proto) == verified
+
+
+@pytest.mark.slow
+def test_make_writes_the_verified_design_and_it_passes_when_made(tmp_path):
+    """The whole loop through make: the simple barrier at 1:100 with quiet sensors, printed in
+    PETG (a design file), fails; make's "Next" names the net it verified, writes it as
+    next-design.json (listed in the manifest), and make with that file passes."""
+    from printgen.run.make import make, verify_step
+
+    proto = tmp_path / "simple.toml"
+    proto.write_text(SIMPLE.read_text() + (
+        "\n[flume]\nwidth_m = 10.0\nmax_discharge_l_per_s = 100000.0\nfroude_min = 0.01\n"
+        "froude_max = 10.0\nsensor_force_n = 0.01\n"))
+    d = plan_run(proto, 100).design
+    stiff = tmp_path / "petg.json"
+    stiff.write_text(dumps(dataclasses.replace(
+        d, net=dataclasses.replace(d.net, material="petg")).to_dict()))
+    only = [("verification", verify_step)]
+    out = tmp_path / "o"
+    ctx = make(proto, 100, out, steps=only, options=RunOptions(design_file=str(stiff)))
+    summary = ctx.record["summary"]
+    assert summary["verdict"] == "FAIL"
+    assert NEXT_DESIGN in json.loads((out / "manifest.json").read_text())["files"]
+    assert f"--design {out}/{NEXT_DESIGN}" in summary["next"]
+    assert ctx.record["advice"]["found"] is True
+    again = make(proto, 100, tmp_path / "o2", steps=only,
+                 options=RunOptions(design_file=str(out / NEXT_DESIGN)))
+    assert again.record["summary"]["verdict"] == "PASS"
+    assert "advice" not in again.record
