@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from printgen.report.flume_drawing import layout_section
 from printgen.report.html import Report
+from printgen.report.jsonout import dumps
 from printgen.report.labfiles import lab_files
 from printgen.report.parts_report import (
     assembly_section,
@@ -19,6 +20,7 @@ from printgen.report.records import CheckRecords, KitRecords, RunRecords
 from printgen.report.report import design_sections, load_case_sections, verification_sections
 from printgen.report.summary import Summary, summarize, summary_html
 from printgen.report.uncertainty import band_sections, measured_sections
+from printgen.verification.advice import NEXT_DESIGN
 
 FIGURES = "figures"  # folder of the figure files in the output
 
@@ -77,4 +79,7 @@ def report_files(run: RunRecords, rep: Report, *, figures: bool = True) -> dict[
                 out[f.also] = f.png
     if run.check is not None:
         out.update({name: text.encode("utf-8") for name, text in lab_files(run.check.lab).items()})
+    advice = run.steps.get("advice")
+    if advice is not None and advice.design is not None:  # the verified net, for make --design
+        out[NEXT_DESIGN] = dumps(advice.design.to_dict()).encode("utf-8")
     return out

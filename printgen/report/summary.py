@@ -110,6 +110,9 @@ def summarize(run: RunRecords, next_step: str = "") -> Summary:
             if v.sensors_to_blame:  # the net is similar: the sensors, not the material
                 nxt = NEXT_SENSORS.format(limit=v.sensors.limit_n, level=v.sensors.level,
                                           share=v.sensors.threshold)
+        advice = run.steps.get("advice")
+        if advice is not None and advice.next:  # a change printgen verified, or why none
+            nxt = advice.next
         if not v.runnable and v.flow is not None:  # a new scale changes the parts too
             nxt = NEXT_FLUME.format(fix=v.flow.fix)
     return Summary(verdict, reason, band, chosen_parts(run.design, run.plan,

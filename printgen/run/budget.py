@@ -46,6 +46,9 @@ DESIGN_LIMIT_S = 600.0  # a design search runs minutes by nature; the limit stop
 # The search verifies its best candidates, soft nets close to the prototype's deformation: each
 # takes several times the Newton iterations of select's pick (measurements.md#design-verification)
 SEARCH_VERIFY_FACTOR = 6.0
+# The advice's candidates (printgen.verification.advice) are nets near the design's, not the
+# search's softest: 1.1 to 1.9 x its Newton iterations on the 1:40 example (134 against 153-254)
+ADVICE_SWEEP_FACTOR = 1.5
 LONG_RUN_S = 30.0  # runs estimated longer show their estimate and progress (make, on a terminal)
 LEVELS = 23  # load levels of a sweep (verify.levels(): 0 to 1.1 by 0.05; tests/test_budget.py)
 # Newton iterations (chord steps included) per load level, averaged over a run's sweeps (the
@@ -126,6 +129,7 @@ class Estimate:
     verification_s: float = 0.0
     parts_s: float = 0.0
     speed: float = 1.0  # this machine's time over the reference machine's (printgen.run.speed)
+    advice_s: float = 0.0  # the advice's wall time, when the verdict is not PASS (`advice_seconds`)
 
     def summary(self) -> str:
         nets = ", ".join(f"{n.name} {n.nodes:,} nodes / {n.unknowns:,} unknowns"
@@ -335,8 +339,31 @@ def estimate(p: Prototype, d: Design, *, cores: int, sweep: bool = True,
     if work.parts and work.sweep and cores > 1:  # the verification in make's helper
         seconds = max(verify, parts, (verify_cpu + parts) / min(cores, 2))
     memory = BASE_MEMORY_B + sum(n.memory_b for n in nets)
-    return Estimate(nets, segments, speed * seconds, memory, cores, run, speed * verify,
-                    speed * parts, speed)
+    advice = advice_seconds(d, cores) if work.sweep else 0.0
+    return Estimate(nets, segments, speed * (seconds + advice), memory, cores, run,
+                    speed * verify, speed * parts, speed, speed * advice)
+
+
+def advice_seconds(d: Design, cores: int) -> float:
+    """Wall seconds of the advice of a run whose verdict is not PASS
+    (printgen.verification.advice), counted in every estimate since the verdict is not known
+    before: its screen (ADVICE_SCREEN nets at SCREEN_RATE per second), then at most
+    ADVICE_ROUNDS x ADVICE_NETS sweeps of nets on the band's net (the design's own on both
+    examples), shared on the cores, and two sweeps of the design's own net (the weaker
+    sensors', a confirmation). A candidate's sweep takes ADVICE_SWEEP_FACTOR times the
+    design's iterations."""
+    from printgen.search.space import SCREEN_RATE
+    from printgen.verification.advice import ADVICE_NETS, ADVICE_ROUNDS, ADVICE_SCREEN
+
+    kind = "border cables" if d.cables else "free top"
+    nodes = model_nodes(d)
+
+    def one(n: float) -> float:
+        return SweepWork("advice", round(3 * n), LEVELS,
+                         LEVELS * iterations_per_level(kind, 3 * n)).seconds
+
+    nets = ADVICE_ROUNDS * ADVICE_NETS * one(nodes) * ADVICE_SWEEP_FACTOR
+    return ADVICE_SCREEN / SCREEN_RATE + nets / max(1, min(cores, 2)) + 2 * one(nodes)
 
 
 def check_budget(p: Prototype, d: Design, *, limit_s: float, cores: int,
@@ -398,16 +425,18 @@ def prototype_sweep_s(p: Prototype) -> float:
 
 
 def check_design_budget(p: Prototype, screened: int, verified: int, *, limit_s: float,
-                        cores: int, speed: float | None = None) -> float:
-    """Seconds a design search takes on `cores`: `screened` nets at SCREEN_RATE per second
-    and `verified` solver verifications (a prototype and a model sweep each); InputError
-    naming both, the limit and the fixes when it passes `limit_s`, before any work."""
+                        cores: int, speed: float | None = None, prototypes: int = 1) -> float:
+    """Seconds a design search takes on `cores`: `screened` nets at SCREEN_RATE per second,
+    `verified` solver verifications (a model sweep each, against the prototype's sweep made
+    once per scale: `prototypes`); InputError naming both, the limit and the fixes when it
+    passes `limit_s`, before any work."""
     from printgen.search.space import SCREEN_RATE
 
     speed = _checked(limit_s, speed)
     c = max(1, cores)
-    one = 2 * prototype_sweep_s(p) * SEARCH_VERIFY_FACTOR  # a prototype and a model sweep
-    seconds = speed * (screened / SCREEN_RATE + verified * one) / c
+    one = prototype_sweep_s(p)
+    seconds = speed * (screened / SCREEN_RATE + verified * one * SEARCH_VERIFY_FACTOR
+                       + prototypes * one) / c
     if seconds > limit_s:
         _too_big(f"design search is too big: {screened:,} nets to screen and {verified} to "
                  f"verify with the solver, about {seconds:.0f} s on {c} cores", seconds,

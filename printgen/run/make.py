@@ -103,6 +103,7 @@ class MakeContext(Shown, CurveTable):
     helper: Helper | None = None  # the helper process of the run (`verification_ahead`)
     toolpaths: dict[str, Any] = field(default_factory=dict)  # per part, built once per run
     volumes_mm3: dict[str, float] = field(default_factory=dict)  # per part's mesh (parts step)
+    out: Path | None = None  # the output folder (the advice's command names files in it)
 
     def summary(self) -> Summary:
         return make_summary(self)
@@ -154,6 +155,7 @@ def make(prototype_path: str | Path, scale: float, out: str | Path, *,
     check_destination(Path(out), force=options.force, inputs=inputs)  # fail fast
     with span("make: plan and estimate"):
         ctx = plan_run(prototype_path, scale, options=options)
+        ctx.out = Path(out)
         est = size_check(ctx, steps is None or any(s is verify_step for _, s in steps))
     if progress and est.seconds > LONG_RUN_S:
         progress(f"estimate: {est.summary()}")
@@ -272,7 +274,8 @@ def size_check(ctx: MakeContext, verifies: bool) -> Estimate:
     keep(ctx, {"size": est})
     ctx.timings.setdefault("timings_s", {}).update(
         {"estimate": est.seconds, "estimate_verification": est.verification_s,
-         "estimate_parts": est.parts_s, "estimate_speed_factor": est.speed})
+         "estimate_parts": est.parts_s, "estimate_speed_factor": est.speed,
+         "estimate_advice": est.advice_s})
     return est
 
 

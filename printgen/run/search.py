@@ -22,6 +22,7 @@ import os
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from printgen.executor import open_runner
 from printgen.inputs.profiles import search_dirs
@@ -33,6 +34,7 @@ from printgen.run.budget import DESIGN_LIMIT_S, check_design_budget, run_cores
 from printgen.run.options import RunOptions
 from printgen.run.provenance import provenance_record
 from printgen.run.shown import design_summary
+from printgen.scaling.record import Design
 from printgen.scaling.similitude import ScaledTargets, scale_targets
 from printgen.search.nets import (
     SearchResult,
@@ -54,19 +56,46 @@ from printgen.search.space import (
 
 
 def verify_task(shared: VerifyShared, task: VerifyTask) -> VerifyScore:
-    """Solver stage of the search: the verification of one design, as a score. Pure: the
-    same task gives the same score in any process (the sweep worker runs it serially)."""
+    """Solver stage of the search: the verification of one design, as a score, against the
+    prototype's sweep the search made once (`prototype_sweep`; without it, swept here too).
+    Pure: the same task gives the same score in any process (the sweep worker runs it
+    serially)."""
     from threadpoolctl import threadpool_limits
 
-    from printgen.verification.preprint import levels, verify
+    from printgen.verification.preprint import verify, verify_plan
 
-    lv = None if shared.level_step is None else levels(step=shared.level_step)
+    lv = search_levels(shared)
     with _serial(), threadpool_limits(limits=1):  # one BLAS thread: the same sums everywhere
-        v = verify(shared.prototype, task.design, lv=lv)
+        if shared.prototype_run is None:
+            v = verify(shared.prototype, task.design, lv=lv)
+        else:  # the model alone; the sensors' share does not enter the score
+            plan = verify_plan(shared.prototype, task.design, lv=lv)
+            fn, args, kw = plan.jobs()[0]
+            v = plan.verified(fn(*args, **kw), shared.prototype_run)
     rms = math.sqrt(sum(m.rms_rel**2 for m in v.mismatches) / len(v.mismatches))
     failed = sorted(set(v.prototype.failed) | set(v.model.failed))
     return VerifyScore(task.key, rms, {m.metric: m.rms_rel for m in v.mismatches},
                        max(m.max_rel for m in v.mismatches), v.ok, tuple(failed))
+
+
+def search_levels(shared: VerifyShared) -> Any:
+    """The load levels of the search's sweeps (None: the verification's own)."""
+    from printgen.verification.preprint import levels
+
+    return None if shared.level_step is None else levels(step=shared.level_step)
+
+
+def prototype_sweep(shared: VerifyShared, design: Design) -> Any:
+    """The prototype's sweep as `verify` makes it beside `design` (at the search's levels),
+    once per search: it does not depend on the candidate net."""
+    from threadpoolctl import threadpool_limits
+
+    from printgen.verification.preprint import verify_plan
+
+    plan = verify_plan(shared.prototype, design, lv=search_levels(shared))
+    fn, args, kw = plan.jobs()[1]
+    with threadpool_limits(limits=1):
+        return fn(*args, **kw)
 
 
 @contextlib.contextmanager
@@ -139,7 +168,8 @@ def check_work(p: Prototype, spaces: dict[float, SearchSpace], o: SearchOptions,
         if o.objective == "deformation" else 0  # each net with every border, select's pick
     cores = run_cores(bool(run.serial), run.workers)
     limit = DESIGN_LIMIT_S if run.time_limit_s is None else run.time_limit_s
-    check_design_budget(p, screened, verified, limit_s=limit, cores=cores)
+    check_design_budget(p, screened, verified, limit_s=limit, cores=cores,
+                        prototypes=len(spaces) if verified else 0)
 
 
 def search_at_scales(prototype: str | Path | Prototype, scales: list[float], *,
@@ -158,6 +188,7 @@ def search_at_scales(prototype: str | Path | Prototype, scales: list[float], *,
             results.append(search(p, s, runner, objective=options.objective,
                                   space=spaces[s], printer=options.printer,
                                   verifier=verify_task, verify_nets=options.verify_nets,
+                                  prototype_sweep=prototype_sweep,
                                   level_step=options.level_step))
         where = runner.where
     return DesignRun(results, where, design_record(p, results, options))

@@ -39,6 +39,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from printgen.run.make import MakeContext
     from printgen.run.options import RunOptions
     from printgen.scaling.record import Design
+    from printgen.verification.advice import Advice
     from printgen.verification.bands import Band
     from printgen.verification.preprint import Verification
 
@@ -268,7 +269,31 @@ def verify_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     with span("verify: records"):
         check, times = verification_records(*sweeps, ctx.targets.scale)
     ctx.timings["verification"] = times
-    return {"verification": check}
+    advice = advice_for(ctx, *sweeps)
+    return {"verification": check} | ({} if advice is None else {"advice": advice})
+
+
+def advice_for(ctx: MakeContext, v: Verification, band: Band) -> Advice | None:
+    """What to change when the verdict is not PASS (printgen.verification.advice), its "Next"
+    line naming the run's files; None on PASS, or when the flume cannot run the test (its
+    fix, a capacity statement, needs no solve). Its wall time goes to the run's timings."""
+    import dataclasses
+
+    from printgen.verification.advice import advise, direction
+
+    if v.verdict == "PASS" or not v.runnable:
+        return None
+    t, s = time.perf_counter(), v.sensors
+    with span("advice"):
+        a = advise(ctx.prototype, ctx.design, v.prototype,
+                   sensors_too_strong=s is not None and s.too_strong,
+                   sensor_limit_n=None if s is None else s.limit_n,
+                   coarsen=band.coarsen, load=ctx.options.load,
+                   way=direction(v.mismatches))
+    ctx.timings.setdefault("timings_s", {})["advice"] = time.perf_counter() - t
+    out = None if ctx.out is None else str(ctx.out)
+    return dataclasses.replace(a, next=a.next_step(str(ctx.prototype.path),
+                                                   ctx.targets.scale, out))
 
 
 def sweeps_done(ctx: MakeContext) -> tuple[Verification, Band] | None:

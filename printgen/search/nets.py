@@ -21,6 +21,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -57,6 +58,7 @@ class VerifyShared:
 
     prototype: Prototype
     level_step: float | None
+    prototype_run: Any = None  # the prototype's sweep, made once per search and shared
 
 
 @dataclass(frozen=True)
@@ -180,8 +182,11 @@ def screen_all(runner: Runner, ctx: SearchContext, points: list[NetPoint]) -> li
 def search(p: Prototype, scale: float, runner: Runner, *, objective: str = "deformation",
            space: SearchSpace | None = None, printer: str | None = None,
            verifier: Verifier | None = None, verify_nets: int = VERIFY_NETS,
-           level_step: float | None = None) -> SearchResult:
-    """Run the search at 1:`scale` on `runner`. `verifier` is required for `deformation`."""
+           level_step: float | None = None,
+           prototype_sweep: Callable[[VerifyShared, Design], Any] | None = None) -> SearchResult:
+    """Run the search at 1:`scale` on `runner`. `verifier` is required for `deformation`;
+    `prototype_sweep` makes the prototype's sweep once, before the verifier's tasks share it
+    (the prototype is the same for every candidate)."""
     if objective not in OBJECTIVES:
         raise InputError(f"objective {objective!r} is not one of {', '.join(OBJECTIVES)}")
     if objective == "deformation" and verifier is None:
@@ -202,7 +207,10 @@ def search(p: Prototype, scale: float, runner: Runner, *, objective: str = "defo
         picks = stage_two(screened, verify_nets)
         tasks = [VerifyTask(str(s.point.index), candidate_design(ctx, s.point, base))
                  for s in picks] + [VerifyTask(SELECT_KEY, base)]
-        scores = runner.map(verifier, tasks, shared=VerifyShared(p, level_step),
+        shared = VerifyShared(p, level_step)
+        if prototype_sweep is not None:
+            shared = dataclasses.replace(shared, prototype_run=prototype_sweep(shared, base))
+        scores = runner.map(verifier, tasks, shared=shared,
                             label=f"1:{t.scale:g} verifying {len(tasks)} nets (solver)")
         verified = {int(v.key): v for v in scores if v.key != SELECT_KEY}
         select_score = next(v for v in scores if v.key == SELECT_KEY)
