@@ -116,9 +116,17 @@ NUMBERS: dict[str, Callable[[dict[str, Any]], str]] = {
 
 
 def numbers(out: Path) -> dict[str, str]:
-    """Every NUMBERS value of the run in the folder `out`."""
+    """Every NUMBERS value of the run in the folder `out`, the run's paths written as the
+    tutorial's commands name them (the prototype `proto.toml`, the output folder `o`)."""
     report = json.loads((out / "report.json").read_text("utf-8"))
-    return {key: value(report) for key, value in NUMBERS.items()}
+    return {key: _as_tutorial(value(report), out) for key, value in NUMBERS.items()}
+
+
+def _as_tutorial(text: str, out: Path) -> str:
+    """`text` with the run's output folder written `o` and its prototype `proto.toml`."""
+    for folder in {str(out.resolve()), str(out)}:
+        text = text.replace(folder, "o")
+    return re.sub(r"\S*realistic_barrier\.toml", "proto.toml", text)
 
 
 def marked(text: str) -> list[tuple[str, str]]:
