@@ -4,6 +4,7 @@ variant and the cheapest test it names, the variants the lab's data exclude, the
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -67,6 +68,32 @@ def test_the_prototype_band_counts_too():
     d = decide(PROTO, band(1.0, {}), proto)
     assert d.verdict == "UNDECIDED" and d.deciding == ["slack"]
     assert d.test == TESTS["prototype initial slack"]
+
+
+def slack_band(factor: float, question: str) -> Band:
+    """A band with the nominal at the prototype and one 0-1 % slack range variant (labelled
+    as its question) moving every curve by `factor`."""
+    return Band(LEVELS, PROTO, {question: {k: factor * c for k, c in PROTO.items()}},
+                {question: ""}, [], 1, {}, info={question: Variant(
+                    question, question=question, weight=1.0, spread="range")})
+
+
+def test_the_two_nets_slack_is_one_input():
+    """Slack that moves both nets alike leaves them alike (geometric similitude hangs the
+    model with the prototype's relative slack): PASS, where the same two ranges taken as
+    independent inputs straddle the tolerance; the pairing is stated in the record."""
+    model, proto = slack_band(1.5, "initial slack"), slack_band(1.5, "prototype initial slack")
+    d = decide(PROTO, model, proto)
+    assert d.verdict == "PASS" and d.assumptions and "similitude" in d.assumptions[0]
+    assert d.to_record()["assumptions"] == d.assumptions
+    own = model.info["initial slack"]
+    apart = decide(PROTO, dataclasses.replace(model, info={"initial slack": dataclasses.replace(
+        own, question="something else")}), proto)
+    assert apart.verdict == "UNDECIDED" and not apart.assumptions
+    # slack that moves the model more than the prototype still decides
+    d = decide(PROTO, slack_band(1.6, "initial slack"), slack_band(1.1, "prototype initial slack"))
+    assert d.verdict == "UNDECIDED" and d.deciding == ["initial slack"]
+    assert d.test == TESTS["initial slack (both nets)"]
 
 
 def test_the_cheapest_test_is_the_first_listed():

@@ -112,7 +112,9 @@ def summarize(run: RunRecords, next_step: str = "") -> Summary:
                                           share=v.sensors.threshold)
         advice = run.steps.get("advice")
         if advice is not None and advice.next:  # a change printgen verified, or why none
-            nxt = advice.next
+            nxt = advice.next if v.verdict != "UNDECIDED" or v.decision is None else (
+                f"{NEXT_UNDECIDED.format(test=v.decision.test)} With the nominal inputs: "
+                f"{advice.next}")
         if not v.runnable and v.flow is not None:  # a new scale changes the parts too
             nxt = NEXT_FLUME.format(fix=v.flow.fix)
     return Summary(verdict, reason, band, chosen_parts(run.design, run.plan,

@@ -275,13 +275,15 @@ def verify_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
 
 def advice_for(ctx: MakeContext, v: Verification, band: Band) -> Advice | None:
     """What to change when the verdict is not PASS (printgen.verification.advice), its "Next"
-    line naming the run's files; None on PASS, or when the flume cannot run the test (its
-    fix, a capacity statement, needs no solve). Its wall time goes to the run's timings."""
+    line naming the run's files; None on PASS, when the flume cannot run the test (its fix, a
+    capacity statement, needs no solve), or when the nominal design already passes and only
+    the band leaves the verdict UNDECIDED (a test settles it, not another net). Its wall time
+    goes to the run's timings."""
     import dataclasses
 
     from printgen.verification.advice import advise, direction
 
-    if v.verdict == "PASS" or not v.runnable:
+    if v.verdict == "PASS" or not v.runnable or v.ok:
         return None
     t, s = time.perf_counter(), v.sensors
     with span("advice"):

@@ -5,10 +5,17 @@ An UNDECIDED verdict names the uncertainty that decides (the variants whose move
 the tolerance, else the one that moves the reading most) and the cheapest lab test that
 settles it (`printgen.verification.variants.TESTS`). The flume's capacity is the caller's
 (`printgen.verification.preprint.Verification.verdict`: a test the flume cannot run fails).
+
+The two nets' initial slack is one input, not two (`paired_slack`): slack is a length ratio,
+and geometric similitude has the model hung with the prototype's relative slack, whatever it
+is; so the verdict compares the model with 1 % slack against the prototype with 1 % slack,
+never one net slack against the other taut. How closely a lab matches the prototype's sag is
+not modelled (the cheapest test that settles the slack still names it).
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -46,6 +53,7 @@ class Decision:
     questions: list[str]
     tests: list[str]
     tolerance: float = TOLERANCE
+    assumptions: list[str] = field(default_factory=list)  # how the bands were compared
 
     @property
     def test(self) -> str:
@@ -69,6 +77,7 @@ class Decision:
         return {"verdict": self.verdict, "tolerance": self.tolerance,
                 "deciding_variants": self.deciding, "deciding_questions": self.questions,
                 "cheapest_test": self.test, "tests": self.tests,
+                "assumptions": self.assumptions,
                 "metrics": [{"metric": m.metric, "status": m.status,
                              "worst_mismatch": m.worst, "best_mismatch": m.best,
                              "deciding_variants": m.deciding} for m in self.metrics]}
@@ -82,6 +91,7 @@ def decide(proto: dict[str, np.ndarray], model: Band, prototype: Band | None = N
            tolerance: float = TOLERANCE) -> Decision:
     """The verdict of the `model` band against the prototype's curves `proto` (METRICS key
     -> (k,), at the band's levels) and its band `prototype` (None: the curves alone)."""
+    model, prototype, assumptions = paired_slack(model, prototype)
     mlo, mhi = model.central()
     plo, phi = prototype.central() if prototype is not None else (proto, proto)
     out: list[MetricDecision] = []
@@ -106,7 +116,38 @@ def decide(proto: dict[str, np.ndarray], model: Band, prototype: Band | None = N
         labels = []
     info = {**model.info, **(prototype.info if prototype is not None else {})}
     questions = list(dict.fromkeys(info[x].question or x for x in labels))
-    return Decision(verdict, out, labels, questions, settling_tests(questions), tolerance)
+    return Decision(verdict, out, labels, questions, settling_tests(questions), tolerance,
+                    assumptions)
+
+
+SLACK = ("initial slack", "prototype initial slack")  # the variants' questions, model's first
+PAIRED = ("the two nets' initial slack is one input: the model hung with the prototype's "
+          "relative slack (geometric similitude), so the model's slack variant is compared "
+          "with the prototype's (0 to 1 % on both)")
+
+
+def paired_slack(model: Band, prototype: Band | None
+                 ) -> tuple[Band, Band | None, list[str]]:
+    """`model` and `prototype` with their initial slack as one input: the model's slack
+    variant moved by the prototype's slack effect (compared with the prototype's nominal, it
+    is the slack model against the slack prototype: effects add, as the central interval
+    takes them) and the prototype's slack variant carrying no weight; unchanged (and no
+    assumption stated) when either band has no weighted slack variant."""
+    if prototype is None:
+        return model, prototype, []
+    ours = [k for k in model.weighted() if model.info[k].question == SLACK[0]]
+    theirs = [k for k in prototype.weighted() if prototype.info[k].question == SLACK[1]]
+    if len(ours) != 1 or len(theirs) != 1:
+        return model, prototype, []
+    m, p = ours[0], theirs[0]
+    joint = {key: model.variants[m][key] - (prototype.variants[p][key]
+                                            - prototype.nominal[key]) for key in METRICS}
+    info = dataclasses.replace(model.info[m], question="initial slack (both nets)")
+    model = dataclasses.replace(model, variants={**model.variants, m: joint},
+                                info={**model.info, m: info})
+    prototype = dataclasses.replace(prototype, info={
+        **prototype.info, p: dataclasses.replace(prototype.info[p], excluded=PAIRED)})
+    return model, prototype, [PAIRED]
 
 
 def _deciding(key: str, p: np.ndarray, m: np.ndarray, peak: float, model: Band,

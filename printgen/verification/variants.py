@@ -106,6 +106,8 @@ TESTS = {
     "sensor routing": "state where the potentiometers sit (in line with the rows or "
                       "downstream of the barrier)",
     "initial slack": "measure the net's sag when mounted, before the water arrives",
+    "initial slack (both nets)": "state the prototype's initial slack (its as-built sag) and "
+                                 "hang the model with the same relative sag",
     "prototype initial slack": "state the prototype's initial slack (its as-built sag)",
     "pressure direction": "photograph the film on the net at full head (does it lie on the "
                           "deformed net?)",
