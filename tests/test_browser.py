@@ -204,8 +204,9 @@ def test_every_plot_axis_has_a_label_with_a_unit(made):
 def test_strains_are_in_percent_and_the_band_cells_read(report):
     text = report.read_text()
     assert "bottom cable elongation (%)" in text or "(sensor wire, strain) (%)" in text
-    assert re.search(r"\d\.\d{2} \(band -?\d+\.\d{2} to -?\d+\.\d{2}\)", text)
-    assert "stiffness (E*A, N)" in text and "stiffness (initial membrane, N/m)" in text
+    assert re.search(r"\d\.\d{2} \(central -?\d+\.\d{2} to -?\d+\.\d{2}; envelope "
+                     r"-?\d+\.\d{2} to -?\d+\.\d{2}\)", text)
+    assert "stiffness (E*A, N)" in text and "stiffness (initial membrane across / up, N/m)" in text
 
 
 def test_no_reference_to_a_file_the_package_lacks(made):

@@ -46,9 +46,9 @@ PASS_PENALTY = 0.002  # per pass: prefer shorter prints among equals
 SCORE_DIGITS = 9  # scores equal to 1e-9 are ties (same E*A, different layout)
 MIN_SPEED_MM_S = 2.0  # slower than this, the flow limit makes the print impractical
 ASSUMED_SAG_RATIO = 0.2  # peak-force estimate: sag / span of a loaded cable or net strip
-CALIBRATE_FIRST = ("print the test pieces (printgen testpieces DESIGN.json: strand coupons and "
-                   "a net panel) and calibrate before printing the barrier (printgen "
-                   "calibrate, then printgen verify)")
+CALIBRATE_FIRST = ("print the test pieces (printgen testpieces with its design file: strand "
+                   "coupons and a net panel) and calibrate before printing the barrier "
+                   "(printgen calibrate, then printgen verify)")
 NET_STRAINS = np.linspace(0.01, 0.40, 40)  # strain range over which net laws are compared
 CHECK_STRAINS = (0.05, 0.30)  # net law errors reported at low and high strain
 NET_ON_TARGET = 0.30  # a net within +-30 % of the small-strain target is on target (as design)

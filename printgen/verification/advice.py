@@ -137,8 +137,9 @@ class Advice:
             where = f"{out}/{NEXT_DESIGN}" if out else NEXT_DESIGN
             cmd += f" --design {where} --out {out}-next" if out else f" --design {where}"
         steps.append(f"run {cmd}")
-        text = (f"{self.change}; printgen verified that it passes "
-                f"({self.tried_text()}). To apply it: " + ", then ".join(steps) + ".")
+        text = (f"{self.change}; printgen verified that it passes with the nominal inputs "
+                f"({self.tried_text()}; its band, which make sweeps, may still leave the "
+                "verdict UNDECIDED). To apply it: " + ", then ".join(steps) + ".")
         return " ".join([text, *self.notes])
 
     def tried_text(self) -> str:
