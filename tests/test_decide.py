@@ -214,3 +214,18 @@ def test_the_readings_of_one_panel_law_are_one_question_weighted_evenly():
     assert all(v.weight_source for v in variants if not v.excluded)  # every weight argued
     squeezed = [v for v in variants if v.question == "mounting span"]
     assert squeezed and all("sag of about" in v.excluded for v in squeezed)
+
+
+def test_a_net_of_another_pattern_cannot_be_the_tested_panel():
+    """The profile's panels were diamond nets: for a square design the 'tested net = the
+    design's net' reading is shown with why it carries no weight."""
+    from conftest import EXAMPLES
+
+    from printgen.run.make import plan_run
+    from printgen.verification.variants import model_variants
+
+    d = plan_run(EXAMPLES / "simple_barrier.toml", 100).design
+    assert d.net.pattern == "square" and d.net.material == "tpe"
+    variants, _ = model_variants(d)
+    tested = [v for v in variants if "tested net" in v.label]
+    assert tested and all("cannot be the tested net" in v.excluded for v in tested)

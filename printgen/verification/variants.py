@@ -248,11 +248,14 @@ def _panel_geometry_variant(d: Design, notes: list[str]) -> list[Variant]:
         notes.append(f"{mat.name} panel law: the design's net is the tested net the profile "
                      "assumes, so the geometry assumption does not change the law")
         return []
+    # the profile's panels were TESTED_PATTERN nets: a net of another pattern cannot be one
+    other = (f"the profile's panels were {TESTED_PATTERN} nets and the design's is "
+             f"{n.pattern}: it cannot be the tested net" if n.pattern != TESTED_PATTERN else "")
     return [Variant(f"{mat.name} panel law: tested net = the design's net",
                     f"{mat.name} profile [measured.panel_law] conditions",
                     SceneOptions(net_factor=ratio), question=READING,
                     weight_source="the profile's tested net is an assumption where its "
-                    "source does not give it")]
+                    "source does not give it", excluded=other)]
 
 
 def _orientation_variants(d: Design) -> list[Variant]:
