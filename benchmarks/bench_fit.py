@@ -21,10 +21,10 @@ from __future__ import annotations
 import json
 import os
 import statistics
-import subprocess
 import sys
-import time
 from pathlib import Path
+
+from benchmarks.timing import run_printgen
 
 ROOT = Path(__file__).resolve().parents[1]
 PROTOTYPE = ROOT / "examples" / "realistic_barrier.toml"
@@ -39,16 +39,9 @@ CORES = 2  # the sweep cores verify runs on (printgen.run.budget.sweep_cores)
 
 def one_run(out: Path, fit: str) -> dict:
     """One `printgen verify --measured --fit FIT` process: times, sweeps, estimate, verdict."""
-    cmd = [sys.executable, "-m", "printgen", "verify", str(PROTOTYPE), "--scale", f"{SCALE:g}",
-           "--design", str(PAPER / "design.json"), "--measured", str(PAPER / "measured.csv"),
-           "--fit", fit, "--out", str(out), "--force", "--time-limit", "3600"]
-    load = os.getloadavg()[0]
-    t = time.perf_counter()
-    proc = subprocess.run(cmd, check=False, capture_output=True, text=True, cwd=ROOT,
-                          env={**os.environ, "PYTHONPATH": str(ROOT)})
-    wall = time.perf_counter() - t
-    if proc.returncode not in (0, 1, 3):  # 1: a mismatch, 3: a verdict on fewer levels
-        raise RuntimeError(f"printgen verify failed ({proc.returncode}): {proc.stderr[-2000:]}")
+    wall, load, _ = run_printgen(["verify", str(PROTOTYPE), "--scale", f"{SCALE:g}", "--design",
+                               str(PAPER / "design.json"), "--measured",
+                               str(PAPER / "measured.csv"), "--fit", fit, "--out", str(out)])
     timings = json.loads((out / "timings.json").read_text())["timings_s"]
     fitted = json.loads((out / "report.json").read_text())["measured"]["fit"]
     return {"fit": fit, "wall_s": round(wall, 2),

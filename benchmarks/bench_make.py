@@ -25,10 +25,10 @@ from __future__ import annotations
 import json
 import os
 import statistics
-import subprocess
 import sys
-import time
 from pathlib import Path
+
+from benchmarks.timing import run_printgen
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "realistic_barrier.toml"
@@ -44,22 +44,15 @@ ESTIMATES = ("estimate", "estimate_verification", "estimate_parts")  # not steps
 
 def one_run(out: Path, example: Path = EXAMPLE) -> dict:
     """Wall time of one `printgen make` process, the step times and solver work it recorded."""
-    cmd = [sys.executable, "-m", "printgen", "make", str(example), "--scale", f"{SCALE:g}",
-           "--out", str(out), "--force", "--time-limit", "3600"]
-    load = os.getloadavg()[0]
-    t = time.perf_counter()
-    proc = subprocess.run(cmd, check=False, capture_output=True, text=True, cwd=ROOT,
-                          env={**os.environ, "PYTHONPATH": str(ROOT)})
-    wall = time.perf_counter() - t
-    if proc.returncode not in (0, 1, 3):  # 1: a mismatch, 3: a verdict on fewer levels
-        raise RuntimeError(f"printgen make failed ({proc.returncode}): {proc.stderr[-2000:]}")
+    wall, load, code = run_printgen(["make", str(example), "--scale", f"{SCALE:g}", "--out",
+                               str(out)])
     timings = json.loads((out / "timings.json").read_text())
     record = json.loads((out / "report.json").read_text())
     steps = timings.get("timings_s", timings)
     counted = record["verification"]["solver_work"]
     cpu = timings["verification"]["solver_work"]["runs"]
     rows = [{**r, "cpu_s": cpu[str(i)]["time_s"]} for i, r in enumerate(counted["runs"])]
-    return {"wall_s": wall, "exit": proc.returncode,
+    return {"wall_s": wall, "exit": code,
             "load_average": [load, os.getloadavg()[0]],
             "estimate_s": float(steps.get("estimate", float("nan"))),
             "steps_s": {k: float(v) for k, v in steps.items() if isinstance(v, (int, float))},

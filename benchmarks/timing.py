@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def best_of(fn, repeat: int):
@@ -36,3 +42,19 @@ def goal_main(run, doc: str, argv: list[str] | None, repeat: int) -> int:
             print(f"{key}: {value}")
         print(f"goal {'met' if report['goal_met'] else 'NOT met'}; all numbers in {a.out}/")
     return 0 if report["goal_met"] else 1
+
+
+def run_printgen(args: list[str]) -> tuple[float, float, int]:
+    """Run `printgen ARGS` from this checkout in its own process, time-limited only by an
+    hour: (wall time s, the load average just before, the exit code); an exit other than 0,
+    1 (a mismatch) or 3 (a verdict on fewer levels) raises with its last error lines."""
+    cmd = [sys.executable, "-m", "printgen", *args, "--force", "--time-limit", "3600"]
+    load = os.getloadavg()[0]
+    t = time.perf_counter()
+    proc = subprocess.run(cmd, check=False, capture_output=True, text=True, cwd=ROOT,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    wall = time.perf_counter() - t
+    if proc.returncode not in (0, 1, 3):
+        raise RuntimeError(f"printgen {args[0]} failed ({proc.returncode}): "
+                           f"{proc.stderr[-2000:]}")
+    return wall, load, proc.returncode
