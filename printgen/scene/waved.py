@@ -20,14 +20,21 @@ ones are (`printgen.scene.scenes.with_factors`).
 from __future__ import annotations
 
 import dataclasses
+from dataclasses import dataclass
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 
-from printgen.barrier.patterns.curved import CurvedStrands, chord, curve_strains
-from printgen.scaling.record import Design, check_net_wave
+from printgen.barrier.patterns.curved import CurvedStrands, blocked_force, chord, curve_strains
+from printgen.inputs.laws import piecewise_linear
+from printgen.inputs.materials import load_material
+from printgen.inputs.prototype import Prototype
+from printgen.scaling.record import Design, Wave, check_net_wave
 from printgen.scaling.section import area_m2
-from printgen.scene.scenes import BarrierScene
+from printgen.scaling.selection import NET_STRAINS, target_net_law
+from printgen.scaling.similitude import ScaledTargets
+from printgen.scene.scenes import BarrierScene, model_net_law
 from printgen.solver import Law
 from printgen.solver.strand_curve import Strand, StrandCurve, strand_curve
 from printgen.units import MM
@@ -91,3 +98,57 @@ def wave_row(c: StrandCurve) -> tuple[str, str, str]:
         f"its material law (compression as tension); {shape}; piecewise linear through "
         f"{len(c.strains)} solved points"),
         "design wave; printgen beam model (printgen.solver.strand_curve)")
+
+
+@dataclass(frozen=True)
+class WaveLaws:
+    """The net laws of a waved design along its mesh_y diagonal (up the barrier, as `select`
+    compares them), in the blocked, infinite net at finite strain
+    (`curved.blocked_force`): the target (the prototype's panel law scaled to the model,
+    `selection.target_net_law`), the design's net with straight strands (the scene's straight
+    strand law) and with its waved ones (the scene's curve), N/m at the net `strains`; and
+    the curve's summary (initial and straightened chord slopes, N per unit strain; knee and
+    excess length, strand strains)."""
+
+    strains: np.ndarray
+    target: np.ndarray
+    straight: np.ndarray
+    curved: np.ndarray
+    wave: Wave
+    initial_slope: float
+    straight_slope: float
+    knee: float
+    excess: float
+
+    def error_rms_log(self, law: np.ndarray) -> float:
+        """RMS of log(law / target) over the strains (the design search's law error)."""
+        return float(np.sqrt(np.mean(np.log(law / self.target) ** 2)))
+
+    def to_record(self) -> dict[str, Any]:
+        return {"direction": "mesh_y diagonal (up the barrier), blocked infinite net",
+                "wave": dataclasses.asdict(self.wave), "net_strains": self.strains,
+                "target_n_per_m": self.target, "straight_n_per_m": self.straight,
+                "curved_n_per_m": self.curved,
+                "error_rms_log": {"straight": self.error_rms_log(self.straight),
+                                  "curved": self.error_rms_log(self.curved)},
+                "strand_curve": {"initial_slope_n": self.initial_slope,
+                                 "straightened_slope_n": self.straight_slope,
+                                 "knee_strain": self.knee, "excess_length": self.excess}}
+
+
+def wave_laws(p: Prototype, t: ScaledTargets, d: Design) -> WaveLaws:
+    """The `WaveLaws` of design `d` (with a wave) at targets `t` of prototype `p`, over the
+    strains the design search compares laws on (`selection.NET_STRAINS`)."""
+    n, w = d.net, d.net.wave
+    if w is None:
+        raise ValueError("wave_laws needs a design with a wave")
+    straight = model_net_law(load_material(n.material), n, None)[0]  # the nominal scene's
+    curve = waved_curve(straight, d)
+    along, across = n.mesh_y_mm * MM, n.mesh_x_mm * MM
+    eps = NET_STRAINS
+    knees, slopes = target_net_law(p, t)
+    return WaveLaws(eps, piecewise_linear(eps, knees, slopes),
+                    blocked_force(n.pattern, straight, along, across, eps),
+                    blocked_force(n.pattern, curve.law(), along, across, eps), w,
+                    curve.initial_slope, curve.straight_slope, curve.knee,
+                    curve.strand.excess())
