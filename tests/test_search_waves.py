@@ -31,6 +31,7 @@ from printgen.search.waves import (
 
 SMALL_STRAIN = 1e-4  # net strain at which the blocked net's law is its small-strain slope
 SMALL_REL = 1e-3  # ... to this (the chord's turn is second order in the strain)
+ROUNDED_MM = 1e-6  # meshes are recorded rounded to 1e-6 mm (space.MESH_DIGITS)
 
 
 @pytest.fixture(scope="module")
@@ -110,3 +111,67 @@ def test_a_design_with_a_wave_round_trips(realistic, tmp_path):
     path = tmp_path / "design.json"
     path.write_text(json.dumps(w.to_dict()))
     assert load_design(path) == w
+
+
+# ------------------------------------------------------------------ square-mesh prototypes
+
+def _simple_context():
+    from printgen.inputs.prototype import load_prototype
+    from printgen.search.space import default_space, search_context
+
+    p = load_prototype(EXAMPLES / "simple_barrier.toml")
+    t = scale_targets(p, 40)
+    space = dataclasses.replace(default_space(p, t), materials=("tpe",), beads=(1,),
+                                layers=(2,), border_beads=(2,))
+    return p, t, search_context(p, t, space), space
+
+
+def test_a_square_mesh_prototype_gets_square_candidates_in_whole_meshes():
+    from printgen.barrier.patterns import get_pattern
+    from printgen.search.space import grid
+
+    p, t, ctx, space = _simple_context()
+    points = grid(ctx, space)
+    assert points and {q.pattern for q in points} == {"square"}
+    for q in points:
+        assert q.mesh_x_mm == q.mesh_y_mm
+        lo, hi = space.mesh_x_mm
+        assert lo - ROUNDED_MM <= q.mesh_x_mm <= hi + ROUNDED_MM
+        assert q.half_cells_x % 2 == 0 and q.half_cells_y % 2 == 0  # whole meshes
+        assert q.mesh_x_mm * q.half_cells_x / 2 == pytest.approx(ctx.width_mm)
+        get_pattern("square").check_mesh(q.mesh_x_mm, q.mesh_y_mm)
+
+
+def test_a_square_candidate_is_screened_and_built_as_a_square_net():
+    from printgen.scaling.plan import make_design
+    from printgen.scaling.section import net_membrane_law
+    from printgen.scaling.selection import select
+    from printgen.search.nets import candidate_design
+    from printgen.search.screen import screen_point, strand_section
+    from printgen.search.space import grid
+
+    p, t, ctx, space = _simple_context()
+    q = grid(ctx, space)[0]
+    s = screen_point(ctx, q)
+    law = net_membrane_law(ctx.material("tpe"), strand_section(ctx, q), q.mesh_y_mm * 1e-3,
+                           q.mesh_x_mm * 1e-3, "square")
+    assert s.membrane_n_per_m == law[1][0]
+    assert s.opening_mm == pytest.approx(q.mesh_x_mm - strand_section(ctx, q).width_mm)
+    d = candidate_design(ctx, q, make_design(p, t, select(p, t)))
+    assert d.net.pattern == "square" and len(d.net.graph().nodes_mm) > 0
+
+
+@pytest.mark.slow
+def test_design_on_the_square_barrier_is_at_least_as_good_as_select():
+    from printgen.run.options import RunOptions
+    from printgen.run.search import SearchOptions, search_at_scales
+
+    opts = SearchOptions(objective="deformation", materials=("tpe",), border_beads=(2,),
+                         verify_nets=1, level_step=0.1)
+    res = search_at_scales(EXAMPLES / "simple_barrier.toml", [40.0], options=opts,
+                           run=RunOptions(serial=True)).results[0]
+    assert res.design.net.pattern == "square"
+    best = res.verified[res.chosen].mismatch
+    if res.wave is not None and res.wave.kept is not None:
+        best = res.wave.verified[res.wave.kept]
+    assert best <= res.select_score.mismatch

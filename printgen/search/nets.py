@@ -1,6 +1,6 @@
 """Inverse design (`printgen design`): the printable net that deforms most like the prototype.
 
-Two stages over the space of `search_space` (material x strand section x diamond mesh x border):
+Stages over the space of `search_space` (material x strand section x mesh x border):
 
 1. screen every candidate by the analytic membrane law (`screen`): error over 1-40 % strain,
    constraints, similitude break, print time (cheap: thousands per second per core);
@@ -123,7 +123,8 @@ def candidate_design(ctx: SearchContext, point: NetPoint, base: Design) -> Desig
     net = NetDesign(material=point.material, print_style=ctx.style.key,
                     width_mm=round(ctx.width_mm, 6), height_mm=round(ctx.height_mm, 6),
                     mesh_x_mm=point.mesh_x_mm, mesh_y_mm=point.mesh_y_mm, strand=sec,
-                    border_width_mm=round(point.border_beads * sec.bead_width_mm, 6))
+                    border_width_mm=round(point.border_beads * sec.bead_width_mm, 6),
+                    pattern=point.pattern)
     return dataclasses.replace(base, net=net)
 
 
@@ -132,7 +133,8 @@ def design_point(ctx: SearchContext, d: Design) -> NetPoint:
     n = d.net
     return NetPoint(-1, n.material, n.strand.beads_across, len(n.strand.layer_heights_mm),
                     round(2 * n.width_mm / n.mesh_x_mm), round(2 * n.height_mm / n.mesh_y_mm),
-                    n.mesh_x_mm, n.mesh_y_mm, round(n.border_width_mm / n.strand.bead_width_mm))
+                    n.mesh_x_mm, n.mesh_y_mm, round(n.border_width_mm / n.strand.bead_width_mm),
+                    n.pattern)
 
 
 def stage_two(screened: list[Screened], nets: int) -> list[Screened]:
