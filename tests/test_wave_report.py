@@ -9,10 +9,10 @@ import json
 
 import numpy as np
 import pytest
-from conftest import EXAMPLES, planned
+from conftest import EXAMPLES, planned, reference_design_1_40
 from numpy.testing import assert_allclose
 
-from printgen.barrier.patterns.curved import blocked_membrane, stress_law
+from printgen.barrier.patterns.curved import blocked_force
 from printgen.inputs.laws import piecewise_linear
 from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style, load_printer
@@ -25,17 +25,19 @@ from printgen.scene.waved import wave_laws
 
 WAVE = Wave(1.5, 1)  # the top of the 1.0-1.5 mm range asked of the 1:40 net
 NEWTON_REL = 1e-8  # the beam model's equilibrium (1e-10 of EA) on forces of order EA x strain
-CURVE_REL = 1e-4  # one strand solved at two sets of strain points (the scene's adds the
-# material law's knee): equal where both solved it, linear between (measured 6e-5)
+ROUND_OFF = 1e-12  # one law built through two orders of float operations
 REDUCED_MM = (40.0, 60.0)  # a piece of the 1:40 net for the price: the same strands, quick
 
 
 def _planned(wave):
+    """The realistic prototype at 1:40 and the reference's TPE design (a measured, softening
+    panel law against the prototype's stiffening one) with `wave`."""
     p, d = planned(EXAMPLES / "realistic_barrier.toml")
     from printgen.scaling.similitude import scale_targets
 
+    ref = reference_design_1_40()
     return p, scale_targets(p, d.scale), dataclasses.replace(
-        d, net=dataclasses.replace(d.net, wave=wave))
+        ref, net=dataclasses.replace(ref.net, wave=wave))
 
 
 def test_the_laws_are_the_target_the_straight_and_the_waved_nets():
@@ -54,19 +56,20 @@ def test_the_laws_are_the_target_the_straight_and_the_waved_nets():
     assert rec["wave"] == {"amplitude_mm": 1.5, "half_waves": 1}
 
 
-def test_the_waved_law_is_the_curved_patterns_for_the_same_material_law():
-    # the realistic net's TPE has a measured panel law on a net of this design's mesh shape:
-    # the curved pattern's stress law (`stress_law`) is the straight scene's per unit area
-    p, t, d = _planned(WAVE)
-    laws = wave_laws(p, t, d)
-    from printgen.barrier.patterns.curved import CurvedStrands
+def test_the_search_and_the_scene_give_the_same_straight_and_waved_laws():
+    # the design search screens waves with the law the verification's scene will use
+    from printgen.scene import build_scene
+    from printgen.search.waves import straight_law
 
-    n = d.net
-    stress, _ = stress_law(load_material(n.material))
-    s = CurvedStrands(WAVE.amplitude_mm, WAVE.half_waves, n.strand.bead_width_mm,
-                      n.strand.beads_across, n.strand.thickness_mm, stress)
-    ref = blocked_membrane(n.pattern, s, n.mesh_y_mm * 1e-3, n.mesh_x_mm * 1e-3, laws.strains)
-    assert_allclose(laws.curved, ref, rtol=CURVE_REL)
+    p, t, d = _planned(WAVE)
+    straight = build_scene(dataclasses.replace(d, net=dataclasses.replace(d.net, wave=None)))
+    law = straight_law(d.net)
+    assert_allclose(law.knees, straight.laws[0].knees, rtol=ROUND_OFF)
+    assert_allclose(law.slopes, straight.laws[0].slopes, rtol=ROUND_OFF)
+    laws = wave_laws(p, t, d)
+    assert_allclose(laws.straight, blocked_force(d.net.pattern, law, d.net.mesh_y_mm * 1e-3,
+                                                 d.net.mesh_x_mm * 1e-3, laws.strains),
+                    rtol=ROUND_OFF)
 
 
 def test_the_section_shows_the_plot_and_the_price():

@@ -150,5 +150,6 @@ def wave_laws(p: Prototype, t: ScaledTargets, d: Design) -> WaveLaws:
     return WaveLaws(eps, piecewise_linear(eps, knees, slopes),
                     blocked_force(n.pattern, straight, along, across, eps),
                     blocked_force(n.pattern, curve.law(), along, across, eps), w,
-                    curve.initial_slope, curve.straight_slope, curve.knee,
+                    curve.initial_slope, curve.straight_slope,
+                    curve.knee if w.amplitude_mm > 0 else 0.0,  # straight from the start
                     curve.strand.excess())

@@ -11,7 +11,8 @@ both slopes; a target without knee: the selection's NET_STRAINS). The target in 
 directions is the prototype's panel law read as the prototype's scene reads it: turned into a
 strand law of the scaled prototype's mesh (its pattern's `strand_law`, along mesh_y) and
 stretched the same way, so target and candidate go through one mapping. The waved strands'
-material law is the curved pattern's (`curved.stress_law`).
+material law is the straight strands' law the verification's scene gives the net
+(`straight_law`: the material's reading) per unit area, as `printgen.scene.waved` takes it.
 
 Verify. The WAVES_VERIFIED best-scored waves are verified by the solver (the search's
 `verifier`); the best is kept when its deformation mismatch is lower than the straight net's.
@@ -32,14 +33,15 @@ from printgen.barrier.patterns.curved import (
     blocked_force,
     check_wave_mm,
     strand_law,
-    stress_law,
 )
 from printgen.errors import GeometryError
 from printgen.inputs.materials import load_material
 from printgen.inputs.prototype import Prototype
 from printgen.scaling.record import Design, NetDesign, Wave
+from printgen.scaling.section import net_membrane_law
 from printgen.scaling.selection import NET_STRAINS, target_net_law
 from printgen.scaling.similitude import ScaledTargets
+from printgen.solver import Law
 from printgen.units import MM
 
 WAVE_STEP_MM = 0.25  # amplitude grid: a quarter of a typical 0.4-0.6 mm bead
@@ -100,7 +102,7 @@ def screen_waves(p: Prototype, t: ScaledTargets, n: NetDesign) -> list[WaveScree
     """Every printable wave of net `n` screened by its law, best first."""
     eps = law_strains(p, t)
     target_up, target_across = target_laws(p, t, eps)
-    stress, how = stress_law(load_material(n.material))
+    stress, how = straight_law(n).scaled(1.0 / (n.strand.area_mm2 * MM * MM)), "scene's reading"
     up, across = n.mesh_y_mm * MM, n.mesh_x_mm * MM
     out = []
     for w in printable_waves(n):
@@ -117,11 +119,20 @@ def straight_screen(p: Prototype, t: ScaledTargets, n: NetDesign) -> tuple[float
     """(error up, across) of net `n` with straight strands, scored as the waves are."""
     eps = law_strains(p, t)
     target_up, target_across = target_laws(p, t, eps)
-    stress, _ = stress_law(load_material(n.material))
-    law = stress.scaled(n.strand.area_mm2 * MM * MM)
+    law = straight_law(n)
     up, across = n.mesh_y_mm * MM, n.mesh_x_mm * MM
     return (_rms_log(blocked_force(n.pattern, law, up, across, eps), target_up),
             _rms_log(blocked_force(n.pattern, law, across, up, eps), target_across))
+
+
+def straight_law(n: NetDesign) -> Law:
+    """The straight strands' law of net `n` as the verification's scene gives them (the
+    material's reading of its panel law, `net_membrane_law`, up the barrier, turned into its
+    pattern's strand law, as `scene.scenes.model_net_law`)."""
+    up, across = n.mesh_y_mm * MM, n.mesh_x_mm * MM
+    knees, slopes, _ = net_membrane_law(load_material(n.material), n.strand, up, across,
+                                        n.pattern)
+    return get_pattern(n.pattern).strand_law(knees, slopes, up, across)
 
 
 def _rms_log(model: np.ndarray, target: np.ndarray) -> float:
