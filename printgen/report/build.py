@@ -20,6 +20,7 @@ from printgen.report.records import CheckRecords, KitRecords, RunRecords
 from printgen.report.report import design_sections, load_case_sections, verification_sections
 from printgen.report.summary import Summary, summarize, summary_html
 from printgen.report.uncertainty import band_sections, measured_sections
+from printgen.report.wave_report import wave_section
 from printgen.verification.advice import NEXT_DESIGN
 
 FIGURES = "figures"  # folder of the figure files in the output
@@ -37,6 +38,8 @@ def build_report(run: RunRecords) -> tuple[Report, Summary]:
         meshes_section(rep, run.steps["parts"])
     if "gcode" in run.steps:
         gcode_section(rep, run.steps["gcode"])
+    if "wave" in run.steps:
+        wave_section(rep, run.steps["wave"])
     kit = run.steps.get("assembly")
     if isinstance(kit, KitRecords):
         assembly_section(rep, kit.assembly, kit.figures)

@@ -53,6 +53,7 @@ from printgen.search.space import (
     half_cell_counts,
     space_factors,
 )
+from printgen.search.waves import WAVES_VERIFIED
 
 
 def verify_task(shared: VerifyShared, task: VerifyTask) -> VerifyScore:
@@ -161,10 +162,11 @@ def check_work(p: Prototype, spaces: dict[float, SearchSpace], o: SearchOptions,
                run: RunOptions) -> None:
     """The search's size against its time limit (`budget.check_design_budget`), before any
     work: every scale's nets screened, and with the deformation objective `verify_nets` of
-    them (with every border) and select's pick verified."""
+    them (with every border), select's pick and the chosen net's best waves verified."""
     screened = sum(math.prod(space_factors(sp, *meshes_of(sp, scale_targets(p, s))))
                    for s, sp in spaces.items())
-    verified = sum(o.verify_nets * len(sp.border_beads) + 1 for sp in spaces.values()) \
+    verified = sum(o.verify_nets * len(sp.border_beads) + 1 + WAVES_VERIFIED
+                   for sp in spaces.values()) \
         if o.objective == "deformation" else 0  # each net with every border, select's pick
     cores = run_cores(bool(run.serial), run.workers)
     limit = DESIGN_LIMIT_S if run.time_limit_s is None else run.time_limit_s

@@ -56,14 +56,12 @@ def part_toolpath(ctx: MakeContext, name: str, part: Any, printer: Printer) -> T
     the G-code and the previews share it."""
     if name not in ctx.toolpaths:
         from printgen.parts.gcode import cable_toolpath, net_toolpath
-        from printgen.parts.geometry.attach import attachment_for
 
         d = ctx.design
         mat, style = load_material(part.material), load_print_style(part.print_style)
         if name == "net":
-            att = (attachment_for(d, hole_compensation_mm=printer.hole_compensation_mm)
-                   if d.cables else None)
-            ctx.toolpaths[name] = net_toolpath(part, printer, style, mat, attachment=att)
+            ctx.toolpaths[name] = net_toolpath(part, printer, style, mat,
+                                               attachment=net_attachment(d, printer))
         else:
             ctx.toolpaths[name] = cable_toolpath(part, printer, style, mat)
     return ctx.toolpaths[name]
@@ -96,7 +94,31 @@ def gcode_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
         retractions = text.count(f"E-{mat.print.retract_length_mm:.5f}")
         rec[name] = GcodeRecord(path.name, len(back.layer_z_mm), tp.volume_mm3,
                                 back.volume_mm3, vs_stl, retractions, est)
-    return {"gcode": rec}
+    out: dict[str, Any] = {"gcode": rec}
+    if d.net.wave is not None:
+        out["wave"] = wave_record(ctx, printer)
+    return out
+
+
+def wave_record(ctx: MakeContext, printer: Printer) -> Any:
+    """The waved net's laws against the target and the straight net's, and its print time
+    and mass against the straight net's (`WaveRecord`)."""
+    from printgen.parts.gcode.price import wave_price
+    from printgen.report.wave_report import WaveRecord
+    from printgen.scene.waved import wave_laws
+
+    d = ctx.design
+    price = wave_price(d.net, printer, load_print_style(d.net.print_style),
+                       load_material(d.net.material), attachment=net_attachment(d, printer))
+    return WaveRecord(wave_laws(ctx.prototype, ctx.targets, d), price)
+
+
+def net_attachment(d: Design, printer: Printer) -> Any:
+    """The net's loops onto its border cables (None: a design without cables)."""
+    from printgen.parts.geometry.attach import attachment_for
+
+    return (attachment_for(d, hole_compensation_mm=printer.hole_compensation_mm)
+            if d.cables else None)
 
 
 def kit_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:

@@ -27,6 +27,7 @@ from printgen.scene.scenes import (
     prototype_scene,
     with_factors,
 )
+from printgen.scene.waved import with_wave_law
 
 
 @dataclass(frozen=True)
@@ -91,6 +92,7 @@ def build_scene(source: Prototype | Design, options: SceneOptions = NOMINAL) -> 
                         else o.sensor_force)
         if o.net_law == "derived":
             s = with_derived_law(s, d, o.orientation)
+        s = with_wave_law(s, source)  # the design's own strands' curve, as stiff per strain
     if (o.net_factor * o.coarsen, o.frame_factor, o.cable_factor) != (1.0, 1.0, 1.0):
         s = with_factors(s, o.net_factor * o.coarsen, o.frame_factor, o.cable_factor)
     if o.pressure != s.pressure:

@@ -96,7 +96,7 @@ def describe(s: Screened) -> str:
     """One phrase naming a candidate net."""
     p = s.point
     return (f"{p.material.upper()} strand of {p.beads_across} bead(s) x {p.layers} layer(s), "
-            f"diamond mesh {p.mesh_x_mm:.4g} x {p.mesh_y_mm:.4g} mm (across x up), border "
+            f"{p.pattern} mesh {p.mesh_x_mm:.4g} x {p.mesh_y_mm:.4g} mm (across x up), border "
             f"{p.border_beads} bead(s)")
 
 

@@ -1,13 +1,16 @@
 """Inverse design (`printgen design`): the printable net that deforms most like the prototype.
 
-Two stages over the space of `search_space` (material x strand section x diamond mesh x border):
+Stages over the space of `search_space` (material x strand section x mesh x border):
 
 1. screen every candidate by the analytic membrane law (`screen`): error over 1-40 % strain,
    constraints, similitude break, print time (cheap: thousands per second per core);
 2. with the `deformation` objective, verify the best few with the solver (`verifier`, the
    pre-print verification over h / h_B = 0-1.1) and rank them by their deformation mismatch:
    the best net of each of the `verify_nets` best material x section pairs, each with every
-   border width, and `select`'s pick for comparison.
+   border width, and `select`'s pick for comparison;
+3. with the `deformation` objective, the chosen net's printable waved strands, screened by their
+   law and the best verified by the solver (`printgen.search.waves`): the design takes the best
+   wave when it deforms more like the prototype than the straight net.
 
 Both stages run on a `printgen.executor.Runner` (this machine's workers, a Dask scheduler, or
 serial): each task is a pure function of a small frozen record, so the result does not depend on
@@ -45,6 +48,7 @@ from printgen.search.space import (
     grid,
     search_context,
 )
+from printgen.search.waves import WaveChoice, wave_stage, with_wave
 
 OBJECTIVES = ("deformation", "stiffness")
 VERIFY_NETS = 3  # nets verified by the solver (each with every border width)
@@ -104,6 +108,7 @@ class SearchResult:
     reasons: tuple[str, ...]
     binding: tuple[str, ...]
     closest: int | None  # feasible candidate closest to the target at small strain
+    wave: WaveChoice | None = None  # the chosen net's waves (deformation objective)
 
     def objective_value(self, i: int) -> float:
         """The ranked objective of candidate i: solver mismatch, or membrane-law error."""
@@ -118,7 +123,8 @@ def candidate_design(ctx: SearchContext, point: NetPoint, base: Design) -> Desig
     net = NetDesign(material=point.material, print_style=ctx.style.key,
                     width_mm=round(ctx.width_mm, 6), height_mm=round(ctx.height_mm, 6),
                     mesh_x_mm=point.mesh_x_mm, mesh_y_mm=point.mesh_y_mm, strand=sec,
-                    border_width_mm=round(point.border_beads * sec.bead_width_mm, 6))
+                    border_width_mm=round(point.border_beads * sec.bead_width_mm, 6),
+                    pattern=point.pattern)
     return dataclasses.replace(base, net=net)
 
 
@@ -127,7 +133,8 @@ def design_point(ctx: SearchContext, d: Design) -> NetPoint:
     n = d.net
     return NetPoint(-1, n.material, n.strand.beads_across, len(n.strand.layer_heights_mm),
                     round(2 * n.width_mm / n.mesh_x_mm), round(2 * n.height_mm / n.mesh_y_mm),
-                    n.mesh_x_mm, n.mesh_y_mm, round(n.border_width_mm / n.strand.bead_width_mm))
+                    n.mesh_x_mm, n.mesh_y_mm, round(n.border_width_mm / n.strand.bead_width_mm),
+                    n.pattern)
 
 
 def stage_two(screened: list[Screened], nets: int) -> list[Screened]:
@@ -216,10 +223,23 @@ def search(p: Prototype, scale: float, runner: Runner, *, objective: str = "defo
         select_score = next(v for v in scores if v.key == SELECT_KEY)
     chosen = _choose(objective, screened, verified)
     closest, binding = binding_constraints(screened, space)
+    design = None if chosen is None else candidate_design(ctx, screened[chosen].point, base)
+    wave = None
+    if objective == "deformation" and verifier and chosen is not None and design:
+        shared, check = VerifyShared(p, level_step), verifier
+
+        def verify(designs: list[Design]) -> list[float]:
+            tasks = [VerifyTask(f"wave-{i}", d) for i, d in enumerate(designs)]
+            return [v.mismatch for v in runner.map(
+                check, tasks, shared=shared,
+                label=f"1:{t.scale:g} verifying {len(tasks)} waved nets (solver)")]
+
+        wave = wave_stage(p, t, design, verified[chosen].mismatch, verify)
+        design = with_wave(design, wave.kept)
     res = SearchResult(p.name, t.scale, objective, space, tuple(screened), verified, base,
                        screen_batch(ctx, [design_point(ctx, base)])[0], select_score,
-                       pareto_indices(objective, screened, verified), chosen,
-                       None if chosen is None else candidate_design(ctx, screened[chosen].point,
-                                                                     base),
-                       (), binding, closest)
-    return dataclasses.replace(res, reasons=(*choice_reasons(res), *target_sentence(screened)))
+                       pareto_indices(objective, screened, verified), chosen, design,
+                       (), binding, closest, wave)
+    waves = () if wave is None else (wave.sentence(),)
+    return dataclasses.replace(res, reasons=(*choice_reasons(res), *waves,
+                                             *target_sentence(screened)))

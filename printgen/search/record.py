@@ -54,6 +54,7 @@ def result_record(res: SearchResult) -> dict[str, Any]:
         "chosen": chosen, "design": None if res.design is None else res.design.to_dict(),
         "chosen_within_small_strain_tolerance": within,
         "reasons": list(res.reasons), "binding_constraints": list(res.binding),
+        "waves": None if res.wave is None else res.wave.to_record(),
         "closest_feasible": None if res.closest is None else sc[res.closest].to_record(),
         "per_material": per_material(sc),
         "select_pick": {**_with_score(res.select_screened, res.select_score),

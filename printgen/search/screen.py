@@ -1,6 +1,6 @@
 """Stage 1 of `printgen design`: screen every candidate net by the analytic membrane law.
 
-For one `NetPoint`: the membrane law of its diamond geometry (`section.net_membrane_law`)
+For one `NetPoint`: the membrane law of its pattern's geometry (`section.net_membrane_law`)
 against the target law over 1-40 % strain, along the load and across it (RMS log error over
 both: a net flattened to soften it along the load stiffens across it), its small-strain error,
 and the constraints: safety factor >= `MIN_SAFETY_FACTOR` at the estimated overflow strand force,
@@ -75,6 +75,7 @@ class Screened:
             "index": p.index, "material": p.material, "beads_across": p.beads_across,
             "layers": p.layers, "mesh_x_mm": p.mesh_x_mm, "mesh_y_mm": p.mesh_y_mm,
             "half_cells": [p.half_cells_x, p.half_cells_y], "border_beads": p.border_beads,
+            "pattern": p.pattern,
             "law_source": self.law_source, "datasheet": self.datasheet,
             "membrane_n_per_m": self.membrane_n_per_m, "target_n_per_m": self.target_n_per_m,
             "error_small_strain": self.error_small, "error_rms_log": self.error_rms_log,
@@ -93,9 +94,12 @@ def strand_section(ctx: SearchContext, point: NetPoint) -> Section:
     return Section(s.bead_width_mm, point.beads_across, tuple(s.layer_heights_mm(point.layers)))
 
 
-def clear_opening_mm(mesh_x_mm: float, mesh_y_mm: float, strand_width_mm: float) -> float:
-    """Clear distance between parallel strands of a diamond mesh (mm): the rhombus height
-    (area a_x a_y / 2 over its side) less one strand width."""
+def clear_opening_mm(mesh_x_mm: float, mesh_y_mm: float, strand_width_mm: float,
+                     pattern: str = "diamond") -> float:
+    """Clear distance between parallel strands (mm): the square's side, the diamond's rhombus
+    height (area a_x a_y / 2 over its side), less one strand width."""
+    if pattern == "square":
+        return mesh_x_mm - strand_width_mm
     side = math.hypot(mesh_x_mm / 2, mesh_y_mm / 2)
     return mesh_x_mm * mesh_y_mm / (2 * side) - strand_width_mm
 
@@ -106,6 +110,9 @@ def print_time_s(ctx: SearchContext, point: NetPoint, sec: Section, speed: float
     speed. Travel moves are not counted: this ranks candidates, it is not a slicer's estimate."""
     px, py = point.mesh_x_mm / 2, point.mesh_y_mm / 2
     diagonals = point.half_cells_x * point.half_cells_y * math.hypot(px, py)
+    if point.pattern == "square":  # the inner strands across and up (the edges: the border)
+        w, h = point.mesh_x_mm * point.half_cells_x / 2, point.mesh_y_mm * point.half_cells_y / 2
+        diagonals = (point.half_cells_x / 2 - 1) * h + (point.half_cells_y / 2 - 1) * w
     border = 2 * (ctx.width_mm + ctx.height_mm)
     per_layer = sec.beads_across * diagonals + point.border_beads * border
     return len(sec.layer_heights_mm) * per_layer / speed
@@ -124,10 +131,14 @@ def bed_violation(ctx: SearchContext, point: NetPoint, bead_mm: float) -> str | 
 
 
 def across_law(knees: tuple[float, ...], slopes: tuple[float, ...], mesh_along: float,
-               mesh_across: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """The membrane law of the same diamond net loaded across: a strand strains eps cos^2
+               mesh_across: float, pattern: str = "diamond"
+               ) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """The membrane law of the same net loaded across. Diamond: a strand strains eps cos^2
     instead of eps sin^2 and 2 / a_along strands carry it, so with r = a_across / a_along
-    (= cot theta) the knees scale by 1 / r^2 and the slopes by r^4."""
+    (= cot theta) the knees scale by 1 / r^2 and the slopes by r^4. Square (a square mesh):
+    the strands across are those along, the same law."""
+    if pattern == "square":
+        return tuple(knees), tuple(slopes)
     r = mesh_across / mesh_along
     return tuple(k / r**2 for k in knees), tuple(k * r**4 for k in slopes)
 
@@ -149,8 +160,8 @@ def screen_point(ctx: SearchContext, point: NetPoint,
     t_slope, want = target or target_curve(ctx)
     sec = strand_section(ctx, point)
     ax, ay = point.mesh_x_mm * MM, point.mesh_y_mm * MM
-    knees, slopes, source = net_membrane_law(m, sec, ay, ax)
-    k2, s2 = across_law(knees, slopes, ay, ax)
+    knees, slopes, source = net_membrane_law(m, sec, ay, ax, point.pattern)
+    k2, s2 = across_law(knees, slopes, ay, ax, point.pattern)
     ratio = np.concatenate([piecewise_linear(NET_STRAINS, knees, slopes),
                             piecewise_linear(NET_STRAINS, k2, s2)]) / want
     rms = float(np.sqrt(np.mean(np.log(ratio) ** 2)))
@@ -158,7 +169,7 @@ def screen_point(ctx: SearchContext, point: NetPoint,
     where = f"net {m.name} strand {sec.width_mm:g}x{sec.thickness_mm:g} mm"
     speed, print_reasons = print_limits(sec, m, ctx.printer, where)
     violations = [("print", r) for r in print_reasons]
-    force = peak_strand_force(t, ax, ay, "diamond")  # the search space is diamond nets
+    force = peak_strand_force(t, ax, ay, point.pattern)
     sf = m.failure_stress()[0] * area_m2(sec) / force
     if sf < MIN_SAFETY_FACTOR:
         violations.append(("strength", (f"{where}, mesh {point.mesh_x_mm:.4g} x "
@@ -167,7 +178,7 @@ def screen_point(ctx: SearchContext, point: NetPoint,
     bed = bed_violation(ctx, point, sec.bead_width_mm)
     if bed:
         violations.append(("bed", bed))
-    opening = clear_opening_mm(point.mesh_x_mm, point.mesh_y_mm, sec.width_mm)
+    opening = clear_opening_mm(point.mesh_x_mm, point.mesh_y_mm, sec.width_mm, point.pattern)
     if opening < MIN_OPENING_MM:
         violations.append(("opening", (f"clear mesh opening {opening:.2f} mm below "
                                       f"{MIN_OPENING_MM:g} mm; use a larger mesh or a thinner "

@@ -1,4 +1,6 @@
-"""The design space of `printgen design`: material x strand section x diamond mesh x border.
+"""The design space of `printgen design`: material x strand section x mesh x border, in the
+printed net's pattern (`selection.printed_pattern`: diamond, or square for a square-mesh
+prototype).
 
 A candidate is a `NetPoint`, a small frozen record that a sweep task evaluates on its own (so
 the results do not depend on where it runs). The mesh is parameterised by whole half-diagonals
@@ -25,6 +27,7 @@ from printgen.scaling.selection import (
     MAX_BEADS_ACROSS,
     MAX_LAYERS,
     net_print_name,
+    printed_pattern,
 )
 from printgen.scaling.similitude import MESH_TOLERANCE, ScaledTargets
 
@@ -54,6 +57,8 @@ class NetPoint:
     mesh_x_mm: float
     mesh_y_mm: float
     border_beads: int
+    pattern: str = "diamond"  # "square": a square mesh of side mesh_x_mm = mesh_y_mm, with
+    # half_cells the doubled whole meshes (mesh = 2 L / half_cells, as the diamond's)
 
     @property
     def net_key(self) -> tuple:
@@ -169,17 +174,34 @@ def grid(ctx: SearchContext, space: SearchSpace) -> list[NetPoint]:
                          f"{MIN_HALF_CELLS}) of half-meshes across the {length:.4g} mm panel; "
                          "widen the bounds")
     check_size(space, len(nxs), len(nys))
+    pattern = printed_pattern(ctx.prototype)
+    meshes = (_square_meshes(ctx, nxs) if pattern == "square" else
+              [(nx, ny, round(2 * ctx.width_mm / nx, MESH_DIGITS),
+                round(2 * ctx.height_mm / ny, MESH_DIGITS)) for nx in nxs for ny in nys])
     out: list[NetPoint] = []
     for mat in space.materials:
         for beads in space.beads:
             for layers in space.layers:
-                for nx in nxs:
-                    for ny in nys:
-                        for border in space.border_beads:
-                            out.append(NetPoint(
-                                len(out), mat, beads, layers, nx, ny,
-                                round(2 * ctx.width_mm / nx, MESH_DIGITS),
-                                round(2 * ctx.height_mm / ny, MESH_DIGITS), border))
+                for nx, ny, mx, my in meshes:
+                    for border in space.border_beads:
+                        out.append(NetPoint(len(out), mat, beads, layers, nx, ny, mx, my,
+                                            border, pattern))
+    return out
+
+
+def _square_meshes(ctx: SearchContext, nxs: list[int]) -> list[tuple[int, int, float, float]]:
+    """(half cells across, up, side, side) of the square meshes whose side fits the panel's
+    width in whole meshes (an even half-cell count) within the bounds across; up, the
+    height rounded to whole meshes as `square_graph` builds it (its bounds do not apply: the
+    mesh is one side both ways)."""
+    out = []
+    for nx in nxs:
+        if nx % 2:
+            continue
+        side = round(2 * ctx.width_mm / nx, MESH_DIGITS)
+        ny = 2 * round(ctx.height_mm / side)
+        if ny >= MIN_HALF_CELLS:
+            out.append((nx, ny, side, side))
     return out
 
 

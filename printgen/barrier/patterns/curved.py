@@ -205,11 +205,19 @@ def blocked_membrane(layout: str, s: CurvedStrands, mesh_along: float, mesh_acro
     along the load, at finite strain: every chord stretched alike by the affine stretch (its
     along-load part times 1 + eps, its across part held), each strand pulling along its
     chord with the curve's force at its chord strain."""
+    return blocked_force(layout, strand_law(layout, s, mesh_along, mesh_across), mesh_along,
+                         mesh_across, strains)
+
+
+def blocked_force(layout: str, law: Law, mesh_along: float, mesh_across: float,
+                  strains: np.ndarray) -> np.ndarray:
+    """`blocked_membrane` of a net whose strands pull with `law` (N per unit chord strain):
+    straight or curved, the same affine stretch."""
     up, side = chord_parts(layout, mesh_along, mesh_across)
     l0 = math.hypot(up, side)
     e = np.asarray(strains, float)
     l1 = np.hypot(side, up * (1 + e))
-    force = strand_law(layout, s, mesh_along, mesh_across).force_and_tangent(l1 / l0 - 1)[0]
+    force = law.force_and_tangent(l1 / l0 - 1)[0]
     return _per_width(layout, mesh_along, mesh_across) * force * up * (1 + e) / l1
 
 
