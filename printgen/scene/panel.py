@@ -53,6 +53,7 @@ from printgen.scaling.panel_test import (  # the solve of the test, below the sc
     simulate,
 )
 from printgen.scaling.record import Design
+from printgen.scaling.section import area_m2
 from printgen.scene.scenes import TESTED_PATTERN, model_net_law, panel_axes
 from printgen.solver import Law
 from printgen.units import MM
@@ -200,11 +201,14 @@ def curved_panel(d: Design, orientation: str, amplitude_mm: float, half_waves: i
         check_wave,
         membrane_law,
         strand_law,
-        stress_law,
     )
 
     n = d.net
-    stress, how = stress_law(load_material(n.material))
+    # the material as the verification reads it (the panel-law reading the material can
+    # produce), per unit area of the design's strands: the waved scene's law too
+    straight, how = model_net_law(load_material(n.material), n, None)
+    stress = straight.scaled(1.0 / area_m2(n.strand))
+    how = f"the design's straight strands' law ({how}) per unit area"
     s = CurvedStrands(amplitude_mm, half_waves, n.strand.bead_width_mm, n.strand.beads_across,
                       n.strand.thickness_mm, stress, how)
     check_wave(n.pattern, s, n.mesh_x_mm, n.mesh_y_mm, "--wave")

@@ -254,9 +254,12 @@ def membrane_law(layout: str, s: CurvedStrands, mesh_along: float,
 
 def stress_law(mat: Material) -> tuple[Law, str]:
     """The material's stress-strain law (Pa per unit strain) and where it comes from: its
-    measured panel law read back to the tested net's strands (the tested net is a straight
-    diamond net, as for the straight nets' laws) and divided by their area, when the profile
-    records that net; else linear at its modulus (measured preferred)."""
+    measured panel law read back to the tested net's strands along the diagonal its profile
+    records (the tested net is a straight diamond net, as for the straight nets' laws) and
+    divided by their area, when the profile records that net; else linear at its modulus
+    (measured preferred). The verification and `printgen panel --wave` read the material as
+    the scene does instead (`printgen.scene.scenes.model_net_law`: the reading the material
+    can produce)."""
     pl = mat.panel_law
     if pl is not None and pl.has_geometry:
         width, thickness = pl.strand_width, pl.strand_thickness
