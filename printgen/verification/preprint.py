@@ -149,9 +149,12 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw: Any
                           f"nothing to compare; first: {next(iter(failed.values()))}")
     loose = [float(r.level) for r in results if r.converged and wire_slack(r.strains, ex)]
     if loose:  # a segment shorter than its knee would pull harder than the sensor
-        raise SolverError(f"{s.name}: a sensor wire segment shortened below its spring's knee "
-                          f"at h/h_B = {loose[0]:g}; raise WIRE_STRAIN in "
-                          "printgen/scene/solvernet.py")
+        raise SolverError(f"{s.name}: its sensor wires ({scene_sensor_force(s):.3g} N each) pull "
+                          f"the net so far at h/h_B = {loose[0]:g} that a wire folds back over "
+                          "its nodes (a "
+                          "segment shorter than 3/8 of its length): the sensors are too strong "
+                          "for this net; lower [flume] sensor_force_n in the prototype file, or "
+                          "print a stiffer net")
     n, m, c = ex.n_nodes, ex.n_elements, ex.n_cables
     d = deformation(s, lv, [r.positions[:n] for r in results],
                     [r.tensions[:m] for r in results], [r.cable_tensions[:c] for r in results])
