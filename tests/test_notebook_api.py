@@ -213,3 +213,13 @@ def test_the_main_guard_message_is_true(tmp_path, how):
             assert words in done.stderr, (words, done.stderr)
     else:
         assert done.returncode == 0 and done.stdout.strip() == "[2.0, 3.0]", done.stderr
+
+
+def test_calibrate_stays_callable_once_its_package_is_imported():
+    """Importing printgen.calibrate's modules (as printgen itself does) makes the package the
+    attribute `printgen.calibrate`: it must still be the verb."""
+    import printgen
+    import printgen.calibrate.reader  # noqa: F401
+
+    with pytest.raises(TypeError, match="material"):
+        printgen.calibrate([])  # the verb's own signature: `material` is required
