@@ -226,7 +226,7 @@ def search(p: Prototype, scale: float, runner: Runner, *, objective: str = "defo
     design = None if chosen is None else candidate_design(ctx, screened[chosen].point, base)
     wave = None
     if objective == "deformation" and verifier and chosen is not None and design:
-        shared, check = VerifyShared(p, level_step), verifier
+        check = verifier  # `shared` as the candidates had it: the one prototype sweep
 
         def verify(designs: list[Design]) -> list[float]:
             tasks = [VerifyTask(f"wave-{i}", d) for i, d in enumerate(designs)]
