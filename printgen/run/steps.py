@@ -315,7 +315,9 @@ def advice_for(ctx: MakeContext, v: Verification, band: Band) -> Advice | None:
                    coarsen=band.coarsen, load=ctx.options.load,
                    way=direction(v.mismatches))
     ctx.timings.setdefault("timings_s", {})["advice"] = time.perf_counter() - t
-    out = None if ctx.out is None else str(ctx.out)
+    # the folder by its name, as run from the folder holding it: the report does not depend
+    # on where the folder sits (a lab moves and archives it whole)
+    out = None if ctx.out is None else ctx.out.name
     return dataclasses.replace(a, next=a.next_step(str(ctx.prototype.path),
                                                    ctx.targets.scale, out))
 
