@@ -126,8 +126,8 @@ def _as_tutorial(text: str, out: Path) -> str:
     """`text` with the run's output folder written `o` and its prototype `proto.toml`."""
     for folder in {str(out.resolve()), str(out)}:
         text = text.replace(folder, "o")
-    text = text.replace(f" {out.name}/", " o/").replace(f" {out.name}-next", " o-next")
-    text = text.replace(f"({out.name}: ", "(o: ")
+    text = text.replace(" OUT/", " o/").replace(" OUT-next", " o-next")
+    text = text.replace("(OUT: ", "(o: ")
     return re.sub(r"\S*realistic_barrier\.toml", "proto.toml", text)
 
 

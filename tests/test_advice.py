@@ -185,7 +185,7 @@ def test_make_writes_the_verified_design_and_it_passes_when_made(tmp_path):
     summary = ctx.record["summary"]
     assert summary["verdict"] == "FAIL"
     assert NEXT_DESIGN in json.loads((out / "manifest.json").read_text())["files"]
-    assert f"--design {out.name}/{NEXT_DESIGN}" in summary["next"]  # run from its parent
+    assert f"--design OUT/{NEXT_DESIGN}" in summary["next"]  # OUT: "this output folder"
     assert ctx.record["advice"]["found"] is True
     again = make(proto, 100, tmp_path / "o2", steps=only,
                  options=RunOptions(design_file=str(out / NEXT_DESIGN)))

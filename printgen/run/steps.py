@@ -295,6 +295,9 @@ def verify_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     return {"verification": check} | ({} if advice is None else {"advice": advice})
 
 
+OUT_WORD = "OUT"  # how the advice's command names the run's output folder
+
+
 def advice_for(ctx: MakeContext, v: Verification, band: Band) -> Advice | None:
     """What to change when the verdict is not PASS (printgen.verification.advice), its "Next"
     line naming the run's files; None on PASS, when the flume cannot run the test (its fix, a
@@ -315,9 +318,9 @@ def advice_for(ctx: MakeContext, v: Verification, band: Band) -> Advice | None:
                    coarsen=band.coarsen, load=ctx.options.load,
                    way=direction(v.mismatches))
     ctx.timings.setdefault("timings_s", {})["advice"] = time.perf_counter() - t
-    # the folder by its name, as run from the folder holding it: the report does not depend
-    # on where the folder sits (a lab moves and archives it whole)
-    out = None if ctx.out is None else ctx.out.name
+    # the folder as OUT, said so: the report does not depend on the folder's name or place
+    # (the same inputs give the same files; a lab moves and archives the folder whole)
+    out = None if ctx.out is None else OUT_WORD
     return dataclasses.replace(a, next=a.next_step(str(ctx.prototype.path),
                                                    ctx.targets.scale, out))
 

@@ -136,7 +136,7 @@ class Advice:
         if self.design is not None:
             where = f"{out}/{NEXT_DESIGN}" if out else NEXT_DESIGN
             cmd += f" --design {where} --out {out}-next" if out else f" --design {where}"
-        steps.append(f"run {cmd}" + (f" ({out}: this output folder, by its name)"
+        steps.append(f"run {cmd}" + (f" ({out}: this output folder)"
                                      if out and self.design is not None else ""))
         text = (f"{self.change}; printgen verified that it passes with the nominal inputs "
                 f"({self.tried_text()}; its band, which make sweeps, may still leave the "
