@@ -454,8 +454,9 @@ def same_mesh(p: Prototype, d: Design, proto: Run, tried: list[Tried], weaker: f
                   f"{CALIBRATE_FIRST}",) if picks[i].datasheet else ())
         return Advice(nets[i].what, designs[i], weaker, "", tuple(tried), len(pool),
                       time.perf_counter() - t0, notes)
-    scope = (f"the design search holds {SEARCHED_PATTERN} nets only, so only the strand of this "
-             f"{d.net.pattern} net was changed: of {len(pool)} printable, strong enough strands")
+    scope = (f"keeping this {d.net.pattern} net's mesh, the advice changed only its strand "
+             "(printgen design searches the meshes too): of "
+             f"{len(pool)} printable, strong enough strands")
     if not picks:
         other = "softer" if way == "stiff" else "stiffer"
         return Advice("", None, None, f"{scope}, none is {other} than this design's",
