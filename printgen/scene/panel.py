@@ -53,7 +53,6 @@ from printgen.scaling.panel_test import (  # the solve of the test, below the sc
     simulate,
 )
 from printgen.scaling.record import Design
-from printgen.scaling.section import area_m2
 from printgen.scene.scenes import TESTED_PATTERN, model_net_law, panel_axes
 from printgen.solver import Law
 from printgen.units import MM
@@ -196,21 +195,19 @@ def curved_panel(d: Design, orientation: str, amplitude_mm: float, half_waves: i
     net law its strand curves give (the blocked, infinite net) to compare with. The panel is
     PRINTED_PANEL long, or longer to hold two meshes; its strains reach 1.5 x the knee."""
     from printgen.barrier.patterns.curved import (
-        CurvedStrands,
         blocked_membrane,
         check_wave,
         membrane_law,
         strand_law,
     )
+    from printgen.scene.waved import waved_strands
 
     n = d.net
     # the material as the verification reads it (the panel-law reading the material can
-    # produce), per unit area of the design's strands: the waved scene's law too
+    # produce), as the waved scene takes it
     straight, how = model_net_law(load_material(n.material), n, None)
-    stress = straight.scaled(1.0 / area_m2(n.strand))
-    how = f"the design's straight strands' law ({how}) per unit area"
-    s = CurvedStrands(amplitude_mm, half_waves, n.strand.bead_width_mm, n.strand.beads_across,
-                      n.strand.thickness_mm, stress, how)
+    s = waved_strands(n, straight, amplitude_mm, half_waves,
+                      f"the design's straight strands' law ({how}) per unit area")
     check_wave(n.pattern, s, n.mesh_x_mm, n.mesh_y_mm, "--wave")
     along, across = panel_axes(n.mesh_x_mm * MM, n.mesh_y_mm * MM, orientation)
     size = (max(PRINTED_PANEL[0], 2 * along), max(PRINTED_PANEL[1], 2 * across))

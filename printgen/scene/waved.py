@@ -30,7 +30,7 @@ from printgen.barrier.patterns.curved import CurvedStrands, blocked_force, chord
 from printgen.inputs.laws import piecewise_linear
 from printgen.inputs.materials import load_material
 from printgen.inputs.prototype import Prototype
-from printgen.scaling.record import Design, Wave, check_net_wave
+from printgen.scaling.record import Design, NetDesign, Wave, check_net_wave
 from printgen.scaling.section import area_m2
 from printgen.scaling.selection import NET_STRAINS, target_net_law
 from printgen.scaling.similitude import ScaledTargets
@@ -58,6 +58,16 @@ def _solved(strand: Strand, strains: tuple[float, ...]) -> StrandCurve:
     return strand_curve(strand, np.array(strains))
 
 
+def waved_strands(n: NetDesign, straight: Law, amplitude_mm: float, half_waves: int,
+                  source: str = "") -> CurvedStrands:
+    """Net `n`'s strands with the wave `amplitude_mm`, `half_waves`, their material law
+    `straight` (N per unit strain of `n`'s straight strands) over their area (see the
+    module); `source` says where that law comes from."""
+    return CurvedStrands(amplitude_mm, half_waves, n.strand.bead_width_mm,
+                         n.strand.beads_across, n.strand.thickness_mm,
+                         straight.scaled(1.0 / area_m2(n.strand)), source)
+
+
 def waved_curve(straight: Law, d: Design) -> StrandCurve:
     """The solved curve of design `d`'s waved strands whose material law is `straight` (N per
     unit strain of the design's straight strands) over their area (see the module)."""
@@ -66,9 +76,7 @@ def waved_curve(straight: Law, d: Design) -> StrandCurve:
         raise ValueError("waved_curve needs a design with a wave")
     if w.amplitude_mm > 0:  # zero: the straight limit, through the same model
         check_net_wave(n, "design")
-    s = CurvedStrands(w.amplitude_mm, w.half_waves, n.strand.bead_width_mm,
-                      n.strand.beads_across, n.strand.thickness_mm,
-                      straight.scaled(1.0 / area_m2(n.strand)))
+    s = waved_strands(n, straight, w.amplitude_mm, w.half_waves)
     strand = s.strand(chord(n.pattern, n.mesh_y_mm, n.mesh_x_mm) * MM)
     return _solved(strand, tuple(float(e) for e in solved_strains(strand)))
 
