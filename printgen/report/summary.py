@@ -103,8 +103,9 @@ def summarize(run: RunRecords, next_step: str = "") -> Summary:
                 if b.levels > 0}  # none where nothing deforms
         ratios = [m.ratio_high for m in v.mismatches if not m.ok]
         nxt = NEXT_PASS if v.ok else (NEXT_STIFF if ratios and min(ratios) < 1 else NEXT_SOFT)
-        if v.verdict == "UNDECIDED" and v.decision is not None:
-            nxt = NEXT_UNDECIDED.format(test=v.decision.test)
+        undecided = (NEXT_UNDECIDED.format(test=v.decision.test)
+                     if v.verdict == "UNDECIDED" and v.decision is not None else "")
+        nxt = undecided or nxt
         if v.sensors is not None:
             sensors = v.sensors.text()
             if v.sensors_to_blame:  # the net is similar: the sensors, not the material
@@ -112,9 +113,8 @@ def summarize(run: RunRecords, next_step: str = "") -> Summary:
                                           share=v.sensors.threshold)
         advice = run.steps.get("advice")
         if advice is not None and advice.next:  # a change printgen verified, or why none
-            nxt = advice.next if v.verdict != "UNDECIDED" or v.decision is None else (
-                f"{NEXT_UNDECIDED.format(test=v.decision.test)} With the nominal inputs: "
-                f"{advice.next}")
+            nxt = (f"{undecided} With the nominal inputs: {advice.next}" if undecided
+                   else advice.next)
         if not v.runnable and v.flow is not None:  # a new scale changes the parts too
             nxt = NEXT_FLUME.format(fix=v.flow.fix)
     return Summary(verdict, reason, band, chosen_parts(run.design, run.plan,
