@@ -191,18 +191,11 @@ def against(proto: Run, run: Run | str, what: str, coarsen: int) -> Tried:
         return Tried(what, False, math.inf, f"the solver did not converge: {run}", coarsen)
     pd, md = proto.deformation, run.deformation
     keep = np.array([lv not in run.failed for lv in pd.levels])
-    mm = compare(_only(pd, keep), _only(md, np.isin(md.levels, pd.levels[keep])))
+    mm = compare(pd.only(keep), md.only(np.isin(md.levels, pd.levels[keep])))
     bad = [m for m in mm if not m.ok and math.isfinite(m.ratio_high)]
     return Tried(what, all(m.ok for m in mm), _rms(mm), "\n".join(headlines(mm)), coarsen,
                  tuple(m.metric for m in bad if m.ratio_high < 1),
                  tuple(m.metric for m in bad if m.ratio_high >= 1))
-
-
-def _only(d: Any, keep: np.ndarray) -> Any:
-    return dataclasses.replace(d, levels=d.levels[keep],
-                               values={k: v[keep] for k, v in d.values.items()},
-                               max_strand_tension=d.max_strand_tension[keep],
-                               max_cable_tension=d.max_cable_tension[keep])
 
 
 def _rms(mm: list[Mismatch]) -> float:

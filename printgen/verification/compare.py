@@ -32,6 +32,11 @@ class Deformation:
     max_strand_tension: np.ndarray  # (k,) N
     max_cable_tension: np.ndarray  # (k,) N
 
+    def only(self, keep: np.ndarray) -> Deformation:
+        """The deformations at the levels `keep` (a (k,) boolean mask) selects."""
+        return Deformation(self.levels[keep], {k: v[keep] for k, v in self.values.items()},
+                           self.max_strand_tension[keep], self.max_cable_tension[keep])
+
 
 def row_strain(x0: np.ndarray, x: np.ndarray) -> float:
     """Elongation of the polyline through a row of nodes: length / initial length - 1."""

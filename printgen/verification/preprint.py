@@ -418,10 +418,7 @@ def stated(case: LoadCase, runs: tuple[Run, Run], sites: tuple[Site, Site]
 
 
 def _only(run: Run, keep: np.ndarray) -> Run:
-    d = run.deformation
-    dd = Deformation(d.levels[keep], {k: v[keep] for k, v in d.values.items()},
-                     d.max_strand_tension[keep], d.max_cable_tension[keep])
-    return dataclasses.replace(run, deformation=dd)
+    return dataclasses.replace(run, deformation=run.deformation.only(keep))
 
 
 @dataclass(frozen=True)
