@@ -165,3 +165,20 @@ def test_the_install_table_names_every_extra():
     named = {e for group in pulled for e in group.split(",")}
     assert set(re.findall(r"`([\w-]+)`", rows["all"])) == named
     assert "docs" not in named  # the site's tools stay out of a developer's `all`
+
+
+def test_the_install_sizes_come_from_the_measurement():
+    """Every size in the table of extras sits in a marker that scripts/install_sizes.py fills
+    from benchmarks/install_sizes.json, and the page holds the JSON's numbers."""
+    import subprocess
+    import sys
+
+    text = (ROOT / "docs" / "index.md").read_text("utf-8").split("## Installing", 1)[1]
+    rows = re.findall(r"^\|[^|\n]*\|[^|\n]*\| ([^|\n]*) \|$", text, re.MULTILINE)
+    sized = [r for r in rows if r not in ("adds", "---")]
+    assert len(sized) >= 12  # the default set and every extra
+    assert all(re.fullmatch(r"<!--size:[\w-]+-->[^<]*MB[^<]*<!--/size-->", r) for r in sized), sized
+    assert not re.search(r"~\s*\d+(\.\d+)?\s*[MG]B", text)  # no size typed by hand
+    done = subprocess.run([sys.executable, str(ROOT / "scripts" / "install_sizes.py"), "--check"],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
