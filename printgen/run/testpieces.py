@@ -69,6 +69,11 @@ def testpieces(design_path: str | Path, out: str | Path, *, orientation: str = "
         rec["panel"]["expected_curve"] = _expected(stage, dp, blocked)
         rec["panel"]["geometry"] = piece.to_record()
         rec["coupon"]["geometry"] = _coupon_geometry(coupon)
+        if d.net.wave is not None:
+            from printgen.run.wavepieces import wave_coupon_files
+
+            rec["wave_coupon"] = wave_coupon_files(stage, d, printer)
+            rec["panel"]["strands"] = dp.strands
         (stage / "README.md").write_text(readme_text(rec, dp.test.describe()))
         (stage / RECORD).write_text(dumps(rec))
     return rec
@@ -83,10 +88,18 @@ def material_source(mat) -> str:
 
 
 def _panel(d: Design, orientation: str):
-    from printgen.scene.panel import design_panel, lattice_size
+    """The simulated free and blocked tests of the design's panel and the printed piece; a
+    waved net's panel is tested with its strands' beam-model law (`scene.panel.curved_panel`),
+    sized as that test."""
+    from printgen.scene.panel import curved_panel, design_panel, lattice_size
 
-    dp = design_panel(d, orientation, "free")
-    blocked = design_panel(d, orientation, "blocked")
+    w = d.net.wave
+    if w is None:
+        dp = design_panel(d, orientation, "free")
+        blocked = design_panel(d, orientation, "blocked")
+    else:
+        dp, blocked = (curved_panel(d, orientation, w.amplitude_mm, w.half_waves, mode)
+                       for mode in ("free", "blocked"))
     length, width = lattice_size(dp.test)
     return dp, blocked, panel_for(d, orientation, length / MM, width / MM)
 
@@ -220,8 +233,17 @@ def readme_text(rec: dict[str, Any], panel_test: str) -> str:
         (f"Expected curve (panel-expected.csv): the virtual panel test, {panel_test}; "
         "columns free (sides free, as tested) and blocked (every strand stretched alike, the "
         "barrier's membrane law: the upper bound)."), *_mechanism_note(rec), "",
-        "## The loop", *rec["loop"], ""]
+        *_wave_section(rec), "## The loop", *rec["loop"], ""]
     return "\n".join(lines)
+
+
+def _wave_section(rec: dict[str, Any]) -> list[str]:
+    """The waved coupon's section (a design with a net wave), with what to print first."""
+    if "wave_coupon" not in rec:
+        return []
+    from printgen.run.wavepieces import wave_readme
+
+    return ["", *wave_readme(rec["wave_coupon"])]
 
 
 def _mechanism_note(rec: dict[str, Any]) -> list[str]:
