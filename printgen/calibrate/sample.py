@@ -128,7 +128,7 @@ def analyse(rec: TestRecord, spec: Specimen, opt: FitOptions) -> SampleFit:
     when the force, stress or modulus is implausible)."""
     peak, strength = peak_and_strength(rec, spec)
     check_stress(rec, spec, strength)
-    x, y, source = _curve(rec, spec, opt)
+    x, y, source = strain_and_y(rec, spec, opt)
     p = loading_branch(y)
     if opt.preload is not None and not rec.has("force"):
         raise CalibrationError(f"{rec.path}: --preload is a force but the file has no force "
@@ -193,7 +193,8 @@ def _modulus_or_none(path: str, x: np.ndarray, y: np.ndarray, force: np.ndarray 
         return None
 
 
-def _curve(rec: TestRecord, spec: Specimen, opt: FitOptions) -> tuple[np.ndarray, np.ndarray, str]:
+def strain_and_y(rec: TestRecord, spec: Specimen, opt: FitOptions
+                 ) -> tuple[np.ndarray, np.ndarray, str]:
     """(strain, y, description of the strain source)."""
     deform = [r for r in ("strain", "displacement") if rec.has(r)]
     if not deform:

@@ -61,7 +61,7 @@ def testpieces(design_path: str | Path, out: str | Path, *, orientation: str = "
                             **provenance_record(command, files={"design_file": design_path},
                                                 design=d)}
     with staged_dir(out, force=force, meta=meta, inputs=inputs) as stage:
-        rec = {"design_file": Path(design_path).name, "material": d.net.material,
+        rec: dict[str, Any] = {"design_file": Path(design_path).name, "material": d.net.material,
                "material_source": material_source(load_material(d.net.material)),
                "coupon": _coupon_files(stage, coupon, printer),
                "panel": _panel_files(stage, piece, printer),
