@@ -1,28 +1,32 @@
-"""Calibrate waved-strand coupons (`printgen testpieces` of a waved design, kind "waved"):
-their exports against the beam model of their strands (`printgen.solver.strand_curve`).
+"""Calibrate waved-strand test pieces (`printgen testpieces` of a waved design, sidecar kind
+"waved"): their exports against the beam model of their strands (`printgen.solver.strand_curve`).
 
 The sidecar's `[wave]` table gives the model's inputs: the chord, the wave, the strands side by
-side, their section, and the material law the prediction assumed (stress knees and slopes).
-Held as designed (assumed, not measured): the wave's geometry, the section, the ends clamped
-by the gripped tabs, the shape of the material law. Measured: the one parameter the beam model
-leaves to the material, the scale of its law. The strand's chord force is linear in a scale
-of the material's stress law at every strain (every fibre's stress scales with it, the
-geometry does not), so the coupon's force is s x the prediction, and s is a linear least-
-squares fit over the loading branch: s = sum(F p) / sum(p^2). The measured law is s x the
-assumed one (its modulus s x the assumed modulus).
+side, their section, and the material law the prediction assumed (stress knees and slopes); a
+waved test panel's (`test = "panel"`) adds its simulated free test (strains and force per
+clamp width). Held as designed (assumed, not measured): the wave's geometry, the section, the
+ends clamped by the gripped tabs (the panel: its pin-jointed net between the clamps), the
+shape of the material law. Measured: the one parameter the beam model leaves to the material,
+the scale of its law. The strand's chord force is linear in a scale of the material's stress
+law at every strain (every fibre's stress scales with it, the geometry does not), and so is
+a displacement-controlled panel's (every strand's law scales, the equilibrium positions do
+not move), so the measured force is s x the prediction, and s is a linear least-squares fit
+over the loading branch: s = sum(F p) / sum(p^2). The measured law is s x the assumed one (its
+modulus s x the assumed modulus). A free panel the solver finds a mechanism has no prediction
+to fit (refused, with the fix).
 
 The shape is the model's check: a continuous bilinear fit (`fit.bilinear_fit`) of the measured
 curve and of the fitted prediction at the same strains gives the knee strain and the two
 slopes of each; their knees and the ratio of their slopes do not depend on s (the wave's
-geometry sets them). The fit reaches the strain the design's strand law is solved to
-(`curved.curve_strains`: the range the net solver uses the curve over); the data beyond it
-are left out (said in the record).
+geometry sets them). The fit reaches the largest strain predicted (the coupon: the strain the
+design's strand law is solved to, `curved.curve_strains`, the range the net solver uses the
+curve over); the data beyond it are left out (said in the warnings).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -42,11 +46,17 @@ from printgen.solver.strand_curve import Strand, StrandCurve, strand_curve
 KIND = "waved"
 WAVE = [
     positive("chord_mm", 1e4, si=False), Field("amplitude_mm", float, lo=0.0, si=False),
-    Field("half_waves", int, lo=1), Field("strands", int, lo=1),
+    Field("half_waves", int, lo=1), Field("strands", int, lo=1, required=False, default=1),
     positive("strand_width_mm", 1e3, si=False), positive("thickness_mm", 1e3, si=False),
     Field("material", str), Field("law_source", str, required=False, default=""),
     Field("stress_knees", list, items=float), Field("stress_slopes_mpa", list, items=float),
+    Field("test", str, choices=("coupon", "panel"), required=False, default="coupon"),
+    Field("panel_strains", list, items=float, required=False, default=[]),
+    Field("panel_n_per_m", list, items=float, required=False, default=[]),
+    Field("panel_hold_share", float, lo=0.0, required=False, default=0.0),
 ]
+MECHANISM = 0.5  # a free panel whose simulated clamp force the solver's hold carries more
+# than half of is a mechanism (printgen panel's measure): its curve is no prediction
 # A bilinear fit needs a knee with points on both sides; fewer than this many loading points
 # (or a curve that never rises) leaves nothing to fit.
 MIN_POINTS = 20
@@ -70,13 +80,37 @@ class WaveModel:
     stress: Law
     material: str
     law_source: str
+    panel_strains: tuple[float, ...] = ()  # a waved test panel's: its simulated free test
+    panel_n_per_m: tuple[float, ...] = ()
+    panel_width: float = 0.0  # m, the panel's clamp width (its force per width is fitted)
+
+    @property
+    def panel(self) -> bool:
+        return bool(self.panel_strains)
+
+    @property
+    def unit(self) -> str:
+        return "N/m" if self.panel else "N"
+
+    def predict(self, strain: np.ndarray) -> np.ndarray:
+        """The predicted coupon force (N, all strands) or panel force per width (N/m)."""
+        if self.panel:
+            return np.interp(strain, (0.0, *self.panel_strains), (0.0, *self.panel_n_per_m))
+        return self.strands * self.curve().law().force_and_tangent(strain)[0]
+
+    def measured(self, force: np.ndarray) -> np.ndarray:
+        """The export's force as the prediction reads it (per clamp width for a panel)."""
+        return force / self.panel_width if self.panel else force
 
     def strand(self) -> Strand:
         return Strand(self.chord, self.amplitude, self.half_waves, self.width, self.thickness,
                       self.stress)
 
     def top(self) -> float:
-        """The chord strain the design's strand law is solved to (`curve_strains`)."""
+        """The largest strain predicted: the chord strain the design's strand law is solved to
+        (`curve_strains`), or the panel's simulated test's last strain."""
+        if self.panel:
+            return self.panel_strains[-1]
         return float(curve_strains(self.strand().excess())[-1])
 
     def curve(self) -> StrandCurve:
@@ -109,9 +143,37 @@ def read_wave(path: str | Path) -> WaveModel:
             f"{path} [wave]: stress law knees {list(knees)} and slopes "
             f"{list(t['stress_slopes_mpa'])} MPa: need increasing knees above 0 and one more "
             "slope than knees, every slope > 0")
-    return WaveModel(t["chord_mm"] * 1e-3, t["amplitude_mm"] * 1e-3, t["half_waves"],
-                     t["strands"], t["strand_width_mm"] * 1e-3, t["thickness_mm"] * 1e-3,
-                     Law(knees, slopes), t["material"], t["law_source"])
+    model = WaveModel(t["chord_mm"] * 1e-3, t["amplitude_mm"] * 1e-3, t["half_waves"],
+                      t["strands"], t["strand_width_mm"] * 1e-3, t["thickness_mm"] * 1e-3,
+                      Law(knees, slopes), t["material"], t["law_source"])
+    return model if t["test"] == "coupon" else _panel(model, t, data, path)
+
+
+def _panel(model: WaveModel, t: dict[str, Any], data: dict[str, Any],
+           path: str | Path) -> WaveModel:
+    """`model` with the waved test panel's simulated free test (its [wave] table's panel_*
+    keys, its clamp width the sidecar's width_mm)."""
+    e, n = tuple(t["panel_strains"]), tuple(t["panel_n_per_m"])
+    if len(e) < 2 or len(e) != len(n) or any(b <= a for a, b in zip((0.0, *e), e,
+                                                                      strict=False)):
+        raise CalibrationError(f"{path} [wave]: a panel's panel_strains ({len(e)}) and "
+                               f"panel_n_per_m ({len(n)}) must be as many, at least 2, the "
+                               "strains increasing from above 0: use the sidecar printgen "
+                               "testpieces wrote")
+    if t["panel_hold_share"] > MECHANISM:
+        raise CalibrationError(
+            f"{path}: the simulated free panel is a mechanism (the solver's hold carries "
+            f"{t['panel_hold_share']:.2g} of its clamp force, over {MECHANISM:g}): its pin-"
+            "jointed free net has no stiffness of its own until it locks, so its curve "
+            "predicts nothing a material law could be fitted to (the printed panel's low-strain "
+            "force comes from its rigid junctions). Calibrate the material with the waved "
+            "coupons (wave-coupon.specimen.toml) and compare this panel's curve with "
+            "panel-expected.csv (between its free and blocked columns)")
+    width = data.get("width_mm")
+    if not isinstance(width, (int, float)) or not width > 0:
+        raise CalibrationError(f"{path}: a waved panel's sidecar needs width_mm (its clamp "
+                               f"width, > 0), got {width!r}")
+    return replace(model, panel_strains=e, panel_n_per_m=n, panel_width=width * 1e-3)
 
 
 @dataclass(frozen=True)
@@ -145,7 +207,7 @@ def fit_sample(path: str, x: np.ndarray, force: np.ndarray, model: WaveModel,
                                f"(the model's range), need {MIN_POINTS} with a rising force: "
                                "check the strain column and the gauge (the chord) in the "
                                "sidecar")
-    pred = model.strands * model.curve().law().force_and_tangent(xs)[0]
+    pred = model.predict(xs)
     scale = float(fs @ pred / (pred @ pred))
     if not (math.isfinite(scale) and scale > 0):
         raise CalibrationError(f"{path}: the measured force does not follow the prediction "
@@ -201,13 +263,15 @@ class WaveCalibration(Shown):
     def assumptions(self) -> tuple[str, str]:
         """(what was measured, what was assumed)."""
         m = self.model
+        piece = (f"the panel's simulated free test (the net's strands pulling with the beam "
+                 f"model's curve, pin-jointed, clamps {m.panel_width * 1e3:.4g} mm wide)"
+                 if m.panel else f"{m.strands} strands, ends clamped by the gripped tabs")
         return ((f"the scale of {m.material}'s stress law through the beam model "
                  f"(x {self.scale.mean:.4g}: initial modulus {self.modulus / 1e6:.4g} MPa)"),
                 (f"the wave as designed ({m.amplitude * 1e3:g} mm amplitude, {m.half_waves} "
                  f"half-wave(s) over a {m.chord * 1e3:.4g} mm chord), the section "
-                 f"{m.width * 1e3:g} x {m.thickness * 1e3:.4g} mm, {m.strands} strands, ends "
-                 "clamped by the gripped tabs, the shape of the material law "
-                 f"({m.law_source or m.material}), compression as tension"))
+                 f"{m.width * 1e3:g} x {m.thickness * 1e3:.4g} mm, {piece}, the shape of the "
+                 f"material law ({m.law_source or m.material}), compression as tension"))
 
     def summary(self) -> Summary:
         (km, kp), (rm, rp) = self.knees(), self.ratios()
@@ -224,12 +288,14 @@ class WaveCalibration(Shown):
                                              "the largest force (worst file)"),
                 ("measured", measured), ("assumed", assumed)]
         rows += [("warning", w) for w in self.warnings]
-        return Summary(f"Waved-coupon calibration: {self.material}", tuple(rows))
+        piece = "panel" if self.model.panel else "coupon"
+        return Summary(f"Waved-{piece} calibration: {self.material}", tuple(rows))
 
     def to_record(self) -> dict[str, Any]:
         (km, kp), (rm, rp) = self.knees(), self.ratios()
         measured, assumed = self.assumptions()
         return {"material": self.material, "kind": KIND, "files": list(self.files),
+                "piece": "panel" if self.model.panel else "coupon", "unit": self.model.unit,
                 "law_scale": {"mean": self.scale.mean, "sd": self.scale.sd, "n": self.scale.n},
                 "modulus_mpa": self.modulus / 1e6,
                 "assumed_modulus_mpa": float(self.model.stress.slopes[0]) / 1e6,
@@ -259,8 +325,8 @@ def calibrate_waved(files: list[tuple[Path, Any]], load, *, material: str, sidec
         x, _, source = strain_and_y(rec, spec, options)
         force = rec.channels["force"]
         p = loading_branch(force)
-        xb, fb, _ = zero_at_preload(x[: p + 1], force[: p + 1], options.preload,
-                                    force[: p + 1], mode=options.zero)
+        xb, fb, _ = zero_at_preload(x[: p + 1], model.measured(force[: p + 1]),
+                                    options.preload, force[: p + 1], mode=options.zero)
         samples.append(fit_sample(rec.path, xb, fb, model, source, flag_notes(rec)))
     scale = summarise([s.scale for s in samples], what="law scale",
                       labels=[Path(s.path).name for s in samples])
@@ -318,41 +384,3 @@ def measured_wave_tables(cal: WaveCalibration, prov: dict[str, Any]) -> dict[str
             law[key] = _r(v * 1e3)
     return {"panel_law": law | prov}
 
-
-def plot_waved(cal: WaveCalibration, path: str | Path) -> Path:
-    """The measured curves against the prediction as assumed (s = 1) and as fitted (s), with
-    both bilinear knees marked: one PNG written atomically."""
-    from printgen import outputs
-    from printgen.calibrate.plot import printable
-
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError as exc:  # pragma: no cover - depends on the install
-        raise CalibrationError("plots need matplotlib: pip install 'printgen[plot]'") from exc
-    import io
-
-    fig, ax = plt.subplots(figsize=(8, 5), constrained_layout=True)
-    m = cal.model
-    e = np.linspace(0.0, max(s.strain_max for s in cal.samples), 200)
-    pred = m.strands * m.curve().law().force_and_tangent(e)[0]
-    for i, s in enumerate(cal.samples):
-        ax.plot(s.x * 100, s.force, color=f"C{i % 10}", lw=1,
-                label=printable(Path(s.path.split(":")[-1]).name))
-    ax.plot(e * 100, pred, "k--", lw=1.5, label="beam model, material law as assumed")
-    ax.plot(e * 100, cal.scale.mean * pred, "k-", lw=1.5,
-            label=f"beam model, law x {cal.scale.mean:.3g} (fitted)")
-    (km, kp) = cal.knees()
-    ax.axvline(km.mean * 100, color="C3", ls=":", label=f"knee measured {km.mean:.2%}")
-    ax.axvline(kp.mean * 100, color="0.4", ls=":", label=f"knee predicted {kp.mean:.2%}")
-    ax.set_xlabel("chord strain (%)")
-    ax.set_ylabel(f"force, {m.strands} strands (N)")
-    ax.set_title(f"{cal.material}: waved coupons against the beam model")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, loc="upper left")
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    plt.close(fig)
-    return outputs.write_bytes(path, buf.getvalue())

@@ -203,7 +203,7 @@ def _waved(cal, args: argparse.Namespace) -> int:
         written["wrote"] = ", ".join(f"[measured.{k}]" for k in
                                      measured_keys(cal, args.date))
     if args.plot:
-        from printgen.calibrate.waved import plot_waved
+        from printgen.calibrate.plot import plot_waved
 
         written["plot"] = str(plot_waved(cal, Path(args.plot) / f"{cal.material}.png"))
     if args.json:

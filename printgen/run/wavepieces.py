@@ -29,6 +29,7 @@ from printgen.scaling.record import Design
 from printgen.scaling.testpieces import COUPON_COUNT
 from printgen.solver import Law
 from printgen.solver.strand_curve import StrandCurve
+from printgen.units import MM
 
 NAME = "wave-coupon"
 EXPECTED = f"{NAME}-expected.csv"
@@ -126,27 +127,54 @@ def _expected(stage: Path, c: WavedCoupon, curve: StrandCurve, straight: Law
 
 
 def _sidecar(stage: Path, c: WavedCoupon, curve: StrandCurve, how: str) -> dict[str, Any]:
-    """wave-coupon.specimen.toml: what `printgen calibrate` reads of the coupon (mm): kind
-    "waved", the gauge (the chord), the strands' total section, and a [wave] table with the
-    beam model's inputs and the material law the prediction assumed."""
+    """wave-coupon.specimen.toml: kind "waved", the gauge (the chord), the strands' total
+    section, and the [wave] table of the beam model's inputs."""
     sec = c.section
     keys = {"kind": "waved", "width_mm": c.strands * sec.width_mm,
             "thickness_mm": sec.thickness_mm, "gauge_length_mm": c.chord_mm,
             "grip_distance_mm": c.chord_mm}
-    law = _law_record(curve)
-    wave = {"chord_mm": c.chord_mm, "amplitude_mm": c.wave.amplitude_mm,
-            "half_waves": c.wave.half_waves, "strands": c.strands,
-            "strand_width_mm": sec.width_mm, "thickness_mm": sec.thickness_mm,
-            "material": c.material, "law_source": how, **law}
-    lines = [(f"# printgen testpieces: the waved coupon {NAME} for printgen calibrate "
-              f"(--specimen {NAME}.specimen.toml)"),
-             ("# strain = tab separation change / the chord (the tabs taken as rigid); width: "
-              "the strands' in-plane widths summed; [wave]: the beam model's inputs and the "
-              "material law the prediction assumed (stress knees, slopes in MPa)")]
+    wave = {**_beam_inputs(curve, how, c.material), "strands": c.strands}
+    _write_sidecar(stage, NAME, keys, wave, "strain = tab separation change / the chord (the "
+                   "tabs taken as rigid); width: the strands' in-plane widths summed")
+    return {**keys, "wave": wave}
+
+
+def wave_panel_sidecar(stage: Path, d: Design, dp, piece) -> dict[str, Any]:
+    """panel.specimen.toml of a waved design's test panel `piece`: kind "waved", its clamps,
+    and the [wave] table of the beam model's inputs with the simulated free test `dp` (what
+    `printgen calibrate` fits the material law's scale to)."""
+    curve, _, how = wave_prediction(d)
+    keys = {"kind": "waved", "width_mm": piece.width_mm, "gauge_length_mm": piece.length_mm,
+            "grip_distance_mm": piece.length_mm}
+    wave = {**_beam_inputs(curve, how, d.net.material), "test": "panel",
+            "panel_strains": [float(e) for e in dp.curve.strains],
+            "panel_n_per_m": [float(n) for n in dp.curve.force_per_width],
+            "panel_hold_share": float(dp.curve.hold_share)}
+    _write_sidecar(stage, "panel", keys, wave, "width: across the load at the clamp edges; "
+                   "length: clamp edge to clamp edge; panel_*: the simulated free test "
+                   "(panel-expected.csv's free column)")
+    return {**keys, "wave": wave}
+
+
+def _beam_inputs(curve: StrandCurve, how: str, material: str) -> dict[str, Any]:
+    """The beam model's inputs (mm, MPa) of the design's strands and the material law the
+    prediction assumed."""
+    st = curve.strand
+    return {"chord_mm": st.chord / MM, "amplitude_mm": st.amplitude / MM,
+            "half_waves": st.half_waves, "strand_width_mm": st.width / MM,
+            "thickness_mm": st.thickness / MM, "material": material, "law_source": how,
+            **_law_record(curve)}
+
+
+def _write_sidecar(stage: Path, name: str, keys: dict[str, Any], wave: dict[str, Any],
+                   note: str) -> None:
+    lines = [(f"# printgen testpieces: the {name}'s sidecar for printgen calibrate "
+              f"(--specimen {name}.specimen.toml)"),
+             f"# {note}; [wave]: the beam model's inputs and the material law the prediction "
+             "assumed (stress knees, slopes in MPa)"]
     lines += [_toml_line(k, v) for k, v in keys.items()]
     lines += ["", "[wave]", *(_toml_line(k, v) for k, v in wave.items())]
-    (stage / f"{NAME}.specimen.toml").write_text("\n".join(lines) + "\n")
-    return {**keys, "wave": wave}
+    (stage / f"{name}.specimen.toml").write_text("\n".join(lines) + "\n")
 
 
 def _toml_line(key: str, v: Any) -> str:
