@@ -43,6 +43,8 @@ SCALE_RTOL = {0.0: 1e-3, 0.005: 0.01, 0.02: 0.02}  # recovered law scale, by the
 # as a fraction of the largest force: noise free, the fit reads the model back to its
 # interpolation (1e-3); a least-squares scale over 600 points errs by about sd / sqrt(600) of
 # the force, far within 1 % and 2 %
+PANEL_LINEAR_RTOL = 1e-6  # a scaled law's panel vs the scaled panel: the solver's equilibrium
+# tolerance (the positions do not move with the scale, the forces follow it exactly)
 KNEE_RTOL = 0.05  # measured vs predicted bilinear knee on data made from the model, noisy
 SCALE = 1.3  # the known scale of the material law the synthetic exports are made with
 N_POINTS = 600
@@ -218,6 +220,7 @@ def test_too_few_points_in_the_model_range_is_an_error(tmp_path):
         calibrate([export], material="petg-lab", specimen_file=side)
 
 
+@pytest.mark.slow
 def test_cli_saves_the_scaled_law_and_refuses_bad_input_with_exit_2(tmp_path, capsys):
     from printgen.cli import main
 
@@ -242,6 +245,7 @@ def test_cli_saves_the_scaled_law_and_refuses_bad_input_with_exit_2(tmp_path, ca
     assert "error" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_saved_law_is_what_the_verification_reads(tmp_path, monkeypatch):
     """The fit of a waved TPE coupon writes TPE's measured panel law with its kappas x s; the
     design's waved strands, read from that profile as the scene reads it, pull s times
@@ -266,6 +270,41 @@ def test_saved_law_is_what_the_verification_reads(tmp_path, monkeypatch):
     np.testing.assert_allclose(after.law().force_and_tangent(e)[0],
                                SCALE * curve.law().force_and_tangent(e)[0],
                                rtol=SCALE_RTOL[0.0])
+
+
+def test_a_waved_panel_is_linear_in_the_law_scale_and_calibrates_back(tmp_path):
+    """The square waved net's simulated free panel (not a mechanism) with its strands' law x
+    s carries s x the force at every strain (the module's claim); an export of that scaled
+    panel, read with the panel's waved sidecar, gives s back."""
+    from types import SimpleNamespace
+
+    from printgen.run.wavepieces import wave_panel_sidecar
+    from printgen.scaling.panel_test import simulate
+    from printgen.scene.panel import curved_panel, lattice_size
+    from printgen.units import MM
+
+    d = _waved()
+    d = dataclasses.replace(d, net=dataclasses.replace(d.net, pattern="square", mesh_x_mm=12.0,
+                                                       mesh_y_mm=12.0))
+    dp = curved_panel(d, "short", WAVE.amplitude_mm, WAVE.half_waves, "free")
+    assert dp.curve.hold_share < 0.5
+    scaled = simulate(dp.law.scaled(SCALE), dp.test, dp.curve.strains)
+    np.testing.assert_allclose(scaled.force_per_width, SCALE * dp.curve.force_per_width,
+                               rtol=PANEL_LINEAR_RTOL)
+    length, width = lattice_size(dp.test)
+    wave_panel_sidecar(tmp_path, d, dp, SimpleNamespace(width_mm=width / MM,
+                                                        length_mm=length / MM))
+    side = tmp_path / "panel.specimen.toml"
+    model = read_wave(side)
+    assert model.panel and model.panel_width == pytest.approx(width)
+    eps = np.linspace(0.0, model.top(), N_POINTS)
+    force = np.interp(eps, (0.0, *scaled.strains), (0.0, *scaled.force_per_width)) * width
+    export = write_export(tmp_path / "panel-1", {"time": np.arange(eps.size) * 0.1,
+                                                 "force": force, "displacement": eps * length},
+                          "bluehill_quoted")
+    cal = calibrate([export], material="tpe-lab", specimen_file=side)
+    assert cal.scale.mean == pytest.approx(SCALE, rel=SCALE_RTOL[0.0])
+    assert "simulated free test" in cal.assumptions()[1]
 
 
 # ----------------------------------------------------------------------------- testpieces
@@ -301,6 +340,17 @@ def test_testpieces_of_a_waved_design_writes_the_coupon_and_its_prediction(piece
     readme = (out / "README.md").read_text()
     assert "Print first: the straight coupon" in readme and "wave-coupon-expected.csv" in readme
     assert "curved strands" in rec["panel"]["strands"]
+
+
+@pytest.mark.slow
+def test_the_diamond_waved_panel_is_a_mechanism_and_calibrate_says_what_to_do(pieces, tmp_path):
+    _, rec, out = pieces
+    assert rec["panel"]["expected_curve"]["free_hold_share"] > 0.5
+    export = write_export(tmp_path / "e", {"time": np.arange(50.0), "force": np.arange(50.0),
+                                           "displacement": np.arange(50.0) * 1e-4},
+                          "bluehill_quoted")
+    with pytest.raises(CalibrationError, match="mechanism.*waved coupons"):
+        calibrate([export], material="tpe-lab", specimen_file=out / "panel.specimen.toml")
 
 
 @pytest.mark.slow

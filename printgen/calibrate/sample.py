@@ -30,7 +30,7 @@ from printgen.calibrate.fit import (
 )
 from printgen.calibrate.plausible import check_modulus, check_stress
 from printgen.calibrate.reader import TestRecord
-from printgen.calibrate.specimen import Specimen, machine_modulus
+from printgen.calibrate.specimen import WAVED, Specimen, machine_modulus
 from printgen.calibrate.status import set_text
 from printgen.calibrate.windows import WindowCheck, check_window
 from printgen.errors import CalibrationError
@@ -230,6 +230,10 @@ def strain_and_y(rec: TestRecord, spec: Specimen, opt: FitOptions
 
 
 def _y(rec: TestRecord, spec: Specimen) -> np.ndarray:
+    if spec.kind == WAVED:  # fitted as force against its prediction (`calibrate.waved`)
+        if not rec.has("force"):
+            raise CalibrationError(f"{rec.path}: a waved test piece needs a force column")
+        return rec.channels["force"]
     if spec.kind == "panel":
         if not rec.has("force"):
             raise CalibrationError(f"{rec.path}: a net panel needs a force column")

@@ -320,10 +320,7 @@ def calibrate_waved(files: list[tuple[Path, Any]], load, *, material: str, sidec
     samples = []
     for path, _ in files:
         rec, spec = load(path)
-        if not rec.has("force"):
-            raise CalibrationError(f"{rec.path}: a waved coupon needs a force column")
-        x, _, source = strain_and_y(rec, spec, options)
-        force = rec.channels["force"]
+        x, force, source = strain_and_y(rec, spec, options)
         p = loading_branch(force)
         xb, fb, _ = zero_at_preload(x[: p + 1], model.measured(force[: p + 1]),
                                     options.preload, force[: p + 1], mode=options.zero)

@@ -70,11 +70,12 @@ def testpieces(design_path: str | Path, out: str | Path, *, orientation: str = "
         rec["panel"]["geometry"] = piece.to_record()
         rec["coupon"]["geometry"] = _coupon_geometry(coupon)
         if d.net.wave is not None:
-            from printgen.run.wavepieces import wave_coupon_files, wave_panel_sidecar
+            from printgen.run.wavepieces import CALIBRATE, wave_coupon_files, wave_panel_sidecar
 
             rec["wave_coupon"] = wave_coupon_files(stage, d, printer)
             rec["panel"]["strands"] = dp.strands
             rec["panel"]["sidecar"] = wave_panel_sidecar(stage, d, dp, piece)
+            rec["loop"][2] = CALIBRATE.format(mat=d.net.material)
         (stage / "README.md").write_text(readme_text(rec, dp.test.describe()))
         (stage / RECORD).write_text(dumps(rec))
     return rec

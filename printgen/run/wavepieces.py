@@ -41,6 +41,15 @@ FIRST = ("Print first: the straight coupon (coupon.*), then the waved coupon "
          f"beam model (against {EXPECTED}); the scale of its curve measures the material "
          "once more, to agree with the straight coupon's.")
 
+CALIBRATE = ("3. calibrate: printgen calibrate EXPORTS --material {mat}-lab --inherits {mat} "
+             "--specimen coupon.specimen.toml --save (the straight coupons: the material); "
+             f"then printgen calibrate EXPORTS --material {{mat}}-lab --specimen {NAME}.specimen"
+             ".toml --plot DIR --save (the waved coupons: the beam model's knee and slopes "
+             "checked, the law's scale measured again and written as the law the verification "
+             "reads); compare the panel's curve with panel-expected.csv (the diamond's free "
+             "panel is a mechanism in the model: its curve lies between the free and blocked "
+             "columns)")
+
 
 def wave_prediction(d: Design) -> tuple[StrandCurve, Law, str]:
     """(the beam model's curve of design `d`'s waved strands, the straight strands' law it
