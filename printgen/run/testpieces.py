@@ -234,9 +234,16 @@ def readme_text(rec: dict[str, Any], panel_test: str) -> str:
         "the frame after clamping, before the test (free sides, as simulated)."),
         (f"Expected curve (panel-expected.csv): the virtual panel test, {panel_test}; "
         "columns free (sides free, as tested) and blocked (every strand stretched alike, the "
-        "barrier's membrane law: the upper bound)."), *_mechanism_note(rec), "",
+        "barrier's membrane law: the upper bound)."), *_strands_note(rec),
+        *_mechanism_note(rec), "",
         *_wave_section(rec), "## The loop", *rec["loop"], ""]
     return "\n".join(lines)
+
+
+def _strands_note(rec: dict[str, Any]) -> list[str]:
+    """How a waved net's panel test takes its strands (the beam model's curve)."""
+    strands = rec["panel"].get("strands")
+    return [f"The panel's strands in the simulated test: {strands}."] if strands else []
 
 
 def _wave_section(rec: dict[str, Any]) -> list[str]:
