@@ -156,16 +156,19 @@ def _piece_files(stage: Path, name: str, kind: str, part, solid: tuple, tp, prin
     return rec
 
 
-def _ini_and_gcode(stage: Path, name: str, kind: str, part, printer, tp, stl_mm3: float
-                   ) -> dict[str, Any]:
-    """The PrusaSlicer .ini and the direct G-code of one piece (read back); their record."""
+def _ini_and_gcode(stage: Path, name: str, kind: str, part, printer, tp, stl_mm3: float,
+                   ini: str | None = None) -> dict[str, Any]:
+    """The PrusaSlicer .ini (`ini`, else the part's own) and the direct G-code of one piece
+    (read back); their record."""
     from printgen.parts.gcode.estimate import print_estimate
     from printgen.parts.gcode.readback import read_gcode_text
     from printgen.parts.gcode.writer import gcode_text
     from printgen.parts.slicer.prusa import prusa_ini_text
 
     mat, style = load_material(part.material), load_print_style(part.print_style)
-    (stage / f"{name}.prusa.ini").write_text(prusa_ini_text(kind, part, printer, style, mat))
+    if ini is None:
+        ini = prusa_ini_text(kind, part, printer, style, mat)
+    (stage / f"{name}.prusa.ini").write_text(ini)
     est = print_estimate(tp, printer, mat)
     text = gcode_text(tp, printer, mat, title=f"test piece {name}", estimate=est)
     (stage / f"{name}.gcode").write_text(text)

@@ -25,6 +25,7 @@ from printgen.inputs.materials import load_material
 from printgen.inputs.printers import load_print_style
 from printgen.parts.geometry.wavecoupon import WavedCoupon, waved_coupon_for
 from printgen.run.steps import _write_part
+from printgen.run.testpieces import _ini_and_gcode
 from printgen.scaling.record import Design
 from printgen.scaling.testpieces import COUPON_COUNT
 from printgen.solver import Law
@@ -76,11 +77,9 @@ def wave_coupon_files(stage: Path, d: Design, printer) -> dict[str, Any]:
 
 
 def _printables(stage: Path, c: WavedCoupon, d: Design, printer) -> dict[str, Any]:
-    """STL, 3MF (with the .ini), .ini and direct G-code of the coupon; their record."""
+    """STL, 3MF (with the .ini), .ini and direct G-code of the coupon; their record (the
+    net's material and print style: the coupon's)."""
     from printgen.parts.gcode.couponpath import coupon_toolpath
-    from printgen.parts.gcode.estimate import print_estimate
-    from printgen.parts.gcode.readback import read_gcode_text
-    from printgen.parts.gcode.writer import gcode_text
     from printgen.parts.geometry.wavecoupon import analytic_coupon_volume, coupon_solid
     from printgen.parts.slicer.coupon import coupon_ini_text
 
@@ -88,16 +87,8 @@ def _printables(stage: Path, c: WavedCoupon, d: Design, printer) -> dict[str, An
     ini = coupon_ini_text(c, d.net, printer, style, mat)
     rec = _write_part(stage, NAME, "net", d.net, coupon_solid(c), printer, None,
                       analytic_coupon_volume(c), ini).to_record()
-    (stage / f"{NAME}.prusa.ini").write_text(ini)
     tp = coupon_toolpath(c, printer, style, mat)
-    est = print_estimate(tp, printer, mat)
-    text = gcode_text(tp, printer, mat, title=f"test piece {NAME}", estimate=est)
-    (stage / f"{NAME}.gcode").write_text(text)
-    back = read_gcode_text(text, filament_diameter_mm=printer.filament_diameter_mm)
-    rec.update({"slicer_profile": f"{NAME}.prusa.ini", "gcode": f"{NAME}.gcode",
-                "gcode_volume_mm3": tp.volume_mm3,
-                "readback_vs_stl": back.volume_mm3 / rec["volume_mm3"] - 1,
-                "layers": len(back.layer_z_mm), "print": est.to_record()})
+    rec.update(_ini_and_gcode(stage, NAME, "net", d.net, printer, tp, rec["volume_mm3"], ini))
     rec["files"] += [f"{NAME}.prusa.ini", f"{NAME}.gcode"]
     return rec
 
