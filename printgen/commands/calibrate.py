@@ -53,7 +53,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                        help=f"specimen {opt.rsplit('_', 1)[0].replace('_', ' ')} "
                             f"({opt.rsplit('_', 1)[1]}), when the file does not give it")
     p.add_argument("--specimen", metavar="TOML", help="specimen sidecar (default: <file>.toml "
-                   "or specimen.toml beside each export)")
+                   "or specimen.toml beside each export); a waved test piece's (kind waved, "
+                   "from printgen testpieces) fits the exports against the beam model of its "
+                   "strands: the material law's scale, the knee and slopes compared")
     p.add_argument("--column", action="append", default=[], metavar="ROLE=NAME",
                    help="choose a column by header name or 1-based index; roles: time, force, "
                         "displacement, strain, stress")
