@@ -185,6 +185,18 @@ def test_a_nonlinear_law_is_scaled_whole(tmp_path):
     assert cal.scale.mean == pytest.approx(SCALE, rel=SCALE_RTOL[0.0])
 
 
+def test_an_extensometer_strain_is_used_and_its_span_questioned(tmp_path):
+    side = _sidecar(tmp_path / "wave.toml")
+    model = read_wave(side)
+    eps = np.linspace(0.0, model.top(), N_POINTS)
+    force = SCALE * model.predict(eps)
+    export = write_export(tmp_path / "ext", {"time": np.arange(eps.size) * 0.1, "force": force,
+                                             "strain": eps}, "bluehill_quoted")
+    cal = calibrate([export], material="petg-lab", specimen_file=side)
+    assert cal.scale.mean == pytest.approx(SCALE, rel=SCALE_RTOL[0.0])
+    assert any("extensometer" in w and "--strain-source crosshead" in w for w in cal.warnings)
+
+
 def test_a_coupon_printed_with_another_wave_is_flagged_by_its_knee(tmp_path):
     """Exports of a wave 30 % deeper than the sidecar's: its knee (about the excess length,
     ~ a^2) falls far later than the model's, and calibrate says so."""

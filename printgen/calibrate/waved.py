@@ -344,6 +344,11 @@ def _with_warnings(cal: WaveCalibration) -> WaveCalibration:
     if left:
         warns.append(f"points beyond {cal.model.top():.1%} chord strain (the range the design's "
                      f"strand law is solved over) left out of the fit in {len(left)} file(s)")
+    ext = [Path(s.path).name for s in cal.samples if s.strain_source.startswith("extensometer")]
+    if ext:
+        warns.append(f"strain from an extensometer in {', '.join(ext)}: the prediction is over "
+                     f"the chord ({cal.model.chord * 1e3:.4g} mm, tab edge to tab edge); if the "
+                     "extensometer spans less, rerun with --strain-source crosshead")
     flagged = [s for s in cal.samples if s.flags]
     warns += [f"{Path(s.path).name}: {'; '.join(s.flags)}" for s in flagged]
     return WaveCalibration(cal.material, cal.model, cal.samples, cal.scale, cal.conditions,
