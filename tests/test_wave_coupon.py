@@ -213,6 +213,7 @@ def test_a_coupon_printed_with_another_wave_is_flagged_by_its_knee(tmp_path):
     ({"wave": False}, "no \\[wave\\] table"),
     ({"knees": (0.1,)}, "one more slope than knees"),
     ({"slopes_mpa": (-3.0,)}, "every slope > 0"),
+    ({"amplitude_mm": 0.0}, "amplitude_mm"),
 ])
 def test_bad_waved_sidecars_are_refused_with_the_fix(kw, message, tmp_path):
     side = _sidecar(tmp_path / "wave.toml", **kw)

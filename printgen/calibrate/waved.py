@@ -45,7 +45,7 @@ from printgen.solver.strand_curve import Strand, StrandCurve, strand_curve
 
 KIND = "waved"
 WAVE = [
-    positive("chord_mm", 1e4, si=False), Field("amplitude_mm", float, lo=0.0, si=False),
+    positive("chord_mm", 1e4, si=False), positive("amplitude_mm", 1e3, si=False),
     Field("half_waves", int, lo=1), Field("strands", int, lo=1, required=False, default=1),
     positive("strand_width_mm", 1e3, si=False), positive("thickness_mm", 1e3, si=False),
     Field("material", str), Field("law_source", str, required=False, default=""),
@@ -60,9 +60,10 @@ MECHANISM = 0.5  # a free panel whose simulated clamp force the solver's hold ca
 # A bilinear fit needs a knee with points on both sides; fewer than this many loading points
 # (or a curve that never rises) leaves nothing to fit.
 MIN_POINTS = 20
-KNEE_TOL = 0.25  # |measured / predicted knee - 1| above this: the model's knee is off
-# (the printed wave's amplitude within about 10 % of the design's moves the knee by ~20 %,
-# the knee strain being about the excess length, ~a^2)
+KNEE_TOL = 0.25  # |measured / predicted knee - 1| above this: the model's knee is off. The
+# knee strain is about the excess length, ~ a^2: a knee 25 % off is an amplitude about 12 %
+# off, 0.12 mm or more on the 1-1.5 mm waves of a 1:40 net, beyond the 0.1 mm a printer
+# places a bead to (`parts.geometry.wave`)
 
 
 @dataclass(frozen=True)
@@ -120,7 +121,7 @@ class WaveModel:
 @lru_cache(maxsize=8)
 def _solved(m: WaveModel) -> StrandCurve:
     s = m.strand()
-    strains = curve_strains(s.excess()) if m.amplitude > 0 else np.linspace(0.0, m.top(), 11)[1:]
+    strains = curve_strains(s.excess())  # the design's strand law's points (`scene.waved`)
     return strand_curve(s, np.union1d(strains, [k for k in s.stress.knees if k < strains[-1]]))
 
 
