@@ -11,8 +11,10 @@ from typing import Any
 from printgen.calibrate.pipeline import Calibration, calibrate
 from printgen.calibrate.reader import TestRecord, read_export
 from printgen.calibrate.sample import FitOptions, SampleFit
+from printgen.calibrate.waved import WaveCalibration
 
-__all__ = ["Calibration", "FitOptions", "SampleFit", "TestRecord", "calibrate", "read_export"]
+__all__ = ["Calibration", "FitOptions", "SampleFit", "TestRecord", "WaveCalibration", "calibrate",
+           "read_export"]
 
 
 class _Verb(types.ModuleType):
@@ -20,7 +22,7 @@ class _Verb(types.ModuleType):
     parent's attribute), where the public verb `printgen.calibrate(...)` was: calling the
     package calls the verb, so a notebook's second call works as its first."""
 
-    def __call__(self, *args: Any, **kwargs: Any) -> Calibration:
+    def __call__(self, *args: Any, **kwargs: Any) -> Calibration | WaveCalibration:
         return calibrate(*args, **kwargs)
 
 

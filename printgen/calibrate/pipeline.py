@@ -12,7 +12,7 @@ import logging
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from printgen.calibrate.aggregate import Stats, spread_only, summarise
 from printgen.calibrate.fit import BREAK_DROP
@@ -31,6 +31,7 @@ from printgen.calibrate.sample import (
 )
 from printgen.calibrate.specimen import (
     KINDS,
+    WAVED,
     Specimen,
     find_sidecar,
     from_metadata,
@@ -41,6 +42,9 @@ from printgen.calibrate.windows import machine_warning, window_warnings
 from printgen.errors import CalibrationError
 from printgen.inputs.profiles import profile_name
 from printgen.outputs.display import Shown, Summary
+
+if TYPE_CHECKING:  # pragma: no cover
+    from printgen.calibrate.waved import WaveCalibration
 
 log = logging.getLogger(__name__)
 
@@ -125,13 +129,16 @@ def calibrate(paths: Sequence[str | Path], *, material: str, options: FitOptions
               columns: Mapping[str, str] | None = None, units: Mapping[str, str] | None = None,
               delimiter: str | None = None, decimal: str | None = None,
               strength_only: bool = False, conditions: str = "",
-              flags: Mapping[str, str] | None = None) -> Calibration:
+              flags: Mapping[str, str] | None = None) -> Calibration | WaveCalibration:
     """Fit every export in `paths` (files, or directories: every export in them; one
     material, one specimen type) and summarise.
 
     specimen : dimension options in SI (width, thickness, area, gauge_length, grip_distance)
     and `kind`; they fill what the files' metadata lines do not give.
     flags : status column -> convention (status.CONVENTIONS); default: decided from the data.
+    A `specimen_file` of kind "waved" (a waved-strand coupon's, from `printgen testpieces`)
+    fits the exports against its beam model instead: a `WaveCalibration`
+    (`printgen.calibrate.waved`).
     """
     if not paths:
         raise CalibrationError("no tensile-test exports given")
@@ -142,6 +149,18 @@ def calibrate(paths: Sequence[str | Path], *, material: str, options: FitOptions
         raise CalibrationError(f"specimen kind {kind!r}; expected one of {', '.join(KINDS)}")
     curve = opt.compliance.source if opt.compliance and opt.compliance.force is not None else None
     files, notes = expand(paths, exclude=[p for p in (curve, specimen_file) if p])
+    if specimen_file is not None and _sidecar_kind(specimen_file) == WAVED:
+        if strength_only or kind is not None:
+            raise CalibrationError(f"{specimen_file} is a waved coupon's sidecar: it is fitted "
+                                   "against its beam model (no --kind, no --strength-only)")
+        from printgen.calibrate.waved import calibrate_waved
+
+        def load(path: Path):
+            return _load(path, specimen or {}, specimen_file, (columns, units, flags),
+                         delimiter, decimal)
+
+        return calibrate_waved(files, load, material=material, sidecar=Path(specimen_file),
+                               options=opt, conditions=conditions)
     fits: list[SampleFit] = []
     strengths: list[StrengthSample] = []
     skipped: list[str] = []
@@ -155,6 +174,10 @@ def calibrate(paths: Sequence[str | Path], *, material: str, options: FitOptions
                 raise
             skipped.append(str(path))
             continue
+        if spec.kind == WAVED:
+            raise CalibrationError(f"{rec.path}: its sidecar is a waved coupon's; give it with "
+                                   "--specimen (it is fitted against the beam model of its "
+                                   "[wave] table)")
         orient[rec.path] = orientation(rec.path, rec.metadata)
         if strength_only:
             strengths.append(_strength_sample(rec, spec))
@@ -170,6 +193,11 @@ def calibrate(paths: Sequence[str | Path], *, material: str, options: FitOptions
                       strength_samples=tuple(strengths), conditions=conditions,
                       warnings=tuple(notes), skipped=tuple(skipped), orientations=orient)
     return _summarise(cal)
+
+
+def _sidecar_kind(path: str | Path) -> str | None:
+    """The `kind` a sidecar names (None when it names none)."""
+    return read_sidecar(Path(path)).get("kind")
 
 
 def _strength_sample(rec, spec) -> StrengthSample:

@@ -14,6 +14,7 @@ import numpy as np
 
 from printgen import outputs
 from printgen.calibrate.pipeline import Calibration
+from printgen.calibrate.waved import WaveCalibration
 from printgen.errors import CalibrationError
 
 ZOOM_MARGIN = 1.5  # right panel shows strains up to this factor times the window's upper end
@@ -59,6 +60,40 @@ def plot_calibration(cal: Calibration, path: str | Path) -> Path:
         ax.set_ylabel(ylab)
         ax.grid(alpha=0.3)
     ax_all.legend(fontsize=7, loc="lower right")
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    plt.close(fig)
+    return outputs.write_bytes(path, buf.getvalue())
+
+
+def plot_waved(cal: WaveCalibration, path: str | Path) -> Path:
+    """The measured curves against the prediction as assumed (s = 1) and as fitted (s), with
+    both bilinear knees marked: one PNG written atomically."""
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError as exc:  # pragma: no cover - depends on the install
+        raise CalibrationError("plots need matplotlib: pip install 'printgen[plot]'") from exc
+    fig, ax = plt.subplots(figsize=(8, 5), constrained_layout=True)
+    m = cal.model
+    e = np.linspace(0.0, max(s.strain_max for s in cal.samples), 200)
+    pred = m.strands * m.curve().law().force_and_tangent(e)[0]
+    for i, s in enumerate(cal.samples):
+        ax.plot(s.x * 100, s.force, color=f"C{i % 10}", lw=1,
+                label=printable(Path(s.path.split(":")[-1]).name))
+    ax.plot(e * 100, pred, "k--", lw=1.5, label="beam model, material law as assumed")
+    ax.plot(e * 100, cal.scale.mean * pred, "k-", lw=1.5,
+            label=f"beam model, law x {cal.scale.mean:.3g} (fitted)")
+    (km, kp) = cal.knees()
+    ax.axvline(km.mean * 100, color="C3", ls=":", label=f"knee measured {km.mean:.2%}")
+    ax.axvline(kp.mean * 100, color="0.4", ls=":", label=f"knee predicted {kp.mean:.2%}")
+    ax.set_xlabel("chord strain (%)")
+    ax.set_ylabel(f"force, {m.strands} strands (N)")
+    ax.set_title(f"{cal.material}: waved coupons against the beam model")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="upper left")
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110)
     plt.close(fig)

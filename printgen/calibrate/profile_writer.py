@@ -21,6 +21,7 @@ import tomli_w
 
 from printgen import outputs
 from printgen.calibrate.pipeline import Calibration
+from printgen.calibrate.waved import WaveCalibration, measured_wave_tables
 from printgen.errors import CalibrationError, PrintgenError
 from printgen.inputs.materials import Material, load_material
 from printgen.inputs.profiles import profile_name
@@ -44,11 +45,15 @@ def output_dir(out: str | Path | None) -> Path:
     return Path(env[0])
 
 
-def measured_tables(cal: Calibration, *, date: str | None = None) -> dict[str, dict[str, Any]]:
+def measured_tables(cal: Calibration | WaveCalibration, *, date: str | None = None
+                    ) -> dict[str, dict[str, Any]]:
     """The `[measured.*]` tables (file units) this calibration gives."""
     day = date or dt.date.today().isoformat()
-    prov = {"source": f"{SOURCE} ({len(cal.files)} files)", "date": day,
-            "files": [Path(f).as_posix() for f in cal.files], "conditions": _conditions(cal)}
+    files = {"source": f"{SOURCE} ({len(cal.files)} files)", "date": day,
+             "files": [Path(f).as_posix() for f in cal.files]}
+    if isinstance(cal, WaveCalibration):
+        return measured_wave_tables(cal, files | {"conditions": cal.conditions})
+    prov = files | {"conditions": _conditions(cal)}
     out: dict[str, dict[str, Any]] = {}
     if cal.kind != "panel" and cal.modulus is not None:
         out["tensile_modulus"] = _value(cal.modulus, "gpa", 1e9) | prov | _fit_info(cal)
@@ -67,7 +72,7 @@ def measured_tables(cal: Calibration, *, date: str | None = None) -> dict[str, d
     return out
 
 
-def write_profile(cal: Calibration, *, name: str, out: str | Path | None = None,
+def write_profile(cal: Calibration | WaveCalibration, *, name: str, out: str | Path | None = None,
                   inherits: str | None = None, date: str | None = None) -> tuple[Path, Material]:
     """Write (or update) `<dir>/materials/<name>.toml`; return its path and the loaded material."""
     name = profile_name(name, "--material")
@@ -179,7 +184,7 @@ def _mode(path: Path) -> int:
     return 0o666 & ~mask
 
 
-def value_sources(cal: Calibration, path: Path, mat: Material) -> dict[str, Any]:
+def value_sources(cal: Calibration | WaveCalibration, path: Path, mat: Material) -> dict[str, Any]:
     """The written profile's modulus and failure stress, each with its own source: this
     calibration, an earlier one kept in the same file, inherited from a parent profile, or a
     datasheet. A value this calibration did not measure is never called measured here."""
@@ -195,7 +200,7 @@ def value_sources(cal: Calibration, path: Path, mat: Material) -> dict[str, Any]
 
 
 def _source(key: str, measured: Any, wrote: set[str], own: dict[str, Any],
-            cal: Calibration) -> str:
+            cal: Calibration | WaveCalibration) -> str:
     parent = own.get("inherits")
     if key in wrote:
         return f"measured: this calibration ({len(cal.files)} files)"

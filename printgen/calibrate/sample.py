@@ -30,7 +30,7 @@ from printgen.calibrate.fit import (
 )
 from printgen.calibrate.plausible import check_modulus, check_stress
 from printgen.calibrate.reader import TestRecord
-from printgen.calibrate.specimen import Specimen, machine_modulus
+from printgen.calibrate.specimen import WAVED, Specimen, machine_modulus
 from printgen.calibrate.status import set_text
 from printgen.calibrate.windows import WindowCheck, check_window
 from printgen.errors import CalibrationError
@@ -128,7 +128,7 @@ def analyse(rec: TestRecord, spec: Specimen, opt: FitOptions) -> SampleFit:
     when the force, stress or modulus is implausible)."""
     peak, strength = peak_and_strength(rec, spec)
     check_stress(rec, spec, strength)
-    x, y, source = _curve(rec, spec, opt)
+    x, y, source = strain_and_y(rec, spec, opt)
     p = loading_branch(y)
     if opt.preload is not None and not rec.has("force"):
         raise CalibrationError(f"{rec.path}: --preload is a force but the file has no force "
@@ -193,7 +193,8 @@ def _modulus_or_none(path: str, x: np.ndarray, y: np.ndarray, force: np.ndarray 
         return None
 
 
-def _curve(rec: TestRecord, spec: Specimen, opt: FitOptions) -> tuple[np.ndarray, np.ndarray, str]:
+def strain_and_y(rec: TestRecord, spec: Specimen, opt: FitOptions
+                 ) -> tuple[np.ndarray, np.ndarray, str]:
     """(strain, y, description of the strain source)."""
     deform = [r for r in ("strain", "displacement") if rec.has(r)]
     if not deform:
@@ -229,6 +230,10 @@ def _curve(rec: TestRecord, spec: Specimen, opt: FitOptions) -> tuple[np.ndarray
 
 
 def _y(rec: TestRecord, spec: Specimen) -> np.ndarray:
+    if spec.kind == WAVED:  # fitted as force against its prediction (`calibrate.waved`)
+        if not rec.has("force"):
+            raise CalibrationError(f"{rec.path}: a waved test piece needs a force column")
+        return rec.channels["force"]
     if spec.kind == "panel":
         if not rec.has("force"):
             raise CalibrationError(f"{rec.path}: a net panel needs a force column")

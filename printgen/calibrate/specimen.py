@@ -1,10 +1,12 @@
 """Specimen dimensions: from the export's metadata lines, else from options, else a TOML sidecar.
 
 Kinds: `cable` (printed strand, width x thickness), `dogbone` (narrow section width x thickness),
-`panel` (net panel: width across and length along the load). Sidecar: `<export>.toml` beside
-the export, or `specimen.toml` in its folder, or the file given with --specimen; keys are the
-fields of `SIDECAR` (mm), plus optional `[columns]` and `[units]` tables (role -> name/unit) and
-a `[flags]` table (status column -> active-high, active-low or ignore).
+`panel` (net panel: width across and length along the load); a sidecar may also name `waved`
+(a waved-strand coupon, `printgen.calibrate.waved`, with its `[wave]` table). Sidecar:
+`<export>.toml` beside the export, or `specimen.toml` in its folder, or the file given with
+--specimen; keys are the fields of `SIDECAR` (mm), plus optional `[columns]` and `[units]`
+tables (role -> name/unit) and a `[flags]` table (status column -> active-high, active-low or
+ignore).
 """
 
 from __future__ import annotations
@@ -22,8 +24,10 @@ from printgen.inputs.schema import Field, load_toml, positive, read_table
 log = logging.getLogger(__name__)
 
 KINDS = ("cable", "dogbone", "panel")
+WAVED = "waved"  # a waved-strand coupon: its sidecar (printgen testpieces) holds the beam
+# model's inputs in a [wave] table (`printgen.calibrate.waved`), so it is a sidecar kind only
 SIDECAR = [
-    Field("kind", str, choices=KINDS, required=False),
+    Field("kind", str, choices=(*KINDS, WAVED), required=False),
     positive("width_mm", 1e4, si=False, required=False),
     positive("thickness_mm", 1e3, si=False, required=False),
     positive("area_mm2", 1e6, si=False, required=False),
@@ -32,6 +36,7 @@ SIDECAR = [
     Field("columns", dict, required=False, default={}),
     Field("units", dict, required=False, default={}),
     Field("flags", dict, required=False, default={}),
+    Field("wave", dict, required=False, default={}),
 ]
 DIMENSIONS = ("width", "thickness", "area", "gauge_length", "grip_distance")
 # Metadata key patterns (lower case) per dimension; the first match wins.

@@ -53,7 +53,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                        help=f"specimen {opt.rsplit('_', 1)[0].replace('_', ' ')} "
                             f"({opt.rsplit('_', 1)[1]}), when the file does not give it")
     p.add_argument("--specimen", metavar="TOML", help="specimen sidecar (default: <file>.toml "
-                   "or specimen.toml beside each export)")
+                   "or specimen.toml beside each export); a waved test piece's (kind waved, "
+                   "from printgen testpieces) fits the exports against the beam model of its "
+                   "strands: the material law's scale, the knee and slopes compared")
     p.add_argument("--column", action="append", default=[], metavar="ROLE=NAME",
                    help="choose a column by header name or 1-based index; roles: time, force, "
                         "displacement, strain, stress")
@@ -153,6 +155,8 @@ def run(args: argparse.Namespace) -> int:
         delimiter="\t" if args.delimiter == "tab" else args.delimiter, decimal=args.decimal,
         strength_only=args.strength_only, conditions=args.conditions,
         flags=_pairs(args.flag, "--flag", "endstop=active-low"))
+    if not isinstance(cal, Calibration):
+        return _waved(cal, args)
     written = {}
     if args.save or args.out:
         from printgen.calibrate.profile_writer import value_sources, write_profile
@@ -182,6 +186,42 @@ def run(args: argparse.Namespace) -> int:
         return 0
     show(cal, written)
     return 0
+
+
+def _waved(cal, args: argparse.Namespace) -> int:
+    """Save, plot and show a waved-coupon calibration (`printgen.calibrate.waved`)."""
+    written: dict[str, object] = {}
+    if args.save or args.out:
+        from printgen.calibrate.profile_writer import write_profile
+
+        if args.inherits is not None and args.inherits.lower() != cal.model.material.lower():
+            raise CalibrationError(
+                f"--inherits {args.inherits}: the waved coupon's fit scales "
+                f"{cal.model.material}'s law (the law its prediction assumed); give --inherits "
+                f"{cal.model.material}")
+        path, mat = write_profile(cal, name=args.material, out=args.out,
+                                  inherits=args.inherits, date=args.date)
+        written["profile"] = str(path)
+        written["wrote"] = ", ".join(f"[measured.{k}]" for k in
+                                     measured_keys(cal, args.date))
+    if args.plot:
+        from printgen.calibrate.plot import plot_waved
+
+        written["plot"] = str(plot_waved(cal, Path(args.plot) / f"{cal.material}.png"))
+    if args.json:
+        emit_json({**cal.to_record(), "written": written})
+        return 0
+    out = console()
+    out.print(escape(cal.summary().text()))
+    for k, v in written.items():
+        out.print(escape(f"{k}: {v}"))
+    return 0
+
+
+def measured_keys(cal, date: str | None) -> list[str]:
+    from printgen.calibrate.profile_writer import measured_tables
+
+    return list(measured_tables(cal, date=date))
 
 
 def show(cal: Calibration, written: dict) -> None:

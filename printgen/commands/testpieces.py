@@ -1,6 +1,7 @@
 """`printgen testpieces DESIGN [--orientation short|long] [--out DIR] [--force] [--json]`: the
-tensile coupons and the net test panel to print and test before the barrier
-(printgen.run.testpieces), written atomically into DIR (default `out/<design>-testpieces`)."""
+tensile coupons and the net test panel to print and test before the barrier, and for a design
+with waved strands the waved-strand coupon and its predicted curve (printgen.run.testpieces),
+written atomically into DIR (default `out/<design>-testpieces`)."""
 
 from __future__ import annotations
 
@@ -46,7 +47,17 @@ def run(args: argparse.Namespace) -> int:
              f"{pg['width_mm']:.4g} mm wide, {pg['length_mm']:.4g} mm apart, "
              f"{pg['clamp_depth_mm']:.4g} mm held each end"),
              f"{rec['panel']['readback_vs_stl']:+.1%}"]]
+    w = rec.get("wave_coupon")
+    if w is not None:
+        g, e = w["geometry"], w["expected_curve"]
+        rows.append(["wave-coupon", (
+            f"{g['strands']} waved strands ({g['amplitude_mm']:g} mm, {g['half_waves']} "
+            f"half-wave(s)) over a {g['chord_mm']:.4g} mm chord between {g['tab_mm']:g} mm "
+            f"tabs; predicted knee {e['knee_strain']:.1%} at {e['force_at_knee_n']:.3g} N"),
+            f"{w['readback_vs_stl']:+.1%}"])
     c.print(table(f"test pieces in {out}", ["piece", "geometry", "G-code vs STL"], rows))
+    if w is not None:
+        c.print(w["print_first"])
     for line in rec["loop"]:
         c.print(line)
     return 0

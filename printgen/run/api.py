@@ -28,6 +28,7 @@ from printgen.scaling.similitude import ScaledTargets, scale_targets
 if TYPE_CHECKING:
     from printgen.calibrate.pipeline import Calibration
     from printgen.calibrate.sample import FitOptions
+    from printgen.calibrate.waved import WaveCalibration
     from printgen.inputs.examples import Example
     from printgen.run.make import MakeContext
     from printgen.run.panel import PanelRun
@@ -200,9 +201,11 @@ def series(prototype: PrototypeLike, scales: Sequence[float] = (1, 10, 30, 50, 1
 
 
 def calibrate(paths: Sequence[str | Path], *, material: str,
-              options: FitOptions | None = None, **kwargs: Any) -> Calibration:
+              options: FitOptions | None = None, **kwargs: Any
+              ) -> Calibration | WaveCalibration:
     """Moduli, strength and panel laws of a material from tensile-test exports (see
-    `printgen.calibrate.pipeline.calibrate` for every keyword)."""
+    `printgen.calibrate.pipeline.calibrate` for every keyword); a waved-strand coupon's
+    exports (its sidecar as `specimen_file`) against the beam model of its strands."""
     from printgen.calibrate.pipeline import calibrate as _calibrate
 
     return _calibrate(paths, material=material, options=options, **kwargs)

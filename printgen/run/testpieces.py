@@ -61,7 +61,7 @@ def testpieces(design_path: str | Path, out: str | Path, *, orientation: str = "
                             **provenance_record(command, files={"design_file": design_path},
                                                 design=d)}
     with staged_dir(out, force=force, meta=meta, inputs=inputs) as stage:
-        rec = {"design_file": Path(design_path).name, "material": d.net.material,
+        rec: dict[str, Any] = {"design_file": Path(design_path).name, "material": d.net.material,
                "material_source": material_source(load_material(d.net.material)),
                "coupon": _coupon_files(stage, coupon, printer),
                "panel": _panel_files(stage, piece, printer),
@@ -69,6 +69,13 @@ def testpieces(design_path: str | Path, out: str | Path, *, orientation: str = "
         rec["panel"]["expected_curve"] = _expected(stage, dp, blocked)
         rec["panel"]["geometry"] = piece.to_record()
         rec["coupon"]["geometry"] = _coupon_geometry(coupon)
+        if d.net.wave is not None:
+            from printgen.run.wavepieces import CALIBRATE, wave_coupon_files, wave_panel_sidecar
+
+            rec["wave_coupon"] = wave_coupon_files(stage, d, printer)
+            rec["panel"]["strands"] = dp.strands
+            rec["panel"]["sidecar"] = wave_panel_sidecar(stage, d, dp, piece)
+            rec["loop"][2] = CALIBRATE.format(mat=d.net.material)
         (stage / "README.md").write_text(readme_text(rec, dp.test.describe()))
         (stage / RECORD).write_text(dumps(rec))
     return rec
@@ -83,10 +90,18 @@ def material_source(mat) -> str:
 
 
 def _panel(d: Design, orientation: str):
-    from printgen.scene.panel import design_panel, lattice_size
+    """The simulated free and blocked tests of the design's panel and the printed piece; a
+    waved net's panel is tested with its strands' beam-model law (`scene.panel.curved_panel`),
+    sized as that test."""
+    from printgen.scene.panel import curved_panel, design_panel, lattice_size
 
-    dp = design_panel(d, orientation, "free")
-    blocked = design_panel(d, orientation, "blocked")
+    w = d.net.wave
+    if w is None:
+        dp = design_panel(d, orientation, "free")
+        blocked = design_panel(d, orientation, "blocked")
+    else:
+        dp, blocked = (curved_panel(d, orientation, w.amplitude_mm, w.half_waves, mode)
+                       for mode in ("free", "blocked"))
     length, width = lattice_size(dp.test)
     return dp, blocked, panel_for(d, orientation, length / MM, width / MM)
 
@@ -141,16 +156,19 @@ def _piece_files(stage: Path, name: str, kind: str, part, solid: tuple, tp, prin
     return rec
 
 
-def _ini_and_gcode(stage: Path, name: str, kind: str, part, printer, tp, stl_mm3: float
-                   ) -> dict[str, Any]:
-    """The PrusaSlicer .ini and the direct G-code of one piece (read back); their record."""
+def _ini_and_gcode(stage: Path, name: str, kind: str, part, printer, tp, stl_mm3: float,
+                   ini: str | None = None) -> dict[str, Any]:
+    """The PrusaSlicer .ini (`ini`, else the part's own) and the direct G-code of one piece
+    (read back); their record."""
     from printgen.parts.gcode.estimate import print_estimate
     from printgen.parts.gcode.readback import read_gcode_text
     from printgen.parts.gcode.writer import gcode_text
     from printgen.parts.slicer.prusa import prusa_ini_text
 
     mat, style = load_material(part.material), load_print_style(part.print_style)
-    (stage / f"{name}.prusa.ini").write_text(prusa_ini_text(kind, part, printer, style, mat))
+    if ini is None:
+        ini = prusa_ini_text(kind, part, printer, style, mat)
+    (stage / f"{name}.prusa.ini").write_text(ini)
     est = print_estimate(tp, printer, mat)
     text = gcode_text(tp, printer, mat, title=f"test piece {name}", estimate=est)
     (stage / f"{name}.gcode").write_text(text)
@@ -219,9 +237,25 @@ def readme_text(rec: dict[str, Any], panel_test: str) -> str:
         "the frame after clamping, before the test (free sides, as simulated)."),
         (f"Expected curve (panel-expected.csv): the virtual panel test, {panel_test}; "
         "columns free (sides free, as tested) and blocked (every strand stretched alike, the "
-        "barrier's membrane law: the upper bound)."), *_mechanism_note(rec), "",
-        "## The loop", *rec["loop"], ""]
+        "barrier's membrane law: the upper bound)."), *_strands_note(rec),
+        *_mechanism_note(rec), "",
+        *_wave_section(rec), "## The loop", *rec["loop"], ""]
     return "\n".join(lines)
+
+
+def _strands_note(rec: dict[str, Any]) -> list[str]:
+    """How a waved net's panel test takes its strands (the beam model's curve)."""
+    strands = rec["panel"].get("strands")
+    return [f"The panel's strands in the simulated test: {strands}."] if strands else []
+
+
+def _wave_section(rec: dict[str, Any]) -> list[str]:
+    """The waved coupon's section (a design with a net wave), with what to print first."""
+    if "wave_coupon" not in rec:
+        return []
+    from printgen.run.wavepieces import wave_readme
+
+    return ["", *wave_readme(rec["wave_coupon"])]
 
 
 def _mechanism_note(rec: dict[str, Any]) -> list[str]:
