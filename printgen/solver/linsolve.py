@@ -9,7 +9,7 @@ lazily (the `fast` extra), in the order `choose_backend` prefers them:
   S = (A + A^T) / 2; its fill-reducing analysis runs once per net, every later step only
   refactorizes numerically;
 - "cholmod" (CHOLMOD's supernodal Cholesky of S through `cvxopt`, nets of CHOLMOD_MIN_DOFS
-  unknowns and more; the wheel carries its own SuiteSparse and OpenBLAS): its AMD ordering
+  unknowns and more; its wheels carry their own SuiteSparse and BLAS): its AMD ordering
   and symbolic analysis once per net, then numeric factorizations on dense supernodal
   blocks, a fifth of qdldl's time at 57k unknowns and a twelfth at 228k; on the first
   factorization that finds S not positive definite it turns to "ldl" for the rest of the net;
@@ -64,8 +64,10 @@ LDL_PARDISO_THREADS = 1  # MKL threads of those factorizations and solves: MKL's
 # per core) costs ten times the CPU per factorization or more
 # (benchmarks/measurements.md#linsolve-threads)
 
-CHOLMOD_MIN_DOFS = 2_000  # from here on CHOLMOD's supernodal Cholesky beats qdldl's LDL^T
-# (whole solves of the simple scene, 1 thread: benchmarks/measurements.md#linsolve-cholmod)
+CHOLMOD_MIN_DOFS = 5_000  # from here on CHOLMOD's supernodal Cholesky beats qdldl's LDL^T:
+# whole solves of simple-pinned at tol 1e-6, 1 thread, CPU: 3.4k unknowns qdldl 0.035 s,
+# CHOLMOD 0.038 s; 7.7k 0.113 against 0.091 s; 57k 4.4 against 0.9 s (`python -m
+# benchmarks.bench_solver --backends ldl cholmod`, its backend_table)
 
 PHASES = {11: "analysis", 22: "factorization", 33: "solve"}  # MKL's phases, as Pardiso counts
 
