@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
 from printgen.solver import Hydrostatic, Net, SlidingCable, linear, solve
 from printgen.solver.driver import FastSolver
@@ -119,3 +120,38 @@ def test_cholmod_and_ldl_agree_on_hard_cases(kw):
     for a, b in zip(runs["ldl"], runs["cholmod"], strict=True):
         assert a.converged and b.converged and b.backend == "cholmod"
         assert _agree(b.displacements, a.displacements) < AGREE
+
+
+class _UnsortedPattern:
+    """A stand-in for a net's Pattern whose upper triangle (CSC) stores each column's rows in
+    reverse: a 2D grid Laplacian plus a shift (positive definite), times the value `data`."""
+
+    def __init__(self, n: int) -> None:
+        lap = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(n, n))
+        eye = sp.identity(n)
+        upper = sp.triu(sp.kron(lap, eye) + sp.kron(eye, lap) + 0.5 * sp.identity(n * n))
+        self.upper = upper.tocsc()
+        self.upper.sort_indices()
+        for c in range(self.upper.shape[1]):  # reverse each column's rows
+            lo, hi = self.upper.indptr[c], self.upper.indptr[c + 1]
+            self.upper.indices[lo:hi] = self.upper.indices[lo:hi][::-1].copy()
+            self.upper.data[lo:hi] = self.upper.data[lo:hi][::-1].copy()
+        self.upper.has_sorted_indices = False
+
+    def symmetric_upper(self, data: float) -> sp.csc_matrix:
+        return sp.csc_matrix((data * self.upper.data, self.upper.indices, self.upper.indptr),
+                             shape=self.upper.shape)
+
+
+def test_cholmod_takes_an_upper_triangle_in_any_row_order():
+    """A pattern whose rows are not sorted within a column: its slots are put in cvxopt's
+    order once, and every factorization (the first and a numeric-only one) solves S x = b."""
+    pattern = _UnsortedPattern(9)
+    handle = Cholmod()
+    b = np.random.default_rng(6).normal(size=pattern.upper.shape[0])
+    for scale in (1.0, 2.0):
+        handle.factor(pattern, scale)  # type: ignore[arg-type]
+        assert handle.order is not None and handle.solve is not None
+        S = pattern.symmetric_upper(scale)
+        full = S + sp.triu(S, 1).T
+        assert _residual(full, handle.solve(b), b) <= LINEAR

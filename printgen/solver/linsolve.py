@@ -285,7 +285,8 @@ class Cholmod:
         self.matrix: Any = None  # cvxopt's spmatrix of the upper triangle (values replaced)
         self.symbolic: Any = None  # CHOLMOD's analysis (ordering, supernodes)
         self.source: Pattern | None = None  # the pattern the analysis was made for
-        self.order = np.zeros(0, dtype=np.int64)  # its upper triangle's CSC slots, cvxopt's order
+        self.order: np.ndarray | None = None  # the upper triangle's slots in cvxopt's order
+        # (None: as they are)
         self.ldl: Ldl | None = None  # the LDL^T the net turned to, once S was indefinite
         self.solve: Callable[[np.ndarray], np.ndarray] | None = None
 
@@ -301,17 +302,18 @@ class Cholmod:
         if self.source is not pattern:  # a new net's pattern: analyse it
             n = upper.shape[0]
             cols = np.repeat(np.arange(n), np.diff(upper.indptr))
-            self.order = np.lexsort((upper.indices, cols))  # cvxopt's order: column, then row
+            # cvxopt's order: column, then row (the pattern's own when its rows are sorted)
+            self.order = None if upper.has_sorted_indices else np.lexsort((upper.indices, cols))
             self.matrix = cvxopt.spmatrix(
-                cvxopt.matrix(upper.data[self.order].astype(np.float64)),
-                cvxopt.matrix(upper.indices[self.order].astype(np.int64)),
-                cvxopt.matrix(cols[self.order].astype(np.int64)), (n, n))
+                cvxopt.matrix(self._ordered(upper.data).astype(np.float64)),
+                cvxopt.matrix(self._ordered(upper.indices).astype(np.int64)),
+                cvxopt.matrix(self._ordered(cols).astype(np.int64)), (n, n))
             self.symbolic = cholmod.symbolic(self.matrix, uplo="U")
             self.source = pattern
             if len(self.matrix.V) != upper.nnz:  # cvxopt merged or dropped slots
                 raise ValueError("cvxopt's matrix lost entries of the pattern")
         else:
-            self.matrix.V = cvxopt.matrix(upper.data[self.order])
+            self.matrix.V = cvxopt.matrix(self._ordered(upper.data))
         self.solve = None
         try:
             cholmod.numeric(self.matrix, self.symbolic)
@@ -322,6 +324,10 @@ class Cholmod:
             self.factor(pattern, data)
             return
         self.solve = self._solve
+
+    def _ordered(self, a: np.ndarray) -> np.ndarray:
+        """Per-slot values `a` of the upper triangle in cvxopt's order."""
+        return a if self.order is None else a[self.order]
 
     def _solve(self, b: np.ndarray) -> np.ndarray:
         import cvxopt
