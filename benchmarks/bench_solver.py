@@ -4,7 +4,8 @@ section 7) at 61 x 21, 121 x 41, 241 x 81 and 481 x 161 nodes, with OpenSeesPy s
 the load paths of the 1:40 verification; the robustness table of the hard cases.
 
     python -m benchmarks.bench_solver --out DIR [--sizes 1 2 4 8] [--no-paths]
-        [--threads N] [--compare-threads 1 2] [--backends ldl cholmod [--backend-refine 1 2]]
+        [--threads N] [--compare-threads 1 2]
+        [--backends ldl cholmod [--backend-refine 1 2] [--backend-path-scale 20]]
 
 Errors are the mid-height centre deflection against a tight-tolerance solve of the same size
 (relative). Loads at the initial node height (the variant OpenSees can model); printgen's
@@ -14,7 +15,8 @@ threads (threadpoolctl; default 1); `size_table` lists them per size with the ba
 the microseconds per unknown, and for PARDISO its CPU by phase (analysis, numeric
 factorizations, solves); --compare-threads 1 2 adds the same solves per thread count
 (`threads_table`); --backends ldl cholmod times the same solve with each linear backend in
-turn (`backend_table`: where CHOLMOD overtakes qdldl). The ratio to OpenSeesPy at 61 x 21 is
+turn (`backend_table`: where CHOLMOD overtakes qdldl), and with --backend-path-scale S the
+verification's load paths at 1:S too (`backend_paths`). The ratio to OpenSeesPy at 61 x 21 is
 also measured pair by pair (`paired_ratio`: PAIRS pairs, alternating, one thread each; wall
 and CPU time of each whole call, median and range, with the load average; in a fresh process
 and in this one, see `paired_both`).
@@ -339,9 +341,47 @@ def backend_table(refines: list[float], backends: list[str], threads: int = THRE
     return out
 
 
-def capture_verification_paths() -> list[tuple]:
-    """(net, loads_at, levels, keywords) of every load path the 1:40 verification solves,
-    recorded while it runs (serially, in this process)."""
+def backend_paths(scale: float, backends: list[str], threads: int = THREADS) -> list[dict]:
+    """The verification's load paths at 1:`scale`, each solved with every installed backend in
+    turn (CPU, iterations, factorizations, and the largest displacement difference to the
+    first backend's, relative to its largest displacement): along a path a backend's
+    analysis is paid once, so the crossover differs from a single solve's. The backend is
+    imposed by replacing `solver.fast.choose_backend` for the duration of each path."""
+    from threadpoolctl import threadpool_limits
+
+    from printgen.solver import fast, linsolve
+
+    installed = {"ldl": linsolve.ldl_available, "cholmod": linsolve.cholmod_available,
+                 "pardiso": linsolve.pardiso_available, "lu": lambda: True}
+    usable = [b for b in backends if installed.get(b, lambda: False)()]
+    out, original = [], fast.choose_backend
+    for k, (net, loads_at, levels, kw) in enumerate(capture_verification_paths(scale)):
+        first = None
+        for backend in usable:
+            fast.choose_backend = lambda size, b=backend: b
+            try:
+                with threadpool_limits(limits=threads):
+                    c0 = time.process_time()
+                    res = solve_path(net, loads_at, levels, **kw)
+                    cpu = time.process_time() - c0
+            finally:
+                fast.choose_backend = original
+            disp = np.array([r.displacements for r in res])
+            first = disp if first is None else first
+            diff = (float(np.abs(disp - first).max() / np.abs(first).max())
+                    if disp.shape == first.shape and np.abs(first).max() > 0 else None)
+            out.append({"scale": scale, "path": k, "unknowns": int((~net.fixed_dofs).sum()),
+                        "levels": len(levels), "backend": backend, "cpu_s": cpu,
+                        "converged_levels": sum(r.converged for r in res),
+                        "iterations": sum(r.iterations for r in res),
+                        "factorizations": sum(r.factorizations for r in res),
+                        "difference_to_first": diff})
+    return out
+
+
+def capture_verification_paths(scale: float = EXAMPLE_SCALE) -> list[tuple]:
+    """(net, loads_at, levels, keywords) of every load path the verification at 1:`scale`
+    (default 1:40) solves, recorded while it runs (serially, in this process)."""
     from printgen import solver
     from printgen.run.api import verify
 
@@ -354,7 +394,7 @@ def capture_verification_paths() -> list[tuple]:
     os.environ["PRINTGEN_SERIAL"] = "1"
     solver.solve_path = recording
     try:
-        verify(EXAMPLE, EXAMPLE_SCALE)
+        verify(EXAMPLE, scale)
     finally:
         solver.solve_path = original
         del os.environ["PRINTGEN_SERIAL"]
@@ -505,7 +545,7 @@ def goals(results: list[dict], paths: list[dict], tent: dict | None,
 
 def run(out: Path, sizes: list[int], with_paths: bool = True, threads: int = THREADS,
         compare_threads: list[int] | None = None, backends: list[str] | None = None,
-        backend_refines: list[float] | None = None) -> dict:
+        backend_refines: list[float] | None = None, path_scale: float | None = None) -> dict:
     from threadpoolctl import threadpool_limits
 
     from printgen.solver.linsolve import pardiso_available
@@ -528,12 +568,14 @@ def run(out: Path, sizes: list[int], with_paths: bool = True, threads: int = THR
     by_threads = thread_table(sizes, compare_threads) if compare_threads else []
     by_backend = backend_table(backend_refines or list(BACKEND_REFINES), backends, threads) \
         if backends else []
+    by_backend_path = backend_paths(path_scale, backends, threads) \
+        if backends and path_scale else []
     report = {"benchmark": "bench_solver", "scene": "simple-pinned",
               "load": "hydrostatic at h = h_B + drag at 6 m/s, at the initial node height",
               "reference_tol": REFERENCE_TOL, "goal_tol": GOAL_TOL, "blas_threads": threads,
               "load_average": _load(),
               "size_table": size_table(results, threads), "threads_table": by_threads,
-              "backend_table": by_backend,
+              "backend_table": by_backend, "backend_paths": by_backend_path,
               "sizes": results,
               "verification_paths": paths, "tent": tent, "robustness": robustness(),
               "opensees_paired": paired, "goals": goals(results, paths, tent, paired),
@@ -567,10 +609,13 @@ def main(argv: list[str] | None = None) -> int:
                     help="also time each backend (ldl, cholmod, pardiso, lu) at tol 1e-6")
     ap.add_argument("--backend-refine", type=float, nargs="+", metavar="R",
                     help=f"mesh refinements of --backends (default {list(BACKEND_REFINES)})")
+    ap.add_argument("--backend-path-scale", type=float, metavar="S",
+                    help="with --backends: also solve the verification's load paths at 1:S "
+                         "with each backend")
     ap.add_argument("--json", action="store_true", help="print the goals as JSON")
     a = ap.parse_args(argv)
     report = run(a.out, a.sizes, not a.no_paths, a.threads, a.compare_threads, a.backends,
-                 a.backend_refine)
+                 a.backend_refine, a.backend_path_scale)
     for res in report["sizes"]:
         for r in res["runs"]:
             err = r.get("error")
@@ -598,6 +643,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{head} cpu {row['cpu_s']:7.3f} s  wall {row['wall_s']:7.3f} s  it "
               f"{row['iterations']} fact {row['factorizations']}  deflection "
               f"{row['deflection_m']:.12e} m")
+    for row in report["backend_paths"]:
+        diff = row["difference_to_first"]
+        print(f"path {row['path']} at 1:{row['scale']:g} ({row['unknowns']} unknowns, "
+              f"{row['levels']} levels) {row['backend']:8s} cpu {row['cpu_s']:6.2f} s  it "
+              f"{row['iterations']} fact {row['factorizations']}  converged "
+              f"{row['converged_levels']}  difference {'-' if diff is None else f'{diff:.1e}'}")
     for p in report["verification_paths"]:
         print(f"path {p['path']} ({p['nodes']} nodes, {p['levels']} levels): fast "
               f"{p['fast']['time_s']:.2f} s, {sum(p['fast']['iterations'])} it, "

@@ -64,10 +64,12 @@ LDL_PARDISO_THREADS = 1  # MKL threads of those factorizations and solves: MKL's
 # per core) costs ten times the CPU per factorization or more
 # (benchmarks/measurements.md#linsolve-threads)
 
-CHOLMOD_MIN_DOFS = 5_000  # from here on CHOLMOD's supernodal Cholesky beats qdldl's LDL^T:
+CHOLMOD_MIN_DOFS = 4_000  # from here on CHOLMOD's supernodal Cholesky beats qdldl's LDL^T:
 # whole solves of simple-pinned at tol 1e-6, 1 thread, CPU: 3.4k unknowns qdldl 0.035 s,
-# CHOLMOD 0.038 s; 7.7k 0.113 against 0.091 s; 57k 4.4 against 0.9 s (`python -m
-# benchmarks.bench_solver --backends ldl cholmod`, its backend_table)
+# CHOLMOD 0.036 s (a tie: the 61 x 21 net stays on qdldl); 7.7k 0.120 against 0.098 s; 57k
+# 4.45 against 0.93 s (`python -m benchmarks.bench_solver --backends ldl cholmod`, its
+# backend_table). Along a load path the analysis is paid once: a load path of the 1:20
+# verification (4.2k unknowns, 23 levels) 1.25 s with qdldl, 0.72 s with CHOLMOD
 
 PHASES = {11: "analysis", 22: "factorization", 33: "solve"}  # MKL's phases, as Pardiso counts
 
