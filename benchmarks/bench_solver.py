@@ -5,6 +5,7 @@ the load paths of the 1:40 verification; the robustness table of the hard cases.
 
     python -m benchmarks.bench_solver --out DIR [--sizes 1 2 4 8] [--no-paths]
         [--threads N] [--compare-threads 1 2]
+        [--backends ldl cholmod [--backend-refine 1 2] [--backend-path-scale 20]]
 
 Errors are the mid-height centre deflection against a tight-tolerance solve of the same size
 (relative). Loads at the initial node height (the variant OpenSees can model); printgen's
@@ -13,10 +14,12 @@ current-height variant is timed too. Times are wall-clock (perf_counter) and CPU
 threads (threadpoolctl; default 1); `size_table` lists them per size with the backend and
 the microseconds per unknown, and for PARDISO its CPU by phase (analysis, numeric
 factorizations, solves); --compare-threads 1 2 adds the same solves per thread count
-(`threads_table`). The ratio to OpenSeesPy at 61 x 21 is also measured pair by pair
-(`paired_ratio`: PAIRS pairs, alternating, one thread each; wall and CPU time of each whole
-call, median and range, with the load average; in a fresh process and in this one, see
-`paired_both`).
+(`threads_table`); --backends ldl cholmod times the same solve with each linear backend in
+turn (`backend_table`: where CHOLMOD overtakes qdldl), and with --backend-path-scale S the
+verification's load paths at 1:S too (`backend_paths`). The ratio to OpenSeesPy at 61 x 21 is
+also measured pair by pair (`paired_ratio`: PAIRS pairs, alternating, one thread each; wall
+and CPU time of each whole call, median and range, with the load average; in a fresh process
+and in this one, see `paired_both`).
 Writes bench_solver.json and bench_solver.png.
 """
 
@@ -44,8 +47,9 @@ GOAL_TOL = 1e-6  # the solver's speed goals are stated at this tolerance
 REPEAT = 3  # timing repeats at GOAL_TOL (best kept)
 PAIRS = 7  # printgen / OpenSeesPy timing pairs at 61 x 21, alternating which runs first
 SIZES = {1: "61 x 21", 2: "121 x 41", 4: "241 x 81", 8: "481 x 161"}
-LINEAR_FROM = 10_000  # goal: cost per unknown within 1.5x from here (14k) to 228k unknowns
+LINEAR_FROM = 10_000  # goal: cost per unknown within 3x from here (14k) to 228k unknowns
 THREADS = 1  # BLAS/MKL threads of the size runs (--threads)
+BACKEND_REFINES = (1.0, 1.5, 2.0, 4.0)  # --backends sizes: 3.4k, 7.7k, 14k, 57k unknowns
 COMPARED = (1, 2, 4)  # sizes also run by OpenSeesPy and by the reference path
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "realistic_barrier.toml"
 EXAMPLE_SCALE = 40.0  # the 1:40 verification whose load paths are timed
@@ -200,15 +204,16 @@ def robustness() -> list[dict]:
     return out
 
 
-def _solve_once(sc, tol: float, method: str):
+def _solve_once(sc, tol: float, method: str, backend: str | None = None):
     """(result, CPU s, PARDISO's CPU by phase or None, set-up CPU s or None): what
     `solver.solve` does, with the fast path's solver kept to read its PARDISO instance's
-    counters; the set-up is the net's NetSystem (pattern, damping, incidence)."""
+    counters; the set-up is the net's NetSystem (pattern, damping, incidence). `backend`:
+    the linear backend (None: `choose_backend`'s)."""
     c0 = time.process_time()
     if method != "fast":
         return solve(sc.net, sc.loads_at(1.0), tol=tol, method=method), \
             time.process_time() - c0, None, None
-    fs = FastSolver(sc.net)
+    fs = FastSolver(sc.net, backend)
     setup = time.process_time() - c0
     r = fs.solve(sc.loads_at(1.0), [], tol, MAX_ITER)
     cpu = time.process_time() - c0
@@ -304,9 +309,79 @@ def thread_table(sizes: list[int], counts: list[int]) -> list[dict]:
     return out
 
 
-def capture_verification_paths() -> list[tuple]:
-    """(net, loads_at, levels, keywords) of every load path the 1:40 verification solves,
-    recorded while it runs (serially, in this process)."""
+def backend_table(refines: list[float], backends: list[str], threads: int = THREADS
+                  ) -> list[dict]:
+    """printgen at GOAL_TOL per size with each linear backend in turn (best CPU of REPEAT,
+    the net's set-up included, BLAS pinned to `threads`): where one backend overtakes another
+    (`linsolve.CHOLMOD_MIN_DOFS`). A backend that is not installed is listed as skipped."""
+    from threadpoolctl import threadpool_limits
+
+    from printgen.solver import linsolve
+
+    installed = {"ldl": linsolve.ldl_available, "cholmod": linsolve.cholmod_available,
+                 "pardiso": linsolve.pardiso_available, "lu": lambda: True}
+    out = []
+    for refine in refines:
+        sc = simple_scene(refine=refine, current_z=False)
+        unknowns = int((~sc.net.fixed_dofs).sum())
+        for backend in backends:
+            row: dict = {"refine": refine, "unknowns": unknowns, "backend": backend}
+            if not installed.get(backend, lambda: False)():
+                out.append({**row, "skipped": f"{backend} not installed"})
+                continue
+            with threadpool_limits(limits=threads):
+                runs = [_solve_once(sc, GOAL_TOL, "fast", backend) for _ in range(REPEAT)]
+            r = runs[0][0]
+            out.append({**row, "converged": r.converged, "iterations": r.iterations,
+                        "factorizations": r.factorizations,
+                        "cpu_s": min(x[1] for x in runs),
+                        "wall_s": min(x[0].seconds for x in runs),
+                        "deflection_m": float(r.displacements[sc.centre, 1]),
+                        "load_average": _load()})
+    return out
+
+
+def backend_paths(scale: float, backends: list[str], threads: int = THREADS) -> list[dict]:
+    """The verification's load paths at 1:`scale`, each solved with every installed backend in
+    turn (CPU, iterations, factorizations, and the largest displacement difference to the
+    first backend's, relative to its largest displacement): along a path a backend's
+    analysis is paid once, so the crossover differs from a single solve's. The backend is
+    imposed by replacing `solver.fast.choose_backend` for the duration of each path."""
+    from threadpoolctl import threadpool_limits
+
+    from printgen.solver import fast, linsolve
+
+    installed = {"ldl": linsolve.ldl_available, "cholmod": linsolve.cholmod_available,
+                 "pardiso": linsolve.pardiso_available, "lu": lambda: True}
+    usable = [b for b in backends if installed.get(b, lambda: False)()]
+    out, original = [], fast.choose_backend
+    for k, (net, loads_at, levels, kw) in enumerate(capture_verification_paths(scale)):
+        first = None
+        for backend in usable:
+            fast.choose_backend = lambda size, b=backend: b
+            try:
+                with threadpool_limits(limits=threads):
+                    c0 = time.process_time()
+                    res = solve_path(net, loads_at, levels, **kw)
+                    cpu = time.process_time() - c0
+            finally:
+                fast.choose_backend = original
+            disp = np.array([r.displacements for r in res])
+            first = disp if first is None else first
+            diff = (float(np.abs(disp - first).max() / np.abs(first).max())
+                    if disp.shape == first.shape and np.abs(first).max() > 0 else None)
+            out.append({"scale": scale, "path": k, "unknowns": int((~net.fixed_dofs).sum()),
+                        "levels": len(levels), "backend": backend, "cpu_s": cpu,
+                        "converged_levels": sum(r.converged for r in res),
+                        "iterations": sum(r.iterations for r in res),
+                        "factorizations": sum(r.factorizations for r in res),
+                        "difference_to_first": diff})
+    return out
+
+
+def capture_verification_paths(scale: float = EXAMPLE_SCALE) -> list[tuple]:
+    """(net, loads_at, levels, keywords) of every load path the verification at 1:`scale`
+    (default 1:40) solves, recorded while it runs (serially, in this process)."""
     from printgen import solver
     from printgen.run.api import verify
 
@@ -319,7 +394,7 @@ def capture_verification_paths() -> list[tuple]:
     os.environ["PRINTGEN_SERIAL"] = "1"
     solver.solve_path = recording
     try:
-        verify(EXAMPLE, EXAMPLE_SCALE)
+        verify(EXAMPLE, scale)
     finally:
         solver.solve_path = original
         del os.environ["PRINTGEN_SERIAL"]
@@ -457,7 +532,7 @@ def goals(results: list[dict], paths: list[dict], tent: dict | None,
     cpu = {res["size"]: res["cpu_us_per_unknown_at_goal_tol"] for res in results
            if res["unknowns"] >= LINEAR_FROM}
     out["cpu_us_per_unknown"] = cpu
-    if len(cpu) > 1:  # goal: within 1.5x from 14k to 228k unknowns
+    if len(cpu) > 1:  # goal: within 3x from 14k to 228k unknowns
         out["cpu_us_per_unknown_spread"] = max(cpu.values()) / min(cpu.values())
     if tent:
         out["tent_iterations"] = {m: tent[m]["iterations"] for m in ("fast", "reference")}
@@ -469,7 +544,8 @@ def goals(results: list[dict], paths: list[dict], tent: dict | None,
 
 
 def run(out: Path, sizes: list[int], with_paths: bool = True, threads: int = THREADS,
-        compare_threads: list[int] | None = None) -> dict:
+        compare_threads: list[int] | None = None, backends: list[str] | None = None,
+        backend_refines: list[float] | None = None, path_scale: float | None = None) -> dict:
     from threadpoolctl import threadpool_limits
 
     from printgen.solver.linsolve import pardiso_available
@@ -490,11 +566,16 @@ def run(out: Path, sizes: list[int], with_paths: bool = True, threads: int = THR
     tent = bench_tent(captured[0][0], captured[0][3].get("tol", GOAL_TOL)) if captured else None
     paired = paired_both() if 1 in sizes else None
     by_threads = thread_table(sizes, compare_threads) if compare_threads else []
+    by_backend = backend_table(backend_refines or list(BACKEND_REFINES), backends, threads) \
+        if backends else []
+    by_backend_path = backend_paths(path_scale, backends, threads) \
+        if backends and path_scale else []
     report = {"benchmark": "bench_solver", "scene": "simple-pinned",
               "load": "hydrostatic at h = h_B + drag at 6 m/s, at the initial node height",
               "reference_tol": REFERENCE_TOL, "goal_tol": GOAL_TOL, "blas_threads": threads,
               "load_average": _load(),
               "size_table": size_table(results, threads), "threads_table": by_threads,
+              "backend_table": by_backend, "backend_paths": by_backend_path,
               "sizes": results,
               "verification_paths": paths, "tent": tent, "robustness": robustness(),
               "opensees_paired": paired, "goals": goals(results, paths, tent, paired),
@@ -524,9 +605,17 @@ def main(argv: list[str] | None = None) -> int:
                     help=f"BLAS/MKL threads of the size runs (default {THREADS})")
     ap.add_argument("--compare-threads", type=int, nargs="+", metavar="N",
                     help="also time each size at tol 1e-6 with each of these thread counts")
+    ap.add_argument("--backends", nargs="+", metavar="NAME",
+                    help="also time each backend (ldl, cholmod, pardiso, lu) at tol 1e-6")
+    ap.add_argument("--backend-refine", type=float, nargs="+", metavar="R",
+                    help=f"mesh refinements of --backends (default {list(BACKEND_REFINES)})")
+    ap.add_argument("--backend-path-scale", type=float, metavar="S",
+                    help="with --backends: also solve the verification's load paths at 1:S "
+                         "with each backend")
     ap.add_argument("--json", action="store_true", help="print the goals as JSON")
     a = ap.parse_args(argv)
-    report = run(a.out, a.sizes, not a.no_paths, a.threads, a.compare_threads)
+    report = run(a.out, a.sizes, not a.no_paths, a.threads, a.compare_threads, a.backends,
+                 a.backend_refine, a.backend_path_scale)
     for res in report["sizes"]:
         for r in res["runs"]:
             err = r.get("error")
@@ -546,6 +635,20 @@ def main(argv: list[str] | None = None) -> int:
     for row in report["threads_table"]:
         print(f"{row['size']:9s} {row['blas_threads']} thread(s): wall {row['wall_s']:6.2f} s  "
               f"cpu {row['cpu_s']:6.2f} s  it {row['iterations']} fact {row['factorizations']}")
+    for row in report["backend_table"]:
+        head = f"{row['unknowns']:7d} unknowns  {row['backend']:8s}"
+        if "skipped" in row:
+            print(f"{head} skipped: {row['skipped']}")
+            continue
+        print(f"{head} cpu {row['cpu_s']:7.3f} s  wall {row['wall_s']:7.3f} s  it "
+              f"{row['iterations']} fact {row['factorizations']}  deflection "
+              f"{row['deflection_m']:.12e} m")
+    for row in report["backend_paths"]:
+        diff = row["difference_to_first"]
+        print(f"path {row['path']} at 1:{row['scale']:g} ({row['unknowns']} unknowns, "
+              f"{row['levels']} levels) {row['backend']:8s} cpu {row['cpu_s']:6.2f} s  it "
+              f"{row['iterations']} fact {row['factorizations']}  converged "
+              f"{row['converged_levels']}  difference {'-' if diff is None else f'{diff:.1e}'}")
     for p in report["verification_paths"]:
         print(f"path {p['path']} ({p['nodes']} nodes, {p['levels']} levels): fast "
               f"{p['fast']['time_s']:.2f} s, {sum(p['fast']['iterations'])} it, "

@@ -12,8 +12,10 @@ import scipy.sparse as sp
 from printgen.solver import Hydrostatic, Net, SlidingCable, linear, solve, solve_path
 from printgen.solver.driver import FastSolver
 from printgen.solver.linsolve import (
+    CHOLMOD_MIN_DOFS,
     PARDISO_MIN_DOFS,
     Factorization,
+    cholmod_available,
     choose_backend,
     ldl_available,
     pardiso_available,
@@ -93,13 +95,13 @@ def test_a_drag_load_path_converges_where_the_level_sits_on_a_node_row(refine):
 
 
 def test_without_the_optional_ldl_the_superlu_fallback_gives_the_same_answer(monkeypatch):
-    """`qdldl` and `pypardiso` not importable (the `fast` extra absent): every solve goes
-    through SuperLU."""
+    """`qdldl`, `cvxopt` and `pypardiso` not importable (the `fast` extra absent): every
+    solve goes through SuperLU."""
     net, loads = _sliding_net()
     with_ldl = solve(net, loads, tol=TIGHT)
-    for name in ("qdldl", "pypardiso"):
+    for name in ("qdldl", "cvxopt", "cvxopt.cholmod", "pypardiso"):
         monkeypatch.setitem(sys.modules, name, None)  # import now raises ImportError
-    assert not ldl_available() and not pardiso_available()
+    assert not ldl_available() and not pardiso_available() and not cholmod_available()
     assert choose_backend(10**6) == "lu"
     fs = FastSolver(net)
     assert fs.stepper.backend == "lu"
@@ -108,14 +110,19 @@ def test_without_the_optional_ldl_the_superlu_fallback_gives_the_same_answer(mon
     assert _agree(plain.displacements, with_ldl.displacements) < AGREE
 
 
-@pytest.mark.parametrize("backend", ["ldl", "pardiso", "lu"])
+def _skip_unless_installed(backend: str) -> None:
+    installed = {"ldl": ldl_available, "cholmod": cholmod_available,
+                 "pardiso": pardiso_available}.get(backend, lambda: True)
+    if not installed():
+        pytest.skip(f"{backend} not installed")
+
+
+@pytest.mark.parametrize("backend", ["ldl", "cholmod", "pardiso", "lu"])
 def test_linear_solves_include_the_follower_term(backend):
     """With the hydrostatic load at the current node height the tangent is not symmetric:
     the LDL^T of its symmetric part + GMRES (and every other backend) must still solve the
     true system."""
-    if (backend == "ldl" and not ldl_available()) or (
-            backend == "pardiso" and not pardiso_available()):
-        pytest.skip(f"{backend} not installed")
+    _skip_unless_installed(backend)
     sc = simple_scene(current_z=True)
     ns = NetSystem(sc.net)
     ns.loads = sc.loads_at(1.0)
@@ -237,17 +244,19 @@ def test_ldl_turns_to_pardiso_on_a_net_factorized_often():
 
 def test_backend_by_size():
     expect_small = "ldl" if ldl_available() else "lu"
-    assert choose_backend(PARDISO_MIN_DOFS - 1) == expect_small
-    assert choose_backend(PARDISO_MIN_DOFS) == ("pardiso" if pardiso_available() else expect_small)
+    expect_large = "cholmod" if cholmod_available() else expect_small
+    assert choose_backend(min(PARDISO_MIN_DOFS, CHOLMOD_MIN_DOFS) - 1) == expect_small
+    if not pardiso_available():
+        assert choose_backend(CHOLMOD_MIN_DOFS) == expect_large
+    assert choose_backend(max(PARDISO_MIN_DOFS, CHOLMOD_MIN_DOFS)) == (
+        "pardiso" if pardiso_available() else expect_large)
 
 
-@pytest.mark.parametrize("backend", ["ldl", "pardiso"])
+@pytest.mark.parametrize("backend", ["ldl", "cholmod", "pardiso"])
 def test_symmetric_solve_is_that_of_the_symmetric_part(backend):
     """symmetric_solve(b) solves S x = b, whether b is the last solve's right-hand side (its
     result is reused) or a new one."""
-    if (backend == "ldl" and not ldl_available()) or (
-            backend == "pardiso" and not pardiso_available()):
-        pytest.skip(f"{backend} not installed")
+    _skip_unless_installed(backend)
     ns, data = _tangent(*_sliding_net())
     A = ns.pattern.csr(data)
     S = 0.5 * (A + A.T)

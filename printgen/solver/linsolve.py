@@ -8,14 +8,19 @@ lazily (the `fast` extra), in the order `choose_backend` prefers them:
   supernodal Cholesky (LDL^T once S proves indefinite) of the symmetric part
   S = (A + A^T) / 2; its fill-reducing analysis runs once per net, every later step only
   refactorizes numerically;
+- "cholmod" (CHOLMOD's supernodal Cholesky of S through `cvxopt`, nets of CHOLMOD_MIN_DOFS
+  unknowns and more; its wheels carry their own SuiteSparse and BLAS): its AMD ordering
+  and symbolic analysis once per net, then numeric factorizations on dense supernodal
+  blocks, a fifth of qdldl's time at 57k unknowns and a twelfth at 228k; on the first
+  factorization that finds S not positive definite it turns to "ldl" for the rest of the net;
 - "ldl" (`qdldl`): a sparse LDL^T of S, ordering computed once per net; on a net that is
   factorized more than LDL_TO_PARDISO times (a load path) and has LDL_PARDISO_MIN_DOFS
   unknowns or more, the later factorizations are PARDISO's when it is installed (one thread;
   about half of qdldl's numeric factorization, an analysis costing about two of qdldl's);
 - "lu": scipy's SuperLU on A (always there; also the reference path's solver).
 
-With "pardiso" and "ldl", GMRES on A preconditioned by S^-1 takes care of the follower term
-(a few iterations: it is a small part of A).
+With "pardiso", "cholmod" and "ldl", GMRES on A preconditioned by S^-1 takes care of the
+follower term (a few iterations: it is a small part of A).
 
 Every result is checked against A (backward error LINEAR_RTOL, or the inexact-Newton
 forcing); GMRES preconditioned by the factorization repairs a result that misses it, and
@@ -59,6 +64,13 @@ LDL_PARDISO_THREADS = 1  # MKL threads of those factorizations and solves: MKL's
 # per core) costs ten times the CPU per factorization or more
 # (benchmarks/measurements.md#linsolve-threads)
 
+CHOLMOD_MIN_DOFS = 4_000  # from here on CHOLMOD's supernodal Cholesky beats qdldl's LDL^T:
+# whole solves of simple-pinned at tol 1e-6, 1 thread, CPU: 3.4k unknowns qdldl 0.035 s,
+# CHOLMOD 0.036 s (a tie: the 61 x 21 net stays on qdldl); 7.7k 0.120 against 0.098 s; 57k
+# 4.45 against 0.93 s (`python -m benchmarks.bench_solver --backends ldl cholmod`, its
+# backend_table). Along a load path the analysis is paid once: a load path of the 1:20
+# verification (4.2k unknowns, 23 levels) 1.25 s with qdldl, 0.72 s with CHOLMOD
+
 PHASES = {11: "analysis", 22: "factorization", 33: "solve"}  # MKL's phases, as Pardiso counts
 
 
@@ -84,6 +96,15 @@ def _mkl_hint() -> None:
             os.environ["PYPARDISO_MKL_RT"] = found[0]
 
 
+def cholmod_available() -> bool:
+    """True when CHOLMOD through `cvxopt` (the `fast` extra) imports."""
+    try:
+        import cvxopt.cholmod  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
 def pardiso_available() -> bool:
     """True when the optional MKL PARDISO wrapper (`pypardiso`) imports."""
     try:
@@ -98,6 +119,8 @@ def choose_backend(size: int) -> str:
     """The fastest installed backend for a system of `size` unknowns."""
     if size >= PARDISO_MIN_DOFS and pardiso_available():
         return "pardiso"
+    if size >= CHOLMOD_MIN_DOFS and cholmod_available():
+        return "cholmod"
     return "ldl" if ldl_available() else "lu"
 
 
@@ -252,17 +275,92 @@ class Ldl:
         self.solve = self.qdldl.solve
 
 
+class Cholmod:
+    """The "cholmod" backend's object of one net: CHOLMOD's supernodal Cholesky L L^T of S
+    (cvxopt's build), its ordering (AMD) and symbolic analysis once per pattern, then numeric
+    factorizations only, which replace the values of one cvxopt matrix in place. The first
+    S that is not positive definite (the follower term's symmetric part, or a tangent made
+    indefinite by the line search's trial states) turns the net to the "ldl" backend's
+    LDL^T (qdldl) for good, or raises when that is not installed.
+
+    Why this one (1 thread, the simple scene's S): qdldl's LDL^T is column by column, and a
+    2D net's factor fills in (0.26 s a numeric factorization at 57k unknowns, 3.9 s at 228k);
+    CHOLMOD's supernodal blocks take 0.05 and 0.33 s on the same AMD ordering. Tried and
+    dropped: CHOLMOD's simplicial LDL^T (cvxopt's supernodal = 0) and cholespy, no faster
+    than qdldl; SuperLU on a METIS nested-dissection order (pymetis), 0.52 s at 58k; a METIS
+    order fed to CHOLMOD, 20 % off the numeric factorization at 228k but 0.6 s to compute
+    and one more dependency; re-passes by GMRES on the last factorization (the "ldl" way),
+    more Newton iterations and twice the CPU at 57k."""
+
+    def __init__(self) -> None:
+        self.matrix: Any = None  # cvxopt's spmatrix of the upper triangle (values replaced)
+        self.symbolic: Any = None  # CHOLMOD's analysis (ordering, supernodes)
+        self.source: Pattern | None = None  # the pattern the analysis was made for
+        self.order: np.ndarray | None = None  # the upper triangle's slots in cvxopt's order
+        # (None: as they are)
+        self.ldl: Ldl | None = None  # the LDL^T the net turned to, once S was indefinite
+        self.solve: Callable[[np.ndarray], np.ndarray] | None = None
+
+    def factor(self, pattern: Pattern, data: np.ndarray) -> None:
+        if self.ldl is not None:
+            self.ldl.factor(pattern, data)
+            self.solve = self.ldl.solve
+            return
+        import cvxopt
+        from cvxopt import cholmod
+
+        upper = pattern.symmetric_upper(data)
+        if self.source is not pattern:  # a new net's pattern: analyse it
+            n = upper.shape[0]
+            cols = np.repeat(np.arange(n), np.diff(upper.indptr))
+            # cvxopt's order: column, then row (the pattern's own when its rows are sorted)
+            self.order = None if upper.has_sorted_indices else np.lexsort((upper.indices, cols))
+            self.matrix = cvxopt.spmatrix(
+                cvxopt.matrix(self._ordered(upper.data).astype(np.float64)),
+                cvxopt.matrix(self._ordered(upper.indices).astype(np.int64)),
+                cvxopt.matrix(self._ordered(cols).astype(np.int64)), (n, n))
+            self.symbolic = cholmod.symbolic(self.matrix, uplo="U")
+            self.source = pattern
+            if len(self.matrix.V) != upper.nnz:  # cvxopt merged or dropped slots
+                raise ValueError("cvxopt's matrix lost entries of the pattern")
+        else:
+            self.matrix.V = cvxopt.matrix(self._ordered(upper.data))
+        self.solve = None
+        try:
+            cholmod.numeric(self.matrix, self.symbolic)
+        except ArithmeticError:  # not positive definite
+            if not ldl_available():
+                raise
+            self.ldl = Ldl()
+            self.factor(pattern, data)
+            return
+        self.solve = self._solve
+
+    def _ordered(self, a: np.ndarray) -> np.ndarray:
+        """Per-slot values `a` of the upper triangle in cvxopt's order."""
+        return a if self.order is None else a[self.order]
+
+    def _solve(self, b: np.ndarray) -> np.ndarray:
+        import cvxopt
+        from cvxopt import cholmod
+
+        x = cvxopt.matrix(np.ascontiguousarray(b, dtype=np.float64))
+        cholmod.solve(self.symbolic, x)
+        return np.asarray(x).ravel()
+
+
 class Factorization:
     """One factorization of A = J + mu D; `solve` returns None when A is singular.
 
-    backend "pardiso", "ldl" or "lu" (see the module docstring); `handle`: the backend's
-    object from an earlier factorization of the same net (an Ldl, a Pardiso), reused so the
+    backend "pardiso", "cholmod", "ldl" or "lu" (see the module docstring); `handle`: the
+    backend's object from an earlier factorization of the same net (a Cholmod, an Ldl, a
+    Pardiso), reused so the
     ordering is not computed again.
     """
 
     def __init__(self, pattern: Pattern, data: np.ndarray, backend: str, handle=None) -> None:
         self.pattern, self.A, self.backend = pattern, pattern.csr(data), backend
-        self.handle: Any = None  # the backend's object (Ldl, Pardiso)
+        self.handle: Any = None  # the backend's object (Cholmod, Ldl, Pardiso)
         self.direct: Callable[[np.ndarray], np.ndarray] | None = None  # its solve
         self.symmetric = False
         self.lu: Any = None  # scipy's SuperLU, when it is needed
@@ -272,6 +370,10 @@ class Factorization:
         try:
             if backend == "ldl":
                 self._factor_ldl(data, handle)
+            elif backend == "cholmod":
+                handle = handle if handle is not None else Cholmod()
+                handle.factor(pattern, data)
+                self.handle, self.direct, self.symmetric = handle, handle.solve, True
             elif backend == "pardiso":
                 handle = handle if handle is not None else Pardiso()
                 handle.factor(pattern.symmetric_upper_csr(data))

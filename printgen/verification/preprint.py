@@ -97,8 +97,8 @@ class Run:
     """One barrier's sweep: its deformation and solver statistics; `shapes`: node positions
     (n, 3) m at the SHAPE_LEVELS it reached; `hold_share`: the largest force of the hold of
     unloaded nodes over the applied load (0 without a hold); `backend`: the solver's linear
-    backend(s) ("ldl", "pardiso", "lu"; comma-separated if several); `unknowns`: the solver
-    net's free degrees of freedom; `cpu_s`: the sweep's CPU time in its process."""
+    backend(s) ("ldl", "cholmod", "pardiso", "lu"; comma-separated if several); `unknowns`:
+    the solver net's free degrees of freedom; `cpu_s`: the sweep's CPU time in its process."""
 
     scene: BarrierScene
     deformation: Deformation
