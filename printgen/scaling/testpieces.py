@@ -37,7 +37,8 @@ class PanelPiece:
     """The printed test panel: its net, the clamp layout and the orientation (mm)."""
 
     net: NetDesign
-    orientation: str  # the mesh diagonal along the load ("short" or "long")
+    orientation: str  # the mesh diagonal along the load ("short" or "long"; a square net's
+    # panel: "strands", pulled along one strand family)
     length_mm: float  # clamp edge to clamp edge, along the load
     width_mm: float  # across the load
     clamp_depth_mm: float  # net held in each clamp beyond its edge (one mesh row)
@@ -82,4 +83,7 @@ def panel_for(d: Design, orientation: str, length_mm: float, width_mm: float) ->
     depth = along  # one whole mesh beyond each clamp edge: node rows stay on the lattice
     net = replace(n, width_mm=width_mm, height_mm=length_mm + 2 * depth,
                   mesh_x_mm=across, mesh_y_mm=along)
-    return PanelPiece(net, orientation, length_mm, width_mm, depth)
+    # a square mesh has no diagonal to choose: its panel is pulled along the strands that run
+    # up the printed panel (its strands across are the same section laid the same way)
+    shown = "strands" if n.pattern == "square" else orientation
+    return PanelPiece(net, shown, length_mm, width_mm, depth)
