@@ -12,7 +12,7 @@ across). Size and clamps (`printgen.scene.panel.square_panel_size`): at least 8 
 and 4 meshes between the clamps, so that the outer strands and the rows in the jaws are small
 parts of the whole. The frame's two side bars are cut after clamping: they are the printed
 border, not strands, so the prediction counts the loaded strands left between them
-(`tested_share`: nx - 1 of the simulated panel's nx + 1).
+(`loaded_strands`: nx - 1 of the simulated panel's nx + 1).
 
 The prediction is the solver's virtual panel test (`printgen.scene.panel`) with the strand law
 the verification gives the design (`model_net_law`; a waved net's: its beam-model curve,
@@ -41,7 +41,7 @@ from printgen.scene.panel import (
     law_strains,
     simulate,
     square_panel_size,
-    tested_share,
+    loaded_strands,
 )
 from printgen.units import MM
 
@@ -78,10 +78,10 @@ def square_panel(d: Design, orientation: str) -> DesignPanel:
                        f"straight strands, {how}")
 
 
-def tested(dp: DesignPanel) -> DesignPanel:
+def as_tested(dp: DesignPanel) -> DesignPanel:
     """`dp` as the printed panel is tested: its force times the loaded strands left once the
     side bars are cut over the simulated ones (every loaded strand carries the same force)."""
-    k, m = tested_share(dp.test)
+    k, m = loaded_strands(dp.test)
     curve = dataclasses.replace(dp.curve, force_per_width=dp.curve.force_per_width * k / m)
     return dataclasses.replace(dp, curve=curve)
 
@@ -90,7 +90,7 @@ def square_expected(stage: Path, dp: DesignPanel) -> dict[str, Any]:
     """panel-expected.csv of the square panel: against strain, the tested panel's force per
     clamp width and clamp force, the simulated panel's force per width and one loaded
     strand's force; its record."""
-    k, m = tested_share(dp.test)
+    k, m = loaded_strands(dp.test)
     width = lattice_size(dp.test)[1]
     strand = dp.curve.force_per_width * width / m
     buf = io.StringIO()
@@ -116,7 +116,7 @@ def square_sidecar(stage: Path, d: Design, dp: DesignPanel, piece) -> dict[str, 
     panels' (kind "waved", its [wave] table); a straight net's kind "panel" with the
     [prediction] table (its simulated test as tested, the strand law it assumed); its
     record."""
-    t = tested(dp)
+    t = as_tested(dp)
     if d.net.wave is not None:
         return wave_panel_sidecar(stage, d, t, piece, TESTED)
     n = d.net
@@ -126,7 +126,7 @@ def square_sidecar(stage: Path, d: Design, dp: DesignPanel, piece) -> dict[str, 
     pred = {"material": n.material, "law_source": t.strands,
             "stress_knees": list(stress.knees),
             "stress_slopes_mpa": [v / 1e6 for v in stress.slopes],
-            "strands": tested_share(t.test)[0], "strand_width_mm": n.strand.width_mm,
+            "strands": loaded_strands(t.test)[0], "strand_width_mm": n.strand.width_mm,
             "thickness_mm": n.strand.thickness_mm, "mesh_mm": n.mesh_x_mm,
             "panel_strains": [float(e) for e in t.curve.strains],
             "panel_n_per_m": [float(v) for v in t.curve.force_per_width],

@@ -60,7 +60,7 @@ from printgen.units import MM
 __all__ = ["HOLD_RATIO", "MODES", "PANEL_TOL", "STRAIN_POINTS", "STRAIN_STEP", "PanelCurve",
            "PanelTest", "analytic_blocked", "lattice_size", "law_strains", "panel_lockup",
            "simulate", "derive_law", "design_panel", "DerivedLaw", "DesignPanel",
-           "refined_knees", "square_panel_size", "tested_share"]
+           "refined_knees", "square_panel_size", "loaded_strands"]
 
 DERIVE_STEPS = 8  # fixed-point passes of the strand-law derivation (each re-solves the test)
 DERIVE_TOL = 1e-3  # ... stopped once the slopes move by less than 0.1 % in a pass
@@ -260,7 +260,7 @@ def square_panel_size(mesh: float) -> tuple[float, float]:
             max(PRINTED_PANEL[1], (SQUARE_MIN_STRANDS + 1) * mesh))
 
 
-def tested_share(t: PanelTest) -> tuple[int, int]:
+def loaded_strands(t: PanelTest) -> tuple[int, int]:
     """(loaded strands of the printed square panel once its two side bars are cut, those of
     the simulated panel): nx - 1 and nx + 1 for nx meshes across (the simulation's edge
     columns are strands, `edge_share`). Every loaded strand carries the same force, so the
