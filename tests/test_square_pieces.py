@@ -27,9 +27,9 @@ from printgen.scene.panel import (
     SQUARE_MIN_STRANDS,
     PanelTest,
     lattice_size,
+    loaded_strands,
     simulate,
     square_panel_size,
-    loaded_strands,
 )
 from printgen.units import MM
 

@@ -39,9 +39,9 @@ from printgen.scene.panel import (
     curved_panel,
     lattice_size,
     law_strains,
+    loaded_strands,
     simulate,
     square_panel_size,
-    loaded_strands,
 )
 from printgen.units import MM
 
