@@ -6,7 +6,8 @@ and passes, and a net test panel of its mesh, each as STL, 3MF, PrusaSlicer .ini
 G-code (read back against the toolpath), the sidecar each test's exports need in
 `printgen calibrate` (`<piece>.specimen.toml`, the keys of `printgen.calibrate.specimen`), and
 the panel's expected force-strain curve from the virtual panel test
-(`printgen.scene.panel`, free sides, as printed panels are tested). The loop:
+(`printgen.scene.panel`, free sides, as printed panels are tested); a square net's panel,
+pulled along its strands, with its own curve and sidecar (`printgen.run.squarepieces`). The loop:
 print pieces -> test -> calibrate -> verify -> print the barrier (LOOP).
 """
 

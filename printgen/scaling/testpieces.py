@@ -14,7 +14,8 @@ Panel: the design's diamond mesh, loaded along one diagonal, sized as the virtua
 (`printgen.scene.panel`): clamp edges on two node rows `length` apart and `width`
 across (whole half-meshes), with one more mesh row beyond each clamp edge for the clamp
 faces to hold and the net's border frame around it. The two side bars of the frame are cut
-before the test (the virtual panel's sides are free).
+before the test (the virtual panel's sides are free). A square mesh has no diagonal to choose:
+its panel is pulled along one strand family, sized as `printgen.run.squarepieces` argues.
 """
 
 from __future__ import annotations
@@ -67,7 +68,8 @@ def coupon_gauge_mm(c: CableDesign) -> float:
 
 
 def panel_for(d: Design, orientation: str, length_mm: float, width_mm: float) -> PanelPiece:
-    """The test panel of design `d`'s mesh loaded along its `orientation` diagonal, with
+    """The test panel of design `d`'s mesh loaded along its `orientation` diagonal (a square
+    mesh's: along its strands up the panel), with
     clamp edges `length_mm` apart and `width_mm` across (the virtual test's lattice size:
     whole half-meshes)."""
     n = d.net
