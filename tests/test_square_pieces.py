@@ -232,3 +232,26 @@ def test_square_panel_sidecar_refuses_a_bad_prediction(tmp_path):
     with pytest.raises(CalibrationError, match="no --kind"):
         calibrate([export], material="tpe-lab", specimen={"kind": "panel"},
                   specimen_file=side)
+
+
+FAILURE_RTOL = 1e-6  # the last predicted strain's strand stress vs the failure stress: the
+# strain is solved in closed form, the panel's force to the solver's tolerance (PANEL_RTOL)
+
+
+def test_a_stiff_strands_prediction_ends_where_the_strands_reach_their_failure_stress():
+    """A PETG square net's panel would be predicted to the 10 % of a linear law, far past its
+    break: the prediction stops where the strand reaches the failure stress, and says so."""
+    from printgen.run.squarepieces import square_panel
+    from printgen.scaling.section import area_m2
+
+    d = _square()
+    d = dataclasses.replace(d, net=dataclasses.replace(d.net, material="petg"))
+    dp = square_panel(d, "short")
+    mat = load_material("petg")
+    _, simulated = loaded_strands(dp.test)
+    width = lattice_size(dp.test)[1]
+    stress = dp.curve.force_per_width[-1] * width / simulated / area_m2(d.net.strand)
+    assert stress == pytest.approx(mat.failure_stress()[0], rel=PANEL_RTOL["free"])
+    assert dp.curve.strains[-1] < 0.1 and "failure stress" in dp.strands
+    assert dp.law.force_and_tangent(dp.curve.strains[-1:])[0][0] == pytest.approx(
+        mat.failure_stress()[0] * area_m2(d.net.strand), rel=FAILURE_RTOL)

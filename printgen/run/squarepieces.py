@@ -26,6 +26,7 @@ from __future__ import annotations
 import csv
 import dataclasses
 import io
+import math
 from pathlib import Path
 from typing import Any
 
@@ -72,10 +73,29 @@ def square_panel(d: Design, orientation: str) -> DesignPanel:
     w = n.wave
     if w is not None:
         return curved_panel(d, orientation, w.amplitude_mm, w.half_waves, "free", size=size)
-    law, how = model_net_law(load_material(n.material), n, None)
+    mat = load_material(n.material)
+    law, how = model_net_law(mat, n, None)
     t = PanelTest(mesh, mesh, size[0], size[1], "free", n.pattern)
-    return DesignPanel("strands", t, law, simulate(law, t, law_strains(law.knees)), None,
+    eps, top = law_strains(law.knees), failure_strain(law, area_m2(n.strand), mat)
+    if top < eps[-1]:  # the test ends where the strands break: no prediction beyond
+        eps = eps * top / eps[-1]
+        how += (f"; up to {top:.2%}, where the strands reach {mat.name}'s failure stress "
+                f"({mat.failure_stress()[0] / 1e6:.3g} MPa, {mat.failure_stress()[1]})")
+    return DesignPanel("strands", t, law, simulate(law, t, eps), None,
                        f"straight strands, {how}")
+
+
+def failure_strain(law, area: float, mat) -> float:
+    """The strain (inf if none) at which a strand of `area` m^2 following `law` (N per unit
+    strain) reaches material `mat`'s failure stress: its slopes are positive, so the force
+    rises through the law's knees to it once."""
+    target = mat.failure_stress()[0] * area
+    lo, force = 0.0, 0.0
+    for knee, slope in zip((*law.knees, math.inf), law.slopes, strict=True):
+        if force + slope * (knee - lo) >= target:
+            return lo + (target - force) / slope
+        force, lo = force + slope * (knee - lo), knee
+    return math.inf
 
 
 def as_tested(dp: DesignPanel) -> DesignPanel:
