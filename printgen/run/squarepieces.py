@@ -6,12 +6,14 @@ strand family, its sides free. The strands along the load carry it, each straine
 (they lie along the load from the start: no mechanism); the strands across carry nothing (their
 ends move alike), so holding the sides would change nothing. The panel measures the strands laid
 up the printed panel (along the printer's y); the strands across are the same section and passes
-laid along x, taken as alike: one panel serves both directions of the net, and this test does
-not check that assumption (a lab that doubts it tests a second panel cut from a wider print
-across). Size and clamps (`printgen.scene.panel.square_panel_size`): at least 8 loaded strands
-and 4 meshes between the clamps, so that the outer strands and the rows in the jaws are small
-parts of the whole. The frame's two side bars are cut after clamping: they are the printed
-border, not strands, so the prediction counts the loaded strands left between them
+laid along x, the two families taking turns at being laid first in a layer
+(`printgen.parts.gcode.netpath`): between the junctions they are alike, and only the junctions
+differ (with an odd number of passes one family is laid first once more). So one panel serves
+both directions of the net; that the printer's x and y lay the same bead is assumed, not
+checked by this test. Size and clamps (`printgen.scene.panel.square_panel_size`): at least 8
+loaded strands and 4 meshes between the clamps, so that the outer strands and the rows in the
+jaws are small parts of the whole. The frame's two side bars are cut after clamping: they are
+the printed border, not strands, so the prediction counts the loaded strands left between them
 (`loaded_strands`: nx - 1 of the simulated panel's nx + 1).
 
 The prediction is the solver's virtual panel test (`printgen.scene.panel`) with the strand law
@@ -170,9 +172,11 @@ def square_readme(rec: dict[str, Any], panel_test: str) -> list[str]:
         "## Net test panel (print 1 or more)",
         (f"Square mesh {p['mesh_along_load_mm']:.4g} mm, pulled along the strands that run up "
          "the printed panel: they carry the load, each strained as the panel; the strands "
-         "across carry nothing. One panel serves both directions of the net (its strands "
-         "across are the same section and passes, laid along the printer's x: taken as alike, "
-         f"not checked by this test). Printed {p['printed_mm'][0]:.4g} x "
+         "across carry nothing. One panel serves both directions of the net: its strands "
+         "across are the same section and passes, laid along the printer's x, the two "
+         "families taking turns at being laid first in a layer, so they differ only at the "
+         "junctions (that the printer's x and y lay the same bead is assumed, not checked by "
+         f"this test). Printed {p['printed_mm'][0]:.4g} x "
          f"{p['printed_mm'][1]:.4g} mm with a border frame. Clamps {p['width_mm']:.4g} mm "
          f"wide, their edges on the node rows {p['length_mm']:.4g} mm apart, each holding "
          f"{p['clamp_depth_mm']:.4g} mm of net and the frame bar beyond. Cut the two side bars "
