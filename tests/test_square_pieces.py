@@ -255,3 +255,16 @@ def test_a_stiff_strands_prediction_ends_where_the_strands_reach_their_failure_s
     assert dp.curve.strains[-1] < 0.1 and "failure stress" in dp.strands
     assert dp.law.force_and_tangent(dp.curve.strains[-1:])[0][0] == pytest.approx(
         mat.failure_stress()[0] * area_m2(d.net.strand), rel=FAILURE_RTOL)
+
+
+@pytest.mark.slow
+def test_cli_writes_a_square_designs_pieces(tmp_path, capsys):
+    from printgen.cli import main
+
+    path = tmp_path / "design.json"
+    path.write_text(dumps(_square().to_dict()))
+    assert main(["testpieces", str(path), "--out", str(tmp_path / "ok"), "--json"]) == 0
+    rec = json.loads(capsys.readouterr().out)
+    assert rec["panel"]["geometry"]["orientation"] == "strands"
+    assert main(["testpieces", str(path), "--out", str(tmp_path / "table")]) == 0
+    assert "panel.specimen.toml" in capsys.readouterr().out
