@@ -1,19 +1,20 @@
 """`printgen testpieces` of a square-mesh design (straight and waved strands): the square test
 panel is no mechanism (its loaded strands carry the strand law, analytic), is sized as argued,
-its meshes are watertight and its direct G-code passes the checker; an export made from its
-simulated test with a known law scale calibrates back to that scale, and the saved profile
-gives the verification's strand law times that scale."""
+its meshes are watertight, its direct G-code passes the checker and PrusaSlicer slices it; an
+export made from its simulated test with a known law scale calibrates back to that scale, and
+the saved profile gives the verification's strand law times that scale."""
 
 from __future__ import annotations
 
 import dataclasses
 import json
+import os
 import subprocess
 import sys
 
 import numpy as np
 import pytest
-from conftest import reference_design_1_40, require_shared
+from conftest import reference_design_1_40, require_shared, require_tool
 from test_calibrate_files import write_export
 
 from printgen.calibrate.pipeline import calibrate
@@ -268,3 +269,21 @@ def test_cli_writes_a_square_designs_pieces(tmp_path, capsys):
     assert rec["panel"]["geometry"]["orientation"] == "strands"
     assert main(["testpieces", str(path), "--out", str(tmp_path / "table")]) == 0
     assert "panel.specimen.toml" in capsys.readouterr().out
+
+
+@pytest.mark.slow
+def test_prusaslicer_slices_the_square_panel_and_the_checker_passes_it(pieces, tmp_path):
+    require_tool("prusa-slicer")
+    script = require_shared("tools/gcode/slice_check.sh")
+    d, _, out = pieces
+    mat = load_material(d.net.material).print
+    env = dict(os.environ, OUT_DIR=str(tmp_path), PYTHON=sys.executable)
+    r = subprocess.run(
+        ["bash", str(script), str(out / "panel.stl"), str(out / "panel.prusa.ini"),
+         "--width", f"{d.net.strand.bead_width_mm}", "--area-model", "stadium",
+         "--layers", f"{len(d.net.strand.layer_heights_mm)}",
+         "--max-flow", f"{mat.max_volumetric_flow_mm3_per_s:g}"],
+        capture_output=True, text=True, env=env, timeout=CHECK_TIMEOUT_S, check=False)
+    last = r.stdout.strip().splitlines()[-1] if r.stdout.strip() else r.stderr
+    assert r.returncode == 0, last
+    assert last.startswith("SLICE-CHECK OK")
