@@ -85,7 +85,7 @@ def test_square_membrane_and_strand_force_are_one_strand_per_mesh():
                                                               rel=EXACT)
 
 
-def test_pattern_specific_rules_are_the_patterns():
+def test_pattern_specific_rules_are_the_patterns(monkeypatch):
     """What differs between patterns outside the graph and the laws (the mesh's name, the mesh
     it may have, whether the virtual panel test models it) is each pattern's own data: a new
     pattern states them (no default, so it is not quietly taken for a diamond)."""
@@ -104,10 +104,17 @@ def test_pattern_specific_rules_are_the_patterns():
     with pytest.raises(TypeError, match="mesh_name"):
         NetPattern("new", *(getattr(square_pattern, f) for f in (
             "graph", "membrane_factor", "strand_law", "strand_force", "span", "nodes")))
-    square = SimpleNamespace(net=SimpleNamespace(pattern="square"))
-    with pytest.raises(GeometryError, match="needs a diamond net; this design's net is 'square' "
-                                            r"\(the virtual panel test models diamonds only"):
-        panel_for(square, "short", 50.0, 30.0)
+    # both registered patterns have a test panel; one without is refused by name
+    from printgen.barrier.patterns import panel_test_patterns
+
+    assert set(panel_test_patterns()) == {"diamond", "square"}
+    untested = dataclasses.replace(square_pattern, name="new", panel_test=False)
+    monkeypatch.setattr("printgen.scaling.testpieces.get_pattern", lambda name: untested)
+    new = SimpleNamespace(net=SimpleNamespace(pattern="new"))
+    with pytest.raises(GeometryError, match="needs a diamond or square net; this design's net "
+                                            r"is 'new' \(the virtual panel test models diamonds "
+                                            "and squares only"):
+        panel_for(new, "short", 50.0, 30.0)
 
 
 def _flat_scene(n: int = 5, height: float = 1.0):

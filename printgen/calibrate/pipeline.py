@@ -41,6 +41,7 @@ from printgen.calibrate.specimen import (
 from printgen.calibrate.windows import machine_warning, window_warnings
 from printgen.errors import CalibrationError
 from printgen.inputs.profiles import profile_name
+from printgen.inputs.schema import load_toml
 from printgen.outputs.display import Shown, Summary
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -149,15 +150,16 @@ def calibrate(paths: Sequence[str | Path], *, material: str, options: FitOptions
         raise CalibrationError(f"specimen kind {kind!r}; expected one of {', '.join(KINDS)}")
     curve = opt.compliance.source if opt.compliance and opt.compliance.force is not None else None
     files, notes = expand(paths, exclude=[p for p in (curve, specimen_file) if p])
-    if specimen_file is not None and _sidecar_kind(specimen_file) == WAVED:
+    if specimen_file is not None and _predicted(specimen_file):
         if strength_only or kind is not None:
-            raise CalibrationError(f"{specimen_file} is a waved coupon's sidecar: it is fitted "
-                                   "against its beam model (no --kind, no --strength-only)")
+            raise CalibrationError(f"{specimen_file} is a waved coupon's or a square panel's "
+                                   "sidecar: it is fitted against its prediction (no --kind, "
+                                   "no --strength-only)")
         from printgen.calibrate.waved import calibrate_waved
 
-        def load(path: Path):
-            return _load(path, specimen or {}, specimen_file, (columns, units, flags),
-                         delimiter, decimal)
+        def load(path: Path):  # the force itself, as the prediction gives it
+            return _load(path, {**(specimen or {}), "kind": WAVED}, specimen_file,
+                         (columns, units, flags), delimiter, decimal)
 
         return calibrate_waved(files, load, material=material, sidecar=Path(specimen_file),
                                options=opt, conditions=conditions)
@@ -195,9 +197,13 @@ def calibrate(paths: Sequence[str | Path], *, material: str, options: FitOptions
     return _summarise(cal)
 
 
-def _sidecar_kind(path: str | Path) -> str | None:
-    """The `kind` a sidecar names (None when it names none)."""
-    return read_sidecar(Path(path)).get("kind")
+def _predicted(path: str | Path) -> bool:
+    """Whether the sidecar at `path` carries a prediction its exports are fitted against: a
+    waved piece's (kind waved) or a square test panel's (kind panel with a [prediction])."""
+    from printgen.calibrate.waved import predicted_panel
+
+    return read_sidecar(Path(path)).get("kind") == WAVED or predicted_panel(
+        load_toml(Path(path), "specimen sidecar"))
 
 
 def _strength_sample(rec, spec) -> StrengthSample:

@@ -79,19 +79,26 @@ def plot_waved(cal: WaveCalibration, path: str | Path) -> Path:
     fig, ax = plt.subplots(figsize=(8, 5), constrained_layout=True)
     m = cal.model
     e = np.linspace(0.0, max(s.strain_max for s in cal.samples), 200)
-    pred = m.strands * m.curve().law().force_and_tangent(e)[0]
+    pred = m.predict(e)  # the coupon's force, or a panel's force per clamp width
+    model = "simulated panel test" if m.panel else "beam model"
     for i, s in enumerate(cal.samples):
         ax.plot(s.x * 100, s.force, color=f"C{i % 10}", lw=1,
                 label=printable(Path(s.path.split(":")[-1]).name))
-    ax.plot(e * 100, pred, "k--", lw=1.5, label="beam model, material law as assumed")
+    ax.plot(e * 100, pred, "k--", lw=1.5, label=f"{model}, material law as assumed")
     ax.plot(e * 100, cal.scale.mean * pred, "k-", lw=1.5,
-            label=f"beam model, law x {cal.scale.mean:.3g} (fitted)")
+            label=f"{model}, law x {cal.scale.mean:.3g} (fitted)")
     (km, kp) = cal.knees()
     ax.axvline(km.mean * 100, color="C3", ls=":", label=f"knee measured {km.mean:.2%}")
     ax.axvline(kp.mean * 100, color="0.4", ls=":", label=f"knee predicted {kp.mean:.2%}")
-    ax.set_xlabel("chord strain (%)")
-    ax.set_ylabel(f"force, {m.strands} strands (N)")
-    ax.set_title(f"{cal.material}: waved coupons against the beam model")
+    if m.panel:
+        ax.set_xlabel("panel strain (%)")
+        ax.set_ylabel("force per clamp width (N/m)")
+        ax.set_title(f"{cal.material}: {'square' if m.straight else 'waved'} test panels "
+                     "against their simulated test")
+    else:
+        ax.set_xlabel("chord strain (%)")
+        ax.set_ylabel(f"force, {m.strands} strands (N)")
+        ax.set_title(f"{cal.material}: waved coupons against the beam model")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="upper left")
     buf = io.BytesIO()

@@ -2,7 +2,8 @@
 
 Kinds: `cable` (printed strand, width x thickness), `dogbone` (narrow section width x thickness),
 `panel` (net panel: width across and length along the load); a sidecar may also name `waved`
-(a waved-strand coupon, `printgen.calibrate.waved`, with its `[wave]` table). Sidecar:
+(a waved-strand coupon, `printgen.calibrate.waved`, with its `[wave]` table), and a square test
+panel's sidecar a `[prediction]` table (its simulated test, fitted the same way). Sidecar:
 `<export>.toml` beside the export, or `specimen.toml` in its folder, or the file given with
 --specimen; keys are the fields of `SIDECAR` (mm), plus optional `[columns]` and `[units]`
 tables (role -> name/unit) and a `[flags]` table (status column -> active-high, active-low or
@@ -37,6 +38,8 @@ SIDECAR = [
     Field("units", dict, required=False, default={}),
     Field("flags", dict, required=False, default={}),
     Field("wave", dict, required=False, default={}),
+    Field("prediction", dict, required=False, default={}),  # a square test panel's simulated
+    # test (`printgen.calibrate.waved`: fitted as the waved pieces are)
 ]
 DIMENSIONS = ("width", "thickness", "area", "gauge_length", "grip_distance")
 # Metadata key patterns (lower case) per dimension; the first match wins.

@@ -21,6 +21,11 @@ slopes of each; their knees and the ratio of their slopes do not depend on s (th
 geometry sets them). The fit reaches the largest strain predicted (the coupon: the strain the
 design's strand law is solved to, `curved.curve_strains`, the range the net solver uses the
 curve over); the data beyond it are left out (said in the warnings).
+
+A square net's straight test panel (sidecar kind "panel" with a `[prediction]` table, from
+`printgen testpieces` of a straight square design) is fitted the same way: its strands along
+the load lie along it from the start, so its simulated free test is linear in the law's scale
+too (no wave: the prediction is the straight strands' law through the panel test).
 """
 
 from __future__ import annotations
@@ -53,6 +58,15 @@ WAVE = [
     Field("test", str, choices=("coupon", "panel"), required=False, default="coupon"),
     Field("panel_strains", list, items=float, required=False, default=[]),
     Field("panel_n_per_m", list, items=float, required=False, default=[]),
+    Field("panel_hold_share", float, lo=0.0, required=False, default=0.0),
+]
+PREDICTION = "prediction"  # a straight square panel's table: its simulated free test
+PANEL_PREDICTION = [
+    Field("material", str), Field("law_source", str, required=False, default=""),
+    Field("stress_knees", list, items=float), Field("stress_slopes_mpa", list, items=float),
+    Field("strands", int, lo=1), positive("strand_width_mm", 1e3, si=False),
+    positive("thickness_mm", 1e3, si=False), positive("mesh_mm", 1e4, si=False),
+    Field("panel_strains", list, items=float), Field("panel_n_per_m", list, items=float),
     Field("panel_hold_share", float, lo=0.0, required=False, default=0.0),
 ]
 MECHANISM = 0.5  # a free panel whose simulated clamp force the solver's hold carries more
@@ -88,6 +102,11 @@ class WaveModel:
     @property
     def panel(self) -> bool:
         return bool(self.panel_strains)
+
+    @property
+    def straight(self) -> bool:
+        """A straight square panel's model (no wave: `_straight_panel`)."""
+        return self.amplitude == 0
 
     @property
     def unit(self) -> str:
@@ -129,6 +148,8 @@ def read_wave(path: str | Path) -> WaveModel:
     """The `[wave]` table of the sidecar at `path` as a WaveModel; CalibrationError naming
     what is missing or wrong."""
     data = load_toml(path, "specimen sidecar")
+    if predicted_panel(data):
+        return _straight_panel(data, path)
     if data.get("kind") != KIND:
         raise CalibrationError(f"{path}: kind {data.get('kind')!r}; a waved coupon's sidecar "
                                f"has kind = \"{KIND}\" (printgen testpieces writes it)")
@@ -137,17 +158,40 @@ def read_wave(path: str | Path) -> WaveModel:
                                "the beam model of its strands, whose inputs the [wave] table "
                                "gives: use the sidecar printgen testpieces wrote")
     t = read_table(data["wave"], WAVE, where=f"{path} [wave]")
+    model = WaveModel(t["chord_mm"] * 1e-3, t["amplitude_mm"] * 1e-3, t["half_waves"],
+                      t["strands"], t["strand_width_mm"] * 1e-3, t["thickness_mm"] * 1e-3,
+                      _stress_law(t, f"{path} [wave]"), t["material"], t["law_source"])
+    return model if t["test"] == "coupon" else _panel(model, t, data, path)
+
+
+def predicted_panel(data: dict[str, Any]) -> bool:
+    """Whether sidecar `data` is a straight square panel's (kind "panel" with a
+    `[prediction]` table), fitted as the waved pieces are."""
+    return data.get("kind") == "panel" and PREDICTION in data
+
+
+def _straight_panel(data: dict[str, Any], path: str | Path) -> WaveModel:
+    """The straight square panel of sidecar `data`'s `[prediction]` table as a WaveModel
+    without a wave (amplitude 0: its chord is the mesh side)."""
+    where = f"{path} [{PREDICTION}]"
+    t = read_table(data[PREDICTION], PANEL_PREDICTION, where=where)
+    model = WaveModel(t["mesh_mm"] * 1e-3, 0.0, 0, t["strands"], t["strand_width_mm"] * 1e-3,
+                      t["thickness_mm"] * 1e-3, _stress_law(t, where), t["material"],
+                      t["law_source"])
+    return _panel(model, t, data, path)
+
+
+def _stress_law(t: dict[str, Any], where: str) -> Law:
+    """The stress law (Pa per unit strain) of a read table's stress_knees and
+    stress_slopes_mpa; CalibrationError naming `where` unless it is a law."""
     knees, slopes = tuple(t["stress_knees"]), tuple(v * 1e6 for v in t["stress_slopes_mpa"])
     if len(slopes) != len(knees) + 1 or not all(v > 0 for v in slopes) \
             or any(b <= a for a, b in zip((0.0, *knees), knees, strict=False)):
         raise CalibrationError(
-            f"{path} [wave]: stress law knees {list(knees)} and slopes "
+            f"{where}: stress law knees {list(knees)} and slopes "
             f"{list(t['stress_slopes_mpa'])} MPa: need increasing knees above 0 and one more "
             "slope than knees, every slope > 0")
-    model = WaveModel(t["chord_mm"] * 1e-3, t["amplitude_mm"] * 1e-3, t["half_waves"],
-                      t["strands"], t["strand_width_mm"] * 1e-3, t["thickness_mm"] * 1e-3,
-                      Law(knees, slopes), t["material"], t["law_source"])
-    return model if t["test"] == "coupon" else _panel(model, t, data, path)
+    return Law(knees, slopes)
 
 
 def _panel(model: WaveModel, t: dict[str, Any], data: dict[str, Any],
@@ -264,6 +308,16 @@ class WaveCalibration(Shown):
     def assumptions(self) -> tuple[str, str]:
         """(what was measured, what was assumed)."""
         m = self.model
+        if m.straight:
+            return ((f"the scale of {m.material}'s stress law through the square panel's "
+                     f"simulated free test (x {self.scale.mean:.4g}: initial modulus "
+                     f"{self.modulus / 1e6:.4g} MPa)"),
+                    (f"{m.strands} straight strands along the load between the clamps (mesh "
+                     f"side {m.chord * 1e3:g} mm, clamps {m.panel_width * 1e3:.4g} mm wide), "
+                     "each strained as the panel, the strands across carrying nothing; the "
+                     f"section {m.width * 1e3:g} x {m.thickness * 1e3:.4g} mm, the junctions "
+                     f"taken as strand, the shape of the material law "
+                     f"({m.law_source or m.material})"))
         piece = (f"the panel's simulated free test (the net's strands pulling with the beam "
                  f"model's curve, pin-jointed, clamps {m.panel_width * 1e3:.4g} mm wide)"
                  if m.panel else f"{m.strands} strands, ends clamped by the gripped tabs")
@@ -289,13 +343,15 @@ class WaveCalibration(Shown):
                                              "the largest force (worst file)"),
                 ("measured", measured), ("assumed", assumed)]
         rows += [("warning", w) for w in self.warnings]
-        piece = "panel" if self.model.panel else "coupon"
-        return Summary(f"Waved-{piece} calibration: {self.material}", tuple(rows))
+        piece = ("Square-panel" if self.model.straight else
+                 "Waved-panel" if self.model.panel else "Waved-coupon")
+        return Summary(f"{piece} calibration: {self.material}", tuple(rows))
 
     def to_record(self) -> dict[str, Any]:
         (km, kp), (rm, rp) = self.knees(), self.ratios()
         measured, assumed = self.assumptions()
-        return {"material": self.material, "kind": KIND, "files": list(self.files),
+        return {"material": self.material, "kind": "panel" if self.model.straight else KIND,
+                "files": list(self.files),
                 "piece": "panel" if self.model.panel else "coupon", "unit": self.model.unit,
                 "law_scale": {"mean": self.scale.mean, "sd": self.scale.sd, "n": self.scale.n},
                 "modulus_mpa": self.modulus / 1e6,
@@ -335,7 +391,7 @@ def calibrate_waved(files: list[tuple[Path, Any]], load, *, material: str, sidec
 def _with_warnings(cal: WaveCalibration) -> WaveCalibration:
     warns = list(cal.scale.warnings)
     km, kp = cal.knees()
-    if abs(km.mean / kp.mean - 1) > KNEE_TOL:
+    if _has_knee(cal.model) and abs(km.mean / kp.mean - 1) > KNEE_TOL:
         warns.append(f"the measured knee ({km.mean:.2%} chord strain) is "
                      f"{km.mean / kp.mean - 1:+.0%} off the beam model's ({kp.mean:.2%}), beyond "
                      f"{KNEE_TOL:.0%}: the printed wave is not the designed one (measure its "
@@ -356,6 +412,12 @@ def _with_warnings(cal: WaveCalibration) -> WaveCalibration:
                            tuple(dict.fromkeys(warns)))
 
 
+def _has_knee(m: WaveModel) -> bool:
+    """Whether the model's curve has a knee to check: a wave's, or a straight panel's law's
+    within the strains it predicts (a straight line's bilinear knee is noise)."""
+    return not m.straight or any(k < m.top() for k in m.stress.knees)
+
+
 def measured_wave_tables(cal: WaveCalibration, prov: dict[str, Any]) -> dict[str, dict]:
     """The `[measured.*]` tables (file units) the fit gives: the assumed material's law scaled
     by s, as the law the verification reads. A material with a measured panel law: that law
@@ -366,8 +428,9 @@ def measured_wave_tables(cal: WaveCalibration, prov: dict[str, Any]) -> dict[str
 
     s, mat = cal.scale, load_material(cal.model.material)
     measured, assumed = cal.assumptions()
-    how = (f"waved-strand coupons through the printgen beam model: measured {measured}; "
-           f"assumed {assumed}")
+    piece = ("a square net's test panel through its simulated test" if cal.model.straight
+             else "waved-strand coupons through the printgen beam model")
+    how = f"{piece}: measured {measured}; assumed {assumed}"
     prov = {**prov, "conditions": f"{prov.get('conditions', '')}; {how}".lstrip("; ")}
     pl = mat.panel_law
     if pl is None:

@@ -1,7 +1,7 @@
 """`printgen testpieces DESIGN [--orientation short|long] [--out DIR] [--force] [--json]`: the
-tensile coupons and the net test panel to print and test before the barrier, and for a design
-with waved strands the waved-strand coupon and its predicted curve (printgen.run.testpieces),
-written atomically into DIR (default `out/<design>-testpieces`)."""
+tensile coupons and the net test panel (a diamond's or a square's) to print and test before the
+barrier, and for a design with waved strands the waved-strand coupon and its predicted curve
+(printgen.run.testpieces), written atomically into DIR (default `out/<design>-testpieces`)."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("design", type=Path, help="a design.json (printgen design or make)")
     p.add_argument("--orientation", choices=("short", "long"), default="short",
                    help="panel: mesh diagonal along the load (default short, as the paper's "
-                        "panels)")
+                        "panels); a square net's panel is pulled along its strands either way")
     p.add_argument("--out", "-o", type=Path, help="output directory")
     p.add_argument("--force", action="store_true",
                    help="replace --out even when it holds files printgen did not write")

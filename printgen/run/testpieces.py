@@ -6,7 +6,8 @@ and passes, and a net test panel of its mesh, each as STL, 3MF, PrusaSlicer .ini
 G-code (read back against the toolpath), the sidecar each test's exports need in
 `printgen calibrate` (`<piece>.specimen.toml`, the keys of `printgen.calibrate.specimen`), and
 the panel's expected force-strain curve from the virtual panel test
-(`printgen.scene.panel`, free sides, as printed panels are tested). The loop:
+(`printgen.scene.panel`, free sides, as printed panels are tested); a square net's panel,
+pulled along its strands, with its own curve and sidecar (`printgen.run.squarepieces`). The loop:
 print pieces -> test -> calibrate -> verify -> print the barrier (LOOP).
 """
 
@@ -66,10 +67,13 @@ def testpieces(design_path: str | Path, out: str | Path, *, orientation: str = "
                "coupon": _coupon_files(stage, coupon, printer),
                "panel": _panel_files(stage, piece, printer),
                "loop": [s.format(n=COUPON_COUNT, mat=d.net.material) for s in LOOP]}
-        rec["panel"]["expected_curve"] = _expected(stage, dp, blocked)
         rec["panel"]["geometry"] = piece.to_record()
         rec["coupon"]["geometry"] = _coupon_geometry(coupon)
-        if d.net.wave is not None:
+        if blocked is None:  # a square net's panel (`printgen.run.squarepieces`)
+            _square_files(stage, d, dp, piece, printer, rec)
+        else:
+            rec["panel"]["expected_curve"] = _expected(stage, dp, blocked)
+        if d.net.wave is not None and blocked is not None:
             from printgen.run.wavepieces import CALIBRATE, wave_coupon_files, wave_panel_sidecar
 
             rec["wave_coupon"] = wave_coupon_files(stage, d, printer)
@@ -92,11 +96,16 @@ def material_source(mat) -> str:
 def _panel(d: Design, orientation: str):
     """The simulated free and blocked tests of the design's panel and the printed piece; a
     waved net's panel is tested with its strands' beam-model law (`scene.panel.curved_panel`),
-    sized as that test."""
+    sized as that test. A square net's: its free test only (None for the blocked one: the
+    strands across carry nothing, so it is the same), sized as `squarepieces` argues."""
     from printgen.scene.panel import curved_panel, design_panel, lattice_size
 
     w = d.net.wave
-    if w is None:
+    if d.net.pattern == "square":
+        from printgen.run.squarepieces import square_panel
+
+        dp, blocked = square_panel(d, orientation), None
+    elif w is None:
         dp = design_panel(d, orientation, "free")
         blocked = design_panel(d, orientation, "blocked")
     else:
@@ -104,6 +113,22 @@ def _panel(d: Design, orientation: str):
                        for mode in ("free", "blocked"))
     length, width = lattice_size(dp.test)
     return dp, blocked, panel_for(d, orientation, length / MM, width / MM)
+
+
+def _square_files(stage: Path, d: Design, dp, piece: PanelPiece, printer,
+                  rec: dict[str, Any]) -> None:
+    """The square panel's expected curve, sidecar and loop step (`run.squarepieces`), and a
+    waved square net's waved coupon, into `rec`."""
+    from printgen.run.squarepieces import square_calibrate, square_expected, square_sidecar
+
+    rec["panel"]["expected_curve"] = square_expected(stage, dp)
+    rec["panel"]["strands"] = dp.strands
+    rec["panel"]["sidecar"] = square_sidecar(stage, d, dp, piece)
+    if d.net.wave is not None:
+        from printgen.run.wavepieces import wave_coupon_files
+
+        rec["wave_coupon"] = wave_coupon_files(stage, d, printer)
+    rec["loop"][2] = square_calibrate(d)
 
 
 def _coupon_geometry(c) -> dict[str, Any]:
@@ -215,7 +240,7 @@ def _expected(stage: Path, dp, blocked) -> dict[str, Any]:
 
 def readme_text(rec: dict[str, Any], panel_test: str) -> str:
     """README.md of the folder: what each piece is, how to test it, the loop."""
-    c, p = rec["coupon"]["geometry"], rec["panel"]["geometry"]
+    c = rec["coupon"]["geometry"]
     lines = [f"# Test pieces for {rec['design_file']} ({rec['material']})", ""]
     if rec["material_source"] == "datasheet":
         lines += [(f"The net's material {rec['material']} rests on datasheet values: print the "
@@ -228,6 +253,19 @@ def readme_text(rec: dict[str, Any], panel_test: str) -> str:
         f"eyelet rings, pin hole {c['pin_hole_mm']:.4g} mm, outer {c['eyelet_outer_mm']:.4g} mm "
         f"({c['ring_width_each_side_mm']:.4g} mm each side = {c['ring_factor']} strand widths), "
         f"pin centres {c['pin_distance_mm']:.4g} mm apart: load it on two pins."), "",
+        *_panel_section(rec, panel_test), *_wave_section(rec), "## The loop", *rec["loop"], ""]
+    return "\n".join(lines)
+
+
+def _panel_section(rec: dict[str, Any], panel_test: str) -> list[str]:
+    """The README's test-panel section: a square net's (`run.squarepieces`), else the
+    diamond's."""
+    p = rec["panel"]["geometry"]
+    if p["orientation"] == "strands":
+        from printgen.run.squarepieces import square_readme
+
+        return square_readme(rec, panel_test)
+    return [
         "## Net test panel (print 1 or more)",
         (f"Loaded along the {p['orientation']} diagonal (mesh {p['mesh_along_load_mm']:.4g} mm "
         f"along x {p['mesh_across_load_mm']:.4g} mm across). Printed {p['printed_mm'][0]:.4g} x "
@@ -238,9 +276,7 @@ def readme_text(rec: dict[str, Any], panel_test: str) -> str:
         (f"Expected curve (panel-expected.csv): the virtual panel test, {panel_test}; "
         "columns free (sides free, as tested) and blocked (every strand stretched alike, the "
         "barrier's membrane law: the upper bound)."), *_strands_note(rec),
-        *_mechanism_note(rec), "",
-        *_wave_section(rec), "## The loop", *rec["loop"], ""]
-    return "\n".join(lines)
+        *_mechanism_note(rec), ""]
 
 
 def _strands_note(rec: dict[str, Any]) -> list[str]:

@@ -139,10 +139,12 @@ def _sidecar(stage: Path, c: WavedCoupon, curve: StrandCurve, how: str) -> dict[
     return {**keys, "wave": wave}
 
 
-def wave_panel_sidecar(stage: Path, d: Design, dp, piece) -> dict[str, Any]:
+def wave_panel_sidecar(stage: Path, d: Design, dp, piece,
+                       note: str = "(panel-expected.csv's free column)") -> dict[str, Any]:
     """panel.specimen.toml of a waved design's test panel `piece`: kind "waved", its clamps,
     and the [wave] table of the beam model's inputs with the simulated free test `dp` (what
-    `printgen calibrate` fits the material law's scale to)."""
+    `printgen calibrate` fits the material law's scale to); `note` says which column of
+    panel-expected.csv that test is."""
     curve, _, how = wave_prediction(d)
     keys = {"kind": "waved", "width_mm": piece.width_mm, "gauge_length_mm": piece.length_mm,
             "grip_distance_mm": piece.length_mm}
@@ -151,8 +153,7 @@ def wave_panel_sidecar(stage: Path, d: Design, dp, piece) -> dict[str, Any]:
             "panel_n_per_m": [float(n) for n in dp.curve.force_per_width],
             "panel_hold_share": float(dp.curve.hold_share)}
     _write_sidecar(stage, "panel", keys, wave, "width: across the load at the clamp edges; "
-                   "length: clamp edge to clamp edge; panel_*: the simulated free test "
-                   "(panel-expected.csv's free column)")
+                   f"length: clamp edge to clamp edge; panel_*: the simulated free test {note}")
     return {**keys, "wave": wave}
 
 
@@ -167,13 +168,16 @@ def _beam_inputs(curve: StrandCurve, how: str, material: str) -> dict[str, Any]:
 
 
 def _write_sidecar(stage: Path, name: str, keys: dict[str, Any], wave: dict[str, Any],
-                   note: str) -> None:
+                   note: str, table: str = "wave",
+                   what: str = "the beam model's inputs") -> None:
+    """`<name>.specimen.toml`: the specimen `keys` and the `[table]` of the prediction's
+    inputs `wave` (`what` they are)."""
     lines = [(f"# printgen testpieces: the {name}'s sidecar for printgen calibrate "
               f"(--specimen {name}.specimen.toml)"),
-             f"# {note}; [wave]: the beam model's inputs and the material law the prediction "
+             f"# {note}; [{table}]: {what} and the material law the prediction "
              "assumed (stress knees, slopes in MPa)"]
     lines += [_toml_line(k, v) for k, v in keys.items()]
-    lines += ["", "[wave]", *(_toml_line(k, v) for k, v in wave.items())]
+    lines += ["", f"[{table}]", *(_toml_line(k, v) for k, v in wave.items())]
     (stage / f"{name}.specimen.toml").write_text("\n".join(lines) + "\n")
 
 

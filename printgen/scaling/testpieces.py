@@ -14,7 +14,8 @@ Panel: the design's diamond mesh, loaded along one diagonal, sized as the virtua
 (`printgen.scene.panel`): clamp edges on two node rows `length` apart and `width`
 across (whole half-meshes), with one more mesh row beyond each clamp edge for the clamp
 faces to hold and the net's border frame around it. The two side bars of the frame are cut
-before the test (the virtual panel's sides are free).
+before the test (the virtual panel's sides are free). A square mesh has no diagonal to choose:
+its panel is pulled along one strand family, sized as `printgen.run.squarepieces` argues.
 """
 
 from __future__ import annotations
@@ -37,7 +38,8 @@ class PanelPiece:
     """The printed test panel: its net, the clamp layout and the orientation (mm)."""
 
     net: NetDesign
-    orientation: str  # the mesh diagonal along the load ("short" or "long")
+    orientation: str  # the mesh diagonal along the load ("short" or "long"; a square net's
+    # panel: "strands", pulled along one strand family)
     length_mm: float  # clamp edge to clamp edge, along the load
     width_mm: float  # across the load
     clamp_depth_mm: float  # net held in each clamp beyond its edge (one mesh row)
@@ -66,7 +68,8 @@ def coupon_gauge_mm(c: CableDesign) -> float:
 
 
 def panel_for(d: Design, orientation: str, length_mm: float, width_mm: float) -> PanelPiece:
-    """The test panel of design `d`'s mesh loaded along its `orientation` diagonal, with
+    """The test panel of design `d`'s mesh loaded along its `orientation` diagonal (a square
+    mesh's: along its strands up the panel), with
     clamp edges `length_mm` apart and `width_mm` across (the virtual test's lattice size:
     whole half-meshes)."""
     n = d.net
@@ -82,4 +85,7 @@ def panel_for(d: Design, orientation: str, length_mm: float, width_mm: float) ->
     depth = along  # one whole mesh beyond each clamp edge: node rows stay on the lattice
     net = replace(n, width_mm=width_mm, height_mm=length_mm + 2 * depth,
                   mesh_x_mm=across, mesh_y_mm=along)
-    return PanelPiece(net, orientation, length_mm, width_mm, depth)
+    # a square mesh has no diagonal to choose: its panel is pulled along the strands that run
+    # up the printed panel (its strands across are the same section laid the same way)
+    shown = "strands" if n.pattern == "square" else orientation
+    return PanelPiece(net, shown, length_mm, width_mm, depth)

@@ -60,7 +60,7 @@ from printgen.units import MM
 __all__ = ["HOLD_RATIO", "MODES", "PANEL_TOL", "STRAIN_POINTS", "STRAIN_STEP", "PanelCurve",
            "PanelTest", "analytic_blocked", "lattice_size", "law_strains", "panel_lockup",
            "simulate", "derive_law", "design_panel", "DerivedLaw", "DesignPanel",
-           "refined_knees"]
+           "refined_knees", "square_panel_size", "loaded_strands"]
 
 DERIVE_STEPS = 8  # fixed-point passes of the strand-law derivation (each re-solves the test)
 DERIVE_TOL = 1e-3  # ... stopped once the slopes move by less than 0.1 % in a pass
@@ -188,12 +188,14 @@ def design_panel(d: Design, orientation: str, mode: str = "free",
 
 
 def curved_panel(d: Design, orientation: str, amplitude_mm: float, half_waves: int,
-                 mode: str = "blocked", points: int = STRAIN_POINTS) -> DesignPanel:
+                 mode: str = "blocked", points: int = STRAIN_POINTS,
+                 size: tuple[float, float] | None = None) -> DesignPanel:
     """The simulated panel test of design `d`'s net printed with curved strands (its layout,
     section and material; the wave's `amplitude_mm` and `half_waves` between junctions,
     `printgen.barrier.patterns.curved`), loaded along its `orientation` diagonal, with the
     net law its strand curves give (the blocked, infinite net) to compare with. The panel is
-    PRINTED_PANEL long, or longer to hold two meshes; its strains reach 1.5 x the knee."""
+    PRINTED_PANEL long, or longer to hold two meshes (`size`: length, clamp width m, when
+    given); its strains reach 1.5 x the knee."""
     from printgen.barrier.patterns.curved import (
         blocked_membrane,
         check_wave,
@@ -210,7 +212,8 @@ def curved_panel(d: Design, orientation: str, amplitude_mm: float, half_waves: i
                       f"the design's straight strands' law ({how}) per unit area")
     check_wave(n.pattern, s, n.mesh_x_mm, n.mesh_y_mm, "--wave")
     along, across = panel_axes(n.mesh_x_mm * MM, n.mesh_y_mm * MM, orientation)
-    size = (max(PRINTED_PANEL[0], 2 * along), max(PRINTED_PANEL[1], 2 * across))
+    if size is None:
+        size = (max(PRINTED_PANEL[0], 2 * along), max(PRINTED_PANEL[1], 2 * across))
     t = PanelTest(along, across, size[0], size[1], mode, n.pattern)
     law = strand_law(n.pattern, s, along, across)
     m = membrane_law(n.pattern, s, along, across)
@@ -234,3 +237,33 @@ def edge_share(t: PanelTest) -> float:
         return 1.0
     nx = round(lattice_size(t)[1] / t.mesh_across)
     return (nx + 1) / nx
+
+
+# The square test panel, pulled along one strand family with its sides free: the strands along
+# the load carry it, each strained as the panel (they lie along the load from the start: no
+# mechanism, `panel_lockup` 0), the strands across carry nothing (their ends move alike). So
+# the pin-jointed panel has no edge zone; the printed one has two: the outer loaded strands
+# (beside the cut side bars, with the stubs of the across strands) and the strands' ends at
+# the clamps (clamp slip and the junction row held in the jaws move the crosshead without
+# straining the gauge). Its size keeps both small against the whole:
+SQUARE_MIN_STRANDS = 8  # loaded strands between the cut side bars: an outer pair off by
+# 20 % (a stub, a bead that ends) moves the panel's force 2 x 0.2 / 8 = 5 %
+SQUARE_MIN_MESHES = 4  # meshes between the clamps: the row at each clamp edge, held by the
+# jaws, is at most 1 / 4 of the gauge's junctions; and at least the paper's printed 43 mm
+
+
+def square_panel_size(mesh: float) -> tuple[float, float]:
+    """(length along the load, clamp width) m of the square test panel of mesh side `mesh`
+    m: SQUARE_MIN_MESHES meshes long and SQUARE_MIN_STRANDS + 1 meshes wide (the loaded
+    strands between the side bars), at least PRINTED_PANEL."""
+    return (max(PRINTED_PANEL[0], SQUARE_MIN_MESHES * mesh),
+            max(PRINTED_PANEL[1], (SQUARE_MIN_STRANDS + 1) * mesh))
+
+
+def loaded_strands(t: PanelTest) -> tuple[int, int]:
+    """(loaded strands of the printed square panel once its two side bars are cut, those of
+    the simulated panel): nx - 1 and nx + 1 for nx meshes across (the simulation's edge
+    columns are strands, `edge_share`). Every loaded strand carries the same force, so the
+    printed panel's force is the simulated one times their ratio."""
+    nx = round(lattice_size(t)[1] / t.mesh_across)
+    return nx - 1, nx + 1

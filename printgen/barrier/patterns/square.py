@@ -88,4 +88,4 @@ def square_graph(width_mm: float, height_mm: float, mesh_x_mm: float,
 
 PATTERN = NetPattern("square", square_graph, membrane_factor, strand_law, strand_force,
                      span, square_nodes, edge_strands=True, mesh_name="mesh side",
-                     check_mesh=check_square, panel_test=False)
+                     check_mesh=check_square, panel_test=True)
