@@ -251,6 +251,7 @@ def test_cli_saves_the_scaled_law_and_refuses_bad_input_with_exit_2(tmp_path, ca
     # wrong parent, missing [wave]: exit 2, nothing written
     assert main(["calibrate", *exports, "--material", "petg-lab2", "--inherits", "tpe",
                  "--specimen", str(side), "--out", str(out)]) == 2
+    assert "the waved coupon's fit scales" in capsys.readouterr().err  # names the piece
     bad = _sidecar(tmp_path / "bad.toml", wave=False)
     assert main(["calibrate", *exports, "--material", "petg-lab3", "--inherits", "petg",
                  "--specimen", str(bad), "--out", str(out)]) == 2

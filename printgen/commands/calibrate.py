@@ -188,6 +188,13 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _piece(model) -> str:
+    """What a law-scale fit's sidecar describes, as its errors name it."""
+    if model.straight:
+        return "test panel"
+    return "waved test panel" if model.panel else "waved coupon"
+
+
 def _waved(cal, args: argparse.Namespace) -> int:
     """Save, plot and show a waved-coupon calibration (`printgen.calibrate.waved`)."""
     written: dict[str, object] = {}
@@ -196,7 +203,7 @@ def _waved(cal, args: argparse.Namespace) -> int:
 
         if args.inherits is not None and args.inherits.lower() != cal.model.material.lower():
             raise CalibrationError(
-                f"--inherits {args.inherits}: the waved coupon's fit scales "
+                f"--inherits {args.inherits}: the {_piece(cal.model)}'s fit scales "
                 f"{cal.model.material}'s law (the law its prediction assumed); give --inherits "
                 f"{cal.model.material}")
         path, mat = write_profile(cal, name=args.material, out=args.out,
