@@ -11,6 +11,7 @@ locked, with its manifest):
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -33,13 +34,16 @@ from printgen.scene.scenes import SENSOR_FORCE_N
 from printgen.verification.series import (
     LEVEL,
     LEVEL_STEP,
+    PROTOTYPE,
     CaseResult,
     NetOptions,
     SeriesShared,
     base_scene,
     cases,
     check_scales,
+    prototype_states,
     rows_for,
+    same_case,
     solve_case,
 )
 from printgen.verification.series_table import Series, summarise
@@ -99,7 +103,7 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
         + ("" if serial else ", starting the workers"))
     with open_runner(scheduler=scheduler, workers=workers, serial=serial,
                      progress=bar) as runner:
-        results = runner.map(solve_case, todo, shared=shared, label="series cases")
+        results = solve_cases(runner, shared, todo)
         where = runner.where
     scene = "simple-free-top" if not base.cables else f"border cables, {base.mounting}"
     s = summarise(shared, lams, results, scene)
@@ -115,6 +119,22 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
                                  provenance_record(options.command, prototype=p.path),
                                  {"total": time.perf_counter() - t0})
     return run
+
+
+def solve_cases(runner, shared: SeriesShared, todo: list[tuple[str, float]]
+                ) -> list[CaseResult]:
+    """Every case of `todo`, in its order: the prototype first, here (the other cases start
+    from its states), then the others on `runner`, each case whose scene is another's
+    (`same_case`) taking that one's result under its own row."""
+    proto, states = prototype_states(shared)
+    warm = dataclasses.replace(shared, start=states)
+    own = [c for c in todo if c != PROTOTYPE and same_case(shared, c) is None]
+    done = dict(zip(own, runner.map(solve_case, own, shared=warm, label="series cases"),
+                    strict=True))
+    done[PROTOTYPE] = proto
+    return [done[c] if c in done else
+            dataclasses.replace(done[same_case(shared, c) or c], row=c[0], scale=c[1])
+            for c in todo]
 
 
 def scene_assumptions(base, net: NetOptions) -> list[tuple[str, str, str]]:
