@@ -101,10 +101,12 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
     base = base_scene(shared)  # geometry errors now, not in a worker
     say(f"{len(todo)} cases ({len(rows)} rows x {len(lams)} scales)"
         + ("" if serial else ", starting the workers"))
+    t_cases = time.perf_counter()
     with open_runner(scheduler=scheduler, workers=workers, serial=serial,
                      progress=bar) as runner:
         results = solve_cases(runner, shared, todo)
         where = runner.where
+    t_cases = time.perf_counter() - t_cases
     scene = "simple-free-top" if not base.cables else f"border cables, {base.mounting}"
     s = summarise(shared, lams, results, scene)
     s.assumptions = [*scene_assumptions(base, shared.net), *scaling_assumptions(shared)]
@@ -117,7 +119,7 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
         say("writing the report")
         run.files = write_series(run, Path(out), force, inputs,
                                  provenance_record(options.command, prototype=p.path),
-                                 {"total": time.perf_counter() - t0})
+                                 {"cases": t_cases, "total": time.perf_counter() - t0})
     return run
 
 
