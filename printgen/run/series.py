@@ -31,6 +31,7 @@ from printgen.run.options import RunOptions
 from printgen.run.provenance import provenance_record
 from printgen.run.shown import series_summary
 from printgen.scene.scenes import SENSOR_FORCE_N
+from printgen.verification.preprint import levels
 from printgen.verification.series import (
     LEVEL,
     LEVEL_STEP,
@@ -96,8 +97,9 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
     if serial is None:
         serial = len(todo) < PARALLEL_FROM and scheduler is None and workers is None
     limit = DEFAULT_LIMIT_S if options.time_limit_s is None else options.time_limit_s
-    check_series_budget(p, len(todo), limit_s=limit,  # before the net is even built
-                        cores=run_cores(serial, workers))
+    estimate, _ = check_series_budget(  # before the net is even built
+        p, len(todo), limit_s=limit, cores=run_cores(serial, workers),
+        levels=len(levels(step=level_step, top=level)), similar=similar_cases(shared, todo))
     base = base_scene(shared)  # geometry errors now, not in a worker
     say(f"{len(todo)} cases ({len(rows)} rows x {len(lams)} scales)"
         + ("" if serial else ", starting the workers"))
@@ -119,8 +121,17 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
         say("writing the report")
         run.files = write_series(run, Path(out), force, inputs,
                                  provenance_record(options.command, prototype=p.path),
-                                 {"cases": t_cases, "total": time.perf_counter() - t0})
+                                 {"estimate": estimate, "cases": t_cases, "cases_count": len(todo),
+                                  "total": time.perf_counter() - t0})
     return run
+
+
+def similar_cases(shared: SeriesShared, todo: list[tuple[str, float]]) -> int:
+    """The cases that are the prototype scaled exactly (the similitude row: its answer is
+    the prototype's, scaled) or another case's scene (`same_case`): the estimate does not
+    count them. The sensors' wires on the models (1 N at every scale) break the similitude."""
+    return sum(1 for c in todo if c != PROTOTYPE and (
+        same_case(shared, c) is not None or (c[0] == "similitude" and not shared.net.sensors)))
 
 
 def solve_cases(runner, shared: SeriesShared, todo: list[tuple[str, float]]
