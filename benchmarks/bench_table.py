@@ -209,15 +209,13 @@ def run(out: Path, rows: list[str], repeat: int, name: str | None = None) -> dic
     return report
 
 
-def record(report: dict, path: Path | None = None) -> None:
-    """Merge the rows into measurements.json's ENTRY, then regenerate its pages."""
-    from benchmarks import measurements
-
-    path = path or measurements.DATA
-    data = json.loads(path.read_text("utf-8"))
+def merged(data: dict, report: dict) -> dict:
+    """measurements.json's `data` with the report's rows in its ENTRY: a row of the same
+    `row` and `label` replaced, the others kept in their order, the new ones after them; the
+    entry's conditions, the report's machine."""
     entry = next((e for e in data["measurements"] if e["id"] == ENTRY), None)
     if entry is None:
-        raise SystemExit(f"{path} has no entry {ENTRY!r}")
+        raise SystemExit(f"measurements.json has no entry {ENTRY!r}")
     new = {(r["row"], r["label"]) for r in report["rows"]}
     keep = [r for r in entry["rows"] if (r["row"], r.get("label")) not in new]
     entry["rows"] = keep + [{k: v for k, v in r.items() if k != "runs"} for r in report["rows"]]
@@ -225,7 +223,16 @@ def record(report: dict, path: Path | None = None) -> None:
     entry["conditions"] = {"machine": f"{m['cores']}-core {m['cpu']}",
                            "solver_backends": ", ".join(m["solver_backends"]),
                            "python": m["python"]}
-    path.write_text(json.dumps(data, indent=1, ensure_ascii=False) + "\n", "utf-8")
+    return data
+
+
+def record(report: dict) -> None:
+    """Merge the rows into measurements.json (`merged`), then regenerate its pages."""
+    from benchmarks import measurements
+
+    data = merged(json.loads(measurements.DATA.read_text("utf-8")), report)
+    measurements.DATA.write_text(json.dumps(data, indent=1, ensure_ascii=False) + "\n",
+                                 "utf-8")
     measurements.main([])
     subprocess.run([sys.executable, str(ROOT / "scripts" / "docs_pages.py")], cwd=ROOT,
                    check=True)

@@ -173,8 +173,8 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0,
     return Run(s, d, [r.iterations for r in results], time.perf_counter() - t0, failed, shapes,
                share, ",".join(sorted({r.backend for r in results})),
                int((~net.fixed_dofs).sum()), time.process_time() - cpu0,
-               {float(r.level): r.displacements for r in results if r.converged}
-               if keep_states else {})
+               {float(x): r.displacements for x, r in zip(lv, results, strict=False)
+                if r.converged} if keep_states else {})  # a path stopped early is shorter
 
 
 @dataclass(frozen=True, repr=False)
