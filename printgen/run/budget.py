@@ -432,16 +432,18 @@ def prototype_sweep_s(p: Prototype) -> float:
 
 
 def check_design_budget(p: Prototype, screened: int, verified: int, *, limit_s: float,
-                        cores: int, speed: float | None = None, prototypes: int = 1) -> float:
+                        cores: int, speed: float | None = None, prototypes: int = 1,
+                        levels: int = LEVELS) -> float:
     """Seconds a design search takes on `cores`: `screened` nets at SCREEN_RATE per second,
     `verified` solver verifications (a model sweep each, against the prototype's sweep made
-    once per scale: `prototypes`); InputError naming both, the limit and the fixes when it
-    passes `limit_s`, before any work."""
+    once per scale: `prototypes`), each sweep over `levels` load levels (--level-step);
+    InputError naming both, the limit and the fixes when it passes `limit_s`, before any
+    work."""
     from printgen.search.space import SCREEN_RATE
 
     speed = _checked(limit_s, speed)
     c = max(1, cores)
-    one = prototype_sweep_s(p)
+    one = prototype_sweep_s(p) * levels / LEVELS
     seconds = speed * (screened / SCREEN_RATE + verified * one * SEARCH_VERIFY_FACTOR
                        + prototypes * one) / c
     if seconds > limit_s:

@@ -166,8 +166,8 @@ def check_work(p: Prototype, spaces: dict[float, SearchSpace], o: SearchOptions,
                run: RunOptions) -> float:
     """The search's size against its time limit (`budget.check_design_budget`), before any
     work: every scale's nets screened, and with the deformation objective `verify_nets` of
-    them (with every border), select's pick and the chosen net's best waves verified.
-    Returns the estimate (s)."""
+    them (with every border), select's pick and the chosen net's best waves verified, each
+    over the search's load levels. Returns the estimate (s)."""
     screened = sum(math.prod(space_factors(sp, *meshes_of(sp, scale_targets(p, s))))
                    for s, sp in spaces.items())
     verified = sum(o.verify_nets * len(sp.border_beads) + 1 + WAVES_VERIFIED
@@ -175,8 +175,11 @@ def check_work(p: Prototype, spaces: dict[float, SearchSpace], o: SearchOptions,
         if o.objective == "deformation" else 0  # each net with every border, select's pick
     cores = run_cores(bool(run.serial), run.workers)
     limit = DESIGN_LIMIT_S if run.time_limit_s is None else run.time_limit_s
+    from printgen.verification.preprint import levels
+
+    lv = levels() if o.level_step is None else levels(step=o.level_step)
     return check_design_budget(p, screened, verified, limit_s=limit, cores=cores,
-                               prototypes=len(spaces) if verified else 0)
+                               prototypes=len(spaces) if verified else 0, levels=len(lv))
 
 
 def search_at_scales(prototype: str | Path | Prototype, scales: list[float], *,
