@@ -168,7 +168,7 @@ def test_time_limit_stop_is_one_line_on_stderr(tmp_path):
 
 def test_design_and_series_estimates_count_their_levels_and_cases():
     """The design search's sweeps over its --level-step's levels; the series' cases over its
-    levels, the prototype first and alone, the similar cases (E / lambda) not counted."""
+    levels, shared out on the cores, the similar cases (E / lambda) not counted."""
     from printgen.inputs.prototype import load_prototype
     from printgen.run.budget import SERIES_REPORT_S, check_design_budget, check_series_budget
 
@@ -177,7 +177,7 @@ def test_design_and_series_estimates_count_their_levels_and_cases():
     full = check_design_budget(p, 0, 10, limit_s=big, cores=1, speed=1.0)
     half = check_design_budget(p, 0, 10, limit_s=big, cores=1, speed=1.0, levels=12)
     assert half == pytest.approx(full * 12 / LEVELS)
-    one = check_series_budget(p, 2, limit_s=big, cores=1, speed=1.0, levels=5)[0]
-    case = one - SERIES_REPORT_S  # the prototype and one more case
+    case = check_series_budget(p, 1, limit_s=big, cores=1, speed=1.0, levels=5)[0] \
+        - SERIES_REPORT_S
     assert check_series_budget(p, 15, limit_s=big, cores=2, speed=1.0, levels=5, similar=4)[0] \
-        == pytest.approx(SERIES_REPORT_S + case / 2 * (1 + 5))  # 1 alone, then 10 on 2 cores
+        == pytest.approx(SERIES_REPORT_S + case * 6)  # 11 cases on 2 cores: 6 rounds

@@ -474,18 +474,17 @@ def check_series_budget(p: Prototype, cases: int, *, limit_s: float, cores: int,
                         speed: float | None = None, levels: int = LEVELS,
                         similar: int = 0) -> tuple[float, float]:
     """(seconds, bytes) a scale series of `cases` solves of the prototype's net takes on
-    `cores`: the prototype's case first, alone, then the others shared out on the cores, each
-    one sweep of `levels` levels (the model nets have the prototype's nodes at every scale) of
-    SERIES_STEP_FACTOR times a sweep's Newton iterations per level, but for the `similar`
-    cases (the prototype scaled exactly: they start from its answer and are not counted),
-    then SERIES_REPORT_S; InputError naming both, the limit and the fixes when it passes
-    `limit_s`, before any solve (a net too large is refused, not run out of memory)."""
+    `cores`: the cases shared out on the cores, each one sweep of `levels` levels (the model
+    nets have the prototype's nodes at every scale) of SERIES_STEP_FACTOR times a sweep's
+    Newton iterations per level, but for the `similar` cases (the prototype scaled exactly:
+    they start from its answer and are not counted), then SERIES_REPORT_S; InputError naming
+    both, the limit and the fixes when it passes `limit_s`, before any solve (a net too large
+    is refused, not run out of memory)."""
     speed = _checked(limit_s, speed)
     nodes = prototype_nodes(p)
     c = max(1, cores)
     one = prototype_sweep_s(p) * levels / LEVELS * SERIES_STEP_FACTOR
-    others = max(0, cases - 1 - similar)
-    seconds = speed * (one * (1 + math.ceil(others / c)) + SERIES_REPORT_S)
+    seconds = speed * (one * math.ceil(max(0, cases - similar) / c) + SERIES_REPORT_S)
     memory = c * (BASE_MEMORY_B + MEMORY_B_PER_NODE * nodes)
     if seconds > limit_s:
         _too_big(f"series is too big: {cases} cases of a {nodes:,}-node net, about "

@@ -42,10 +42,11 @@ from printgen.verification.series import (
     base_scene,
     cases,
     check_scales,
-    prototype_states,
     rows_for,
     same_case,
     solve_case,
+    solve_cold,
+    starts_cold,
 )
 from printgen.verification.series_table import Series, summarise
 
@@ -136,16 +137,20 @@ def similar_cases(shared: SeriesShared, todo: list[tuple[str, float]]) -> int:
 
 def solve_cases(runner, shared: SeriesShared, todo: list[tuple[str, float]]
                 ) -> list[CaseResult]:
-    """Every case of `todo`, in its order: the prototype first, here (the other cases start
-    from its states), then the others on `runner`, each case whose scene is another's
-    (`same_case`) taking that one's result under its own row."""
-    proto, states = prototype_states(shared)
-    warm = dataclasses.replace(shared, start=states)
-    own = sorted((c for c in todo if c != PROTOTYPE and same_case(shared, c) is None),
+    """Every case of `todo`, in its order, on `runner`: the prototype and the cases that
+    start cold (`starts_cold`) first, then the others from the prototype's states, each
+    round the longest case first; each case whose scene is another's (`same_case`) takes
+    that one's result under its own row."""
+    own = sorted((c for c in todo if same_case(shared, c) is None),
                  key=lambda c: _work_rank(shared, c))  # the longest first: an even finish
-    done = dict(zip(own, runner.map(solve_case, own, shared=warm, label="series cases"),
+    first = [c for c in own if starts_cold(shared, c)]
+    runs = dict(zip(first, runner.map(solve_cold, first, shared=shared, label="series cases"),
                     strict=True))
-    done[PROTOTYPE] = proto
+    warm = dataclasses.replace(shared, start=runs[PROTOTYPE][1])
+    rest = [c for c in own if c not in runs]
+    done = {c: r for c, (r, _) in runs.items()}
+    done.update(zip(rest, runner.map(solve_case, rest, shared=warm, label="series cases"),
+                    strict=True))
     return [done[c] if c in done else
             dataclasses.replace(done[same_case(shared, c) or c], row=c[0], scale=c[1])
             for c in todo]
