@@ -24,11 +24,11 @@ def best_of(fn, repeat: int):
 
 def machine() -> dict:
     """Where a benchmark ran: the CPU, its cores, the load average (1 min) at the start, the
-    Python and the solver's linear backends installed (`ldl`: qdldl; `pardiso`: MKL, the
-    optional extra), so that numbers from two machines or loads are not mixed up."""
+    Python and the solver's linear backends installed (each `linsolve.<name>_available()`
+    that is true, and SciPy's `lu`), so that numbers from two machines or loads are not mixed up."""
     import platform
 
-    from printgen.solver.linsolve import ldl_available, pardiso_available
+    from printgen.solver import linsolve
 
     cpu = platform.processor() or platform.machine()
     with contextlib.suppress(OSError):
@@ -36,8 +36,8 @@ def machine() -> dict:
             if line.startswith("model name"):
                 cpu = line.split(":", 1)[1].strip()
                 break
-    backends = [name for name, ok in (("ldl", ldl_available()),
-                                      ("pardiso", pardiso_available())) if ok] + ["lu"]
+    backends = [name.removesuffix("_available") for name in sorted(dir(linsolve))
+                if name.endswith("_available") and getattr(linsolve, name)()] + ["lu"]
     return {"cpu": cpu, "cores": os.cpu_count() or 1, "load_average": os.getloadavg()[0],
             "python": platform.python_version(), "solver_backends": backends}
 
