@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import subprocess
 import sys
@@ -19,6 +20,26 @@ def best_of(fn, repeat: int):
         out = fn()
         best = min(best, time.perf_counter() - t)
     return best, out
+
+
+def machine() -> dict:
+    """Where a benchmark ran: the CPU, its cores, the load average (1 min) at the start, the
+    Python and the solver's linear backends installed (each `linsolve.<name>_available()`
+    that is true, and SciPy's `lu`), so that numbers from two machines or loads are not mixed up."""
+    import platform
+
+    from printgen.solver import linsolve
+
+    cpu = platform.processor() or platform.machine()
+    with contextlib.suppress(OSError):
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    backends = [name.removesuffix("_available") for name in sorted(dir(linsolve))
+                if name.endswith("_available") and getattr(linsolve, name)()] + ["lu"]
+    return {"cpu": cpu, "cores": os.cpu_count() or 1, "load_average": os.getloadavg()[0],
+            "python": platform.python_version(), "solver_backends": backends}
 
 
 def goal_main(run, doc: str, argv: list[str] | None, repeat: int) -> int:
@@ -44,11 +65,14 @@ def goal_main(run, doc: str, argv: list[str] | None, repeat: int) -> int:
     return 0 if report["goal_met"] else 1
 
 
-def run_printgen(args: list[str]) -> tuple[float, float, int]:
+def run_printgen(args: list[str], force: bool = True) -> tuple[float, float, int]:
     """Run `printgen ARGS` from this checkout in its own process, time-limited only by an
     hour: (wall time s, the load average just before, the exit code); an exit other than 0,
-    1 (a mismatch) or 3 (a verdict on fewer levels) raises with its last error lines."""
-    cmd = [sys.executable, "-m", "printgen", *args, "--force", "--time-limit", "3600"]
+    1 (a mismatch) or 3 (a verdict on fewer levels) raises with its last error lines.
+    `force`: replace the output folder (`--force`; `design` has no such option: give it a
+    new folder)."""
+    cmd = [sys.executable, "-m", "printgen", *args, *(["--force"] if force else []),
+           "--time-limit", "3600"]
     load = os.getloadavg()[0]
     t = time.perf_counter()
     proc = subprocess.run(cmd, check=False, capture_output=True, text=True, cwd=ROOT,

@@ -141,9 +141,12 @@ def benchmarks_page() -> str:
     from benchmarks import measurements
 
     body = measurements.render(measurements.load()).split("\n", 1)[1]
-    intro = ("The measurements behind printgen's tuned constants (the run's estimate, the "
-             "solver's thresholds): what each constant is, the benchmark that measured it and "
-             "its rows. Run `printgen bench` in a clone for this machine's numbers.")
+    intro = ("First the whole check, what a user waits for against its goals (make, verify's "
+             "fits, design, series, the solver), each row measured by `printgen bench table` "
+             "with its machine, load and estimate; then the measurements behind printgen's "
+             "tuned constants (the run's estimate, the solver's thresholds): what each "
+             "constant is, the benchmark that measured it and its rows. Run `printgen bench` "
+             "in a clone for this machine's numbers.")
     return "\n".join(["# Benchmarks", "",
                       GENERATED.format(source="benchmarks/measurements.json"), "",
                       intro, body.replace(

@@ -164,3 +164,20 @@ def test_time_limit_stop_is_one_line_on_stderr(tmp_path):
     assert proc.stderr.count("\n") == 1 and proc.stderr.startswith("printgen make: stopped"), \
         proc.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_design_and_series_estimates_count_their_levels_and_cases():
+    """The design search's sweeps over its --level-step's levels; the series' cases over its
+    levels, shared out on the cores, the similar cases (E / lambda) not counted."""
+    from printgen.inputs.prototype import load_prototype
+    from printgen.run.budget import SERIES_REPORT_S, check_design_budget, check_series_budget
+
+    p = load_prototype(REALISTIC)
+    big = 1e9  # no limit: the estimates alone
+    full = check_design_budget(p, 0, 10, limit_s=big, cores=1, speed=1.0)
+    half = check_design_budget(p, 0, 10, limit_s=big, cores=1, speed=1.0, levels=12)
+    assert half == pytest.approx(full * 12 / LEVELS)
+    case = check_series_budget(p, 1, limit_s=big, cores=1, speed=1.0, levels=5)[0] \
+        - SERIES_REPORT_S
+    assert check_series_budget(p, 15, limit_s=big, cores=2, speed=1.0, levels=5, similar=4)[0] \
+        == pytest.approx(SERIES_REPORT_S + case * 6)  # 11 cases on 2 cores: 6 rounds

@@ -1,6 +1,7 @@
-"""`printgen bench solver|sweeps|gcode|parts|design|make|figures|timeline|fit --out DIR`: run a
-benchmark of benchmarks/ (a source checkout) and write its JSON/PNG into DIR. An installed wheel has
-no benchmarks/: there the command is not offered (argparse lists the commands that are)."""
+"""`printgen bench solver|sweeps|gcode|parts|design|make|figures|timeline|fit|table --out DIR`:
+run a benchmark of benchmarks/ (a source checkout) and write its JSON/PNG into DIR (`table`: every
+row of the speed table in one JSON, benchmarks/bench_table.py). An installed wheel has no
+benchmarks/: there the command is not offered (argparse lists the commands that are)."""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ from printgen.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[2]
 BENCHES = ("solver", "sweeps", "gcode", "parts", "design", "make", "figures", "timeline",
-           "fit")
+           "fit", "table")
 
 
 def available() -> bool:

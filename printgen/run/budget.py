@@ -81,6 +81,13 @@ FIXED_S = 2.0  # start-up, planning, the net's parts and slicer profile, the rep
 BASE_MEMORY_B = 150e6  # Python, numpy, scipy and the geometry libraries
 MEMORY_B_PER_NODE = 20e3  # sparse factor, path results kept per level (1998 nodes: +39 MB)
 COARSEN_MAX = 1000.0  # search bound for the mesh factor that fits
+# A scale series steps its load by 0.25, five times a sweep's step: 1.55 x a sweep's Newton
+# iterations per level on the paper's series of the simple barrier (652 counted over its 10
+# cases that are not the prototype scaled, 4 loaded levels each, against 10.5 a level);
+# then its start-up and report (wall of the command less its cases': 3.3 s)
+# (benchmarks/measurements.md#series-estimate)
+SERIES_STEP_FACTOR = 1.55
+SERIES_REPORT_S = 3.0
 
 
 @dataclass(frozen=True)
@@ -425,16 +432,18 @@ def prototype_sweep_s(p: Prototype) -> float:
 
 
 def check_design_budget(p: Prototype, screened: int, verified: int, *, limit_s: float,
-                        cores: int, speed: float | None = None, prototypes: int = 1) -> float:
+                        cores: int, speed: float | None = None, prototypes: int = 1,
+                        levels: int = LEVELS) -> float:
     """Seconds a design search takes on `cores`: `screened` nets at SCREEN_RATE per second,
     `verified` solver verifications (a model sweep each, against the prototype's sweep made
-    once per scale: `prototypes`); InputError naming both, the limit and the fixes when it
-    passes `limit_s`, before any work."""
+    once per scale: `prototypes`), each sweep over `levels` load levels (--level-step);
+    InputError naming both, the limit and the fixes when it passes `limit_s`, before any
+    work."""
     from printgen.search.space import SCREEN_RATE
 
     speed = _checked(limit_s, speed)
     c = max(1, cores)
-    one = prototype_sweep_s(p)
+    one = prototype_sweep_s(p) * levels / LEVELS
     seconds = speed * (screened / SCREEN_RATE + verified * one * SEARCH_VERIFY_FACTOR
                        + prototypes * one) / c
     if seconds > limit_s:
@@ -462,15 +471,20 @@ def _too_big(what: str, seconds: float, limit_s: float, fixes: str) -> None:
 
 
 def check_series_budget(p: Prototype, cases: int, *, limit_s: float, cores: int,
-                        speed: float | None = None) -> tuple[float, float]:
+                        speed: float | None = None, levels: int = LEVELS,
+                        similar: int = 0) -> tuple[float, float]:
     """(seconds, bytes) a scale series of `cases` solves of the prototype's net takes on
-    `cores` (each case one sweep of LEVELS levels; the model nets have the prototype's nodes
-    at every scale); InputError naming both, the limit and the fixes when it passes
-    `limit_s`, before any solve (a net too large is refused, not run out of memory)."""
+    `cores`: the cases shared out on the cores, each one sweep of `levels` levels (the model
+    nets have the prototype's nodes at every scale) of SERIES_STEP_FACTOR times a sweep's
+    Newton iterations per level, but for the `similar` cases (the prototype scaled exactly:
+    they start from its answer and are not counted), then SERIES_REPORT_S; InputError naming
+    both, the limit and the fixes when it passes `limit_s`, before any solve (a net too large
+    is refused, not run out of memory)."""
     speed = _checked(limit_s, speed)
     nodes = prototype_nodes(p)
     c = max(1, cores)
-    seconds = speed * prototype_sweep_s(p) * math.ceil(cases / c)
+    one = prototype_sweep_s(p) * levels / LEVELS * SERIES_STEP_FACTOR
+    seconds = speed * (one * math.ceil(max(0, cases - similar) / c) + SERIES_REPORT_S)
     memory = c * (BASE_MEMORY_B + MEMORY_B_PER_NODE * nodes)
     if seconds > limit_s:
         _too_big(f"series is too big: {cases} cases of a {nodes:,}-node net, about "

@@ -11,7 +11,9 @@ whole, `outputs.staged_dir`):
 - candidates.json: every candidate of every scale (one row per line);
 - design.json (the chosen net at the main scale) and design-1-<lambda>.json per scale: what
   `printgen make --design FILE` prints;
-- pareto-1-<lambda>.png: objective against |dPi2|, |dPi3| and print time.
+- pareto-1-<lambda>.png: objective against |dPi2|, |dPi3| and print time;
+- timings.json: the run's estimate and the search's wall time, s (the one file that differs
+  between identical runs).
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,7 +30,7 @@ from typing import Any
 from printgen.executor import open_runner
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
-from printgen.outputs import check_destination, write_folder
+from printgen.outputs import TIMINGS, check_destination, write_folder
 from printgen.outputs.display import Shown, Summary
 from printgen.report.jsonout import dumps
 from printgen.run.budget import DESIGN_LIMIT_S, check_design_budget, run_cores
@@ -136,6 +139,7 @@ class DesignRun(Shown):
     where: str
     record: dict = field(default_factory=dict)
     files: list[str] = field(default_factory=list)
+    timings: dict = field(default_factory=dict)  # s: the estimate, the search (timings.json)
 
     def summary(self) -> Summary:
         return design_summary(self)
@@ -159,10 +163,11 @@ def meshes_of(space: SearchSpace, t: ScaledTargets) -> tuple[int, int]:
 
 
 def check_work(p: Prototype, spaces: dict[float, SearchSpace], o: SearchOptions,
-               run: RunOptions) -> None:
+               run: RunOptions) -> float:
     """The search's size against its time limit (`budget.check_design_budget`), before any
     work: every scale's nets screened, and with the deformation objective `verify_nets` of
-    them (with every border), select's pick and the chosen net's best waves verified."""
+    them (with every border), select's pick and the chosen net's best waves verified, each
+    over the search's load levels. Returns the estimate (s)."""
     screened = sum(math.prod(space_factors(sp, *meshes_of(sp, scale_targets(p, s))))
                    for s, sp in spaces.items())
     verified = sum(o.verify_nets * len(sp.border_beads) + 1 + WAVES_VERIFIED
@@ -170,8 +175,11 @@ def check_work(p: Prototype, spaces: dict[float, SearchSpace], o: SearchOptions,
         if o.objective == "deformation" else 0  # each net with every border, select's pick
     cores = run_cores(bool(run.serial), run.workers)
     limit = DESIGN_LIMIT_S if run.time_limit_s is None else run.time_limit_s
-    check_design_budget(p, screened, verified, limit_s=limit, cores=cores,
-                        prototypes=len(spaces) if verified else 0)
+    from printgen.verification.preprint import levels
+
+    lv = levels() if o.level_step is None else levels(step=o.level_step)
+    return check_design_budget(p, screened, verified, limit_s=limit, cores=cores,
+                               prototypes=len(spaces) if verified else 0, levels=len(lv))
 
 
 def search_at_scales(prototype: str | Path | Prototype, scales: list[float], *,
@@ -181,8 +189,9 @@ def search_at_scales(prototype: str | Path | Prototype, scales: list[float], *,
     scheduler at `run.scheduler`, or serially)."""
     run = run or RunOptions()
     p = prototype if isinstance(prototype, Prototype) else load_prototype(prototype)
+    t0 = time.perf_counter()
     spaces = {s: space_for(p, s, options) for s in scales}  # every bound checked before work
-    check_work(p, spaces, options, run)
+    estimate = check_work(p, spaces, options, run)
     results = []
     with open_runner(scheduler=run.scheduler, workers=run.workers, serial=bool(run.serial),
                      progress=progress) as runner:
@@ -193,7 +202,8 @@ def search_at_scales(prototype: str | Path | Prototype, scales: list[float], *,
                                   prototype_sweep=prototype_sweep,
                                   level_step=options.level_step))
         where = runner.where
-    return DesignRun(results, where, design_record(p, results, options))
+    return DesignRun(results, where, design_record(p, results, options),
+                     timings={"estimate": estimate, "search": time.perf_counter() - t0})
 
 
 def design_record(p: Prototype, results: list[SearchResult], o: SearchOptions) -> dict:
@@ -237,7 +247,8 @@ def write_outputs(run: DesignRun, out: str | Path, main_scale: float | None,
     from printgen.report.design_plots import pareto_figure
 
     files: dict[str, str | bytes] = {"report.json": dumps(run.record),
-                                     "candidates.json": candidates_json(run.results)}
+                                     "candidates.json": candidates_json(run.results),
+                                     TIMINGS: dumps({"timings_s": run.timings})}
     for r in run.results:
         if r.design is not None:
             text = dumps(r.design.to_dict())
@@ -247,6 +258,6 @@ def write_outputs(run: DesignRun, out: str | Path, main_scale: float | None,
         files[f"pareto-1-{r.scale:g}.png"] = pareto_figure(r)
     inputs = design_inputs(prototype) if prototype is not None else []
     path = prototype.path if isinstance(prototype, Prototype) else prototype
-    run.files = write_folder(out, files, inputs=inputs,
+    run.files = write_folder(out, files, inputs=inputs, volatile=(TIMINGS,),
                              meta=provenance_record(command, prototype=path))
     return run.files

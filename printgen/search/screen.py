@@ -152,12 +152,35 @@ def target_curve(ctx: SearchContext) -> tuple[float, np.ndarray]:
                                              piecewise_linear(NET_STRAINS, *laws["across"])])
 
 
-def screen_point(ctx: SearchContext, point: NetPoint,
-                 target: tuple[float, np.ndarray] | None = None) -> Screened:
-    """Analytic membrane law, constraints and similitude break of one candidate
-    (`target`: `target_curve(ctx)`, computed here when not given)."""
+@dataclass(frozen=True)
+class NetLaw:
+    """What a candidate's screening shares with every border width of the same net (material,
+    section, mesh, pattern): its membrane laws against the target, constraints but the bed's,
+    similitude break. `screen_batch` computes it once per net."""
+
+    source: str
+    datasheet: bool
+    slope: float  # small-strain membrane stiffness in the worse direction, N/m
+    worse: float
+    rms: float
+    force: float
+    safety_factor: float
+    speed: float
+    opening: float
+    d_pi2: float
+    d_pi3: float
+    violations: tuple[tuple[str, str], ...]
+    across: float
+    up: float
+
+
+def net_law(ctx: SearchContext, point: NetPoint, target: tuple[float, np.ndarray],
+            force: float | None = None) -> NetLaw:
+    """The border-independent part of `screen_point` (see the module); `force`: the
+    estimated peak strand force (N) of its mesh (`peak_strand_force`), computed when not
+    given."""
     t, m = ctx.targets, ctx.material(point.material)
-    t_slope, want = target or target_curve(ctx)
+    _, want = target
     sec = strand_section(ctx, point)
     ax, ay = point.mesh_x_mm * MM, point.mesh_y_mm * MM
     knees, slopes, source = net_membrane_law(m, sec, ay, ax, point.pattern)
@@ -169,15 +192,12 @@ def screen_point(ctx: SearchContext, point: NetPoint,
     where = f"net {m.name} strand {sec.width_mm:g}x{sec.thickness_mm:g} mm"
     speed, print_reasons = print_limits(sec, m, ctx.printer, where)
     violations = [("print", r) for r in print_reasons]
-    force = peak_strand_force(t, ax, ay, point.pattern)
+    force = peak_strand_force(t, ax, ay, point.pattern) if force is None else force
     sf = m.failure_stress()[0] * area_m2(sec) / force
     if sf < MIN_SAFETY_FACTOR:
         violations.append(("strength", (f"{where}, mesh {point.mesh_x_mm:.4g} x "
                                        f"{point.mesh_y_mm:.4g} mm: safety factor {sf:.2f} below "
                                        f"{MIN_SAFETY_FACTOR} at {force:.3g} N (overflow)")))
-    bed = bed_violation(ctx, point, sec.bead_width_mm)
-    if bed:
-        violations.append(("bed", bed))
     opening = clear_opening_mm(point.mesh_x_mm, point.mesh_y_mm, sec.width_mm, point.pattern)
     if opening < MIN_OPENING_MM:
         violations.append(("opening", (f"clear mesh opening {opening:.2f} mm below "
@@ -188,14 +208,46 @@ def screen_point(ctx: SearchContext, point: NetPoint,
     up, across = float(ratio[0] - 1), float(ratio[len(NET_STRAINS)] - 1)
     worse = up if abs(math.log1p(up)) >= abs(math.log1p(across)) else across
     slope = slopes[0] if worse is up else s2[0]
-    return Screened(point, source, datasheet, slope, slope / (1 + worse), worse, rms,
-                    rms + DATASHEET_PENALTY * datasheet, force, sf, speed, opening,
-                    dx if abs(dx) >= abs(dy) else dy,
-                    equal_area_diameter(sec) / t["strand_d"] - 1,
-                    print_time_s(ctx, point, sec, speed), tuple(violations), across, up)
+    return NetLaw(source, datasheet, slope, worse, rms, force, sf, speed, opening,
+                  dx if abs(dx) >= abs(dy) else dy,
+                  equal_area_diameter(sec) / t["strand_d"] - 1, tuple(violations), across, up)
+
+
+def screen_point(ctx: SearchContext, point: NetPoint,
+                 target: tuple[float, np.ndarray] | None = None,
+                 law: NetLaw | None = None) -> Screened:
+    """Analytic membrane law, constraints and similitude break of one candidate
+    (`target`: `target_curve(ctx)`, computed here when not given; `law`: its `net_law`,
+    likewise)."""
+    n = law or net_law(ctx, point, target or target_curve(ctx))
+    sec = strand_section(ctx, point)
+    violations = list(n.violations)
+    bed = bed_violation(ctx, point, sec.bead_width_mm)
+    if bed:  # in the order the constraints were always listed: print, strength, bed, opening
+        at = sum(1 for k, _ in violations if k in ("print", "strength"))
+        violations.insert(at, ("bed", bed))
+    return Screened(point, n.source, n.datasheet, n.slope, n.slope / (1 + n.worse), n.worse,
+                    n.rms, n.rms + DATASHEET_PENALTY * n.datasheet, n.force, n.safety_factor,
+                    n.speed, n.opening, n.d_pi2, n.d_pi3,
+                    print_time_s(ctx, point, sec, n.speed), tuple(violations), n.across, n.up)
 
 
 def screen_batch(ctx: SearchContext, points: list[NetPoint]) -> list[Screened]:
-    """`screen_point` over a batch (a sweep task: pure, ordered like `points`)."""
+    """`screen_point` over a batch (a sweep task: pure, ordered like `points`): the law of
+    each net once, shared by its border widths (the grid's innermost factor), and the peak
+    strand force of each mesh once, shared by every material and section."""
     target = target_curve(ctx)
-    return [screen_point(ctx, p, target) for p in points]
+    laws: dict[tuple, NetLaw] = {}
+    forces: dict[tuple, float] = {}
+    out = []
+    for p in points:
+        key = (p.material, p.beads_across, p.layers, p.mesh_x_mm, p.mesh_y_mm, p.pattern)
+        law = laws.get(key)
+        if law is None:
+            mesh = key[3:]
+            if mesh not in forces:
+                forces[mesh] = peak_strand_force(ctx.targets, p.mesh_x_mm * MM, p.mesh_y_mm * MM,
+                                                 p.pattern)
+            law = laws[key] = net_law(ctx, p, target, forces[mesh])
+        out.append(screen_point(ctx, p, target, law))
+    return out

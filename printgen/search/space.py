@@ -39,7 +39,9 @@ MESH_DIGITS = 6  # mesh diagonals are rounded to 1e-6 mm in the records
 # candidates.json), about SCREEN_RATE nets per second on one core; the simple barrier's default
 # space at 1:40 holds ~230k, and unbounded mesh ranges reach tens of millions.
 MAX_CANDIDATES = 500_000
-SCREEN_RATE = 6_000  # nets screened per second, for the refusal's time estimate
+# nets screened per second on one core, for the estimates (26k measured on the 1:40 grid:
+# benchmarks/measurements.md#design-verification)
+SCREEN_RATE = 20_000
 # The solver stage's load-level step (h / h_B): 1 to 220 levels per sweep of 0 to 1.1.
 LEVEL_STEP_RANGE = (0.005, 1.1)
 

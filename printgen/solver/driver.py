@@ -96,9 +96,14 @@ def solve_path(net: Net, loads_at: Callable[[float], Sequence],
                levels: Sequence[float] | np.ndarray, *,
                tol: float = TOL_FORCE, max_iter: int = MAX_ITER, strict: bool = False,
                max_cuts: int = MAX_CUTS, skip_failed: bool = False,
-               method: str = "fast") -> list[Result]:
+               method: str = "fast",
+               guesses: Callable[[float], list[np.ndarray]] | None = None) -> list[Result]:
     """Solve at each level in order, warm-started; a failing level is reached by sub-steps.
 
+    `guesses(level)`: more starts (displacements, m) for a level, e.g. a similar net's
+    converged state there; the fast method starts from the lowest potential of these and the
+    path's own starts, so a poor guess costs one evaluation, never the answer (a guess of
+    another shape is ignored).
     Returns one Result per level. A level that cannot be reached stops the path (strict
     raises SolverError instead); with `skip_failed` its unconverged Result (converged=False,
     with the reason) is kept and the next level starts from the last converged state.
@@ -112,8 +117,10 @@ def solve_path(net: Net, loads_at: Callable[[float], Sequence],
         res, cuts, start, target = None, 0, done, level
         while True:
             if fast is not None:
-                res = fast.solve(loads_at(target), _starts(history, target), tol, max_iter,
-                                 target)
+                extra = [] if guesses is None else [  # another net's: not a start here
+                    g for g in guesses(target) if np.shape(g) == fast.ns.x0.shape]
+                res = fast.solve(loads_at(target), _starts(history, target) + extra, tol,
+                                 max_iter, target)
             else:
                 res = newton.solve(net, loads_at(target), u0=history[-1][1] if history else None,
                                    tol=tol, max_iter=max_iter, level=target)

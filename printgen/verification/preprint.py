@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -110,6 +111,7 @@ class Run:
     backend: str = ""
     unknowns: int = 0
     cpu_s: float = 0.0
+    states: dict[float, np.ndarray] = field(default_factory=dict)  # kept on request: `sweep`
 
     def work(self) -> dict[str, Any]:
         """What the solver did (printgen.run.budget.counted_work): the net's unknowns, the
@@ -128,10 +130,14 @@ class Run:
                            for lv, x in sorted(self.shapes.items())}}
 
 
-def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw: Any) -> Run:
+def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0,
+          guesses: Callable[[float], list[np.ndarray]] | None = None, keep_states: bool = False,
+          **load_kw: Any) -> Run:
     """Solve the load path (`load_kw`: the load case and site of `loads_function`); levels
     that do not converge are kept in `Run.failed` (left out of the comparison); SolverError
-    only when fewer than MIN_COMPARED levels converge."""
+    only when fewer than MIN_COMPARED levels converge. `guesses`: more warm starts per level
+    (`solver.solve_path`); `keep_states`: keep each converged level's displacements (m, every
+    solver node) in `Run.states`, a warm start for a similar net."""
     t0, cpu0 = time.perf_counter(), time.process_time()
     net, ex = build(s, slack=slack)
     loads_at = loads_function(s, **load_kw)
@@ -142,7 +148,7 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw: Any
         return loads_at(r)
 
     results = solver.solve_path(net, tracked, lv, tol=SOLVER_TOL, max_cuts=PATH_CUTS,
-                                skip_failed=True)
+                                skip_failed=True, guesses=guesses)
     failed = {float(r.level): r.reason for r in results if not r.converged}
     if len(lv) - len(failed) < min(MIN_COMPARED, len(lv)):
         raise SolverError(f"{s.name}: {len(failed)} of {len(lv)} load levels did not converge, "
@@ -166,7 +172,9 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0, **load_kw: Any
               if r.converged and np.any(np.isclose(r.level, SHAPE_LEVELS))}
     return Run(s, d, [r.iterations for r in results], time.perf_counter() - t0, failed, shapes,
                share, ",".join(sorted({r.backend for r in results})),
-               int((~net.fixed_dofs).sum()), time.process_time() - cpu0)
+               int((~net.fixed_dofs).sum()), time.process_time() - cpu0,
+               {float(x): r.displacements for x, r in zip(lv, results, strict=False)
+                if r.converged} if keep_states else {})  # a path stopped early is shorter
 
 
 @dataclass(frozen=True, repr=False)

@@ -6,6 +6,7 @@ pattern is one module plus its test). Lengths of the graph in mm, of the laws in
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -97,7 +98,14 @@ def printed_pattern_names() -> tuple[str, ...]:
 
 
 def patterns() -> dict[str, NetPattern]:
-    """Every pattern, by name."""
+    """Every pattern, by name (a copy: the registry is read once per process)."""
+    return dict(_registry())
+
+
+@functools.cache
+def _registry() -> dict[str, NetPattern]:
+    """The registry's scan of this package, once: `get_pattern` runs for every candidate a
+    design search screens, and the folder's scan was more than half of its time."""
     import printgen.barrier.patterns as package
     from printgen.barrier.registry import entries
 
@@ -107,7 +115,7 @@ def patterns() -> dict[str, NetPattern]:
 def get_pattern(name: str) -> NetPattern:
     """The pattern called `name` (or the one it is drawn as, `AS_DRAWN`); InputError
     listing the known ones otherwise."""
-    known = patterns()
+    known = _registry()
     found = known.get(AS_DRAWN.get(name, name))
     if found is None:
         raise InputError(f"net pattern {name!r} is not one of {', '.join(known)}; add "
