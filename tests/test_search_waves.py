@@ -151,20 +151,22 @@ def test_a_net_without_printable_waves_is_swept_straight_only(realistic):
 
 @pytest.mark.slow  # the beam model solves the softest printable waves of a PETG net (~5 s)
 def test_a_net_whose_softest_wave_stays_too_stiff_is_left_out_with_its_reason(realistic):
+    # PETG's best-ranked straight net (1 bead x 1 layer, as the search ranks them) is hundreds
+    # of times the target; its printable waves soften it, not enough
     from printgen.scaling.plan import make_design
     from printgen.scaling.selection import select
+    from printgen.search.choice import rank_key
     from printgen.search.nets import candidate_design
-    from printgen.search.screen import screen_point
+    from printgen.search.screen import screen_batch
     from printgen.search.space import grid, search_context
 
     p, t, d = realistic
     space = dataclasses.replace(_space(p, t), materials=("petg",), beads=(1,), layers=(1,),
                                 border_beads=(2,))
     ctx = search_context(p, t, space)
-    q = grid(ctx, space)[0]
-    s = screen_point(ctx, q)
-    assert s.error_across > STIFF_LIMIT  # PETG straight: hundreds of times the target
-    cand = candidate_design(ctx, q, make_design(p, t, select(p, t)))
+    s = min((x for x in screen_batch(ctx, grid(ctx, space)) if x.feasible), key=rank_key)
+    assert s.error_across > STIFF_LIMIT
+    cand = candidate_design(ctx, s.point, make_design(p, t, select(p, t)))
     nets, out = wave_nets(d, [(cand, s.error_across)])
     assert nets == [d.net]
     assert len(out) == 1 and out[0].startswith("petg") and f"limit {STIFF_LIMIT:g}" in out[0]
