@@ -18,6 +18,10 @@ Mechanics the search follows (each a lever, searched, not set):
   wave straightens across long before up and leaves the net softer up than across. A softer net
   up carries less of the water to the border cables, whose elongation is their tension over
   E A: the top cable reads low. A steeper mesh (larger diagonal up) raises the share up;
+- the top sensor's wire runs along the top cable and shares the equilibrium of its sag: its
+  pull takes part of the cable's tension, so the cable stretches less than the prototype's,
+  by about the pull over the cable's E A (a shallow cable's e (e + F / EA)^2 = e0^3); only
+  weaker sensors lift that part (the prototype file's `[flume] sensor_force_n`);
 - the material and section set the straightened stiffness the wave softens.
 
 Search, every sweep on the coarse net (`WAVE_COARSEN` times the design's meshes, strands as many
@@ -262,9 +266,9 @@ class WaveChoice:
         force = self.best_straight.sensor_force_n
         head = (f"waved strands: {len(self.trials)} nets swept on a {WAVE_COARSEN} x coarser "
                 f"net and {len(self.full)} on their own, scored by the flume's readings "
-                f"(sensors pulling {force:.3g} N each, the prototype file's) against the "
-                f"prototype's; best straight net {self.best_straight.label()}: "
-                f"{self.best_straight.readings()}")
+                f"(sensors pulling {force:.3g} N each: the prototype file's [flume] "
+                "sensor_force_n, else the paper's) against the prototype's; best straight net "
+                f"{self.best_straight.label()}: {self.best_straight.readings()}")
         if self.kept is None:
             return f"{head}; no waved net reads closer: the straight strands are kept"
         within = "all within" if self.kept.matched else "not all within"
