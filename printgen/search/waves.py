@@ -33,8 +33,9 @@ times stiffer: the same membrane stiffness, the waved strands' own curve) at WAV
 2. on each net, its straight strands and the printable waves by half-wave count in rising
    amplitude, a count's scan stopped once the mid-height at h/h_B = 1 reads more than
    POINT_TOLERANCE high (more amplitude only softens) or the sweep fails;
-3. for the MESH_TRIALS best trials: the same section and wave (and one amplitude step either
-   side) on every diagonal up of the search space (the share up), straight strands too;
+3. for the best waved trial of each of the MESH_TRIALS best materials: the same section and
+   wave (and one amplitude step either side) on every diagonal up of the search space (the
+   share up), straight strands too;
 4. the FULL_TRIALS best trials and the best straight net are swept on the design's own net at
    the search's levels (their deformation mismatch too), and the best is kept when its worst
    point is better than the best straight net's.
@@ -75,15 +76,15 @@ WAVE_COARSEN = 2  # screening net: meshes twice coarser (about 7 x faster; on th
 WAVE_LEVEL_STEP = 0.1  # screening sweep's level step: 0.5, 0.8 and 1.0 are levels of it
 STIFF_LIMIT = 2.0  # softest printable wave's small-strain stiffness over the target: beyond,
 # the readings are at least 2^(-2/3) - 1 = -37 % off (strains ~ stiffness^(-2/3))
-MESH_TRIALS = 2  # best trials whose section and wave are tried on every diagonal up
+MESH_TRIALS = 2  # materials whose best waved trial is tried on every diagonal up
 FULL_TRIALS = 5  # best trials swept on the design's own net (some a coarse sweep passes
 # fail there: the sensor wires fold over a soft net's shorter segments)
 SMALL_STRAIN = 1e-6  # strand strain the straight law's small-strain tangent is read at (its
 # first segment; at zero a tension-only law has no tangent)
 # The stage's solver work for the run's time estimate, in sweeps of the design's own net: its
 # own-net sweeps (the chosen and best straight nets, FULL_TRIALS), and its screening sweeps at
-# about a seventh of one each (measured on the realistic barrier at 1:40: about 90 of them).
-WAVES_VERIFIED = FULL_TRIALS + 2 + 90 // 7
+# about a seventh of one each (measured on the realistic barrier at 1:40: about 120 of them).
+WAVES_VERIFIED = FULL_TRIALS + 2 + 120 // 7
 
 
 def point_key(metric: str, level: float) -> str:
@@ -355,8 +356,7 @@ def wave_stage(chosen: Design, candidates: Iterable[tuple[Design, float]],
                  if step < len(ws) and not _overshot(done[key])}
     # step 3: the best trials' section and wave on every diagonal up
     heights = half_cell_counts(chosen.net.height_mm, space.mesh_y_mm)
-    for best in sorted((r for r in trials.values() if r.net.wave is not None),
-                       key=Trial.key)[:MESH_TRIALS]:
+    for best in best_per_material(trials.values())[:MESH_TRIALS]:
         w = best.net.wave
         assert w is not None
         steps = [Wave(round(w.amplitude_mm + d * WAVE_STEP_MM, 6), w.half_waves)
@@ -380,6 +380,14 @@ def wave_stage(chosen: Design, candidates: Iterable[tuple[Design, float]],
     kept = waved[0] if waved and waved[0].key() < best_straight.key() else None
     return WaveChoice(tuple(ranked), tuple(sorted(full.values(), key=Trial.key)),
                       full[chosen.net], best_straight, kept, tuple(left_out))
+
+
+def best_per_material(trials: Iterable[Trial]) -> list[Trial]:
+    """The best waved trial of each material, best first."""
+    best: dict[str, Trial] = {}
+    for r in sorted((r for r in trials if r.net.wave is not None), key=Trial.key):
+        best.setdefault(r.net.material, r)
+    return sorted(best.values(), key=Trial.key)
 
 
 def _overshot(r: Trial) -> bool:
