@@ -268,3 +268,22 @@ def test_design_on_the_square_barrier_is_at_least_as_good_as_select():
     if res.wave is not None and res.wave.kept is not None:
         best = res.wave.kept.mismatch
     assert best <= res.select_score.mismatch
+
+
+@pytest.mark.slow  # three sweeps of the realistic barrier's model and one of its prototype (~15 s)
+def test_the_solver_task_on_the_own_net_gives_the_verifiers_mismatch(realistic):
+    # the stage's own-net sweep is the verification's sweep: the same mismatch as the search's
+    # verifier, to round-off; on the coarse net it reads every point
+    from printgen.run.search import prototype_sweep, verify_task
+    from printgen.run.wave_sweep import wave_task
+    from printgen.search.nets import VerifyShared, VerifyTask
+
+    p, _, d = realistic
+    shared = VerifyShared(p, 0.1)
+    shared = dataclasses.replace(shared, prototype_run=prototype_sweep(shared, d))
+    own = wave_task(shared, WaveTask("own", d, 1))
+    assert own.mismatch == pytest.approx(verify_task(shared, VerifyTask("v", d)).mismatch,
+                                         rel=1e-9)
+    coarse = wave_task(shared, WaveTask("coarse", d, WAVE_COARSEN))
+    assert math.isfinite(coarse.worst) and math.isnan(coarse.mismatch)
+    assert coarse.net == d.net and coarse.coarsen == WAVE_COARSEN

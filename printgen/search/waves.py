@@ -50,6 +50,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from printgen.barrier.patterns import get_pattern
 from printgen.barrier.patterns.curved import (
     CurvedStrands,
     check_wave_mm,
@@ -208,8 +209,6 @@ def printable_waves(n: NetDesign) -> list[Wave]:
 def straight_law(n: NetDesign) -> Law:
     """The straight strands' law of net `n` (the material's membrane law up the barrier,
     `net_membrane_law`, turned into its pattern's strand law), N per unit strain."""
-    from printgen.barrier.patterns import get_pattern
-
     up, across = n.mesh_y_mm * MM, n.mesh_x_mm * MM
     knees, slopes, _ = net_membrane_law(load_material(n.material), n.strand, up, across,
                                         n.pattern)
@@ -267,8 +266,8 @@ class WaveChoice:
         force = self.best_straight.sensor_force_n
         head = (f"waved strands: {len(self.trials)} nets swept on a {WAVE_COARSEN} x coarser "
                 f"net and {len(self.full)} on their own, scored by the flume's readings "
-                f"(sensors pulling {force:.3g} N each: the prototype file's [flume] "
-                "sensor_force_n, else the paper's) against the prototype's; best straight net "
+                f"(sensors pulling {force:.3g} N each: sensor_force_n of the prototype file's "
+                "flume table, else the paper's) against the prototype's; best straight net "
                 f"{self.best_straight.label()}: {self.best_straight.readings()}")
         if self.kept is None:
             return f"{head}; no waved net reads closer: the straight strands are kept"
@@ -314,8 +313,6 @@ def wave_nets(chosen: Design, candidates: Iterable[tuple[Design, float]]
 
 def membrane_across(n: NetDesign) -> float:
     """The straight net's small-strain membrane stiffness across the barrier (N/m)."""
-    from printgen.barrier.patterns import get_pattern
-
     law = straight_law(n)
     pat = get_pattern(n.pattern)
     return pat.membrane_factor(n.mesh_x_mm * MM, n.mesh_y_mm * MM) * \
