@@ -80,10 +80,11 @@ def test_the_screening_levels_hold_every_point():
         assert np.any(np.isclose(lv, float(key.split("@")[1])))
 
 
-def _fake_sweep(seen, mid_per_mm=0.25, wave_gain=0.0):
+def _fake_sweep(seen, mid_per_mm=0.25, wave_gain=0.0, wave_mismatch=0.1):
     """A stand-in for the solver: the mid-height reads -0.5 + mid_per_mm x amplitude (a
     larger wave softens), the top cable -0.3 + 0.05 per mm of diagonal up beyond 6 mm (a
-    steeper mesh carries more to the cables), less `wave_gain` for a waved net."""
+    steeper mesh carries more to the cables), less `wave_gain` for a waved net; mismatch 0.1
+    straight, `wave_mismatch` waved."""
     def sweep(tasks: list[WaveTask]) -> list[Trial]:
         out = []
         for t in tasks:
@@ -93,7 +94,8 @@ def _fake_sweep(seen, mid_per_mm=0.25, wave_gain=0.0):
             mid = -0.5 + mid_per_mm * a
             top = -0.3 + 0.05 * (n.mesh_y_mm - 6) + (0 if n.wave is None else wave_gain)
             errors = {k: (top if "top" in k else mid) for k in POINT_KEYS}
-            out.append(Trial(n, errors, 0.1, 1.0, t.coarsen))
+            mismatch = 0.1 if n.wave is None else wave_mismatch
+            out.append(Trial(n, errors, mismatch, 1.0, t.coarsen))
         return out
     return sweep
 
@@ -137,6 +139,13 @@ def test_a_waved_net_that_reads_worse_than_straight_is_not_kept(realistic):
     assert choice.kept is None and "straight strands are kept" in choice.sentence()
     assert choice.design(d) == d
     assert choice.to_record()["kept"] is None
+
+
+def test_a_waved_net_reading_closer_but_deforming_less_alike_is_not_kept(realistic):
+    p, t, d = realistic
+    choice = wave_stage(d, [], _space(p, t), _fake_sweep([], wave_mismatch=0.2))
+    assert choice.kept is None and "0.100" in choice.sentence()
+    assert min(x.worst for x in choice.full) < choice.best_straight.worst  # it read closer
 
 
 def test_a_net_without_printable_waves_is_swept_straight_only(realistic):

@@ -37,8 +37,10 @@ times stiffer: the same membrane stiffness, the waved strands' own curve) at WAV
    wave (and one amplitude step either side) on every diagonal up of the search space (the
    share up), straight strands too;
 4. the FULL_TRIALS best trials and the best straight net are swept on the design's own net at
-   the search's levels (their deformation mismatch too), and the best is kept when its worst
-   point is better than the best straight net's.
+   the search's levels, with their deformation mismatch (the verification's RMS over every
+   level and quantity); among the waved nets whose mismatch is no higher than the search's
+   chosen straight net's (a wave must not trade the whole loading for the flume's points), the
+   best is kept when its worst point is better than the best straight net's.
 """
 
 from __future__ import annotations
@@ -270,7 +272,9 @@ class WaveChoice:
                 "flume table, else the paper's) against the prototype's; best straight net "
                 f"{self.best_straight.label()}: {self.best_straight.readings()}")
         if self.kept is None:
-            return f"{head}; no waved net reads closer: the straight strands are kept"
+            return (f"{head}; no waved net reads closer with a deformation mismatch no higher "
+                    f"than the chosen straight net's ({self.chosen_straight.mismatch:.3f}): "
+                    "the straight strands are kept")
         within = "all within" if self.kept.matched else "not all within"
         return (f"{head}; printed with {self.kept.label()}: {self.kept.readings()} "
                 f"({within} +-{POINT_TOLERANCE:.0%})")
@@ -373,7 +377,8 @@ def wave_stage(chosen: Design, candidates: Iterable[tuple[Design, float]],
     unique = list(dict.fromkeys(own))
     full = dict(zip(unique, run(unique, 1), strict=True))
     best_straight = min((full[chosen.net], full[straight.net]), key=Trial.key)
-    waved = sorted((full[n] for n in picks), key=Trial.key)
+    limit = full[chosen.net].mismatch
+    waved = sorted((full[n] for n in picks if not full[n].mismatch > limit), key=Trial.key)
     kept = waved[0] if waved and waved[0].key() < best_straight.key() else None
     return WaveChoice(tuple(ranked), tuple(sorted(full.values(), key=Trial.key)),
                       full[chosen.net], best_straight, kept, tuple(left_out))
