@@ -38,9 +38,10 @@ times stiffer: the same membrane stiffness, the waved strands' own curve) at WAV
    share up), straight strands too;
 4. the FULL_TRIALS best trials and the best straight net are swept on the design's own net at
    the search's levels, with their deformation mismatch (the verification's RMS over every
-   level and quantity); among the waved nets whose mismatch is no higher than the search's
-   chosen straight net's (a wave must not trade the whole loading for the flume's points), the
-   best is kept when its worst point is better than the best straight net's.
+   level and quantity); among the waved nets that read every point within POINT_TOLERANCE or
+   whose mismatch is no higher than the search's chosen straight net's (a wave that mends the
+   flume's points only in part must not cost the whole loading), the best is kept when its
+   worst point is better than the best straight net's.
 """
 
 from __future__ import annotations
@@ -272,9 +273,9 @@ class WaveChoice:
                 "flume table, else the paper's) against the prototype's; best straight net "
                 f"{self.best_straight.label()}: {self.best_straight.readings()}")
         if self.kept is None:
-            return (f"{head}; no waved net reads closer with a deformation mismatch no higher "
-                    f"than the chosen straight net's ({self.chosen_straight.mismatch:.3f}): "
-                    "the straight strands are kept")
+            return (f"{head}; no waved net reads closer, within +-{POINT_TOLERANCE:.0%} or with "
+                    "a deformation mismatch no higher than the chosen straight net's "
+                    f"({self.chosen_straight.mismatch:.3f}): the straight strands are kept")
         within = "all within" if self.kept.matched else "not all within"
         return (f"{head}; printed with {self.kept.label()}: {self.kept.readings()} "
                 f"({within} +-{POINT_TOLERANCE:.0%})")
@@ -378,7 +379,8 @@ def wave_stage(chosen: Design, candidates: Iterable[tuple[Design, float]],
     full = dict(zip(unique, run(unique, 1), strict=True))
     best_straight = min((full[chosen.net], full[straight.net]), key=Trial.key)
     limit = full[chosen.net].mismatch
-    waved = sorted((full[n] for n in picks if not full[n].mismatch > limit), key=Trial.key)
+    waved = sorted((full[n] for n in picks if full[n].matched or not full[n].mismatch > limit),
+                   key=Trial.key)
     kept = waved[0] if waved and waved[0].key() < best_straight.key() else None
     return WaveChoice(tuple(ranked), tuple(sorted(full.values(), key=Trial.key)),
                       full[chosen.net], best_straight, kept, tuple(left_out))
