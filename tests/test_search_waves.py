@@ -189,7 +189,7 @@ def test_a_net_whose_softest_wave_stays_too_stiff_is_left_out_with_its_reason(re
     assert len(out) == 1 and out[0].startswith("petg") and f"limit {STIFF_LIMIT:g}" in out[0]
 
 
-@pytest.mark.slow  # the search with its wave stage on the realistic barrier (~2-3 min serial)
+@pytest.mark.slow  # the search with its wave stage on the realistic barrier (1.5-3.5 min serial)
 def test_the_search_finds_a_waved_net_reading_within_tolerance_where_straight_does_not(
         tmp_path):
     # the realistic barrier with sensors of 0.5 N, within the 0.52 N its sensors check allows at
@@ -287,7 +287,7 @@ def test_design_on_the_square_barrier_is_at_least_as_good_as_select():
     assert best <= res.select_score.mismatch
 
 
-@pytest.mark.slow  # three sweeps of the realistic barrier's model and one of its prototype (~15 s)
+@pytest.mark.slow  # three sweeps of the realistic model, one of its prototype (1-10 s, by load)
 def test_the_solver_task_on_the_own_net_gives_the_verifiers_mismatch(realistic):
     # the stage's own-net sweep is the verification's sweep: the same mismatch as the search's
     # verifier, to round-off; on the coarse net it reads every point
