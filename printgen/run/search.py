@@ -37,6 +37,7 @@ from printgen.run.budget import DESIGN_LIMIT_S, check_design_budget, run_cores
 from printgen.run.options import RunOptions
 from printgen.run.provenance import provenance_record
 from printgen.run.shown import design_summary
+from printgen.run.wave_sweep import wave_task
 from printgen.scaling.record import Design
 from printgen.scaling.similitude import ScaledTargets, scale_targets
 from printgen.search.nets import (
@@ -200,7 +201,7 @@ def search_at_scales(prototype: str | Path | Prototype, scales: list[float], *,
                                   space=spaces[s], printer=options.printer,
                                   verifier=verify_task, verify_nets=options.verify_nets,
                                   prototype_sweep=prototype_sweep,
-                                  level_step=options.level_step))
+                                  level_step=options.level_step, wave_sweep=wave_task))
         where = runner.where
     return DesignRun(results, where, design_record(p, results, options),
                      timings={"estimate": estimate, "search": time.perf_counter() - t0})

@@ -8,9 +8,9 @@ Stages over the space of `search_space` (material x strand section x mesh x bord
    pre-print verification over h / h_B = 0-1.1) and rank them by their deformation mismatch:
    the best net of each of the `verify_nets` best material x section pairs, each with every
    border width, and `select`'s pick for comparison;
-3. with the `deformation` objective, the chosen net's printable waved strands, screened by their
-   law and the best verified by the solver (`printgen.search.waves`): the design takes the best
-   wave when it deforms more like the prototype than the straight net.
+3. with the `deformation` objective, nets with printable waved strands, searched by the solver
+   on the flume's readings (`printgen.search.waves`): the design takes the best waved net when
+   it reads closer to the prototype than the best straight net.
 
 Both stages run on a `printgen.executor.Runner` (this machine's workers, a Dask scheduler, or
 serial): each task is a pure function of a small frozen record, so the result does not depend on
@@ -48,7 +48,7 @@ from printgen.search.space import (
     grid,
     search_context,
 )
-from printgen.search.waves import WaveChoice, wave_stage, with_wave
+from printgen.search.waves import Trial, WaveChoice, WaveTask, wave_stage
 
 OBJECTIVES = ("deformation", "stiffness")
 VERIFY_NETS = 3  # nets verified by the solver (each with every border width)
@@ -190,10 +190,12 @@ def search(p: Prototype, scale: float, runner: Runner, *, objective: str = "defo
            space: SearchSpace | None = None, printer: str | None = None,
            verifier: Verifier | None = None, verify_nets: int = VERIFY_NETS,
            level_step: float | None = None,
-           prototype_sweep: Callable[[VerifyShared, Design], Any] | None = None) -> SearchResult:
+           prototype_sweep: Callable[[VerifyShared, Design], Any] | None = None,
+           wave_sweep: Callable[[VerifyShared, WaveTask], Trial] | None = None) -> SearchResult:
     """Run the search at 1:`scale` on `runner`. `verifier` is required for `deformation`;
     `prototype_sweep` makes the prototype's sweep once, before the verifier's tasks share it
-    (the prototype is the same for every candidate)."""
+    (the prototype is the same for every candidate); `wave_sweep`: the wave stage's solver
+    task (None: no wave stage)."""
     if objective not in OBJECTIVES:
         raise InputError(f"objective {objective!r} is not one of {', '.join(OBJECTIVES)}")
     if objective == "deformation" and verifier is None:
@@ -225,17 +227,17 @@ def search(p: Prototype, scale: float, runner: Runner, *, objective: str = "defo
     closest, binding = binding_constraints(screened, space)
     design = None if chosen is None else candidate_design(ctx, screened[chosen].point, base)
     wave = None
-    if objective == "deformation" and verifier and chosen is not None and design:
-        check = verifier  # `shared` as the candidates had it: the one prototype sweep
+    if objective == "deformation" and wave_sweep is not None and chosen is not None and design:
+        task = wave_sweep  # `shared` as the candidates had it: the one prototype sweep
 
-        def verify(designs: list[Design]) -> list[float]:
-            tasks = [VerifyTask(f"wave-{i}", d) for i, d in enumerate(designs)]
-            return [v.mismatch for v in runner.map(
-                check, tasks, shared=shared,
-                label=f"1:{t.scale:g} verifying {len(tasks)} waved nets (solver)")]
+        def sweep(tasks: list[WaveTask]) -> list[Trial]:
+            return runner.map(task, tasks, shared=shared,
+                              label=f"1:{t.scale:g} sweeping {len(tasks)} waved nets (solver)")
 
-        wave = wave_stage(p, t, design, verified[chosen].mismatch, verify)
-        design = with_wave(design, wave.kept)
+        ranked = sorted((s for s in screened if s.feasible), key=rank_key)
+        wave = wave_stage(design, ((candidate_design(ctx, s.point, base), s.error_across)
+                                   for s in ranked), space, sweep)
+        design = wave.design(design)
     res = SearchResult(p.name, t.scale, objective, space, tuple(screened), verified, base,
                        screen_batch(ctx, [design_point(ctx, base)])[0], select_score,
                        pareto_indices(objective, screened, verified), chosen, design,
