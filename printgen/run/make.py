@@ -7,7 +7,7 @@ files under `stage` and returns its records (printgen.report.records), which `ma
 with the plan's; the report is built once from them at the end (printgen.report.build), and
 report.json is their records. Wall-clock times go to the run's timings (timings.json) only.
 The verification, the longest and needing nothing from the others, starts in a worker process
-at the beginning and its step collects it.
+at the beginning, with the advice beside its band's variants, and its step collects them.
 """
 
 from __future__ import annotations

@@ -3,7 +3,8 @@
 report is built once from them (printgen.report.build), their wall-clock times go to the
 run's timings (`ctx.timings`). The pipeline is `printgen.run.make`. The verification's
 sweeps (`verification_sweeps`) run in a helper process from the start of the run while the
-other steps run here. The report's figures are drawings (printgen.report.html.Drawing) until
+other steps run here; the advice runs there too, beside the band's variants
+(`sweeps_and_advice`). The report's figures are drawings (printgen.report.html.Drawing) until
 the report is built; then they are drawn all at once, side by side in the helper's worker
 processes (`draw_figures`).
 """
