@@ -146,7 +146,7 @@ def test_verification_in_the_helper_equals_the_verification_step(made_simple_dra
     monkeypatch.setattr(make_mod, "helper", _spy(make_mod.helper, started))
     ahead = make_mod.make(path, 40, tmp_path / "ahead", steps=steps,
                           options=RunOptions(load="drag"))
-    assert started == ["verification_sweeps", "draw_all"]  # the figures: drawn in its workers
+    assert started == ["sweeps_and_advice", "draw_all"]  # the figures: drawn in its workers
     assert ahead.report.blocks == inline.report.blocks
     assert (dumps(split_timings(ahead.record["verification"])[0])
             == dumps(split_timings(inline.record["verification"])[0]))

@@ -60,7 +60,9 @@ def test_verbs_keywords_are_shorthands_of_the_record():
 
 
 def test_make_helper_receives_the_record():
-    from printgen.run.steps import verification_sweeps
+    from printgen.run.steps import sweeps_and_advice, verification_sweeps
 
-    assert list(inspect.signature(verification_sweeps).parameters) == [
+    assert list(inspect.signature(sweeps_and_advice).parameters) == [
+        "prototype", "design", "options"]
+    assert list(inspect.signature(verification_sweeps).parameters)[:3] == [
         "prototype", "design", "options"]

@@ -85,3 +85,6 @@ def test_variants_are_data_in_the_report_order():
     assert len({v.label for v in variants}) == len(variants)
     fs = "mounted in the 300 mm free section"
     assert [v.label for v in variants][-2:] == [fs, f"{fs}, bottom on the bed"]
+    # the folded net of the free section, bottom free, is the band's longest sweep: it starts
+    # first (the order the sweeps start in changes no number)
+    assert max(variants, key=lambda v: v.effort).label == fs

@@ -3,6 +3,7 @@ against the reference path (COO assembly, SuperLU every step): the same equilibr
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 
 import numpy as np
@@ -317,3 +318,31 @@ def test_predicted_tensions_follow_the_linearised_law_and_stay_tension_only():
     assert evaluate(ns, u + np.vstack([np.zeros(3), across])).bar[1][0] > 1.4 * t0
     back = np.array([-0.05, 0.0, 0.0]) / ns.L
     assert _predicted_tensions(ns, st, None, back, 1.0, None)[0] == 0.0
+
+
+def test_a_failing_level_is_cut_from_the_last_converged_sub_step(monkeypatch):
+    """Sub-steps halve from the last converged state: with a solver that converges only on
+    increments of at most 0.3, the path 0 -> 1 goes 1 (fails), 0.5 (fails), 0.25, 0.5,
+    0.75, 1.0, never solving a reached load twice; with one halving allowed it stops."""
+    tried: list[float] = []
+    reached = [0.0]
+    original = FastSolver.solve
+
+    def only_small_steps(self, loads, starts, tol, max_iter, level=None):
+        res = original(self, loads, starts, tol, max_iter, level)
+        tried.append(float(level))
+        if level - reached[-1] > 0.3:  # the stand-in for a level Newton cannot reach
+            return dataclasses.replace(res, converged=False, reason="too far")
+        reached.append(float(level))
+        return res
+
+    monkeypatch.setattr(FastSolver, "solve", only_small_steps)
+    sc = simple_scene()
+    out = solve_path(sc.net, sc.loads_at, [1.0], tol=1e-6, max_cuts=2)
+    assert out[0].converged
+    assert tried == [1.0, 0.5, 0.25, 0.5, 0.75, 1.0]
+    tried.clear()
+    reached[:] = [0.0]
+    out = solve_path(sc.net, sc.loads_at, [1.0], tol=1e-6, max_cuts=1, skip_failed=True)
+    assert not out[0].converged and "after 1 step cuts" in out[0].reason
+    assert tried == [1.0, 0.5]

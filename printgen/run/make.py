@@ -7,7 +7,7 @@ files under `stage` and returns its records (printgen.report.records), which `ma
 with the plan's; the report is built once from them at the end (printgen.report.build), and
 report.json is their records. Wall-clock times go to the run's timings (timings.json) only.
 The verification, the longest and needing nothing from the others, starts in a worker process
-at the beginning and its step collects it.
+at the beginning, with the advice beside its band's variants, and its step collects them.
 """
 
 from __future__ import annotations
@@ -59,8 +59,8 @@ from printgen.run.steps import (
     parts_step,
     preload_parts,
     slicer_step,
+    sweeps_and_advice,
     timed,
-    verification_sweeps,
     verify_step,
 )
 from printgen.scaling.design_file import load_design
@@ -239,10 +239,11 @@ def report_pdf(ctx: MakeContext, stage: Path, progress: Callable[[str], None] | 
 
 @contextlib.contextmanager
 def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]]) -> Iterator[None]:
-    """Start the verification's sweeps (`verification_sweeps`) in a helper process now, so
-    that they run while the parts are built here; `sweeps_done` and `verify_step` collect
-    them (a long run's per-level progress comes from the sweeps' workers straight to this
-    process: printgen.executor.local). Only on 2 cores or more: on one there is nothing to gain."""
+    """Start the verification's sweeps and the advice (`sweeps_and_advice`) in a helper
+    process now, so that they run while the parts are built here; `sweeps_done` and
+    `verify_step` collect them (a long run's per-level progress comes from the sweeps'
+    workers straight to this process: printgen.executor.local). Only on 2 cores or more: on
+    one there is nothing to gain."""
     serial = os.environ.get("PRINTGEN_SERIAL") or cores() < 2
     if serial or not any(s is verify_step for _, s in steps):
         yield
@@ -251,7 +252,7 @@ def verification_ahead(ctx: MakeContext, steps: list[tuple[str, Step]]) -> Itera
     with helper() as h:
         ctx.helper = h
         ctx.background["verification sweeps"] = ctx.helper.submit(
-            timed, verification_sweeps, ctx.prototype, ctx.design, ctx.options)
+            timed, sweeps_and_advice, ctx.prototype, ctx.design, ctx.options)
         try:
             with signals_deferred():  # a signal meanwhile would be lost in trimesh's imports
                 preload_parts()

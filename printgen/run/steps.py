@@ -3,7 +3,8 @@
 report is built once from them (printgen.report.build), their wall-clock times go to the
 run's timings (`ctx.timings`). The pipeline is `printgen.run.make`. The verification's
 sweeps (`verification_sweeps`) run in a helper process from the start of the run while the
-other steps run here. The report's figures are drawings (printgen.report.html.Drawing) until
+other steps run here; the advice runs there too, beside the band's variants
+(`sweeps_and_advice`). The report's figures are drawings (printgen.report.html.Drawing) until
 the report is built; then they are drawn all at once, side by side in the helper's worker
 processes (`draw_figures`).
 """
@@ -283,41 +284,76 @@ def part_thickness(kind: str, part) -> float:
 def verify_step(ctx: MakeContext, stage: Path) -> dict[str, Any]:
     """Prototype vs model over the loading sweep, the model's uncertainty band
     (printgen.verification.bands), and the steel counter-example, from the sweeps of the
-    helper process `make` started them in, or computed here: their records
+    helper process `make` started them in, or computed here, with the advice (computed
+    alongside the band's variants, `sweeps_and_advice`): their records
     (`verification_records`), their times in the run's timings."""
-    sweeps = sweeps_done(ctx)
-    if sweeps is None:
-        sweeps = verification_sweeps(ctx.prototype, ctx.design, ctx.options)
+    done = sweeps_done(ctx)
+    if done is None:
+        done = sweeps_and_advice(ctx.prototype, ctx.design, ctx.options)
+    v, band, early = done
     with span("verify: records"):
-        check, times = verification_records(*sweeps, ctx.targets.scale)
+        check, times = verification_records(v, band, ctx.targets.scale)
     ctx.timings["verification"] = times
-    advice = advice_for(ctx, *sweeps)
+    advice = advice_for(ctx, v, band, early)
     return {"verification": check} | ({} if advice is None else {"advice": advice})
 
 
 OUT_WORD = "OUT"  # how the advice's command names the run's output folder
 
 
-def advice_for(ctx: MakeContext, v: Verification, band: Band) -> Advice | None:
-    """What to change when the verdict is not PASS (printgen.verification.advice), its "Next"
-    line naming the run's files; None on PASS, when the flume cannot run the test (its fix, a
-    capacity statement, needs no solve), or when the nominal design already passes and only
-    the band leaves the verdict UNDECIDED (a test settles it, not another net). Its wall time
-    goes to the run's timings."""
-    import dataclasses
+def wants_advice(v: Verification) -> bool:
+    """Whether the run advises a change: not on PASS, not when the flume cannot run the test
+    (its fix, a capacity statement, needs no solve), and not when the nominal design already
+    passes and only the band leaves the verdict UNDECIDED (a test settles it, not another
+    net). On the nominal verification, before the band decides, it is wanted whenever the
+    run's will be: the advice computed then is dropped should the band's verdict be PASS."""
+    return v.verdict != "PASS" and v.runnable and not v.ok
 
+
+def run_advice(prototype: Prototype, design: Design, options: RunOptions, v: Verification,
+               coarsen: int) -> tuple[Advice, float]:
+    """(what to change, printgen.verification.advice, and its wall time in s) for the run
+    whose nominal verification is `v` and whose band runs on the net `coarsen` times
+    coarser."""
     from printgen.verification.advice import advise, direction
 
-    if v.verdict == "PASS" or not v.runnable or v.ok:
-        return None
     t, s = time.perf_counter(), v.sensors
     with span("advice"):
-        a = advise(ctx.prototype, ctx.design, v.prototype,
+        a = advise(prototype, design, v.prototype,
                    sensors_too_strong=s is not None and s.too_strong,
                    sensor_limit_n=None if s is None else s.limit_n,
-                   coarsen=band.coarsen, load=ctx.options.load,
-                   way=direction(v.mismatches))
-    ctx.timings.setdefault("timings_s", {})["advice"] = time.perf_counter() - t
+                   coarsen=coarsen, load=options.load, way=direction(v.mismatches))
+    return a, time.perf_counter() - t
+
+
+def sweeps_and_advice(prototype: Prototype, design: Design, options: RunOptions
+                      ) -> tuple[Verification, Band, tuple[Advice, float] | None]:
+    """`verification_sweeps` with the advice (`run_advice`) computed while the band's
+    variants run, its sweeps queued behind theirs on the same workers (None: no advice
+    wanted by the nominal verification, `wants_advice`). The advice needs only the nominal
+    verification and the band's coarsening, so it waits for no variant."""
+    early: list[tuple[Advice, float]] = []
+
+    def alongside(nominal: Verification, coarsen: int) -> None:
+        if wants_advice(nominal):
+            early.append(run_advice(prototype, design, options, nominal, coarsen))
+
+    v, band = verification_sweeps(prototype, design, options, alongside=alongside)
+    return v, band, early[0] if early else None
+
+
+def advice_for(ctx: MakeContext, v: Verification, band: Band,
+               early: tuple[Advice, float] | None) -> Advice | None:
+    """What to change when the verdict is not PASS (`wants_advice`), from the advice computed
+    alongside the band (`early`; computed here when missing), its "Next" line naming the
+    run's files. Its wall time goes to the run's timings."""
+    import dataclasses
+
+    if not wants_advice(v):
+        return None
+    a, seconds = early if early is not None else run_advice(
+        ctx.prototype, ctx.design, ctx.options, v, band.coarsen)
+    ctx.timings.setdefault("timings_s", {})["advice"] = seconds
     # the folder as OUT, said so: the report does not depend on the folder's name or place
     # (the same inputs give the same files; a lab moves and archives the folder whole)
     out = None if ctx.out is None else OUT_WORD
@@ -325,9 +361,10 @@ def advice_for(ctx: MakeContext, v: Verification, band: Band) -> Advice | None:
                                                    ctx.targets.scale, out))
 
 
-def sweeps_done(ctx: MakeContext) -> tuple[Verification, Band] | None:
-    """The verification's sweeps when they ran in the helper process (waiting for them), else
-    None."""
+def sweeps_done(ctx: MakeContext
+                ) -> tuple[Verification, Band, tuple[Advice, float] | None] | None:
+    """The verification's sweeps and advice (`sweeps_and_advice`) when they ran in the
+    helper process (waiting for them), else None."""
     pending = ctx.background.pop("verification sweeps", None)
     if pending is None:
         return None
@@ -390,14 +427,16 @@ def timed(fn: Callable, /, *args: Any, **kwargs: Any) -> tuple[Any, float]:
     return fn(*args, **kwargs), time.perf_counter() - t
 
 
-def verification_sweeps(prototype: Prototype, design: Design,
-                        options: RunOptions) -> tuple[Verification, Band]:
+def verification_sweeps(prototype: Prototype, design: Design, options: RunOptions, *,
+                        alongside: Callable[[Verification, int], object] | None = None
+                        ) -> tuple[Verification, Band]:
     """Both barriers' load sweeps compared, and the model's uncertainty band, under the
     run's load case (`options.load`; each of `options.loads` too, nominal sweeps only).
 
     The sweep is the scene realistic-1:40 with border cables, simple-free-top without them
     (docs/physics.md: Pre-print verification); every load level is solved on both. Needs nothing
-    from the other steps, so it can run in a worker process while they run.
+    from the other steps, so it can run in a worker process while they run. `alongside`: as
+    `verify_with_band`'s.
     """
     from printgen.report.plots import load_pyplot
     from printgen.verification.pooled import verify_with_band
@@ -406,7 +445,7 @@ def verification_sweeps(prototype: Prototype, design: Design,
     # matplotlib is imported while the sweeps run: the figures' workers start with it
     return verify_with_band(prototype, design, load=options.load, counterexample=True,
                             free_section=free_section(prototype), meanwhile=load_pyplot,
-                            loads=tuple(options.loads))
+                            loads=tuple(options.loads), alongside=alongside)
 
 
 def solver_work(v: Verification, band: Band) -> dict[str, Any]:

@@ -98,7 +98,9 @@ def solve_path(net: Net, loads_at: Callable[[float], Sequence],
                max_cuts: int = MAX_CUTS, skip_failed: bool = False,
                method: str = "fast",
                guesses: Callable[[float], list[np.ndarray]] | None = None) -> list[Result]:
-    """Solve at each level in order, warm-started; a failing level is reached by sub-steps.
+    """Solve at each level in order, warm-started; a failing level is reached by sub-steps:
+    each failure halves the sub-step from the last converged state (at most `max_cuts`
+    halvings per level), each success goes on by the same sub-step towards the level.
 
     `guesses(level)`: more starts (displacements, m) for a level, e.g. a similar net's
     converged state there; the fast method starts from the lowest potential of these and the
@@ -114,7 +116,7 @@ def solve_path(net: Net, loads_at: Callable[[float], Sequence],
     history: list[tuple[float, np.ndarray]] = []
     done = 0.0
     for level in levels:
-        res, cuts, start, target = None, 0, done, level
+        res, cuts, step, target = None, 0, level - done, level
         while True:
             if fast is not None:
                 extra = [] if guesses is None else [  # another net's: not a start here
@@ -129,12 +131,14 @@ def solve_path(net: Net, loads_at: Callable[[float], Sequence],
                 done = target
                 if target == level:
                     break
-                target = level
+                # on from the sub-step reached, by sub-steps of the size that converged
+                target = level if abs(level - done) <= abs(step) else done + step
                 continue
             if cuts >= max_cuts:
                 break
             cuts += 1
-            target = start + 0.5 * (target - start)
+            step *= 0.5  # halved from the last converged state, not from the level's start
+            target = done + step
         if not res.converged:
             msg = f"load level {level:g}: {res.reason} (after {cuts} step cuts)"
             if strict:

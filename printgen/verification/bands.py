@@ -181,14 +181,15 @@ def _largest_change(c: dict[str, np.ndarray], ref: dict[str, np.ndarray]) -> flo
 def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
                variants: list[Variant] | None = None, notes: list[str] | None = None,
                free_section: float | None = None, ahead: dict[int, Future] | None = None,
-               then: Callable[[], object] | None = None) -> Band:
+               then: Callable[[int], object] | None = None) -> Band:
     """Sweep every variant of design `d` and collect them around the `nominal` run (the
     model's sweep on the design's own net, as `verify` ran it), at the same levels.
 
     The variants run on the coarsest net that passes the refinement test (`ahead`: its
     sweeps already started, `refinement_test`); there a variant's curve is the nominal plus
-    the variant's change on the coarse net. `then` is called once the variants are started
-    (within printgen.executor.local.shared_pool: to queue more jobs behind them).
+    the variant's change on the coarse net. `then` is called with that net's coarsening
+    once the variants are started (within printgen.executor.local.shared_pool: to queue more
+    jobs behind them, or to work here while they run).
     """
     t0 = time.perf_counter()
     lv = nominal.deformation.levels
@@ -213,7 +214,7 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
         jobs.append((run_variant, (d, nominal_variant, lv, k, load_kw), {}))
     started = submit_jobs(jobs)
     if then is not None:
-        then()
+        then(k)
     done = collect(started)
     extra = done[len(variants):]  # the nominal on the coarse net, when k > 1
     base = curves(extra[0]) if extra else None

@@ -44,13 +44,17 @@ from printgen.verification.variants import Variant
 def verify_with_band(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
                      counterexample: bool = False, free_section: float | None = None,
                      meanwhile: Callable[[], object] | None = None,
-                     loads: tuple[str, ...] = ()) -> tuple[Verification, Band]:
+                     loads: tuple[str, ...] = (),
+                     alongside: Callable[[Verification, int], object] | None = None
+                     ) -> tuple[Verification, Band]:
     """`verify(p, d, load=load, counterexample=...)` and the model's uncertainty band around
     its model run (`model_band`), the prototype's (`prototype_band`, kept on the
     verification with the bands' three-valued verdict, `decide`), on one pool, with the
     nominal sweeps of each other load case of `loads` (`with_cases`; queued behind the band's
     variants); `meanwhile` is called here once the first sweeps have started (this process
-    then only waits)."""
+    then only waits); `alongside` with the nominal verification (its band not decided yet)
+    and the band's coarsening once the band's variants are started: work that needs them
+    (make's advice) runs here while they run, its own sweeps queued behind them."""
     plan = verify_plan(p, d, load=load)
     base = Variant(options=SceneOptions(mounting=plan.ms.mounting,
                                         sensor_force=scene_sensor_force(plan.ms)))
@@ -58,10 +62,12 @@ def verify_with_band(p: Prototype, d: Design, *, load: str | LoadCase | None = N
     cases: dict[str, list[Future]] = {}
     with shared_pool() as pool:
 
-        def queue_cases() -> None:
+        def behind_variants(coarsen: int) -> None:  # the other cases' sweeps, `alongside`
             for spec in other_cases(loads, plan.case.spec):
                 cases[spec] = [pool.submit(fn, *args, **kw) for fn, args, kw
                                in case_plan(p, d, spec, plan.ms.mounting).jobs()]
+            if alongside is not None:
+                alongside(nominal, coarsen)
 
         pair = [pool.submit(fn, *args, **kw) for fn, args, kw in plan.jobs()]
         loaded = [pool.submit(fn, *args, **kw) for fn, args, kw in plan.sensor_jobs()]
@@ -73,12 +79,13 @@ def verify_with_band(p: Prototype, d: Design, *, load: str | LoadCase | None = N
         with span("verify: nominal sweeps"):
             model, proto = collect(pair)
             v = plan.verified(model, proto, None, collect(loaded)[0] if loaded else None)
+            nominal = v
         # the prototype's variants queue before the model's: they are few and quick
         theirs = [pool.submit(fn, *args, **kw) for fn, args, kw
                   in prototype_jobs(p, v.prototype, plan.kw_p)]
         with span("verify: band"):
             band = model_band(d, v.model, load_kw=plan.kw_m, free_section=free_section,
-                              ahead=ahead, then=queue_cases)
+                              ahead=ahead, then=behind_variants)
             pband = prototype_band(p, v.prototype, collect(theirs))
             v = dataclasses.replace(v, decision=decide(v.prototype.deformation.values, band,
                                                        pband), prototype_band=pband)

@@ -68,10 +68,13 @@ EVEN = "not stated by the source: every answer equally likely"
 # measured law: exclusive answers of one question (never combined: two softer readings of the
 # same test would make a net softer than either), each weighted evenly with the nominal reading
 READING = "panel-law reading"
-# effort ranks: the sweeps measured longest run first (initial slack is a mechanism until
-# its strands tighten; then the mounting span, another mounting, the derived law, the
-# normal pressure; the rest are quick)
-SLOWEST, SLOWER, SLOW, MEDIUM, QUICKER = 5, 4, 3, 2, 1
+# effort ranks: the sweeps measured longest run first (the net squeezed into a narrower free
+# section with its bottom free hangs folded, most strands slack: its lowest loaded level
+# finds no equilibrium from any sub-step, so it spends every iteration the path allows and
+# is the band's longest sweep by far; initial slack is a mechanism until its strands
+# tighten; then the mounting span on the bed, another mounting, the derived law, the normal
+# pressure; the rest are quick)
+FOLDED, SLOWEST, SLOWER, SLOW, MEDIUM, QUICKER = 6, 5, 4, 3, 2, 1
 
 
 @dataclass(frozen=True)
@@ -330,7 +333,7 @@ def _model_form_variants(d: Design, free_section: float | None, notes: list[str]
                "apart; how the excess is held is not stated (reference section 4)")
         why = squeezed_slack(width, free_section, d.net.height_mm * MM)
         out += [Variant(f"mounted in the {fs}", src, SceneOptions(span=free_section),
-                        effort=SLOWER, question="mounting span", excluded=why),
+                        effort=FOLDED, question="mounting span", excluded=why),
                 Variant(f"mounted in the {fs}, bottom on the bed",
                         src + "; its slack bottom cable lies on the bed",
                         SceneOptions(span=free_section, bed="held"), effort=SLOWER,
