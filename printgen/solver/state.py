@@ -20,7 +20,7 @@ from .assemble import Bars, bar_energy, nondimensional, strand_laws
 from .linsolve import PARDISO_MIN_DOFS, Pardiso, ldl_available, pardiso_available
 from .loads import total_forces
 from .model import Net
-from .pattern import SYM_PAIRS, Pattern, pair_values
+from .pattern import SYM_PAIRS, pair_values, shared_pattern
 
 _SYM_A, _SYM_B = (np.array(x) for x in zip(*SYM_PAIRS, strict=True))
 _SYM_DIAGONAL = np.flatnonzero(_SYM_A == _SYM_B)
@@ -35,8 +35,8 @@ class NetSystem:
         self.L, self.S, self.bars, self.cables = s.L, s.S, s.bars, s.cables
         self.cable_set = CableSet(self.cables)
         self.free = s.free
-        self.pattern = Pattern(self.n, self.free, self.bars.i, self.bars.j,
-                               [c.nodes for c in self.cables])
+        self.pattern = shared_pattern(self.n, self.free, self.bars.i, self.bars.j,
+                                      [c.nodes for c in self.cables])
         self.damping = self._damping()
         m = len(self.bars.rest)  # node-by-strand incidence: +1 at the strand's j, -1 at its i
         self.incidence = sp.csr_matrix((np.repeat([1.0, -1.0], m), (np.concatenate(
