@@ -319,29 +319,37 @@ def test_predicted_tensions_follow_the_linearised_law_and_stay_tension_only():
     assert _predicted_tensions(ns, st, None, back, 1.0, None)[0] == 0.0
 
 
-@pytest.mark.skipif(not ldl_available(), reason="qdldl not installed")
-def test_a_finished_nets_qdldl_handle_serves_the_next_net_of_its_pattern(monkeypatch):
-    """A solve leaves its qdldl handle to the next net of the same topology (here another
-    geometry: 1:10), whose factorizations are then numeric only; that net's answer is the
-    one a fresh handle gives, digit for digit (same pattern: same ordering, same factors)."""
+@pytest.mark.parametrize("backend", ["ldl", "cholmod"])
+def test_a_finished_nets_handle_serves_the_next_net_of_its_pattern(monkeypatch, backend):
+    """A solve leaves its qdldl or CHOLMOD handle to the next net of the same topology (here
+    another geometry: 1:10), whose factorizations are then numeric only; that net's answer
+    is the one a fresh handle gives, digit for digit (same pattern: same ordering, same
+    factors). A handle turned to another backend is not left."""
     import weakref
 
     from printgen.solver import fast
 
-    monkeypatch.setattr(fast, "_SPARE_LDL", weakref.WeakKeyDictionary())
+    if not (ldl_available() if backend == "ldl" else cholmod_available()):
+        pytest.skip(f"{backend} not installed")
+    monkeypatch.setattr(fast, "_SPARE", weakref.WeakKeyDictionary())
     first, other = simple_scene(current_z=False), simple_scene(scale=10.0, current_z=False)
-    fresh = FastSolver(other.net).solve(other.loads_at(1.0), [], 1e-6, 400)
-    fast._SPARE_LDL.clear()
-    solver = FastSolver(first.net)
+    fresh = FastSolver(other.net, backend).solve(other.loads_at(1.0), [], 1e-6, 400)
+    fast._SPARE.clear()
+    solver = FastSolver(first.net, backend)
     assert solver.stepper.handle is None
     solver.solve(first.loads_at(1.0), [], 1e-6, 400)
     left = solver.stepper.handle
-    assert left.qdldl is not None and left.count > 0
+    assert fast._reusable(left, solver.ns.pattern)
     del solver
-    reused = FastSolver(other.net)
+    reused = FastSolver(other.net, backend)
     assert reused.ns.pattern is NetSystem(first.net).pattern
-    assert reused.stepper.handle is left and left.count == 0
+    assert reused.stepper.handle is left
+    assert FastSolver(other.net, backend).stepper.handle is None  # taken: one net at a time
     res = reused.solve(other.loads_at(1.0), [], 1e-6, 400)
     assert res.converged and res.iterations == fresh.iterations
     np.testing.assert_array_equal(res.displacements, fresh.displacements)
-    assert FastSolver(other.net).stepper.handle is None  # taken: one net at a time
+    if backend == "cholmod":
+        left.ldl = object()  # as after an indefinite S: LDL^T for good, not for the next net
+    else:
+        left.pardiso = object()
+    assert not fast._reusable(left, reused.ns.pattern)

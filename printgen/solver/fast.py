@@ -50,7 +50,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .linsolve import Factorization, Ldl, choose_backend, refine, row_sum_norm
+from .linsolve import Cholmod, Factorization, Ldl, choose_backend, refine, row_sum_norm
 from .newton import (
     ARMIJO,
     MAX_BACKTRACK,
@@ -82,23 +82,32 @@ PDAS_PASSES = 1  # active-set re-solves per Newton step at most, each by GMRES o
 # (benchmarks/measurements.md#fast-chord-and-repass)
 
 
-# a finished net's qdldl handle, per tangent pattern (`pattern.shared_pattern`: one per
-# topology), for the next net of that pattern: qdldl's AMD ordering and symbolic analysis
-# depend on the pattern alone, so that net's first factorization is numeric only (61 x 21
-# nodes: 4.0 -> 1.8 ms, the same factors). Weak keys: a pattern no net uses frees its handle.
-_SPARE_LDL: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+# a finished net's linear-solver handle, per tangent pattern (`pattern.shared_pattern`: one
+# per topology) and backend, for the next net of that pattern: qdldl's AMD ordering and
+# CHOLMOD's symbolic analysis depend on the pattern alone, so that net's factorizations are
+# numeric only (61 x 21 nodes, qdldl: the first 4.0 -> 1.8 ms), with the same factors.
+# Weak keys: a pattern no net uses frees its handles.
+_SPARE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _SPARE_LOCK = threading.Lock()
 
 
-def _spare_ldl(ns: NetSystem, backend: str) -> Ldl | None:
-    """A spare qdldl handle of the net's pattern (see _SPARE_LDL), or None."""
-    if backend != "ldl":
-        return None
+def _spare_handle(ns: NetSystem, backend: str) -> Ldl | Cholmod | None:
+    """A spare handle of the net's pattern and backend (see _SPARE), or None."""
     with _SPARE_LOCK:
-        handle = _SPARE_LDL.pop(ns.pattern, None)
-    if handle is not None:
+        handle = _SPARE.get(ns.pattern, {}).pop(backend, None)
+    if isinstance(handle, Ldl):
         handle.count = 0  # this net's own factorizations decide a switch to PARDISO
     return handle
+
+
+def _reusable(handle: object, pattern: object) -> bool:
+    """Whether a handle is as a new net's would be after its analysis: a qdldl one (not
+    switched to PARDISO), a CHOLMOD one of this pattern (not turned to LDL^T)."""
+    if isinstance(handle, Ldl):
+        return handle.qdldl is not None and handle.pardiso is None
+    if isinstance(handle, Cholmod):
+        return handle.ldl is None and handle.source is pattern
+    return False
 
 
 class Stepper:
@@ -107,7 +116,7 @@ class Stepper:
     def __init__(self, ns: NetSystem, backend: str | None = None) -> None:
         self.ns = ns
         self.backend = backend or choose_backend(ns.pattern.size)
-        self.handle = _spare_ldl(ns, self.backend)
+        self.handle = _spare_handle(ns, self.backend)
         self.factorizations = 0
         self.active: np.ndarray | None = None  # slack strands the last step's model stretched
         self.predicted: np.ndarray | None = None  # strand tensions the last step's model reached
@@ -129,11 +138,12 @@ class Stepper:
         return self.factor(self.matrix(st, boost))
 
     def __del__(self) -> None:
-        """Leave a qdldl handle (not one switched to PARDISO) to the next net of the pattern."""
-        handle = self.handle
-        if isinstance(handle, Ldl) and handle.qdldl is not None and handle.pardiso is None:
-            with contextlib.suppress(Exception), _SPARE_LOCK:  # at exit, modules may be gone
-                _SPARE_LDL[self.ns.pattern] = handle
+        """Leave the handle to the next net of the pattern (`_SPARE`) when `_reusable`."""
+        with contextlib.suppress(Exception):  # at interpreter exit, modules may be gone
+            pattern = self.ns.pattern
+            if _reusable(self.handle, pattern):
+                with _SPARE_LOCK:
+                    _SPARE.setdefault(pattern, {})[self.backend] = self.handle
 
 
 def iterate(ns: NetSystem, st: State, tol: float, max_iter: int, stepper: Stepper
