@@ -325,16 +325,18 @@ def test_a_finished_nets_handle_serves_the_next_net_of_its_pattern(monkeypatch, 
     another geometry: 1:10), whose factorizations are then numeric only; that net's answer
     is the one a fresh handle gives, digit for digit (same pattern: same ordering, same
     factors). A handle turned to another backend is not left."""
+    import gc
     import weakref
+    from collections import OrderedDict
 
-    from printgen.solver import fast
+    from printgen.solver import fast, pattern
 
     if not (ldl_available() if backend == "ldl" else cholmod_available()):
         pytest.skip(f"{backend} not installed")
-    monkeypatch.setattr(fast, "_SPARE", weakref.WeakKeyDictionary())
+    monkeypatch.setattr(pattern, "_shared", OrderedDict())
     first, other = simple_scene(current_z=False), simple_scene(scale=10.0, current_z=False)
     fresh = FastSolver(other.net, backend).solve(other.loads_at(1.0), [], 1e-6, 400)
-    fast._SPARE.clear()
+    pattern.clear_shared()
     solver = FastSolver(first.net, backend)
     assert solver.stepper.handle is None
     solver.solve(first.loads_at(1.0), [], 1e-6, 400)
@@ -353,3 +355,10 @@ def test_a_finished_nets_handle_serves_the_next_net_of_its_pattern(monkeypatch, 
     else:
         left.pardiso = object()
     assert not fast._reusable(left, reused.ns.pattern)
+    last = FastSolver(first.net, backend)
+    last.solve(first.loads_at(1.0), [], 1e-6, 400)
+    gone = weakref.ref(last.stepper.handle)
+    pattern.clear_shared()  # a pattern no longer shared keeps no handle
+    del last
+    gc.collect()  # a Cholmod handle refers to itself (its bound `solve`)
+    assert gone() is None

@@ -45,7 +45,6 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import threading
-import weakref
 from collections.abc import Callable
 
 import numpy as np
@@ -60,6 +59,7 @@ from .newton import (
     POTENTIAL_ROUND_OFF,
     ROUND_OFF,
 )
+from .pattern import shared_extras
 from .state import NetSystem, State, evaluate, ray_potential, tangent_values
 
 FORCING = 0.1  # inexact Newton: linear solves to min(FORCING, |R| / force scale), relative
@@ -82,19 +82,21 @@ PDAS_PASSES = 1  # active-set re-solves per Newton step at most, each by GMRES o
 # (benchmarks/measurements.md#fast-chord-and-repass)
 
 
-# a finished net's linear-solver handle, per tangent pattern (`pattern.shared_pattern`: one
-# per topology) and backend, for the next net of that pattern: qdldl's AMD ordering and
-# CHOLMOD's symbolic analysis depend on the pattern alone, so that net's factorizations are
-# numeric only (61 x 21 nodes, qdldl: the first 4.0 -> 1.8 ms), with the same factors.
-# Weak keys: a pattern no net uses frees its handles.
-_SPARE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+# a finished net's linear-solver handle, per backend, kept with its tangent pattern while
+# that is shared (`pattern.shared_extras`: one pattern per topology) for the next net of the
+# pattern: qdldl's AMD ordering and CHOLMOD's symbolic analysis depend on the pattern alone,
+# so that net's factorizations are numeric only (61 x 21 nodes, qdldl: the first 4.0 -> 1.8
+# ms), with the same factors
 _SPARE_LOCK = threading.Lock()
 
 
 def _spare_handle(ns: NetSystem, backend: str) -> Ldl | Cholmod | None:
-    """A spare handle of the net's pattern and backend (see _SPARE), or None."""
+    """A spare handle of the net's pattern and backend, or None."""
+    extras = shared_extras(ns.pattern)
+    if extras is None:
+        return None
     with _SPARE_LOCK:
-        handle = _SPARE.get(ns.pattern, {}).pop(backend, None)
+        handle = extras.setdefault("spare_handles", {}).pop(backend, None)
     if isinstance(handle, Ldl):
         handle.count = 0  # this net's own factorizations decide a switch to PARDISO
     return handle
@@ -138,12 +140,13 @@ class Stepper:
         return self.factor(self.matrix(st, boost))
 
     def __del__(self) -> None:
-        """Leave the handle to the next net of the pattern (`_SPARE`) when `_reusable`."""
+        """Leave the handle to the next net of the pattern (`_spare_handle`) when `_reusable`."""
         with contextlib.suppress(Exception):  # at interpreter exit, modules may be gone
             pattern = self.ns.pattern
-            if _reusable(self.handle, pattern):
+            extras = shared_extras(pattern)
+            if extras is not None and _reusable(self.handle, pattern):
                 with _SPARE_LOCK:
-                    _SPARE.setdefault(pattern, {})[self.backend] = self.handle
+                    extras.setdefault("spare_handles", {})[self.backend] = self.handle
 
 
 def iterate(ns: NetSystem, st: State, tol: float, max_iter: int, stepper: Stepper

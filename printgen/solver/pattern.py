@@ -247,7 +247,9 @@ def _index(a: np.ndarray) -> np.ndarray:
     return a.astype(np.int32 if small else np.int64)
 
 
-_shared: OrderedDict[bytes, Pattern] = OrderedDict()
+# the shared patterns by topology, each with a dict its users keep derived objects in
+# (`shared_extras`), dropped with it
+_shared: OrderedDict[bytes, tuple[Pattern, dict]] = OrderedDict()
 _shared_lock = threading.Lock()
 
 
@@ -269,18 +271,26 @@ def shared_pattern(n_nodes: int, free: np.ndarray, bar_i: np.ndarray, bar_j: np.
         found = _shared.get(key)
         if found is not None:
             _shared.move_to_end(key)
-            return found
+            return found[0]
     pattern = Pattern(n_nodes, free, bar_i, bar_j, cable_nodes)
     size = pattern.nbytes()
     with _shared_lock:
         if size <= SHARED_BYTES:
-            _shared[key] = pattern
-            while sum(p.nbytes() for p in _shared.values()) > SHARED_BYTES:
+            _shared[key] = (pattern, {})
+            while sum(p.nbytes() for p, _ in _shared.values()) > SHARED_BYTES:
                 _shared.popitem(last=False)
     return pattern
 
 
+def shared_extras(pattern: Pattern) -> dict | None:
+    """The dict kept with `pattern` while it is shared (`shared_pattern`), for objects that
+    depend on the pattern alone (the solver's spare factorization handles); None when the
+    pattern is not kept. Their bytes do not count towards SHARED_BYTES."""
+    with _shared_lock:
+        return next((extras for p, extras in _shared.values() if p is pattern), None)
+
+
 def clear_shared() -> None:
-    """Forget the shared patterns (a benchmark's cold solve; tests)."""
+    """Forget the shared patterns and their extras (a benchmark's cold solve; tests)."""
     with _shared_lock:
         _shared.clear()
