@@ -1,4 +1,5 @@
-"""A fixed sparse pattern of the tangent on the free degrees of freedom, computed once per net.
+"""A fixed sparse pattern of the tangent on the free degrees of freedom, computed once per net
+topology (`shared_pattern`: nets of one topology share it within a process).
 
 Every Newton step has the same non-zero positions: the 3 x 3 node blocks of each strand and
 each sliding-cable segment, the dense block of each cable (all its nodes share one tension),
@@ -260,7 +261,7 @@ def shared_pattern(n_nodes: int, free: np.ndarray, bar_i: np.ndarray, bar_j: np.
     a Pattern depends on nothing else and is only read once built. A band's variants, a
     fit's trials and repeated solves of one net differ in geometry, laws or loads, not in
     topology. Least recently used patterns go first once SHARED_BYTES are held."""
-    digest = hashlib.blake2b(digest_size=20)  # 160 bits: no two topologies of a process meet
+    digest = hashlib.blake2b(digest_size=20)  # 160 bits: a collision is out of reach
     for a in (np.asarray(n_nodes), free, bar_i, bar_j, *cable_nodes):
         arr = np.ascontiguousarray(a, dtype=np.int64 if a.dtype.kind in "iu" else a.dtype)
         digest.update(np.asarray(arr.shape, dtype=np.int64).tobytes())  # parts' boundaries
