@@ -258,3 +258,31 @@ def test_shared_pattern_is_one_per_topology_and_equals_a_fresh_build(monkeypatch
     assert [p for p, _ in pattern_module._shared.values()] == [ns.pattern, least]
     pattern_module.clear_shared()
     assert NetSystem(net).pattern is not ns.pattern
+
+
+def test_membrane_shape_of_a_net_reuses_its_topologys_laplacian_ordering(monkeypatch):
+    """The next net of a topology (here moved and stretched, so other weights) solves its
+    Laplacians with the qdldl objects the last one left (`pattern.shared_extras`): the
+    shape a fresh factorization gives, digit for digit; on a net with rollers, one object
+    per distinct set of free nodes."""
+    from collections import OrderedDict
+
+    from printgen.solver.linsolve import ldl_available
+
+    if not ldl_available():
+        pytest.skip("qdldl not installed")
+    monkeypatch.setattr(pattern_module, "_shared", OrderedDict())
+    net = _partly_fixed_net()
+    moved = Net(net.nodes * [1.3, 1.0, 0.8] + 0.1, net.fixed, net.elements, net.laws,
+                element_law=net.element_law, cables=net.cables)
+    b = np.random.default_rng(6).normal(size=NetSystem(net).pattern.size)
+    fresh = NetSystem(moved).membrane_shape(b)
+    pattern_module.clear_shared()
+    NetSystem(net).membrane_shape(b)
+    ns = NetSystem(moved)
+    spares = [v for k, v in pattern_module.shared_extras(ns.pattern).items()
+              if k[0] == "laplacian"]
+    assert len(spares) == 2 and all("qdldl" in s for s in spares)  # rollers: x, z vs y
+    left = [s["qdldl"] for s in spares]
+    np.testing.assert_array_equal(ns.membrane_shape(b), fresh)
+    assert [s["qdldl"] for s in spares] == left  # used, and left again
