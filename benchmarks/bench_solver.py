@@ -84,10 +84,11 @@ def paired_ratio(pairs: int = PAIRS) -> dict:
     less sensitive to the other processes); OpenSees's test is printgen's (max-norm, tol of
     printgen's force scale: `opensees_net`). Median and range of the per-pair ratios.
 
-    printgen's repeated solves of the one net reuse its tangent pattern (`shared_pattern`:
-    built once per topology and process, as along a fit or a band); each pair also times a
-    cold printgen solve (the shared patterns forgotten first: the pattern built inside the
-    call, as OpenSees builds its model), reported as `cold_cpu` and `cold_wall`."""
+    printgen's repeated solves of the one net reuse its tangent pattern and the last solve's
+    factorization objects (`shared_pattern`, `shared_extras`: kept per topology and process,
+    as along a fit or a band); each pair also times a cold printgen solve (all of those
+    forgotten first: the pattern built and the orderings computed inside the call, as
+    OpenSees builds its model), reported as `cold_cpu` and `cold_wall`."""
     from threadpoolctl import threadpool_info, threadpool_limits
 
     sc = simple_scene(refine=1, current_z=False)
