@@ -6,6 +6,7 @@ the load paths of the 1:40 verification; the robustness table of the hard cases.
     python -m benchmarks.bench_solver --out DIR [--sizes 1 2 4 8] [--no-paths]
         [--threads N] [--compare-threads 1 2]
         [--backends ldl cholmod [--backend-refine 1 2] [--backend-path-scale 20]]
+    python -m benchmarks.bench_solver --out DIR --opensees-only
 
 Errors are the mid-height centre deflection against a tight-tolerance solve of the same size
 (relative). Loads at the initial node height (the variant OpenSees can model); printgen's
@@ -19,8 +20,8 @@ turn (`backend_table`: where CHOLMOD overtakes qdldl), and with --backend-path-s
 verification's load paths at 1:S too (`backend_paths`). The ratio to OpenSeesPy at 61 x 21 is
 also measured pair by pair (`paired_ratio`: PAIRS pairs, alternating, one thread each; wall
 and CPU time of each whole call, median and range, with the load average; in a fresh process
-and in this one, see `paired_both`).
-Writes bench_solver.json and bench_solver.png.
+and in this one, see `paired_both`); --opensees-only measures only that.
+Writes bench_solver.json and bench_solver.png (--opensees-only: bench_solver_opensees.json).
 """
 
 from __future__ import annotations
@@ -39,6 +40,7 @@ from printgen.solver.driver import FastSolver
 from printgen.solver.linsolve import Pardiso
 from printgen.solver.loads import total_forces
 from printgen.solver.newton import MAX_ITER
+from printgen.solver.pattern import clear_shared
 from printgen.solver.scenes import simple_scene
 
 REFERENCE_TOL = 1e-13  # the reference solve: round-off level
@@ -80,7 +82,13 @@ def paired_ratio(pairs: int = PAIRS) -> dict:
     load. Each side is timed around its whole call (printgen's `solve`, its NetSystem built
     inside; OpenSees's model built inside), wall (perf_counter) and CPU (process_time: far
     less sensitive to the other processes); OpenSees's test is printgen's (max-norm, tol of
-    printgen's force scale: `opensees_net`). Median and range of the per-pair ratios."""
+    printgen's force scale: `opensees_net`). Median and range of the per-pair ratios.
+
+    printgen's repeated solves of the one net reuse its tangent pattern and the last solve's
+    factorization objects (`shared_pattern`, `shared_extras`: kept per topology and process,
+    as along a fit or a band); each pair also times a cold printgen solve (all of those
+    forgotten first: the pattern built and the orderings computed inside the call, as
+    OpenSees builds its model), reported as `cold_cpu` and `cold_wall`."""
     from threadpoolctl import threadpool_info, threadpool_limits
 
     sc = simple_scene(refine=1, current_z=False)
@@ -93,7 +101,9 @@ def paired_ratio(pairs: int = PAIRS) -> dict:
         return {"skipped": f"OpenSeesPy not available: {exc}"}
     loads = total_forces(sc.loads_at(1.0), net.nodes)[0]
 
-    def printgen_s() -> tuple[float, float, float]:
+    def printgen_s(cold: bool = False) -> tuple[float, float, float]:
+        if cold:
+            clear_shared()
         w, c = time.perf_counter(), time.process_time()
         r = solve(net, sc.loads_at(1.0), tol=GOAL_TOL)
         c, w = time.process_time() - c, time.perf_counter() - w
@@ -125,17 +135,21 @@ def paired_ratio(pairs: int = PAIRS) -> dict:
 
 
 def _alternate(printgen_s, opensees_s, pairs: int) -> list[dict]:
-    """`pairs` pairs of timings, printgen first in the even pairs, OpenSees in the odd ones."""
+    """`pairs` pairs of timings, printgen (then its cold solve) first in the even pairs,
+    OpenSees (then printgen's cold solve) in the odd ones."""
     times = []
     for k in range(pairs):
         if k % 2 == 0:
             pg = printgen_s()
+            cold = printgen_s(cold=True)
             os_ = opensees_s()
         else:
             os_ = opensees_s()
+            cold = printgen_s(cold=True)
             pg = printgen_s()
         times.append({"printgen_wall_s": pg[0], "printgen_cpu_s": pg[1],
-                      "printgen_result_s": pg[2], "opensees_wall_s": os_[0],
+                      "printgen_result_s": pg[2], "printgen_cold_wall_s": cold[0],
+                      "printgen_cold_cpu_s": cold[1], "opensees_wall_s": os_[0],
                       "opensees_cpu_s": os_[1]})
     return times
 
@@ -169,8 +183,12 @@ def _summary(times: list[dict]) -> dict:
     """The per-pair ratios (OpenSees / printgen), wall and CPU, and their median and range."""
     wall = [t["opensees_wall_s"] / t["printgen_wall_s"] for t in times]
     cpu = [t["opensees_cpu_s"] / t["printgen_cpu_s"] for t in times]
+    cold_wall = [t["opensees_wall_s"] / t["printgen_cold_wall_s"] for t in times]
+    cold_cpu = [t["opensees_cpu_s"] / t["printgen_cold_cpu_s"] for t in times]
     return {"pairs": times, "wall_ratios": wall, "cpu_ratios": cpu, "wall": _spread(wall),
-            "cpu": _spread(cpu), "printgen_cpu_s": _spread([t["printgen_cpu_s"] for t in times]),
+            "cpu": _spread(cpu), "cold_wall": _spread(cold_wall), "cold_cpu": _spread(cold_cpu),
+            "printgen_cpu_s": _spread([t["printgen_cpu_s"] for t in times]),
+            "printgen_cold_cpu_s": _spread([t["printgen_cold_cpu_s"] for t in times]),
             "opensees_cpu_s": _spread([t["opensees_cpu_s"] for t in times])}
 
 
@@ -522,7 +540,7 @@ def goals(results: list[dict], paths: list[dict], tent: dict | None,
     for run in (paired or {}).values():
         if "cpu" in run:
             out[f"opensees_ratio_61x21_paired ({run['opensees_blas']})"] = {
-                "cpu": run["cpu"], "wall": run["wall"]}
+                k: run[k] for k in ("cpu", "wall", "cold_cpu", "cold_wall")}
     big = at("241 x 81", "printgen")
     if big:
         out["time_241x81_s"] = big["time_s"]
@@ -595,6 +613,32 @@ def _pardiso_note(row: dict) -> str:
             f"{w['solve_cpu_s']:.2f} s)")
 
 
+def _print_paired(paired: dict | None) -> None:
+    for where, pair in (paired or {}).items():
+        if "cpu" not in pair:
+            print(f"OpenSeesPy pairs ({where}): {pair.get('skipped', 'not run')}")
+            continue
+        print(f"OpenSeesPy ({pair['opensees_blas']}) / printgen at {pair['size']} ({where}), "
+              f"{len(pair['pairs'])} alternating pairs, 1 thread each, load "
+              f"{pair['load_average_before'][0]:.1f} -> {pair['load_average_after'][0]:.1f}: "
+              + ", ".join(f"{k} median {pair[k]['median']:.1f}x (range {pair[k]['min']:.1f}-"
+                          f"{pair[k]['max']:.1f}x)" for k in ("cpu", "wall", "cold_cpu",
+                                                              "cold_wall")))
+
+
+def _opensees_only(out: Path) -> int:
+    """--opensees-only: `paired_both` alone, written to bench_solver_opensees.json."""
+    out.mkdir(parents=True, exist_ok=True)
+    paired = paired_both()
+    path = out / "bench_solver_opensees.json"
+    path.write_text(json.dumps({"benchmark": "bench_solver", "scene": "simple-pinned",
+                                "goal_tol": GOAL_TOL, "opensees_paired": paired}, indent=1)
+                    + "\n")
+    _print_paired(paired)
+    print(f"all numbers: {path}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", required=True, type=Path)
@@ -613,7 +657,11 @@ def main(argv: list[str] | None = None) -> int:
                     help="with --backends: also solve the verification's load paths at 1:S "
                          "with each backend")
     ap.add_argument("--json", action="store_true", help="print the goals as JSON")
+    ap.add_argument("--opensees-only", action="store_true",
+                    help="only the paired OpenSeesPy / printgen ratio at 61 x 21")
     a = ap.parse_args(argv)
+    if a.opensees_only:
+        return _opensees_only(a.out)
     report = run(a.out, a.sizes, not a.no_paths, a.threads, a.compare_threads, a.backends,
                  a.backend_refine, a.backend_path_scale)
     for res in report["sizes"]:
@@ -654,13 +702,7 @@ def main(argv: list[str] | None = None) -> int:
               f"{p['fast']['time_s']:.2f} s, {sum(p['fast']['iterations'])} it, "
               f"{p['fast']['factorizations_per_level']:.1f} fact/level; reference "
               f"{p['reference']['time_s']:.2f} s, {sum(p['reference']['iterations'])} it")
-    for pair in (report.get("opensees_paired") or {}).values():
-        if "cpu" in pair:
-            print(f"OpenSeesPy ({pair['opensees_blas']}) / printgen at {pair['size']}, "
-                  f"{len(pair['pairs'])} alternating pairs, 1 thread each, load "
-                  f"{pair['load_average_before'][0]:.1f}: " + ", ".join(
-                      f"{k} median {pair[k]['median']:.1f}x (range {pair[k]['min']:.1f}-"
-                      f"{pair[k]['max']:.1f}x)" for k in ("cpu", "wall")))
+    _print_paired(report.get("opensees_paired"))
     if a.json:
         print(json.dumps(report["goals"], indent=1))
     else:

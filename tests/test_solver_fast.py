@@ -346,3 +346,48 @@ def test_a_failing_level_is_cut_from_the_last_converged_sub_step(monkeypatch):
     out = solve_path(sc.net, sc.loads_at, [1.0], tol=1e-6, max_cuts=1, skip_failed=True)
     assert not out[0].converged and "after 1 step cuts" in out[0].reason
     assert tried == [1.0, 0.5]
+
+
+@pytest.mark.parametrize("backend", ["ldl", "cholmod"])
+def test_a_finished_nets_handle_serves_the_next_net_of_its_pattern(monkeypatch, backend):
+    """A solve leaves its qdldl or CHOLMOD handle to the next net of the same topology (here
+    another geometry: 1:10), whose factorizations are then numeric only; that net's answer
+    is the one a fresh handle gives, digit for digit (same pattern: same ordering, same
+    factors). A handle turned to another backend is not left."""
+    import gc
+    import weakref
+    from collections import OrderedDict
+
+    from printgen.solver import fast, pattern
+
+    if not (ldl_available() if backend == "ldl" else cholmod_available()):
+        pytest.skip(f"{backend} not installed")
+    monkeypatch.setattr(pattern, "_shared", OrderedDict())
+    first, other = simple_scene(current_z=False), simple_scene(scale=10.0, current_z=False)
+    fresh = FastSolver(other.net, backend).solve(other.loads_at(1.0), [], 1e-6, 400)
+    pattern.clear_shared()
+    solver = FastSolver(first.net, backend)
+    assert solver.stepper.handle is None
+    solver.solve(first.loads_at(1.0), [], 1e-6, 400)
+    left = solver.stepper.handle
+    assert fast._reusable(left, solver.ns.pattern)
+    del solver
+    reused = FastSolver(other.net, backend)
+    assert reused.ns.pattern is NetSystem(first.net).pattern
+    assert reused.stepper.handle is left
+    assert FastSolver(other.net, backend).stepper.handle is None  # taken: one net at a time
+    res = reused.solve(other.loads_at(1.0), [], 1e-6, 400)
+    assert res.converged and res.iterations == fresh.iterations
+    np.testing.assert_array_equal(res.displacements, fresh.displacements)
+    if backend == "cholmod":
+        left.ldl = object()  # as after an indefinite S: LDL^T for good, not for the next net
+    else:
+        left.pardiso = object()
+    assert not fast._reusable(left, reused.ns.pattern)
+    last = FastSolver(first.net, backend)
+    last.solve(first.loads_at(1.0), [], 1e-6, 400)
+    gone = weakref.ref(last.stepper.handle)
+    pattern.clear_shared()  # a pattern no longer shared keeps no handle
+    del last
+    gc.collect()  # a Cholmod handle refers to itself (its bound `solve`)
+    assert gone() is None

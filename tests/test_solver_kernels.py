@@ -11,8 +11,10 @@ import pytest
 import scipy.sparse as sp
 
 from printgen.solver import Hydrostatic, Net, SlidingCable, linear, piecewise
+from printgen.solver import pattern as pattern_module
 from printgen.solver.assemble import internal, strain_energy
 from printgen.solver.linsolve import PARDISO_MIN_DOFS, row_sum_norm
+from printgen.solver.pattern import Pattern
 from printgen.solver.scenes import simple_scene, square_net
 from printgen.solver.state import NetSystem, evaluate, ray_potential, tangent_values
 
@@ -213,3 +215,74 @@ def test_membrane_shape_of_a_net_with_a_part_hanging_on_nothing_is_none():
                        cables=net.cables))
     assert ns.membrane_shape(np.ones(ns.pattern.size)) is None
     assert NetSystem(net).membrane_shape(np.ones(NetSystem(net).pattern.size)) is not None
+
+
+def _same_pattern(a: Pattern, b: Pattern) -> None:
+    for name, value in vars(a).items():
+        other = vars(b)[name]
+        for x, y in zip(*((v if isinstance(v, tuple) else (v,)) for v in (value, other)),
+                        strict=True):
+            if sp.issparse(x):
+                assert (x != y).nnz == 0, name
+            else:
+                np.testing.assert_array_equal(x, y, err_msg=name)
+
+
+def test_shared_pattern_is_one_per_topology_and_equals_a_fresh_build(monkeypatch):
+    """Nets of one topology (other node positions, laws, anchors' coordinates) share one
+    Pattern, equal to the one built afresh; another anchor set, another strand or another
+    cable gets its own; patterns past SHARED_BYTES are dropped, least recently used first."""
+    monkeypatch.setattr(pattern_module, "_shared", type(pattern_module._shared)())
+    net, _ = _net()
+    ns = NetSystem(net)
+    moved = Net(net.nodes * 1.3 + 0.1, net.fixed, net.elements, [linear(7.0)],
+                cables=[SlidingCable(net.cables[0].nodes, linear(1.0))])
+    assert NetSystem(moved).pattern is ns.pattern
+    fresh = Pattern(ns.n, ns.free, ns.bars.i, ns.bars.j, [c.nodes for c in ns.cables])
+    _same_pattern(ns.pattern, fresh)
+    rollers = _partly_fixed_net()
+    no_cable = Net(net.nodes, net.fixed, net.elements, LAWS, element_law=net.element_law)
+    fewer = Net(net.nodes, net.fixed, net.elements[:-1], LAWS,
+                element_law=net.element_law[:-1], cables=net.cables)
+    others = [NetSystem(x).pattern for x in (rollers, no_cable, fewer)]
+    assert len({id(p) for p in [ns.pattern, *others]}) == 4
+    _same_pattern(others[0], Pattern(len(rollers.nodes), ~rollers.fixed_dofs.ravel(),
+                                     ns.bars.i, ns.bars.j, [c.nodes for c in ns.cables]))
+    assert len(pattern_module._shared) == 4
+    # room for two of them: a new one and the one used last stay
+    monkeypatch.setattr(pattern_module, "SHARED_BYTES", 2 * ns.pattern.nbytes() + 1)
+    NetSystem(net)
+    least = NetSystem(Net(net.nodes, net.fixed, net.elements[:-2], LAWS,
+                          element_law=net.element_law[:-2], cables=net.cables)).pattern
+    assert least.nbytes() < ns.pattern.nbytes()
+    assert [p for p, _ in pattern_module._shared.values()] == [ns.pattern, least]
+    pattern_module.clear_shared()
+    assert NetSystem(net).pattern is not ns.pattern
+
+
+def test_membrane_shape_of_a_net_reuses_its_topologys_laplacian_ordering(monkeypatch):
+    """The next net of a topology (here moved and stretched, so other weights) solves its
+    Laplacians with the qdldl objects the last one left (`pattern.shared_extras`): the
+    shape a fresh factorization gives, digit for digit; on a net with rollers, one object
+    per distinct set of free nodes."""
+    from collections import OrderedDict
+
+    from printgen.solver.linsolve import ldl_available
+
+    if not ldl_available():
+        pytest.skip("qdldl not installed")
+    monkeypatch.setattr(pattern_module, "_shared", OrderedDict())
+    net = _partly_fixed_net()
+    moved = Net(net.nodes * [1.3, 1.0, 0.8] + 0.1, net.fixed, net.elements, net.laws,
+                element_law=net.element_law, cables=net.cables)
+    b = np.random.default_rng(6).normal(size=NetSystem(net).pattern.size)
+    fresh = NetSystem(moved).membrane_shape(b)
+    pattern_module.clear_shared()
+    NetSystem(net).membrane_shape(b)
+    ns = NetSystem(moved)
+    spares = [v for k, v in pattern_module.shared_extras(ns.pattern).items()
+              if k[0] == "laplacian"]
+    assert len(spares) == 2 and all("qdldl" in s for s in spares)  # rollers: x, z vs y
+    left = [s["qdldl"] for s in spares]
+    np.testing.assert_array_equal(ns.membrane_shape(b), fresh)
+    assert [s["qdldl"] for s in spares] == left  # used, and left again

@@ -42,12 +42,14 @@ The answer is the same (R = 0 to the same tolerance): only the path to it differ
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import threading
 from collections.abc import Callable
 
 import numpy as np
 
-from .linsolve import Factorization, choose_backend, refine, row_sum_norm
+from .linsolve import Cholmod, Factorization, Ldl, choose_backend, refine, row_sum_norm
 from .newton import (
     ARMIJO,
     MAX_BACKTRACK,
@@ -57,6 +59,7 @@ from .newton import (
     POTENTIAL_ROUND_OFF,
     ROUND_OFF,
 )
+from .pattern import shared_extras
 from .state import NetSystem, State, evaluate, ray_potential, tangent_values
 
 FORCING = 0.1  # inexact Newton: linear solves to min(FORCING, |R| / force scale), relative
@@ -79,13 +82,43 @@ PDAS_PASSES = 1  # active-set re-solves per Newton step at most, each by GMRES o
 # (benchmarks/measurements.md#fast-chord-and-repass)
 
 
+# a finished net's linear-solver handle, per backend, kept with its tangent pattern while
+# that is shared (`pattern.shared_extras`: one pattern per topology) for the next net of the
+# pattern: qdldl's AMD ordering and CHOLMOD's symbolic analysis depend on the pattern alone,
+# so that net's factorizations are numeric only (61 x 21 nodes, qdldl: the first 4.0 -> 1.8
+# ms), with the same factors
+_SPARE_LOCK = threading.Lock()
+
+
+def _spare_handle(ns: NetSystem, backend: str) -> Ldl | Cholmod | None:
+    """A spare handle of the net's pattern and backend, or None."""
+    extras = shared_extras(ns.pattern)
+    if extras is None:
+        return None
+    with _SPARE_LOCK:
+        handle = extras.setdefault("spare_handles", {}).pop(backend, None)
+    if isinstance(handle, Ldl):
+        handle.count = 0  # this net's own factorizations decide a switch to PARDISO
+    return handle
+
+
+def _reusable(handle: object, pattern: object) -> bool:
+    """Whether a handle is as a new net's would be after its analysis: a qdldl one (not
+    switched to PARDISO), a CHOLMOD one of this pattern (not turned to LDL^T)."""
+    if isinstance(handle, Ldl):
+        return handle.qdldl is not None and handle.pardiso is None
+    if isinstance(handle, Cholmod):
+        return handle.ldl is None and handle.source is pattern
+    return False
+
+
 class Stepper:
     """Factorizations of one net, reusing the backend's ordering; counts what it does."""
 
     def __init__(self, ns: NetSystem, backend: str | None = None) -> None:
         self.ns = ns
         self.backend = backend or choose_backend(ns.pattern.size)
-        self.handle = None
+        self.handle = _spare_handle(ns, self.backend)
         self.factorizations = 0
         self.active: np.ndarray | None = None  # slack strands the last step's model stretched
         self.predicted: np.ndarray | None = None  # strand tensions the last step's model reached
@@ -105,6 +138,15 @@ class Stepper:
 
     def newton(self, st: State, boost: float = 1.0) -> Factorization:
         return self.factor(self.matrix(st, boost))
+
+    def __del__(self) -> None:
+        """Leave the handle to the next net of the pattern (`_spare_handle`) when `_reusable`."""
+        with contextlib.suppress(Exception):  # at interpreter exit, modules may be gone
+            pattern = self.ns.pattern
+            extras = shared_extras(pattern)
+            if extras is not None and _reusable(self.handle, pattern):
+                with _SPARE_LOCK:
+                    extras.setdefault("spare_handles", {})[self.backend] = self.handle
 
 
 def iterate(ns: NetSystem, st: State, tol: float, max_iter: int, stepper: Stepper

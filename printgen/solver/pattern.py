@@ -1,4 +1,5 @@
-"""A fixed sparse pattern of the tangent on the free degrees of freedom, computed once per net.
+"""A fixed sparse pattern of the tangent on the free degrees of freedom, computed once per net
+topology (`shared_pattern`: nets of one topology share it within a process).
 
 Every Newton step has the same non-zero positions: the 3 x 3 node blocks of each strand and
 each sliding-cable segment, the dense block of each cable (all its nodes share one tension),
@@ -12,6 +13,10 @@ reads) a fixed selection.
 
 from __future__ import annotations
 
+import hashlib
+import threading
+from collections import OrderedDict
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -19,6 +24,11 @@ import scipy.sparse as sp
 # entries (a, b) finds its value among those six
 SYM_PAIRS = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 SYM_INDEX = np.array([[0, 1, 2], [1, 3, 4], [2, 4, 5]])
+# patterns kept per process for reuse by later nets of the same topology (`shared_pattern`),
+# at most this many bytes of arrays in all: the simple scene's pattern takes 5 MB at 61 x 21
+# nodes and 85 MB at 241 x 81 (`Pattern.nbytes`), so the nets a fit or a band sweeps over
+# stay, and one of 481 x 161 nodes (about 4 x 85 MB) is not kept
+SHARED_BYTES = 256 * 2**20
 
 
 def pair_values(k: np.ndarray) -> np.ndarray:
@@ -189,6 +199,18 @@ class Pattern:
         self.z_slots = (self.indptr[z_row[self.z_take]] + offset[diagonal_entry[node]]
                         + rank[3 * node + 2])
 
+    def nbytes(self) -> int:
+        """Bytes of the arrays and sparse operators this pattern holds."""
+        total = 0
+        for value in vars(self).values():
+            parts = value if isinstance(value, tuple) else (value,)
+            for part in parts:
+                if isinstance(part, np.ndarray):
+                    total += part.nbytes
+                elif sp.issparse(part):
+                    total += sum(getattr(part, k).nbytes for k in ("data", "indices", "indptr"))
+        return total
+
     def assemble(self, strand_upper: np.ndarray, cables: np.ndarray, dz: np.ndarray
                  ) -> np.ndarray:
         """CSR data of the strands' symmetric blocks, given by their upper triangles (m, 6)
@@ -224,3 +246,52 @@ def _index(a: np.ndarray) -> np.ndarray:
     """`a` as scipy's index type for it: int32 when its values fit, else int64."""
     small = a.size == 0 or int(a.max()) < np.iinfo(np.int32).max
     return a.astype(np.int32 if small else np.int64)
+
+
+# the shared patterns by topology, each with a dict its users keep derived objects in
+# (`shared_extras`), dropped with it
+_shared: OrderedDict[bytes, tuple[Pattern, dict]] = OrderedDict()
+_shared_lock = threading.Lock()
+
+
+def shared_pattern(n_nodes: int, free: np.ndarray, bar_i: np.ndarray, bar_j: np.ndarray,
+                   cable_nodes: list[np.ndarray]) -> Pattern:
+    """The Pattern of this topology (node count, free dofs, strand node pairs, cables' node
+    sequences), built once per process and shared by every later net of the same topology:
+    a Pattern depends on nothing else and is only read once built. A band's variants, a
+    fit's trials and repeated solves of one net differ in geometry, laws or loads, not in
+    topology. Least recently used patterns go first once SHARED_BYTES are held."""
+    digest = hashlib.blake2b(digest_size=20)  # 160 bits: a collision is out of reach
+    for a in (np.asarray(n_nodes), free, bar_i, bar_j, *cable_nodes):
+        arr = np.ascontiguousarray(a, dtype=np.int64 if a.dtype.kind in "iu" else a.dtype)
+        digest.update(np.asarray(arr.shape, dtype=np.int64).tobytes())  # parts' boundaries
+        digest.update(arr.dtype.str.encode())
+        digest.update(arr.tobytes())
+    key = digest.digest()
+    with _shared_lock:
+        found = _shared.get(key)
+        if found is not None:
+            _shared.move_to_end(key)
+            return found[0]
+    pattern = Pattern(n_nodes, free, bar_i, bar_j, cable_nodes)
+    size = pattern.nbytes()
+    with _shared_lock:
+        if size <= SHARED_BYTES:
+            _shared[key] = (pattern, {})
+            while sum(p.nbytes() for p, _ in _shared.values()) > SHARED_BYTES:
+                _shared.popitem(last=False)
+    return pattern
+
+
+def shared_extras(pattern: Pattern) -> dict | None:
+    """The dict kept with `pattern` while it is shared (`shared_pattern`), for objects that
+    depend on the pattern alone (the solver's spare factorization handles); None when the
+    pattern is not kept. Their bytes do not count towards SHARED_BYTES."""
+    with _shared_lock:
+        return next((extras for p, extras in _shared.values() if p is pattern), None)
+
+
+def clear_shared() -> None:
+    """Forget the shared patterns and their extras (a benchmark's cold solve; tests)."""
+    with _shared_lock:
+        _shared.clear()
