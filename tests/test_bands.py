@@ -22,6 +22,7 @@ COARSE = 3  # the 1:40 net with a 3x coarser mesh (50 nodes): fast sweeps
 LEVELS = np.round(np.arange(0.0, 1.11, 0.1), 10)  # 0.1 steps keep the sweeps short
 ROUND = 1e-12  # round-off allowed between a curve and the band's edge
 LEVELS_V = np.linspace(0.0, 1.1, 12)
+SOFT = 0.005  # a net 200x softer than the 1:40 design's: its 1 N sensor wires fold it
 
 
 
@@ -42,6 +43,21 @@ def test_band_contains_the_nominal_and_every_variant():
                 assert np.all(lo[key] <= c + ROUND) and np.all(c <= hi[key] + ROUND)
     lo, hi = b.envelope()
     assert np.max(hi["deflection"] - lo["deflection"]) > 0  # the variants move the curve
+
+
+def test_a_variant_the_solver_refuses_is_recorded_not_fatal():
+    """A variant whose net is so soft that the sensor wires fold it (the solver's
+    SolverError) gets no curves and the solver's reason; the band and the other variants
+    stand (make and verify go on to a verdict that names it)."""
+    d = coarse_design_1_40(COARSE)
+    nominal = run_variant(d, Variant(), LEVELS)
+    folding = Variant("soft net", options=SceneOptions(net_factor=SOFT, frame_factor=SOFT))
+    b = model_band(d, nominal, variants=[folding, Variant("stiffer cables", options=SceneOptions(
+        cable_factor=1.3))])
+    assert set(b.refused) == {"soft net"} and "folds back" in b.refused["soft net"]
+    assert all(np.all(np.isnan(c)) for c in b.variants["soft net"].values())
+    assert not np.any(np.isnan(b.variants["stiffer cables"]["deflection"]))
+    assert "soft net" not in b.weighted() and "refused" in b.excluded["soft net"]
 
 
 def test_refinement_test_keeps_the_design_net_when_coarsening_changes_the_answer(monkeypatch):

@@ -61,6 +61,28 @@ def test_an_excluded_variant_does_not_decide():
     assert d.verdict == "PASS"
 
 
+def test_an_input_the_solver_refuses_keeps_the_verdict_from_passing():
+    """A weighted variant with no curves (the solver refused it: its sensor wires fold the
+    net) turns a PASS of the others into UNDECIDED, decided by that input; a FAIL stays FAIL,
+    and a refused variant excluded on its own grounds decides nothing."""
+    why = "its sensor wires fold back over their nodes"
+    nan = {k: np.full(len(LEVELS), np.nan) for k in METRICS}
+
+    def refusing(nominal: float, excluded: str = "") -> Band:
+        b = band(nominal, {"free section": (nominal, "mounting span", 0.5, excluded),
+                           "a bit soft": (1.1 * nominal, "lateral mounting", 0.5, "")})
+        return dataclasses.replace(b, variants={**b.variants, "free section": nan},
+                                   refused={"free section": why})
+
+    d = decide(PROTO, refusing(1.0))
+    assert d.verdict == "UNDECIDED" and d.deciding == ["free section"]
+    assert d.questions == ["mounting span"] and d.test == TESTS["mounting span"]
+    assert why in d.sentence() and d.to_record()["refused_variants"] == {"free section": why}
+    assert decide(PROTO, refusing(2.0)).verdict == "FAIL"
+    assert decide(PROTO, refusing(1.0, excluded="sags visibly")).verdict == "PASS"
+    assert "the solver refused it" in refusing(1.0).excluded["free section"]
+
+
 def test_the_prototype_band_counts_too():
     proto = Band(LEVELS, PROTO, {"slack": {k: 1.5 * c for k, c in PROTO.items()}}, {"slack": ""},
                  [], 1, {}, info={"slack": Variant("slack", question="prototype initial slack",

@@ -48,6 +48,9 @@ def band_sections(rep: Report, v: Verification, band: Band) -> None:
     for label, lv in band.failed.items():
         rep.verdict(False, f"{label}: no converged state at h/h_B = "
                            f"{', '.join(f'{x:g}' for x in lv)}; left out of the band there")
+    for label, why in band.refused.items():
+        rep.verdict(False, f"{label}: the solver refused this input ({why}); no curves, left "
+                           "out of the band (the verdict cannot pass while it is plausible)")
     lo, hi = band.envelope()
     clo, chi = band.central()
     p = v.prototype.deformation.values
@@ -137,7 +140,7 @@ def band_record(v: Verification, band: Band) -> dict[str, Any]:
         "variants": band.sources, "variant_curves": band.variants, "notes": band.notes,
         "coarsen": band.coarsen, "refinement_change": {str(k): c for k, c in
                                                        band.refinement.items()},
-        "not_converged": band.failed,
+        "not_converged": band.failed, "refused": band.refused,
         "verdicts": [_verdict(b) for b in band_verdicts(p, band)],
         "verdicts_from_start": [_verdict(b) for b in band_verdicts(p, band, from_start=True)],
     }  # its wall time (band.seconds) goes to the run's timings

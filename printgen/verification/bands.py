@@ -10,6 +10,11 @@ nominal curves stay within `REFINE_TOL` of the design's own net (the refinement 
 with the nominal); a variant's curve is then the nominal curve plus the variant's change on
 the coarse net. Every sweep warm-starts each level from the previous one (solver.solve_path)
 and the runs go to worker processes in parallel.
+
+A variant the solver refuses (its sensor wires fold the net, or too few levels converge:
+`SolverError`) has no curves: it is recorded with the solver's reason (`Band.refused`) and
+carries no weight in the central interval, and the verdict cannot be PASS while such an input
+is plausible (`printgen.verification.decide`): under it the test cannot run as designed.
 """
 
 from __future__ import annotations
@@ -24,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from printgen.barrier.loads import LoadCase
-from printgen.errors import GeometryError
+from printgen.errors import GeometryError, SolverError
 from printgen.executor.local import collect, submit_jobs
 from printgen.inputs.prototype import Prototype
 from printgen.scaling.record import Design
@@ -52,6 +57,22 @@ def run_variant(d: Design, v: Variant, lv: np.ndarray, coarsen: int = 1,
     module-level, picklable)."""
     scene = build_scene(d, dataclasses.replace(v.options, coarsen=coarsen))
     return sweep(scene, lv, slack=v.slack, **(load_kw or {}))
+
+
+@dataclass(frozen=True)
+class Refused:
+    """A variant's sweep the solver refused, with its reason (the SolverError's message)."""
+
+    reason: str
+
+
+def try_variant(d: Design, v: Variant, lv: np.ndarray, coarsen: int = 1,
+                load_kw: dict | None = None) -> Run | Refused:
+    """`run_variant`, with a refusal of the solver returned as `Refused` (a worker job)."""
+    try:
+        return run_variant(d, v, lv, coarsen, load_kw)
+    except SolverError as e:
+        return Refused(str(e))
 
 
 def curves(run: Run) -> dict[str, np.ndarray]:
@@ -84,12 +105,16 @@ class Band:
     sensor_force: float | None = None  # N per sensor wire of the nominal run, kept by every variant
     info: dict[str, Variant] = field(default_factory=dict)  # label -> its variant (weights)
     data_excluded: dict[str, str] = field(default_factory=dict)  # label -> the data's reason
+    refused: dict[str, str] = field(default_factory=dict)  # label -> the solver's reason
 
     @property
     def excluded(self) -> dict[str, str]:
         """label -> why the variant carries no weight: its own reason (the material, the
-        geometry), or the lab's data (`printgen.verification.measured.excluded_by_data`)."""
+        geometry), the solver's refusal (no curves), or the lab's data
+        (`printgen.verification.measured.excluded_by_data`)."""
         out = {k: v.excluded for k, v in self.info.items() if v.excluded}
+        for k, r in self.refused.items():
+            out[k] = "; ".join(x for x in (out.get(k, ""), f"the solver refused it: {r}") if x)
         for k, r in self.data_excluded.items():
             out[k] = "; ".join(x for x in (out.get(k, ""), f"excluded by the data: {r}") if x)
         return out
@@ -209,7 +234,7 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
         k, change = refinement_test(d, nom, lv, load_kw, nominal_variant, work, ahead)
     # longest first (the worker that takes the last job should not start a long one late)
     order = sorted(range(len(variants)), key=lambda i: -variants[i].effort)
-    jobs: list[tuple] = [(run_variant, (d, variants[i], lv, k, load_kw), {}) for i in order]
+    jobs: list[tuple] = [(try_variant, (d, variants[i], lv, k, load_kw), {}) for i in order]
     if k > 1:
         jobs.append((run_variant, (d, nominal_variant, lv, k, load_kw), {}))
     started = submit_jobs(jobs)
@@ -221,16 +246,21 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
     runs = [done[order.index(i)] for i in range(len(variants))]
     # report.json's solver_work rows: the slack variant's first, then the list's order
     recorded = sorted(range(len(variants)), key=lambda i: -variants[i].slack)
-    work += [runs[i].work() for i in recorded] + [r.work() for r in extra]
-    out, failed = {}, {}
+    work += [r.work() for r in (runs[i] for i in recorded) if isinstance(r, Run)]
+    work += [r.work() for r in extra]
+    out, failed, refused = {}, {}, {}
     for v, r in zip(variants, runs, strict=True):
+        if isinstance(r, Refused):
+            refused[v.label] = r.reason
+            out[v.label] = {m: np.full(len(lv), np.nan) for m in METRICS}
+            continue
         c = curves(r)
         out[v.label] = c if base is None else {m: nom[m] + c[m] - base[m] for m in METRICS}
         if r.failed:
             failed[v.label] = sorted(r.failed)
     return Band(lv, nom, out, {v.label: v.source for v in variants}, list(notes or []), k,
                 change, time.perf_counter() - t0, failed, mounting, work, force,
-                {v.label: v for v in variants})
+                {v.label: v for v in variants}, refused=refused)
 
 
 def run_prototype_variant(p: Prototype, v: Variant, lv: np.ndarray, load_kw: dict | None = None

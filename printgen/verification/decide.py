@@ -11,6 +11,11 @@ and geometric similitude has the model hung with the prototype's relative slack,
 is; so the verdict compares the model with 1 % slack against the prototype with 1 % slack,
 never one net slack against the other taut. How closely a lab matches the prototype's sag is
 not modelled (the cheapest test that settles the slack still names it).
+
+A weighted input under which the solver refuses the model (`Band.refused`: its sensor wires
+fold the net, say) has no curves to compare; the test cannot run as designed under it, so the
+verdict is not PASS while it is plausible: a PASS of the others becomes UNDECIDED, decided by
+that input (a FAIL stays FAIL).
 """
 
 from __future__ import annotations
@@ -54,6 +59,7 @@ class Decision:
     tests: list[str]
     tolerance: float = TOLERANCE
     assumptions: list[str] = field(default_factory=list)  # how the bands were compared
+    refused: dict[str, str] = field(default_factory=dict)  # deciding inputs the solver refused
 
     @property
     def test(self) -> str:
@@ -64,6 +70,11 @@ class Decision:
         """The verdict's sentence for UNDECIDED (empty otherwise)."""
         if self.verdict != "UNDECIDED":
             return ""
+        if self.refused:
+            return (f"the other inputs pass, but under {'; '.join(self.refused)} the solver "
+                    f"cannot run the test ({'; '.join(dict.fromkeys(self.refused.values()))}); "
+                    f"it turns on {', '.join(self.questions)}; the cheapest test that settles "
+                    f"it: {self.test}")
         open_ = [METRICS[m.metric].split(" (")[0] for m in self.metrics
                  if m.status == "UNDECIDED"]
         return (f"the model's and the prototype's central bands straddle the "
@@ -77,7 +88,7 @@ class Decision:
         return {"verdict": self.verdict, "tolerance": self.tolerance,
                 "deciding_variants": self.deciding, "deciding_questions": self.questions,
                 "cheapest_test": self.test, "tests": self.tests,
-                "assumptions": self.assumptions,
+                "assumptions": self.assumptions, "refused_variants": self.refused,
                 "metrics": [{"metric": m.metric, "status": m.status,
                              "worst_mismatch": m.worst, "best_mismatch": m.best,
                              "deciding_variants": m.deciding} for m in self.metrics]}
@@ -112,12 +123,18 @@ def decide(proto: dict[str, np.ndarray], model: Band, prototype: Band | None = N
     kinds = {m.status for m in out}
     verdict = "FAIL" if "FAIL" in kinds else "UNDECIDED" if "UNDECIDED" in kinds else "PASS"
     labels = sorted({x for m in out for x in m.deciding}, key=lambda x: -effects.get(x, 0.0))
+    refused = {k: r for k, r in model.refused.items()
+               if model.info[k].weight > 0 and not model.info[k].excluded}
+    if verdict == "PASS" and refused:  # no curves under these inputs: the test cannot run
+        verdict, labels = "UNDECIDED", list(refused)
+    else:
+        refused = {}
     if verdict != "UNDECIDED":
         labels = []
     info = {**model.info, **(prototype.info if prototype is not None else {})}
     questions = list(dict.fromkeys(info[x].question or x for x in labels))
     return Decision(verdict, out, labels, questions, settling_tests(questions), tolerance,
-                    assumptions)
+                    assumptions, refused)
 
 
 SLACK = ("initial slack", "prototype initial slack")  # the variants' questions, model's first
