@@ -165,17 +165,24 @@ def solver_rows(out: Path, repeat: int) -> list[dict]:
     t241 = goals.get("time_241x81_s")
     spread = goals.get("cpu_us_per_unknown_spread")
     paired = [v for k, v in goals.items() if k.startswith("opensees_ratio_61x21_paired")]
-    ratio = paired[0]["wall"]["median"] if paired else None  # {"wall"|"cpu": median, range}
-    cpu_ratio = paired[0]["cpu"]["median"] if paired else None
+    # {"wall"|"cpu"|"cold_wall"|"cold_cpu": median, range}. The goal's ratio is the cold one:
+    # OpenSees builds its model at every call, so printgen's solve there builds its pattern and
+    # factorization afresh too; the warm ratio (a pattern shared by repeated solves of one
+    # topology, as a band's variants and a fit's trials have it) is shown beside it.
+    median = {k: paired[0][k]["median"] for k in ("wall", "cpu", "cold_wall", "cold_cpu")
+              } if paired else {}
+    ratio = median.get("cold_wall")
     return [_row("solver 241 x 81, tol 1e-6", "printgen bench solver", t241, "s",
                  f"<= {GOAL_241_S:g} s", None if t241 is None else t241 <= GOAL_241_S, load),
             _row("solver CPU per unknown, 14k to 228k unknowns", "printgen bench solver", spread,
                  "x (largest / smallest)", f"within {GOAL_PER_UNKNOWN:g}x",
                  None if spread is None else spread <= GOAL_PER_UNKNOWN, load,
                  cpu_us_per_unknown=goals.get("cpu_us_per_unknown")),
-            _row("OpenSeesPy / printgen at 61 x 21", "printgen bench solver", ratio, "x",
-                 f">= {GOAL_OPENSEES:g}x", None if ratio is None else ratio >= GOAL_OPENSEES,
-                 load, cpu_ratio=cpu_ratio)]
+            _row("OpenSeesPy / printgen at 61 x 21 (each solve from scratch)",
+                 "printgen bench solver", ratio, "x", f">= {GOAL_OPENSEES:g}x",
+                 None if ratio is None else ratio >= GOAL_OPENSEES, load,
+                 cold_cpu_ratio=median.get("cold_cpu"), warm_wall_ratio=median.get("wall"),
+                 warm_cpu_ratio=median.get("cpu"))]
 
 
 ROWS: dict[str, Callable[[Path, int], list[dict]]] = {
