@@ -105,6 +105,25 @@ def planned(path: Path, scale: float = 40):
     return p, make_design(p, t, select(p, t))
 
 
+PIECE_FILES = (".stl", ".3mf", ".prusa.ini", ".gcode", ".specimen.toml")  # each test piece's
+
+
+def piece_files(piece: str) -> set[str]:
+    """The files `printgen testpieces` writes for one piece ("coupon", "panel", ...)."""
+    return {piece + suffix for suffix in PIECE_FILES}
+
+
+def write_test_pieces(d, root: Path):
+    """`printgen testpieces` of design `d` through its design.json in `root`: (d, the
+    record, the output folder)."""
+    from printgen.report.jsonout import dumps
+    from printgen.run.testpieces import testpieces
+
+    path = root / "design.json"
+    path.write_text(dumps(d.to_dict()))
+    return d, testpieces(path, root / "out"), root / "out"
+
+
 def coarse_simple_file(folder: Path) -> Path:
     """examples/simple_barrier.toml on a mesh twice as coarse (COARSE_SIMPLE), written in
     `folder`: the same scene on fewer nodes."""

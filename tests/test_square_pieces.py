@@ -14,7 +14,13 @@ import sys
 
 import numpy as np
 import pytest
-from conftest import reference_design_1_40, require_shared, require_tool
+from conftest import (
+    piece_files,
+    reference_design_1_40,
+    require_shared,
+    require_tool,
+    write_test_pieces,
+)
 from test_calibrate_files import write_export
 
 from printgen.calibrate.pipeline import calibrate
@@ -101,13 +107,8 @@ def test_panel_size_holds_the_argued_strands_and_meshes(mesh_mm):
 # ----------------------------------------------------------------------------- the folder
 @pytest.fixture(scope="module", params=list(DESIGNS))
 def pieces(request, tmp_path_factory):
-    from printgen.run.testpieces import testpieces
-
-    root = tmp_path_factory.mktemp(f"square-{request.param}")
-    d = DESIGNS[request.param]()
-    path = root / "design.json"
-    path.write_text(dumps(d.to_dict()))
-    return d, testpieces(path, root / "out"), root / "out"
+    return write_test_pieces(DESIGNS[request.param](), tmp_path_factory.mktemp(
+        f"square-{request.param}"))
 
 
 @pytest.mark.slow
@@ -115,8 +116,7 @@ def test_folder_holds_the_pieces_the_sidecars_and_the_square_loop(pieces):
     d, rec, out = pieces
     names = {p.name for p in out.iterdir()}
     for piece in ("coupon", "panel"):
-        assert {f"{piece}.stl", f"{piece}.3mf", f"{piece}.prusa.ini", f"{piece}.gcode",
-                f"{piece}.specimen.toml"} <= names
+        assert piece_files(piece) <= names
     assert ("wave-coupon.stl" in names) == (d.net.wave is not None)
     listed = set(json.loads((out / "manifest.json").read_text())["files"])
     assert names - {"manifest.json"} <= listed

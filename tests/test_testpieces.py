@@ -12,7 +12,7 @@ import sys
 
 import numpy as np
 import pytest
-from conftest import reference_design_1_40, require_shared, require_tool
+from conftest import piece_files, reference_design_1_40, require_shared, require_tool
 from test_calibrate_files import write_export
 
 from printgen.calibrate.pipeline import calibrate
@@ -58,8 +58,7 @@ def test_folder_holds_every_piece_its_sidecars_and_the_loop(pieces):
     d, rec, out = pieces
     names = {p.name for p in out.iterdir()}
     for piece in ("coupon", "panel"):
-        assert {f"{piece}.stl", f"{piece}.3mf", f"{piece}.prusa.ini", f"{piece}.gcode",
-                f"{piece}.specimen.toml"} <= names
+        assert piece_files(piece) <= names
     assert {"panel-expected.csv", "README.md", RECORD, "manifest.json"} <= names
     listed = set(json.loads((out / "manifest.json").read_text())["files"])
     assert names - {"manifest.json"} <= listed

@@ -15,7 +15,7 @@ import sys
 
 import numpy as np
 import pytest
-from conftest import reference_design_1_40, require_shared, require_tool
+from conftest import reference_design_1_40, require_shared, require_tool, write_test_pieces
 from test_calibrate_files import write_export
 
 from printgen.calibrate.pipeline import calibrate
@@ -31,7 +31,6 @@ from printgen.parts.geometry.wavecoupon import (
     coupon_solid,
     waved_coupon_for,
 )
-from printgen.report.jsonout import dumps
 from printgen.scaling.record import Section, Wave
 
 VOLUME_TOL = 0.02  # the brief: the coupon's volume within 2 % of the analytic one, and its
@@ -324,13 +323,7 @@ def test_a_waved_panel_is_linear_in_the_law_scale_and_calibrates_back(tmp_path):
 # ----------------------------------------------------------------------------- testpieces
 @pytest.fixture(scope="module")
 def pieces(tmp_path_factory):
-    from printgen.run.testpieces import testpieces
-
-    root = tmp_path_factory.mktemp("waved-pieces")
-    path = root / "design.json"
-    d = _waved()
-    path.write_text(dumps(d.to_dict()))
-    return d, testpieces(path, root / "out"), root / "out"
+    return write_test_pieces(_waved(), tmp_path_factory.mktemp("waved-pieces"))
 
 
 @pytest.mark.slow

@@ -20,8 +20,8 @@ from printgen.errors import CalibrationError
 ZOOM_MARGIN = 1.5  # right panel shows strains up to this factor times the window's upper end
 
 
-def plot_calibration(cal: Calibration, path: str | Path) -> Path:
-    """Write the calibration plot to `path` (PNG) atomically; return the path."""
+def _pyplot():
+    """matplotlib's pyplot on the Agg backend, or a CalibrationError saying how to get it."""
     try:
         import matplotlib
 
@@ -29,6 +29,20 @@ def plot_calibration(cal: Calibration, path: str | Path) -> Path:
         import matplotlib.pyplot as plt
     except ImportError as exc:  # pragma: no cover - depends on the install
         raise CalibrationError("plots need matplotlib: pip install 'printgen[plot]'") from exc
+    return plt
+
+
+def _save(plt, fig, path: str | Path) -> Path:
+    """Write `fig` to `path` as a PNG, atomically, and close it."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    plt.close(fig)
+    return outputs.write_bytes(path, buf.getvalue())
+
+
+def plot_calibration(cal: Calibration, path: str | Path) -> Path:
+    """Write the calibration plot to `path` (PNG) atomically; return the path."""
+    plt = _pyplot()
     if not cal.samples:
         raise CalibrationError("nothing to plot: no curves were fitted (force-only files)")
     panel = cal.kind == "panel"
@@ -60,22 +74,13 @@ def plot_calibration(cal: Calibration, path: str | Path) -> Path:
         ax.set_ylabel(ylab)
         ax.grid(alpha=0.3)
     ax_all.legend(fontsize=7, loc="lower right")
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    plt.close(fig)
-    return outputs.write_bytes(path, buf.getvalue())
+    return _save(plt, fig, path)
 
 
 def plot_waved(cal: WaveCalibration, path: str | Path) -> Path:
     """The measured curves against the prediction as assumed (s = 1) and as fitted (s), with
     both bilinear knees marked: one PNG written atomically."""
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError as exc:  # pragma: no cover - depends on the install
-        raise CalibrationError("plots need matplotlib: pip install 'printgen[plot]'") from exc
+    plt = _pyplot()
     fig, ax = plt.subplots(figsize=(8, 5), constrained_layout=True)
     m = cal.model
     e = np.linspace(0.0, max(s.strain_max for s in cal.samples), 200)
@@ -101,10 +106,7 @@ def plot_waved(cal: WaveCalibration, path: str | Path) -> Path:
         ax.set_title(f"{cal.material}: waved coupons against the beam model")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="upper left")
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    plt.close(fig)
-    return outputs.write_bytes(path, buf.getvalue())
+    return _save(plt, fig, path)
 
 
 def printable(name: str) -> str:
