@@ -124,6 +124,36 @@ def write_test_pieces(d, root: Path):
     return d, testpieces(path, root / "out"), root / "out"
 
 
+PIECE_SLICE_TIMEOUT_S = 300  # s: PrusaSlicer and the checker on one test piece, loaded machine
+
+
+def slice_check_piece(d, out: Path, piece: str, tmp_path: Path, width: str | None = None
+                      ) -> str:
+    """Slice test piece `piece` of design `d` (in folder `out`) with PrusaSlicer and check
+    the G-code with the shared checker (slice_check.sh) at the net strand's bead, or at
+    `width` (mm, as text); assert it passes and return the checker's last line."""
+    import os
+    import subprocess
+    import sys
+
+    from printgen.inputs.materials import load_material
+
+    require_tool("prusa-slicer")
+    script = require_shared("tools/gcode/slice_check.sh")
+    mat = load_material(d.net.material).print
+    env = dict(os.environ, OUT_DIR=str(tmp_path), PYTHON=sys.executable)
+    r = subprocess.run(
+        ["bash", str(script), str(out / f"{piece}.stl"), str(out / f"{piece}.prusa.ini"),
+         "--width", width or f"{d.net.strand.bead_width_mm}", "--area-model", "stadium",
+         "--layers", f"{len(d.net.strand.layer_heights_mm)}",
+         "--max-flow", f"{mat.max_volumetric_flow_mm3_per_s:g}"],
+        capture_output=True, text=True, env=env, timeout=PIECE_SLICE_TIMEOUT_S, check=False)
+    last = r.stdout.strip().splitlines()[-1] if r.stdout.strip() else r.stderr
+    assert r.returncode == 0, last
+    assert last.startswith("SLICE-CHECK OK"), last
+    return last
+
+
 def coarse_simple_file(folder: Path) -> Path:
     """examples/simple_barrier.toml on a mesh twice as coarse (COARSE_SIMPLE), written in
     `folder`: the same scene on fewer nodes."""

@@ -79,6 +79,24 @@ def write_export(path: Path, channels: dict[str, np.ndarray], variant_name: str,
     return out
 
 
+def noisy_breaking_exports(folder: Path, stem: str, eps: np.ndarray, force: np.ndarray,
+                           length: float, noise: float, n: int = 3, seed: int = 36
+                           ) -> list[Path]:
+    """`n` Bluehill-like exports of a test of `force` (N) at strains `eps` over gauge
+    `length` (m): normal noise of SD `noise` x the largest force, then a drop (the break) a
+    fit must leave out."""
+    rng = np.random.default_rng(seed)
+    tail = np.linspace(0, 1, 20)[1:]
+    e = np.concatenate([eps, eps[-1] + 0.002 * tail])
+    paths = []
+    for i in range(n):
+        f = force + noise * force.max() * rng.standard_normal(eps.size)
+        f = np.concatenate([f, f[-1] * (1 - 0.9 * tail)])
+        ch = {"time": np.arange(e.size) * 0.1, "force": f, "displacement": e * length}
+        paths.append(write_export(folder / f"{stem}-{i}", ch, "bluehill_quoted"))
+    return paths
+
+
 def _channels(n: int = 50) -> dict[str, np.ndarray]:
     t = np.linspace(0.0, 10.0, n)
     return {"time": t, "force": 1234.5 * t + 0.25, "displacement": 1e-4 * t}

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import os
 import subprocess
 import sys
 
@@ -18,10 +17,10 @@ from conftest import (
     piece_files,
     reference_design_1_40,
     require_shared,
-    require_tool,
+    slice_check_piece,
     write_test_pieces,
 )
-from test_calibrate_files import write_export
+from test_calibrate_files import noisy_breaking_exports, write_export
 
 from printgen.calibrate.pipeline import calibrate
 from printgen.calibrate.specimen import read_sidecar
@@ -172,16 +171,7 @@ def _panel_exports(tmp_path, out, scale: float, noise: float, n: int = 3) -> lis
     length = read_sidecar(out / "panel.specimen.toml")["grip_distance"]
     eps = np.linspace(0.0, model.top(), N_POINTS)
     force = scale * model.predict(eps) * model.panel_width
-    rng = np.random.default_rng(36)
-    paths = []
-    for i in range(n):
-        f = force + noise * force.max() * rng.standard_normal(eps.size)
-        tail = np.linspace(0, 1, 20)[1:]
-        e = np.concatenate([eps, eps[-1] + 0.002 * tail])
-        f = np.concatenate([f, f[-1] * (1 - 0.9 * tail)])
-        ch = {"time": np.arange(e.size) * 0.1, "force": f, "displacement": e * length}
-        paths.append(write_export(tmp_path / f"panel-{i}", ch, "bluehill_quoted"))
-    return paths
+    return noisy_breaking_exports(tmp_path, "panel", eps, force, length, noise, n)
 
 
 @pytest.mark.slow
@@ -273,17 +263,5 @@ def test_cli_writes_a_square_designs_pieces(tmp_path, capsys):
 
 @pytest.mark.slow
 def test_prusaslicer_slices_the_square_panel_and_the_checker_passes_it(pieces, tmp_path):
-    require_tool("prusa-slicer")
-    script = require_shared("tools/gcode/slice_check.sh")
     d, _, out = pieces
-    mat = load_material(d.net.material).print
-    env = dict(os.environ, OUT_DIR=str(tmp_path), PYTHON=sys.executable)
-    r = subprocess.run(
-        ["bash", str(script), str(out / "panel.stl"), str(out / "panel.prusa.ini"),
-         "--width", f"{d.net.strand.bead_width_mm}", "--area-model", "stadium",
-         "--layers", f"{len(d.net.strand.layer_heights_mm)}",
-         "--max-flow", f"{mat.max_volumetric_flow_mm3_per_s:g}"],
-        capture_output=True, text=True, env=env, timeout=CHECK_TIMEOUT_S, check=False)
-    last = r.stdout.strip().splitlines()[-1] if r.stdout.strip() else r.stderr
-    assert r.returncode == 0, last
-    assert last.startswith("SLICE-CHECK OK")
+    slice_check_piece(d, out, "panel", tmp_path)

@@ -6,13 +6,17 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import os
 import subprocess
 import sys
 
 import numpy as np
 import pytest
-from conftest import piece_files, reference_design_1_40, require_shared, require_tool
+from conftest import (
+    piece_files,
+    reference_design_1_40,
+    require_shared,
+    slice_check_piece,
+)
 from test_calibrate_files import write_export
 
 from printgen.calibrate.pipeline import calibrate
@@ -111,20 +115,8 @@ def test_direct_gcode_passes_the_checker(pieces, piece):
 
 @pytest.mark.parametrize("piece", ["coupon", "panel"])
 def test_prusaslicer_slices_the_piece_and_the_checker_passes_it(pieces, piece, tmp_path):
-    require_tool("prusa-slicer")
-    script = require_shared("tools/gcode/slice_check.sh")
     d, _, out = pieces
-    mat = load_material(d.net.material).print
-    env = dict(os.environ, OUT_DIR=str(tmp_path), PYTHON=sys.executable)
-    r = subprocess.run(
-        ["bash", str(script), str(out / f"{piece}.stl"), str(out / f"{piece}.prusa.ini"),
-         "--width", f"{d.net.strand.bead_width_mm}", "--area-model", "stadium",
-         "--layers", f"{len(d.net.strand.layer_heights_mm)}",
-         "--max-flow", f"{mat.max_volumetric_flow_mm3_per_s:g}"],
-        capture_output=True, text=True, env=env, timeout=SLICE_TIMEOUT_S, check=False)
-    last = r.stdout.strip().splitlines()[-1] if r.stdout.strip() else r.stderr
-    assert r.returncode == 0, last
-    assert last.startswith("SLICE-CHECK OK")
+    slice_check_piece(d, out, piece, tmp_path)
 
 
 def test_coupon_export_of_a_known_modulus_calibrates_back(pieces, tmp_path):

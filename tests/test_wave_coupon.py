@@ -9,14 +9,18 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import os
 import subprocess
 import sys
 
 import numpy as np
 import pytest
-from conftest import reference_design_1_40, require_shared, require_tool, write_test_pieces
-from test_calibrate_files import write_export
+from conftest import (
+    reference_design_1_40,
+    require_shared,
+    slice_check_piece,
+    write_test_pieces,
+)
+from test_calibrate_files import noisy_breaking_exports, write_export
 
 from printgen.calibrate.pipeline import calibrate
 from printgen.calibrate.waved import WaveCalibration, WaveModel, read_wave
@@ -144,18 +148,9 @@ def _exports(tmp_path, model: WaveModel, scale: float, noise: float, n: int = 3,
     """Bluehill-like exports of coupons whose law is `scale` x the model's: force from the
     beam model, crosshead displacement over the chord, normal noise of SD `noise` x the
     largest force, then a drop (the break) the fit must leave out."""
-    rng = np.random.default_rng(seed)
     eps = np.linspace(0.0, model.top(), N_POINTS)
     force = scale * model.strands * model.curve().law().force_and_tangent(eps)[0]
-    paths = []
-    for i in range(n):
-        f = force + noise * force.max() * rng.standard_normal(eps.size)
-        tail = np.linspace(0, 1, 20)[1:]
-        e = np.concatenate([eps, eps[-1] + 0.002 * tail])
-        f = np.concatenate([f, f[-1] * (1 - 0.9 * tail)])
-        ch = {"time": np.arange(e.size) * 0.1, "force": f, "displacement": e * model.chord}
-        paths.append(write_export(tmp_path / f"wave-{i}", ch, "bluehill_quoted"))
-    return paths
+    return noisy_breaking_exports(tmp_path, "wave", eps, force, model.chord, noise, n, seed)
 
 
 @pytest.mark.parametrize("noise", SCALE_RTOL)
@@ -371,21 +366,9 @@ def test_testpieces_sidecar_calibrates_a_synthetic_export_back(pieces, tmp_path)
 
 @pytest.mark.slow
 def test_prusaslicer_slices_the_waved_coupon_and_the_checker_passes_it(pieces, tmp_path):
-    require_tool("prusa-slicer")
-    script = require_shared("tools/gcode/slice_check.sh")
     d, _, out = pieces
-    mat = load_material(d.net.material).print
     ini = dict(line.split(" = ", 1) for line in
                (out / "wave-coupon.prusa.ini").read_text().splitlines() if " = " in line)
-    env = dict(os.environ, OUT_DIR=str(tmp_path), PYTHON=sys.executable)
     # the tabs (most of the coupon's extrusion) are laid at the .ini's extrusion width
-    r = subprocess.run(
-        ["bash", str(script), str(out / "wave-coupon.stl"), str(out / "wave-coupon.prusa.ini"),
-         "--width", ini["extrusion_width"], "--area-model", "stadium",
-         "--layers", f"{len(d.net.strand.layer_heights_mm)}",
-         "--max-flow", f"{mat.max_volumetric_flow_mm3_per_s:g}"],
-        capture_output=True, text=True, env=env, timeout=SLICE_TIMEOUT_S, check=False)
-    last = r.stdout.strip().splitlines()[-1] if r.stdout.strip() else r.stderr
-    assert r.returncode == 0, last
-    assert last.startswith("SLICE-CHECK OK")
+    slice_check_piece(d, out, "wave-coupon", tmp_path, width=ini["extrusion_width"])
 
