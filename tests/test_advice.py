@@ -158,8 +158,8 @@ def test_the_design_search_sweeps_the_prototype_once_per_scale(monkeypatch):
     run = search_at_scales(REALISTIC, [40.0, 50.0], options=small, run=RunOptions(serial=True))
     proto = [n for n in names if "prototype" in n]
     assert len(proto) == 2  # one per scale
-    # and select's pick, and the waves of the chosen net the wave stage verified
-    verified = sum(len(r.verified) + 1 + (len(r.wave.verified) if r.wave else 0)
+    # and select's pick, and the wave stage's sweeps (coarse trials, then on the own net)
+    verified = sum(len(r.verified) + 1 + (len(r.wave.trials) + len(r.wave.full) if r.wave else 0)
                    for r in run.results)
     assert len(names) - len(proto) == verified
 
