@@ -69,14 +69,17 @@ def testpieces(design_path: str | Path, out: str | Path, *, orientation: str = "
                "loop": [s.format(n=COUPON_COUNT, mat=d.net.material) for s in LOOP]}
         rec["panel"]["geometry"] = piece.to_record()
         rec["coupon"]["geometry"] = _coupon_geometry(coupon)
+        if d.net.wave is not None:
+            from printgen.run.wavepieces import wave_coupon_files
+
+            rec["wave_coupon"] = wave_coupon_files(stage, d, printer)
         if blocked is None:  # a square net's panel (`printgen.run.squarepieces`)
-            _square_files(stage, d, dp, piece, printer, rec)
+            _square_files(stage, d, dp, piece, rec)
         else:
             rec["panel"]["expected_curve"] = _expected(stage, dp, blocked)
         if d.net.wave is not None and blocked is not None:
-            from printgen.run.wavepieces import CALIBRATE, wave_coupon_files, wave_panel_sidecar
+            from printgen.run.wavepieces import CALIBRATE, wave_panel_sidecar
 
-            rec["wave_coupon"] = wave_coupon_files(stage, d, printer)
             rec["panel"]["strands"] = dp.strands
             rec["panel"]["sidecar"] = wave_panel_sidecar(stage, d, dp, piece)
             rec["loop"][2] = CALIBRATE.format(mat=d.net.material)
@@ -115,19 +118,14 @@ def _panel(d: Design, orientation: str):
     return dp, blocked, panel_for(d, orientation, length / MM, width / MM)
 
 
-def _square_files(stage: Path, d: Design, dp, piece: PanelPiece, printer,
-                  rec: dict[str, Any]) -> None:
-    """The square panel's expected curve, sidecar and loop step (`run.squarepieces`), and a
-    waved square net's waved coupon, into `rec`."""
+def _square_files(stage: Path, d: Design, dp, piece: PanelPiece, rec: dict[str, Any]) -> None:
+    """The square panel's expected curve, sidecar and loop step (`run.squarepieces`), into
+    `rec`."""
     from printgen.run.squarepieces import square_calibrate, square_expected, square_sidecar
 
     rec["panel"]["expected_curve"] = square_expected(stage, dp)
     rec["panel"]["strands"] = dp.strands
     rec["panel"]["sidecar"] = square_sidecar(stage, d, dp, piece)
-    if d.net.wave is not None:
-        from printgen.run.wavepieces import wave_coupon_files
-
-        rec["wave_coupon"] = wave_coupon_files(stage, d, printer)
     rec["loop"][2] = square_calibrate(d)
 
 
