@@ -60,9 +60,7 @@ def coupon_toolpath(c: WavedCoupon, printer: Printer, style: PrintStyle,
                        BORDER, travel)
         for i, line in enumerate(lines):
             pts = line if (i + k) % 2 == 0 else line[::-1]
-            mid = (pts[1:, 0] + pts[:-1, 0]) / 2
-            in_tab = (mid < 0.0) | (mid > c.chord_mm)
-            for p0, p1, lap in zip(pts[:-1], pts[1:], in_tab, strict=True):
+            for p0, p1, lap in zip(pts[:-1], pts[1:], _in_tabs(pts, c.chord_mm), strict=True):
                 b.line(p0, p1, zk, sec.bead_width_mm, h, v,
                        style.crossing_flow_factor if lap else 1.0, k, STRAND_PLUS, travel)
     return b.toolpath([float(round(x, 6)) for x in z], f"waved coupon {c.name}")
@@ -79,6 +77,13 @@ def _strand_lines(c: WavedCoupon) -> list[np.ndarray]:
             off = (i - (sec.beads_across - 1) / 2) * sec.bead_width_mm
             out.append(_split_at_edges(ws.polyline(-lap, c.chord_mm + lap, off), c.chord_mm))
     return out
+
+
+def _in_tabs(line: np.ndarray, chord_mm: float) -> np.ndarray:
+    """Per move of polyline `line` (split at the tab edges: `_split_at_edges`), whether it
+    lies in a tab (its midpoint outside the gauge, 0 to chord_mm)."""
+    mid = (line[1:, 0] + line[:-1, 0]) / 2
+    return (mid < 0.0) | (mid > chord_mm)
 
 
 def _split_at_edges(p: np.ndarray, chord_mm: float) -> np.ndarray:
@@ -104,8 +109,7 @@ def coupon_volume_budget(c: WavedCoupon, crossing_flow_factor: float) -> VolumeB
     gauge = lap = 0.0
     for line in _strand_lines(c):
         seg = np.hypot(*np.diff(line, axis=0).T)
-        mid = (line[1:, 0] + line[:-1, 0]) / 2
-        inside = (mid < 0.0) | (mid > c.chord_mm)
+        inside = _in_tabs(line, c.chord_mm)
         gauge += float(seg[~inside].sum()) * sec.bead_width_mm
         lap += float(seg[inside].sum()) * sec.bead_width_mm
     return VolumeBudget((tabs + gauge + lap) * t, 0.0, lap * t, 1.0, 0,
