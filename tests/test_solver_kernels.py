@@ -255,7 +255,7 @@ def test_shared_pattern_is_one_per_topology_and_equals_a_fresh_build(monkeypatch
     least = NetSystem(Net(net.nodes, net.fixed, net.elements[:-2], LAWS,
                           element_law=net.element_law[:-2], cables=net.cables)).pattern
     assert least.nbytes() < ns.pattern.nbytes()
-    assert [p for p, _ in pattern_module._shared.values()] == [ns.pattern, least]
+    assert [entry[0] for entry in pattern_module._shared.values()] == [ns.pattern, least]
     pattern_module.clear_shared()
     assert NetSystem(net).pattern is not ns.pattern
 

@@ -250,7 +250,7 @@ def _index(a: np.ndarray) -> np.ndarray:
 
 # the shared patterns by topology, each with a dict its users keep derived objects in
 # (`shared_extras`), dropped with it
-_shared: OrderedDict[bytes, tuple[Pattern, dict]] = OrderedDict()
+_shared: OrderedDict[bytes, tuple[Pattern, dict, int]] = OrderedDict()  # + its nbytes()
 _shared_lock = threading.Lock()
 
 
@@ -277,8 +277,8 @@ def shared_pattern(n_nodes: int, free: np.ndarray, bar_i: np.ndarray, bar_j: np.
     size = pattern.nbytes()
     with _shared_lock:
         if size <= SHARED_BYTES:
-            _shared[key] = (pattern, {})
-            while sum(p.nbytes() for p, _ in _shared.values()) > SHARED_BYTES:
+            _shared[key] = (pattern, {}, size)
+            while sum(entry[2] for entry in _shared.values()) > SHARED_BYTES:
                 _shared.popitem(last=False)
     return pattern
 
@@ -288,7 +288,7 @@ def shared_extras(pattern: Pattern) -> dict | None:
     depend on the pattern alone (the solver's spare factorization handles); None when the
     pattern is not kept. Their bytes do not count towards SHARED_BYTES."""
     with _shared_lock:
-        return next((extras for p, extras in _shared.values() if p is pattern), None)
+        return next((extras for p, extras, _ in _shared.values() if p is pattern), None)
 
 
 def clear_shared() -> None:
