@@ -42,7 +42,7 @@ def drawings(example: Path) -> list:
     ctx = plan_run(example, SCALE)
     with TemporaryDirectory() as tmp:
         ctx.records.steps.update(kit_step(ctx, Path(tmp)))
-    v, band = verification_sweeps(ctx.prototype, ctx.design)
+    v, band = verification_sweeps(ctx.prototype, ctx.design, ctx.options)
     ctx.records.steps["verification"] = verification_records(v, band, SCALE)[0]
     rep, _ = build_report(ctx.records)
     return list(zip([f.name for f in rep.figures], rep.pending(), strict=True))
