@@ -13,11 +13,13 @@ Errors are the mid-height centre deflection against a tight-tolerance solve of t
 current-height variant is timed too. Times are wall-clock (perf_counter) and CPU
 (process_time), each the best of REPEAT at GOAL_TOL, with BLAS/MKL pinned to --threads
 threads (threadpoolctl; default 1); `size_table` lists them per size with the backend and
-the microseconds per unknown, and for PARDISO its CPU by phase (analysis, numeric
-factorizations, solves); --compare-threads 1 2 adds the same solves per thread count
-(`threads_table`); --backends ldl cholmod times the same solve with each linear backend in
-turn (`backend_table`: where CHOLMOD overtakes qdldl), and with --backend-path-scale S the
-verification's load paths at 1:S too (`backend_paths`). The ratio to OpenSeesPy at 61 x 21 is
+the microseconds per unknown, and for PARDISO and CHOLMOD their CPU by phase (analysis,
+numeric factorizations, solves), and one more solve per size from cold (the shared patterns
+forgotten first: `cold_cpu_s`, the goals' `cpu_us_per_unknown_spread_cold`);
+--compare-threads 1 2 adds the same solves per thread count (`threads_table`); --backends
+ldl cholmod times the same solve with each linear backend in turn (`backend_table`: where
+CHOLMOD overtakes qdldl), and with --backend-path-scale S the verification's load paths at
+1:S too (`backend_paths`). The ratio to OpenSeesPy at 61 x 21 is
 also measured pair by pair (`paired_ratio`: PAIRS pairs, alternating, one thread each; wall
 and CPU time of each whole call, median and range, with the load average; in a fresh process
 and in this one, see `paired_both`); --opensees-only measures only that.
@@ -37,7 +39,7 @@ import numpy as np
 
 from printgen.solver import solve, solve_path
 from printgen.solver.driver import FastSolver
-from printgen.solver.linsolve import Pardiso
+from printgen.solver.linsolve import Cholmod, Pardiso
 from printgen.solver.loads import total_forces
 from printgen.solver.newton import MAX_ITER
 from printgen.solver.pattern import clear_shared
@@ -222,30 +224,55 @@ def robustness() -> list[dict]:
     return out
 
 
-def _solve_once(sc, tol: float, method: str, backend: str | None = None):
-    """(result, CPU s, PARDISO's CPU by phase or None, set-up CPU s or None): what
-    `solver.solve` does, with the fast path's solver kept to read its PARDISO instance's
-    counters; the set-up is the net's NetSystem (pattern, damping, incidence). `backend`:
-    the linear backend (None: `choose_backend`'s)."""
+def _solve_once(sc, tol: float, method: str, backend: str | None = None, cold: bool = False):
+    """(result, CPU s, the backend's CPU by phase or None, set-up CPU s or None): what
+    `solver.solve` does, with the fast path's solver kept to read its PARDISO or CHOLMOD
+    object's counters (`_phases`); the set-up is the net's NetSystem (pattern, damping,
+    incidence). `backend`: the linear backend (None: `choose_backend`'s). `cold`: the shared
+    patterns forgotten first, so the pattern, CHOLMOD's or qdldl's analysis and the
+    membrane start's ordering are all computed inside the call, as for a net solved once."""
+    if cold:
+        clear_shared()
     c0 = time.process_time()
     if method != "fast":
         return solve(sc.net, sc.loads_at(1.0), tol=tol, method=method), \
             time.process_time() - c0, None, None
     fs = FastSolver(sc.net, backend)
     setup = time.process_time() - c0
+    before = fs.stepper.handle, _counters(fs.stepper.handle)  # a spare handle: counted before
     r = fs.solve(sc.loads_at(1.0), [], tol, MAX_ITER)
     cpu = time.process_time() - c0
-    handle = fs.stepper.handle
-    work = None
-    if isinstance(handle, Pardiso):
-        work = {f"{name}_cpu_s": handle.cpu[name] for name in handle.cpu}
-        work |= {f"{name}_calls": handle.calls[name] for name in handle.calls}
-    return r, cpu, work, setup
+    return r, cpu, _phases(fs.stepper.handle, before), setup
 
 
-def _run(sc, tol: float, d_ref: float, *, method: str = "fast", repeat: int = 1) -> dict:
-    """One printgen solve at `tol` (best wall time and best CPU time of `repeat`; PARDISO's
-    CPU by phase in the run of best CPU)."""
+def _counters(handle) -> dict | None:
+    """A PARDISO or CHOLMOD object's CPU seconds and calls by phase (`linsolve.PHASES`), as
+    {"<phase>_cpu_s": ..., "<phase>_calls": ...}; None for other backends."""
+    if not isinstance(handle, Pardiso | Cholmod):
+        return None
+    return ({f"{name}_cpu_s": handle.cpu[name] for name in handle.cpu}
+            | {f"{name}_calls": handle.calls[name] for name in handle.calls})
+
+
+def _phases(handle, before: tuple) -> dict | None:
+    """This solve's part of the handle's counters (a handle reused from an earlier net of the
+    pattern has counted that net's too), with the backend's name."""
+    now = _counters(handle)
+    if now is None:
+        return None
+    start = before[1] if before[0] is handle and before[1] is not None else {}
+    return {"backend": "pardiso" if isinstance(handle, Pardiso) else "cholmod",
+            **{k: v - start.get(k, 0) for k, v in now.items()}}
+
+
+def _run(sc, tol: float, d_ref: float, *, method: str = "fast", repeat: int = 1,
+         cold: bool = False) -> dict:
+    """One printgen solve at `tol` (best wall time and best CPU time of `repeat`; the
+    backend's CPU by phase in the run of best CPU). `cold`: one more solve with the shared
+    patterns forgotten first (`_solve_once`), its CPU and set-up as `cold_cpu_s` and
+    `cold_setup_cpu_s`: a net small enough for the pattern cache (`pattern.SHARED_BYTES`) is
+    warm in the repeats (its pattern and analysis from the solves before), a larger one cold
+    in every solve, so the per-unknown comparison across sizes needs the cold solve too."""
     best, cpu, work, setup = None, float("inf"), None, None
     for _ in range(repeat):
         r, c, w, s = _solve_once(sc, tol, method)
@@ -253,20 +280,26 @@ def _run(sc, tol: float, d_ref: float, *, method: str = "fast", repeat: int = 1)
             cpu, work, setup = c, w, s
         best = r if best is None or r.seconds < best.seconds else best
     d = float(best.displacements[sc.centre, 1])
-    return {"tool": "printgen" if method == "fast" else "printgen reference path (before)",
-            "tol": tol, "converged": best.converged, "max_strain": float(best.strains.max()),
-            "max_tension_n": float(best.tensions.max()), "iterations": best.iterations,
-            "factorizations": best.factorizations, "backend": best.backend,
-            "time_s": best.seconds, "cpu_s": cpu, "setup_cpu_s": setup, "pardiso": work,
-            "deflection_m": d,
-            "error": abs(d / d_ref - 1)}
+    out = {"tool": "printgen" if method == "fast" else "printgen reference path (before)",
+           "tol": tol, "converged": best.converged, "max_strain": float(best.strains.max()),
+           "max_tension_n": float(best.tensions.max()), "iterations": best.iterations,
+           "factorizations": best.factorizations, "backend": best.backend,
+           "time_s": best.seconds, "cpu_s": cpu, "setup_cpu_s": setup, "phases": work,
+           "deflection_m": d,
+           "error": abs(d / d_ref - 1)}
+    if cold:
+        r, c, w, s = _solve_once(sc, tol, method, cold=True)
+        out |= {"cold_cpu_s": c, "cold_setup_cpu_s": s, "cold_phases": w,
+                "cold_converged": r.converged}
+    return out
 
 
 def bench_size(refine: int) -> dict:
     sc = simple_scene(refine=refine, current_z=False)
     ref = solve(sc.net, sc.loads_at(1.0), tol=REFERENCE_TOL, strict=True)
     d_ref = float(ref.displacements[sc.centre, 1])
-    runs = [_run(sc, tol, d_ref, repeat=REPEAT if tol == GOAL_TOL else 1) for tol in TOLERANCES]
+    runs = [_run(sc, tol, d_ref, repeat=REPEAT if tol == GOAL_TOL else 1, cold=tol == GOAL_TOL)
+            for tol in TOLERANCES]
     if refine in COMPARED:
         runs.append(_run(sc, GOAL_TOL, d_ref, method="reference"))
     cur = simple_scene(refine=refine, current_z=True)
@@ -285,7 +318,9 @@ def bench_size(refine: int) -> dict:
             "reference_iterations": ref.iterations,
             "slack_strands_at_reference": int(ref.slack.sum()),
             "us_per_unknown_at_goal_tol": 1e6 * goal["time_s"] / unknowns,
-            "cpu_us_per_unknown_at_goal_tol": 1e6 * goal["cpu_s"] / unknowns, "runs": runs}
+            "cpu_us_per_unknown_at_goal_tol": 1e6 * goal["cpu_s"] / unknowns,
+            "cold_cpu_us_per_unknown_at_goal_tol": 1e6 * goal["cold_cpu_s"] / unknowns,
+            "runs": runs}
 
 
 def size_table(results: list[dict], threads: int) -> list[dict]:
@@ -300,7 +335,10 @@ def size_table(results: list[dict], threads: int) -> list[dict]:
                     "setup_cpu_s": goal.get("setup_cpu_s"),
                     "us_per_unknown_wall": res["us_per_unknown_at_goal_tol"],
                     "us_per_unknown_cpu": res["cpu_us_per_unknown_at_goal_tol"],
-                    "pardiso": goal.get("pardiso")})
+                    "phases": goal.get("phases"), "cold_cpu_s": goal.get("cold_cpu_s"),
+                    "cold_setup_cpu_s": goal.get("cold_setup_cpu_s"),
+                    "cold_us_per_unknown_cpu": res.get("cold_cpu_us_per_unknown_at_goal_tol"),
+                    "cold_phases": goal.get("cold_phases")})
     return out
 
 
@@ -552,6 +590,14 @@ def goals(results: list[dict], paths: list[dict], tent: dict | None,
     out["cpu_us_per_unknown"] = cpu
     if len(cpu) > 1:  # goal: within 3x from 14k to 228k unknowns
         out["cpu_us_per_unknown_spread"] = max(cpu.values()) / min(cpu.values())
+    # the same from one cold solve per size: the best of REPEAT above reuses the pattern and
+    # the factorization's analysis of the solves before it up to pattern.SHARED_BYTES (241 x
+    # 81 nodes), and builds them in every solve beyond (481 x 161)
+    cold = {res["size"]: res["cold_cpu_us_per_unknown_at_goal_tol"] for res in results
+            if res["unknowns"] >= LINEAR_FROM and "cold_cpu_us_per_unknown_at_goal_tol" in res}
+    out["cpu_us_per_unknown_cold"] = cold
+    if len(cold) > 1:
+        out["cpu_us_per_unknown_spread_cold"] = max(cold.values()) / min(cold.values())
     if tent:
         out["tent_iterations"] = {m: tent[m]["iterations"] for m in ("fast", "reference")}
     if paths:
@@ -603,14 +649,13 @@ def run(out: Path, sizes: list[int], with_paths: bool = True, threads: int = THR
     return report
 
 
-def _pardiso_note(row: dict) -> str:
-    """PARDISO's share of a size-table row's CPU, by phase ("" for other backends)."""
-    w = row.get("pardiso")
+def _phases_note(w: dict | None) -> str:
+    """PARDISO's or CHOLMOD's share of a solve's CPU, by phase ("" for other backends)."""
     if not w:
         return ""
-    return (f"  (PARDISO: analysis {w['analysis_cpu_s']:.2f} s, {w['factorization_calls']} "
-            f"factorizations {w['factorization_cpu_s']:.2f} s, {w['solve_calls']} solves "
-            f"{w['solve_cpu_s']:.2f} s)")
+    return (f"  ({w['backend'].upper()}: analysis {w['analysis_cpu_s']:.2f} s, "
+            f"{w['factorization_calls']} factorizations {w['factorization_cpu_s']:.2f} s, "
+            f"{w['solve_calls']} solves {w['solve_cpu_s']:.2f} s)")
 
 
 def _print_paired(paired: dict | None) -> None:
@@ -679,7 +724,12 @@ def main(argv: list[str] | None = None) -> int:
               f"{row['blas_threads']} thread(s)  wall {row['wall_s']:6.2f} s  cpu "
               f"{row['cpu_s']:6.2f} s  {row['us_per_unknown_cpu']:5.1f} us/unknown (cpu)  it "
               f"{row['iterations']} fact {row['factorizations']} (set-up "
-              f"{row['setup_cpu_s']:.2f} s){_pardiso_note(row)}")
+              f"{row['setup_cpu_s']:.2f} s){_phases_note(row['phases'])}")
+        if row["cold_cpu_s"] is not None:
+            print(f"{'':9s} {'':7s} cold (pattern and analysis in the call): cpu "
+                  f"{row['cold_cpu_s']:6.2f} s  {row['cold_us_per_unknown_cpu']:5.1f} us/unknown "
+                  f"(cpu)  (set-up {row['cold_setup_cpu_s']:.2f} s)"
+                  f"{_phases_note(row['cold_phases'])}")
     for row in report["threads_table"]:
         print(f"{row['size']:9s} {row['blas_threads']} thread(s): wall {row['wall_s']:6.2f} s  "
               f"cpu {row['cpu_s']:6.2f} s  it {row['iterations']} fact {row['factorizations']}")

@@ -67,6 +67,21 @@ def test_cholmod_refactorizes_on_the_same_pattern_without_a_new_analysis():
         assert _residual(ns.pattern.csr(scale * data), x, b) <= LINEAR
 
 
+def test_cholmod_counts_its_phases():
+    """One analysis per pattern, one count per numeric factorization and per solve, and CPU
+    time in each (what bench solver's size table reports beside PARDISO's)."""
+    sc = simple_scene(current_z=True)
+    ns, data = _tangent(sc.net, sc.loads_at(1.0))
+    handle = Cholmod()
+    for scale in (1.0, 2.0, 3.0):
+        handle.factor(ns.pattern, scale * data)
+    assert handle.solve is not None
+    handle.solve(np.ones(ns.pattern.size))
+    assert handle.calls == {"analysis": 1, "factorization": 3, "solve": 1}
+    assert all(handle.cpu[phase] >= 0.0 for phase in handle.calls)
+    assert handle.cpu["factorization"] > 0.0
+
+
 @pytest.mark.skipif(not ldl_available(), reason="qdldl not installed")
 def test_cholmod_turns_to_ldlt_when_the_matrix_is_indefinite():
     """A shift of the diagonal by half its largest entry makes S indefinite: the Cholesky

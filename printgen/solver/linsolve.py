@@ -290,7 +290,11 @@ class Cholmod:
     than qdldl; SuperLU on a METIS nested-dissection order (pymetis), 0.52 s at 58k; a METIS
     order fed to CHOLMOD, 20 % off the numeric factorization at 228k but 0.6 s to compute
     and one more dependency; re-passes by GMRES on the last factorization (the "ldl" way),
-    more Newton iterations and twice the CPU at 57k."""
+    more Newton iterations and twice the CPU at 57k; a nested-dissection order from the
+    nodes' positions (recursive bisection, no dependency), 0.30 s a numeric factorization at
+    228k as AMD's; re-passes as a low-rank update of the last factorization (Woodbury), which
+    needs one solve per changed strand: cvxopt solves the right-hand sides one by one (0.05 s
+    each at 228k, 6 for a factorization's cost) while a re-pass there changes 2-604 strands."""
 
     def __init__(self) -> None:
         self.matrix: Any = None  # cvxopt's spmatrix of the upper triangle (values replaced)
@@ -300,6 +304,15 @@ class Cholmod:
         # (None: as they are)
         self.ldl: Ldl | None = None  # the LDL^T the net turned to, once S was indefinite
         self.solve: Callable[[np.ndarray], np.ndarray] | None = None
+        # CPU seconds (process_time) and calls by phase, as `Pardiso` counts them: the
+        # analysis (cvxopt's matrix and CHOLMOD's symbolic factorization), the numeric
+        # factorizations, the solves; CHOLMOD's own only (not the LDL^T's it may turn to)
+        self.cpu = dict.fromkeys(PHASES.values(), 0.0)
+        self.calls = dict.fromkeys(PHASES.values(), 0)
+
+    def _count(self, phase: str, since: float) -> None:
+        self.cpu[phase] += time.process_time() - since
+        self.calls[phase] += 1
 
     def factor(self, pattern: Pattern, data: np.ndarray) -> None:
         if self.ldl is not None:
@@ -310,6 +323,7 @@ class Cholmod:
         from cvxopt import cholmod
 
         upper = pattern.symmetric_upper(data)
+        t0 = time.process_time()
         if self.source is not pattern:  # a new net's pattern: analyse it
             n = upper.shape[0]
             cols = np.repeat(np.arange(n), np.diff(upper.indptr))
@@ -323,11 +337,14 @@ class Cholmod:
             self.source = pattern
             if len(self.matrix.V) != upper.nnz:  # cvxopt merged or dropped slots
                 raise ValueError("cvxopt's matrix lost entries of the pattern")
+            self._count("analysis", t0)
+            t0 = time.process_time()
         else:
             self.matrix.V = cvxopt.matrix(self._ordered(upper.data))
         self.solve = None
         try:
             cholmod.numeric(self.matrix, self.symbolic)
+            self._count("factorization", t0)
         except ArithmeticError:  # not positive definite
             if not ldl_available():
                 raise
@@ -344,8 +361,10 @@ class Cholmod:
         import cvxopt
         from cvxopt import cholmod
 
+        t0 = time.process_time()
         x = cvxopt.matrix(np.ascontiguousarray(b, dtype=np.float64))
         cholmod.solve(self.symbolic, x)
+        self._count("solve", t0)
         return np.asarray(x).ravel()
 
 
