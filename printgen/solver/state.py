@@ -51,13 +51,8 @@ class NetSystem:
         diagonal of 1: the stiffness of a net under unit force density. Damping a step with
         mu D instead of mu I moves a node without stiffness with its neighbours (a membrane
         shape), not alone along its own out-of-balance force."""
-        eye = np.eye(3)[None]
-        vals = [pair_values((1.0 / self.bars.rest)[:, None, None] * eye).ravel()]
-        for c in self.cables:
-            vals.append(pair_values((1.0 / c.l0)[:, None, None] * eye).ravel())
-            vals.append(np.zeros((3 * len(c.nodes)) ** 2))
-        vals.append(np.zeros(9 * self.n))
-        data = self.pattern.scatter(np.concatenate(vals))
+        data = self.pattern.member_blocks(np.concatenate(
+            [1.0 / self.bars.rest, *(1.0 / c.l0 for c in self.cables)]))
         mean = float(data[self.pattern.diagonal].mean()) if self.pattern.size else 1.0
         return data / (mean or 1.0)
 
