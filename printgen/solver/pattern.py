@@ -29,10 +29,10 @@ _SYM_INDEX8 = SYM_INDEX.astype(np.int8)  # one byte per CSR entry (`Pattern._sym
 _ON_DIAGONAL = np.isin(np.arange(6), SYM_INDEX.diagonal())  # which of the six lie on it
 _PAIR_SIGN = np.array([1.0, 1.0, -1.0, -1.0])  # a member's blocks ii, jj, ij, ji: +k, +k, -k, -k
 # patterns kept per process for reuse by later nets of the same topology (`shared_pattern`),
-# at most this many bytes of arrays in all: the simple scene's pattern takes 3.8 MB at 61 x
-# 21 nodes and 65 MB at 241 x 81 (`Pattern.nbytes` as built), so the nets a fit or a band
-# sweeps over stay, and one of 481 x 161 nodes (262 MB) is not kept
-SHARED_BYTES = 256 * 2**20
+# at most this many bytes of arrays in all: the simple scene's pattern takes 3.3 MB at 61 x
+# 21 nodes, 56 MB at 241 x 81 and 226 MB at 481 x 161 (`Pattern.nbytes` as built), so the
+# nets a fit or a band sweeps over stay (three of 241 x 81), and one of 481 x 161 is not kept
+SHARED_BYTES = 192 * 2**20
 
 
 def pair_values(k: np.ndarray) -> np.ndarray:
@@ -139,9 +139,7 @@ class Pattern:
         for p, kind in zip(p_parts, kinds, strict=True):
             groups.append((kind, p, inverse[at:at + p.size].reshape(p.shape)))
             at += p.size
-        row_at = np.where(fmask, self.indptr[:-1][np.maximum(index, 0)].reshape(n, 3), 0)
-        self._slot_parts = (groups, row_at, fmask, offset[:, None] + rank.reshape(n, 3)[ecol],
-                            fmask[ecol])
+        self._slot_parts = (groups, index, fmask, offset, rank, ecol)
         self._mirror_parts = (np.searchsorted(node_keys, ecol * n + erow), offset, rank,
                               free_dofs)  # node entry (q, p) of each (p, q)
         self._entries(n, ecol, width, row_start[free_dofs // 3], row_len, index, fmask)
@@ -150,14 +148,15 @@ class Pattern:
         self.diagonal = self.indptr[:-1] + offset[inverse[-n:]][free_dofs // 3] + rank[free_dofs]
         self._triangles(rank[free_dofs])
         # the node entries of the strands' blocks, then of every cable's segments'
-        self._members = (np.concatenate([e for kind, _, e in groups if kind == "member"]),
+        members = [e for kind, _, e in groups if kind == "member"]
+        self._members = (members[0] if len(members) == 1 else np.concatenate(members),
                          len(node_keys))
         self._maps(len(bar_i), len(node_keys), inverse[-n:], offset, rank, index)
         # the index arrays of the matrices built at every step, in scipy's own index type:
         # given int64, scipy checks their range and converts them at every construction (61 x
         # 21 net: 60 against 17 us a CSR matrix, ~20 matrices a solve)
-        self._csr_index = (_index(self.cols), _index(self.indptr))
-        self._upper_index = (_index(self.upper_indices), _index(self.upper_indptr))
+        self._csr_index = (self.cols, _index(self.indptr))
+        self._upper_index = (self.upper_indices, _index(self.upper_indptr))
 
     def _entries(self, n: int, ecol: np.ndarray, width: np.ndarray, row_start: np.ndarray,
                  row_len: np.ndarray, index: np.ndarray, fmask: np.ndarray) -> None:
@@ -165,8 +164,8 @@ class Pattern:
         its node row's widened entries (from row_start, row_len long); and each entry's
         place in the symmetric 3 x 3 block of its node entry (`SYM_INDEX`)."""
         src = np.arange(self.nnz) + np.repeat(row_start - self.indptr[:-1], row_len)
-        self.cols = index.reshape(n, 3)[ecol][fmask[ecol]][src]
-        self.entry = np.repeat(np.arange(len(ecol)), width)[src]
+        self.cols = _index(index.reshape(n, 3)[ecol][fmask[ecol]][src], self.size)
+        self.entry = _index(np.repeat(np.arange(len(ecol)), width)[src], len(ecol))
         component = self._mirror_parts[3] % 3  # x, y or z of each free dof
         self._sym = _SYM_INDEX8[np.repeat(component, row_len), component[self.cols]]
         # the entries on their node block's diagonal (row and column both x, y or z)
@@ -254,12 +253,19 @@ class Pattern:
         return sp.csr_matrix((sign[at], strand[at] + np.repeat(self._sym, per),
                               _index(indptr, int(indptr[-1]))), shape=(self.nnz, 6 * m))
 
+    @cached_property
+    def _slot_maps(self) -> tuple[np.ndarray, ...]:
+        """The CSR start of every dof's row (n x 3), whether it is free, and every node
+        entry's column offset per free dof and whether that column is free (entries x 3)."""
+        _, index, fmask, offset, rank, ecol = self._slot_parts
+        row_at = np.where(fmask, self.indptr[:-1][np.maximum(index, 0)].reshape(fmask.shape), 0)
+        return row_at, fmask, offset[:, None] + rank.reshape(fmask.shape)[ecol], fmask[ecol]
+
     def _group_slots(self, group: tuple[str, np.ndarray, np.ndarray]
                      ) -> tuple[np.ndarray, np.ndarray]:
         """(kept, CSR positions of the kept) slots of one slot group."""
-        _, row_at, fmask, col_at, col_free = self._slot_parts
         kind, p, e = group
-        return _positions(kind, p, e, row_at, fmask, col_at, col_free)
+        return _positions(kind, p, e, *self._slot_maps)
 
     @cached_property
     def _slots(self) -> tuple[np.ndarray, np.ndarray]:
@@ -337,10 +343,10 @@ def _nbytes(value: object) -> int:
 
 def _index(a: np.ndarray, bound: int | None = None) -> np.ndarray:
     """`a` as scipy's index type for it: int32 when its values (below `bound` when given)
-    fit, else int64."""
+    fit, else int64 (`a` itself when it has that type)."""
     top = bound if bound is not None else 0 if a.size == 0 else int(a.max())
     small = top < np.iinfo(np.int32).max
-    return a.astype(np.int32 if small else np.int64)
+    return a.astype(np.int32 if small else np.int64, copy=False)
 
 
 # the shared patterns by topology, each with a dict its users keep derived objects in
