@@ -162,9 +162,11 @@ def anchored(n: int, nodes: np.ndarray, i: np.ndarray, j: np.ndarray) -> bool:
     of 667 nodes beside the 61 x 21 net: LDL^T returned a finite shape of 3e11)."""
     held = np.ones(n, bool)
     held[nodes] = False
-    graph = sp.coo_matrix((np.ones(len(i)), (i, j)), shape=(n, n))
-    _, label = csgraph.connected_components(graph, directed=False)
-    return bool(np.all(np.isin(label[nodes], label[held])))
+    graph = sp.csr_matrix((np.ones(len(i)), (i, j)), shape=(n, n))  # what csgraph reads
+    count, label = csgraph.connected_components(graph, directed=False)
+    reached = np.zeros(count, bool)  # the parts that hold a held node
+    reached[label[held]] = True
+    return bool(reached[label[nodes]].all())
 
 
 class CableSet:
