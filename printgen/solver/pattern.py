@@ -141,7 +141,8 @@ class Pattern:
         self._slot_parts = (groups, index, fmask, offset, rank, ecol)
         self._mirror_parts = (np.searchsorted(node_keys, ecol * n + erow), offset, rank,
                               free_dofs)  # node entry (q, p) of each (p, q)
-        entry = self._entries(n, ecol, width, row_start[free_dofs // 3], row_len, index, fmask)
+        entry, sym = self._entries(n, ecol, width, row_start[free_dofs // 3], row_len, index,
+                                   fmask)
         # each free dof's diagonal entry: its row's start, plus its node block's offset in
         # the row, plus its rank among its node's free dofs
         self.diagonal = self.indptr[:-1] + offset[inverse[-n:]][free_dofs // 3] + rank[free_dofs]
@@ -150,7 +151,7 @@ class Pattern:
         members = [e for kind, _, e in groups if kind == "member"]
         self._members = (members[0] if len(members) == 1 else np.concatenate(members),
                          len(node_keys))
-        self._maps(len(bar_i), entry, len(node_keys), inverse[-n:], offset, rank, index)
+        self._maps(len(bar_i), entry, sym, len(node_keys), inverse[-n:], offset, rank, index)
         # the index arrays of the matrices built at every step, in scipy's own index type:
         # given int64, scipy checks their range and converts them at every construction (61 x
         # 21 net: 60 against 17 us a CSR matrix, ~20 matrices a solve)
@@ -158,12 +159,13 @@ class Pattern:
         self._upper_index = (self.upper_indices, _index(self.upper_indptr))
 
     def _entries(self, n: int, ecol: np.ndarray, width: np.ndarray, row_start: np.ndarray,
-                 row_len: np.ndarray, index: np.ndarray, fmask: np.ndarray) -> np.ndarray:
+                 row_len: np.ndarray, index: np.ndarray, fmask: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray]:
         """Columns and node entries of the CSR entries, row by row: each free dof's row is
-        its node row's widened entries (from row_start, row_len long); and each entry's
-        place in the symmetric 3 x 3 block of its node entry (`SYM_INDEX`), from the x, y
-        or z of its row and column, in bytes. Returns the node entries as intp (what
-        indexing reads without a conversion); `entry` keeps them in scipy's index type."""
+        its node row's widened entries (from row_start, row_len long). Returns the node
+        entries as intp (what indexing reads without a conversion; `entry` keeps them in
+        scipy's index type) and each entry's place in the symmetric 3 x 3 block of its node
+        entry (`SYM_INDEX`), from the x, y or z of its row and column, in bytes."""
         src = np.arange(self.nnz) + np.repeat(row_start - self.indptr[:-1], row_len)
         free_cols = fmask[ecol]  # which columns of each node entry are free
         self.cols = _index(index.reshape(n, 3)[ecol][free_cols], self.size)[src]
@@ -172,9 +174,8 @@ class Pattern:
         a = np.repeat((self._mirror_parts[3] % 3).astype(np.int8), row_len)
         b = np.broadcast_to(_XYZ, free_cols.shape)[free_cols][src]
         lo, hi = np.minimum(a, b), np.maximum(a, b)
-        self._sym = lo * (5 - lo) // 2 + hi  # SYM_INDEX[a, b]: 0, 1, 2 / 3, 4 / 5
         self._block_diagonal = np.flatnonzero(a == b)  # on their node block's diagonal
-        return entry
+        return entry, lo * (5 - lo) // 2 + hi  # SYM_INDEX[a, b]: 0, 1, 2 / 3, 4 / 5
 
     @cached_property
     def rows(self) -> np.ndarray:
@@ -216,8 +217,9 @@ class Pattern:
             [[0], np.cumsum(np.bincount(self.rows[rows], minlength=self.size))])
         return rows, self._mirrors(rows), (_index(self.cols[rows]), _index(indptr))
 
-    def _maps(self, m: int, entry: np.ndarray, n_entries: int, diagonal_entry: np.ndarray,
-              offset: np.ndarray, rank: np.ndarray, index: np.ndarray) -> None:
+    def _maps(self, m: int, entry: np.ndarray, sym: np.ndarray, n_entries: int,
+              diagonal_entry: np.ndarray, offset: np.ndarray, rank: np.ndarray,
+              index: np.ndarray) -> None:
         """The scatter as sparse operators: the upper triangles (m, 6) of the strands'
         symmetric blocks k -> CSR data in one product (each strand's four blocks +k, +k,
         -k, -k; each row sums its strands from the last to the first, as the product of
@@ -225,7 +227,7 @@ class Pattern:
         CSR positions of the node diagonal blocks' z columns (the hydrostatic load's
         z-derivative)."""
         n = len(diagonal_entry)
-        self.strand_map = self._strand_map(m, entry, n_entries)
+        self.strand_map = self._strand_map(m, entry, sym, n_entries)
         groups = self._slot_parts[0][1:-1]  # the cables' segments and dense blocks
         if groups:
             keep, slot = zip(*(self._group_slots(g) for g in groups), strict=True)
@@ -242,11 +244,12 @@ class Pattern:
         self.z_slots = (self.indptr[z_row[self.z_take]] + offset[diagonal_entry[node]]
                         + rank[3 * node + 2])
 
-    def _strand_map(self, m: int, entry: np.ndarray, n_entries: int) -> sp.csr_matrix:
+    def _strand_map(self, m: int, entry: np.ndarray, sym: np.ndarray, n_entries: int
+                    ) -> sp.csr_matrix:
         """CSR data <- the strands' upper triangles (m, 6): each CSR entry (node entry
-        `entry`) sums the strand blocks of its node entry, the strands from the last to the
-        first (a stable sort of the blocks taken in reverse), each block's value at the
-        entry's place in it."""
+        `entry`, place `sym` in its block) sums the strand blocks of its node entry, the
+        strands from the last to the first (a stable sort of the blocks taken in reverse),
+        each block's value at the entry's place in it."""
         blocks = self._slot_parts[0][0][2].ravel()  # node entry of each strand's 4 blocks
         order = blocks.size - 1 - np.argsort(blocks[::-1], kind="stable")
         strand = _index(6 * (order // 4), 6 * m)  # each sorted block's first upper value
@@ -256,7 +259,7 @@ class Pattern:
         indptr = np.concatenate([[0], np.cumsum(per)])
         at = np.arange(indptr[-1]) + np.repeat(
             (np.cumsum(count) - count)[entry] - indptr[:-1], per)
-        return sp.csr_matrix((sign[at], strand[at] + np.repeat(self._sym, per),
+        return sp.csr_matrix((sign[at], strand[at] + np.repeat(sym, per),
                               _index(indptr, int(indptr[-1]))), shape=(self.nnz, 6 * m))
 
     @cached_property

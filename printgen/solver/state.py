@@ -54,7 +54,8 @@ class NetSystem:
         data = self.pattern.member_blocks(np.concatenate(
             [1.0 / self.bars.rest, *(1.0 / c.l0 for c in self.cables)]))
         mean = float(data[self.pattern.diagonal].mean()) if self.pattern.size else 1.0
-        return data / (mean or 1.0)
+        data /= mean or 1.0
+        return data
 
     def membrane_shape(self, b: np.ndarray) -> np.ndarray | None:
         """D^-1 b on the free dofs, solved per direction on the node graph (D is the graph
