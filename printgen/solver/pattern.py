@@ -26,6 +26,7 @@ import scipy.sparse as sp
 SYM_PAIRS = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 SYM_INDEX = np.array([[0, 1, 2], [1, 3, 4], [2, 4, 5]])
 _XYZ = np.arange(3, dtype=np.int8)  # a dof's direction, in a byte
+_INT32_MAX = int(np.iinfo(np.int32).max)
 _PAIR_SIGN = np.array([1.0, 1.0, -1.0, -1.0])  # a member's blocks ii, jj, ij, ji: +k, +k, -k, -k
 # patterns kept per process for reuse by later nets of the same topology (`shared_pattern`),
 # at most this many bytes of arrays in all: the simple scene's pattern takes 3.3 MB at 61 x
@@ -354,7 +355,7 @@ def _index(a: np.ndarray, bound: int | None = None) -> np.ndarray:
     """`a` as scipy's index type for it: int32 when its values (below `bound` when given)
     fit, else int64 (`a` itself when it has that type)."""
     top = bound if bound is not None else 0 if a.size == 0 else int(a.max())
-    small = top < np.iinfo(np.int32).max
+    small = top < _INT32_MAX
     return a.astype(np.int32 if small else np.int64, copy=False)
 
 
@@ -368,7 +369,8 @@ def shared_pattern(n_nodes: int, free: np.ndarray, bar_i: np.ndarray, bar_j: np.
                    cable_nodes: list[np.ndarray]) -> Pattern:
     """The Pattern of this topology (node count, free dofs, strand node pairs, cables' node
     sequences), built once per process and shared by every later net of the same topology:
-    a Pattern depends on nothing else and is only read once built. A band's variants, a
+    a Pattern depends on nothing else and is only read once built (the parts it builds
+    on demand follow from it alone: any thread gets the same arrays). A band's variants, a
     fit's trials and repeated solves of one net differ in geometry, laws or loads, not in
     topology. Least recently used patterns go first once SHARED_BYTES are held."""
     digest = hashlib.blake2b(digest_size=20)  # 160 bits: a collision is out of reach
