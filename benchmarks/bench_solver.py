@@ -22,7 +22,8 @@ CHOLMOD overtakes qdldl), and with --backend-path-scale S the verification's loa
 1:S too (`backend_paths`). The ratio to OpenSeesPy at 61 x 21 is
 also measured pair by pair (`paired_ratio`: PAIRS pairs, alternating, one thread each; wall
 and CPU time of each whole call, median and range, with the load average; in a fresh process
-and in this one, see `paired_both`); --opensees-only measures only that.
+and in this one, see `paired_both`), with where a printgen solve's CPU goes, cold and warm
+(`solve_phases`); --opensees-only measures only that.
 Writes bench_solver.json and bench_solver.png (--opensees-only: bench_solver_opensees.json).
 """
 
@@ -127,13 +128,46 @@ def paired_ratio(pairs: int = PAIRS) -> dict:
                   for p in threadpool_info()]
         printgen_s()
         times = _alternate(printgen_s, opensees_s, pairs)
+        phases = solve_phases(net, sc.loads_at(1.0), pairs)
     threads["after"] = _threads()
-    return {"size": SIZES[1], **_summary(times),
+    return {"size": SIZES[1], **_summary(times), "phases_cpu_ms": phases,
             "opensees": f"{STEPS} load steps, BandSPD, NormUnbalance (max-norm) at {GOAL_TOL:g}"
                         " x printgen's force scale; each side timed around its whole call",
             "force_scale_n": scale, "threads_per_library": pinned, "opensees_blas": opensees_blas(),
             "process_threads": threads, "load_average_before": load_before,
             "load_average_after": _load()}
+
+
+def solve_phases(net, loads, runs: int) -> dict:
+    """Where a printgen solve's CPU goes, cold (the shared patterns and factorization
+    objects forgotten first, as in `paired_ratio`'s cold solve) and warm, measured apart from
+    the pairs: the tangent pattern built alone (`Pattern`), the set-up (`FastSolver`: the
+    nondimensional net, the pattern, the damping, the incidence, the backend's handle) and
+    the solve (`FastSolver.solve`: the membrane start with its Laplacian factorizations,
+    then the Newton iterations, whose first factorization orders the tangent when cold).
+    Milliseconds, median of `runs`."""
+    from printgen.solver.pattern import Pattern
+
+    out = {}
+    for kind in ("cold", "warm"):
+        times: dict[str, list[float]] = {"pattern": [], "setup": [], "solve": []}
+        for _ in range(runs):
+            if kind == "cold":
+                clear_shared()
+            c = time.process_time()
+            fs = FastSolver(net)
+            times["setup"].append(time.process_time() - c)
+            c = time.process_time()
+            r = fs.solve(loads, [], GOAL_TOL, MAX_ITER)
+            times["solve"].append(time.process_time() - c)
+            assert r.converged, r.reason
+            ns = fs.ns
+            c = time.process_time()
+            if kind == "cold":
+                Pattern(ns.n, ns.free, ns.bars.i, ns.bars.j, [k.nodes for k in ns.cables])
+            times["pattern"].append(time.process_time() - c)  # warm: shared, not built
+        out[kind] = {k: 1e3 * float(np.median(v)) for k, v in times.items()}
+    return out
 
 
 def _alternate(printgen_s, opensees_s, pairs: int) -> list[dict]:
@@ -669,6 +703,9 @@ def _print_paired(paired: dict | None) -> None:
               + ", ".join(f"{k} median {pair[k]['median']:.1f}x (range {pair[k]['min']:.1f}-"
                           f"{pair[k]['max']:.1f}x)" for k in ("cpu", "wall", "cold_cpu",
                                                               "cold_wall")))
+        for kind, ms in pair.get("phases_cpu_ms", {}).items():
+            print(f"  printgen {kind} solve, CPU ms (median): " + ", ".join(
+                f"{k} {v:.1f}" for k, v in ms.items()))
 
 
 def _opensees_only(out: Path) -> int:

@@ -16,6 +16,7 @@ from __future__ import annotations
 import hashlib
 import threading
 from collections import OrderedDict
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -24,11 +25,14 @@ import scipy.sparse as sp
 # entries (a, b) finds its value among those six
 SYM_PAIRS = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 SYM_INDEX = np.array([[0, 1, 2], [1, 3, 4], [2, 4, 5]])
+_XYZ = np.arange(3, dtype=np.int8)  # a dof's direction, in a byte
+_INT32_MAX = int(np.iinfo(np.int32).max)
+_PAIR_SIGN = np.array([1.0, 1.0, -1.0, -1.0])  # a member's blocks ii, jj, ij, ji: +k, +k, -k, -k
 # patterns kept per process for reuse by later nets of the same topology (`shared_pattern`),
-# at most this many bytes of arrays in all: the simple scene's pattern takes 5 MB at 61 x 21
-# nodes and 85 MB at 241 x 81 (`Pattern.nbytes`), so the nets a fit or a band sweeps over
-# stay, and one of 481 x 161 nodes (about 4 x 85 MB) is not kept
-SHARED_BYTES = 256 * 2**20
+# at most this many bytes of arrays in all: the simple scene's pattern takes 3.3 MB at 61 x
+# 21 nodes, 56 MB at 241 x 81 and 226 MB at 481 x 161 (`Pattern.nbytes` as built), so the
+# nets a fit or a band sweeps over stay (three of 241 x 81), and one of 481 x 161 is not kept
+SHARED_BYTES = 192 * 2**20
 
 
 def pair_values(k: np.ndarray) -> np.ndarray:
@@ -62,6 +66,19 @@ def _node_slots(bar_i: np.ndarray, bar_j: np.ndarray, cable_nodes: list[np.ndarr
     return p_parts, q_parts, kinds
 
 
+def _unique(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """np.unique(keys, return_inverse=True), by a stable sort: the keys come in sorted
+    runs (a member's node pairs in member order), which a merge sort takes as they are (61
+    x 21 nodes: a sixth of the quicksort's time)."""
+    order = np.argsort(keys, kind="stable")
+    ordered = keys[order]
+    new = np.ones(len(keys), bool)
+    np.not_equal(ordered[1:], ordered[:-1], out=new[1:])
+    inverse = np.empty(len(keys), np.intp)
+    inverse[order] = np.cumsum(new) - 1
+    return ordered[new], inverse
+
+
 def _positions(kind: str, p: np.ndarray, e: np.ndarray, row_at: np.ndarray,
                row_free: np.ndarray, col_at: np.ndarray, col_free: np.ndarray
                ) -> tuple[np.ndarray, np.ndarray]:
@@ -88,7 +105,11 @@ class Pattern:
     CSR is that graph with every node entry widened to its column node's free dofs, so a
     slot's CSR position is its row's start, plus its node entry's offset in the row, plus
     its column's rank among that node's free dofs; no sort of the slots, no COO -> CSR
-    conversion (CPU, 241 x 81 nodes: 0.41 -> 0.22 s; 481 x 161: 1.7 -> 1.0 s).
+    conversion (CPU, 241 x 81 nodes: 0.41 -> 0.22 s; 481 x 161: 1.7 -> 1.0 s). What every
+    solve reads is built from the node entries as well (the strands' operator from each
+    node entry's strands, the damping from each node entry's sums), without the slots'
+    positions: those (`slot`, `keep`, what `scatter` reads), the whole transpose map and
+    the upper triangle in CSR (PARDISO's) are built when first asked for.
     """
 
     def __init__(self, n_nodes: int, free: np.ndarray, bar_i: np.ndarray, bar_j: np.ndarray,
@@ -97,7 +118,7 @@ class Pattern:
         p_parts, q_parts, kinds = _node_slots(bar_i, bar_j, cable_nodes, n)
         keys = np.concatenate([p.ravel().astype(np.int64) * n + q.ravel()
                                for p, q in zip(p_parts, q_parts, strict=True)])
-        node_keys, inverse = np.unique(keys, return_inverse=True)
+        node_keys, inverse = _unique(keys)
         erow, ecol = node_keys // n, node_keys % n
         fmask = free.reshape(n, 3)
         self.size = int(free.sum())
@@ -114,61 +135,92 @@ class Pattern:
         self.indptr = np.concatenate([[0], np.cumsum(row_len)])
         self.nnz = int(self.indptr[-1])
 
-        row_at = np.where(fmask, self.indptr[:-1][np.maximum(index, 0)].reshape(n, 3), 0)
-        col_at, col_free = offset[:, None] + rank.reshape(n, 3)[ecol], fmask[ecol]
-        keep, slot, at = [], [], 0
+        groups, at = [], 0  # each slot group's kind, node pairs and their node entries
         for p, kind in zip(p_parts, kinds, strict=True):
-            k, pos = _positions(kind, p, inverse[at:at + p.size].reshape(p.shape), row_at,
-                                fmask, col_at, col_free)
-            keep.append(k)
-            slot.append(pos)
+            groups.append((kind, p, inverse[at:at + p.size].reshape(p.shape)))
             at += p.size
-        self.keep, self.slot = np.concatenate(keep), np.concatenate(slot)
-
-        self._entries(node_keys, n, width, offset, row_start[free_dofs // 3], row_len, rank,
-                      index, fmask)
-        self._triangles()
-        self._maps(len(bar_i), len(self.keep), inverse[-n:], offset, rank, index)
+        self._slot_parts = (groups, index, fmask, offset, rank, ecol)
+        self._mirror_parts = (np.searchsorted(node_keys, ecol * n + erow), offset, rank,
+                              free_dofs)  # node entry (q, p) of each (p, q)
+        entry, sym = self._entries(n, ecol, width, row_start[free_dofs // 3], row_len, index,
+                                   fmask)
+        # each free dof's diagonal entry: its row's start, plus its node block's offset in
+        # the row, plus its rank among its node's free dofs
+        self.diagonal = self.indptr[:-1] + offset[inverse[-n:]][free_dofs // 3] + rank[free_dofs]
+        self._triangles(entry, rank[free_dofs])
+        # the node entries of the strands' blocks, then of every cable's segments'
+        members = [e for kind, _, e in groups if kind == "member"]
+        self._members = (members[0] if len(members) == 1 else np.concatenate(members),
+                         len(node_keys))
+        self._maps(len(bar_i), entry, sym, len(node_keys), inverse[-n:], offset, rank, index)
         # the index arrays of the matrices built at every step, in scipy's own index type:
         # given int64, scipy checks their range and converts them at every construction (61 x
         # 21 net: 60 against 17 us a CSR matrix, ~20 matrices a solve)
-        self._csr_index = (_index(self.cols), _index(self.indptr))
-        self._upper_index = (_index(self.upper_indices), _index(self.upper_indptr))
-        self._upper_csr_index = (_index(self.upper_cols), _index(self.upper_rows_indptr))
+        self._csr_index = (self.cols, _index(self.indptr))
+        self._upper_index = (self.upper_indices, _index(self.upper_indptr))
 
-    def _entries(self, node_keys: np.ndarray, n: int, width: np.ndarray, offset: np.ndarray,
-                 row_start: np.ndarray, row_len: np.ndarray, rank: np.ndarray,
-                 index: np.ndarray, fmask: np.ndarray) -> None:
-        """Rows, columns and mirror positions of the CSR entries, row by row: each free dof's
-        row is its node row's widened entries (from row_start, row_len long)."""
-        erow, ecol = node_keys // n, node_keys % n
-        entry_cols = index.reshape(n, 3)[ecol][fmask[ecol]]
-        entry_node = np.repeat(np.arange(len(node_keys)), width)
+    def _entries(self, n: int, ecol: np.ndarray, width: np.ndarray, row_start: np.ndarray,
+                 row_len: np.ndarray, index: np.ndarray, fmask: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray]:
+        """Columns and node entries of the CSR entries, row by row: each free dof's row is
+        its node row's widened entries (from row_start, row_len long). Returns the node
+        entries as intp (what indexing reads without a conversion; `entry` keeps them in
+        scipy's index type) and each entry's place in the symmetric 3 x 3 block of its node
+        entry (`SYM_INDEX`), from the x, y or z of its row and column, in bytes."""
         src = np.arange(self.nnz) + np.repeat(row_start - self.indptr[:-1], row_len)
-        self.rows = np.repeat(np.arange(self.size), row_len)
-        self.cols = entry_cols[src]
-        mirror = np.searchsorted(node_keys, ecol * n + erow)  # node entry (q, p) of (p, q)
-        self.transpose = (self.indptr[self.cols] + offset[mirror[entry_node[src]]]
-                          + rank[np.flatnonzero(fmask.ravel())[self.rows]])
+        free_cols = fmask[ecol]  # which columns of each node entry are free
+        self.cols = _index(index.reshape(n, 3)[ecol][free_cols], self.size)[src]
+        entry = np.repeat(np.arange(len(ecol)), width)[src]
+        self.entry = _index(entry, len(ecol))
+        a = np.repeat((self._mirror_parts[3] % 3).astype(np.int8), row_len)
+        b = np.broadcast_to(_XYZ, free_cols.shape)[free_cols][src]
+        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        self._block_diagonal = np.flatnonzero(a == b)  # on their node block's diagonal
+        return entry, lo * (5 - lo) // 2 + hi  # SYM_INDEX[a, b]: 0, 1, 2 / 3, 4 / 5
 
-    def _triangles(self) -> None:
-        """Diagonal and upper-triangle selections: the upper triangle in CSC order (column,
-        then row) is the lower triangle's CSR order mirrored."""
-        self.diagonal = np.flatnonzero(self.rows == self.cols)
-        lower = np.flatnonzero(self.rows >= self.cols)
-        self.upper = self.transpose[lower]
+    @cached_property
+    def rows(self) -> np.ndarray:
+        """The row of every CSR entry."""
+        return np.repeat(np.arange(self.size), np.diff(self.indptr))
+
+    def _mirrors(self, at: np.ndarray | slice) -> np.ndarray:
+        """CSR positions of the mirrors (column, row) of the CSR entries `at`."""
+        mirror, offset, rank, free_dofs = self._mirror_parts
+        return (self.indptr[self.cols[at]] + offset[mirror[self.entry[at]]]
+                + rank[free_dofs[self.rows[at]]])
+
+    @cached_property
+    def transpose(self) -> np.ndarray:
+        """The CSR position of every entry's mirror."""
+        return self._mirrors(slice(None))
+
+    def _triangles(self, entry: np.ndarray, row_rank: np.ndarray) -> None:
+        """Upper-triangle selections: the upper triangle in CSC order (column, then row) is
+        the lower triangle's CSR order mirrored, and a row's lower triangle is its entries
+        up to its diagonal (its columns ascend). row_rank: each row's dof's rank among its
+        node's free dofs; entry: each CSR entry's node entry."""
+        count = self.diagonal - self.indptr[:-1] + 1
+        self.upper_indptr = np.concatenate([[0], np.cumsum(count)])
+        lower = np.arange(self.upper_indptr[-1]) + np.repeat(
+            self.indptr[:-1] - self.upper_indptr[:-1], count)
         self.upper_transpose = lower  # each upper entry's mirror
         self.upper_indices = self.cols[lower]
-        self.upper_indptr = np.concatenate(
-            [[0], np.cumsum(np.bincount(self.rows[lower], minlength=self.size))])
-        self.upper_rows = np.flatnonzero(self.rows <= self.cols)  # CSR order: row, then column
-        self.upper_cols = self.cols[self.upper_rows]
-        self.upper_mirror = self.transpose[self.upper_rows]
-        self.upper_rows_indptr = np.concatenate(
-            [[0], np.cumsum(np.bincount(self.rows[self.upper_rows], minlength=self.size))])
+        mirror, offset, _, _ = self._mirror_parts
+        self.upper = (self.indptr[self.upper_indices] + offset[mirror[entry[lower]]]
+                      + np.repeat(row_rank, count))
 
-    def _maps(self, m: int, n_slots: int, diagonal_entry: np.ndarray, offset: np.ndarray,
-              rank: np.ndarray, index: np.ndarray) -> None:
+    @cached_property
+    def _upper_csr(self) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, np.ndarray]]:
+        """The upper triangle in CSR order (row, then column): its entries, their mirrors
+        and its index arrays."""
+        rows = np.flatnonzero(self.rows <= self.cols)
+        indptr = np.concatenate(
+            [[0], np.cumsum(np.bincount(self.rows[rows], minlength=self.size))])
+        return rows, self._mirrors(rows), (_index(self.cols[rows]), _index(indptr))
+
+    def _maps(self, m: int, entry: np.ndarray, sym: np.ndarray, n_entries: int,
+              diagonal_entry: np.ndarray, offset: np.ndarray, rank: np.ndarray,
+              index: np.ndarray) -> None:
         """The scatter as sparse operators: the upper triangles (m, 6) of the strands'
         symmetric blocks k -> CSR data in one product (each strand's four blocks +k, +k,
         -k, -k; each row sums its strands from the last to the first, as the product of
@@ -176,22 +228,16 @@ class Pattern:
         CSR positions of the node diagonal blocks' z columns (the hydrostatic load's
         z-derivative)."""
         n = len(diagonal_entry)
-        n_cable = n_slots - 36 * m - 9 * n
-        strand = np.flatnonzero(self.keep[:36 * m])
-        k = len(strand)  # grouped by position, later strands first: a counting sort (CSR ->
-        # CSC keeps the row order within a column) of the strand slots in reverse order
-        by_slot = sp.csr_matrix((np.ones(k), self.slot[:k][::-1], np.arange(k + 1)),
-                                shape=(k, self.nnz)).tocsc()
-        order = strand[k - 1 - by_slot.indices]
-        sign = np.repeat([1.0, 1.0, -1.0, -1.0], 9)  # slot (e, block, a, b) of strand e
-        strand_of, within = np.divmod(order, 36)
-        src = strand_of * 6 + np.tile(SYM_INDEX.ravel(), 4)[within]
-        self.strand_map = sp.csr_matrix((sign[within], src, by_slot.indptr),
-                                        shape=(self.nnz, 6 * m))
-        cable = np.flatnonzero(self.keep[36 * m:36 * m + n_cable])
-        self.cable_map = sp.csr_matrix(
-            (np.ones(len(cable)), (self.slot[len(strand):len(strand) + len(cable)], cable)),
-            shape=(self.nnz, n_cable))
+        self.strand_map = self._strand_map(m, entry, sym, n_entries)
+        groups = self._slot_parts[0][1:-1]  # the cables' segments and dense blocks
+        if groups:
+            keep, slot = zip(*(self._group_slots(g) for g in groups), strict=True)
+            cable = np.flatnonzero(np.concatenate(keep))
+            self.cable_map = sp.csr_matrix(
+                (np.ones(len(cable)), (np.concatenate(slot), cable)),
+                shape=(self.nnz, sum(len(k) for k in keep)))
+        else:
+            self.cable_map = sp.csr_matrix((self.nnz, 0))
         every = np.arange(n)  # (node, a): row 3 node + a, column 3 node + 2
         z_row, z_col = index[3 * every[:, None] + np.arange(3)].ravel(), index[3 * every + 2]
         self.z_take = np.flatnonzero((z_row >= 0) & (z_col.repeat(3) >= 0))
@@ -199,17 +245,68 @@ class Pattern:
         self.z_slots = (self.indptr[z_row[self.z_take]] + offset[diagonal_entry[node]]
                         + rank[3 * node + 2])
 
+    def _strand_map(self, m: int, entry: np.ndarray, sym: np.ndarray, n_entries: int
+                    ) -> sp.csr_matrix:
+        """CSR data <- the strands' upper triangles (m, 6): each CSR entry (node entry
+        `entry`, place `sym` in its block) sums the strand blocks of its node entry, the
+        strands from the last to the first (a stable sort of the blocks taken in reverse),
+        each block's value at the entry's place in it."""
+        blocks = self._slot_parts[0][0][2].ravel()  # node entry of each strand's 4 blocks
+        order = blocks.size - 1 - np.argsort(blocks[::-1], kind="stable")
+        strand = _index(6 * (order // 4), 6 * m)  # each sorted block's first upper value
+        sign = _PAIR_SIGN[order % 4]
+        count = np.bincount(blocks, minlength=n_entries)
+        per = count[entry]  # strand blocks at each CSR entry
+        indptr = np.concatenate([[0], np.cumsum(per)])
+        at = np.arange(indptr[-1]) + np.repeat(
+            (np.cumsum(count) - count)[entry] - indptr[:-1], per)
+        return sp.csr_matrix((sign[at], strand[at] + np.repeat(sym, per),
+                              _index(indptr, int(indptr[-1]))), shape=(self.nnz, 6 * m))
+
+    @cached_property
+    def _slot_maps(self) -> tuple[np.ndarray, ...]:
+        """The CSR start of every dof's row (n x 3), whether it is free, and every node
+        entry's column offset per free dof and whether that column is free (entries x 3)."""
+        _, index, fmask, offset, rank, ecol = self._slot_parts
+        row_at = np.where(fmask, self.indptr[:-1][np.maximum(index, 0)].reshape(fmask.shape), 0)
+        return row_at, fmask, offset[:, None] + rank.reshape(fmask.shape)[ecol], fmask[ecol]
+
+    def _group_slots(self, group: tuple[str, np.ndarray, np.ndarray]
+                     ) -> tuple[np.ndarray, np.ndarray]:
+        """(kept, CSR positions of the kept) slots of one slot group."""
+        kind, p, e = group
+        return _positions(kind, p, e, *self._slot_maps)
+
+    @cached_property
+    def _slots(self) -> tuple[np.ndarray, np.ndarray]:
+        parts = [self._group_slots(g) for g in self._slot_parts[0]]
+        return np.concatenate([k for k, _ in parts]), np.concatenate([s for _, s in parts])
+
+    @property
+    def keep(self) -> np.ndarray:
+        """Which slots have a free row and column (slot order)."""
+        return self._slots[0]
+
+    @property
+    def slot(self) -> np.ndarray:
+        """The CSR position of every kept slot."""
+        return self._slots[1]
+
+    def member_blocks(self, weights: np.ndarray) -> np.ndarray:
+        """CSR data of the slot values `pair_values(w I3)` of the strands, then every
+        cable's segments (weights w in that order; zeros in every other slot), summed as
+        `scatter` sums them: the diagonal of a node block gets its node entry's values in
+        slot order, the rest exact zeros."""
+        entry, n_entries = self._members
+        sums = np.bincount(entry.ravel(), (weights[:, None] * _PAIR_SIGN).ravel(), n_entries)
+        data = np.zeros(self.nnz)
+        on = self._block_diagonal
+        data[on] = sums[self.entry[on]]
+        return data
+
     def nbytes(self) -> int:
-        """Bytes of the arrays and sparse operators this pattern holds."""
-        total = 0
-        for value in vars(self).values():
-            parts = value if isinstance(value, tuple) else (value,)
-            for part in parts:
-                if isinstance(part, np.ndarray):
-                    total += part.nbytes
-                elif sp.issparse(part):
-                    total += sum(getattr(part, k).nbytes for k in ("data", "indices", "indptr"))
-        return total
+        """Bytes of the arrays and sparse operators this pattern holds (those built so far)."""
+        return _nbytes(list(vars(self).values()))
 
     def assemble(self, strand_upper: np.ndarray, cables: np.ndarray, dz: np.ndarray
                  ) -> np.ndarray:
@@ -238,14 +335,28 @@ class Pattern:
 
     def symmetric_upper_csr(self, data: np.ndarray) -> sp.csr_matrix:
         """The same upper triangle in CSR (what MKL PARDISO reads for a symmetric matrix)."""
-        sym = 0.5 * (data[self.upper_rows] + data[self.upper_mirror])
-        return sp.csr_matrix((sym, *self._upper_csr_index), shape=(self.size, self.size))
+        rows, mirror, index = self._upper_csr
+        sym = 0.5 * (data[rows] + data[mirror])
+        return sp.csr_matrix((sym, *index), shape=(self.size, self.size))
 
 
-def _index(a: np.ndarray) -> np.ndarray:
-    """`a` as scipy's index type for it: int32 when its values fit, else int64."""
-    small = a.size == 0 or int(a.max()) < np.iinfo(np.int32).max
-    return a.astype(np.int32 if small else np.int64)
+def _nbytes(value: object) -> int:
+    """Bytes of the arrays and sparse matrices in `value` (nested in tuples and lists)."""
+    if isinstance(value, np.ndarray):
+        return value.nbytes
+    if sp.issparse(value):
+        return sum(getattr(value, k).nbytes for k in ("data", "indices", "indptr"))
+    if isinstance(value, tuple | list):
+        return sum(_nbytes(v) for v in value)
+    return 0
+
+
+def _index(a: np.ndarray, bound: int | None = None) -> np.ndarray:
+    """`a` as scipy's index type for it: int32 when its values (below `bound` when given)
+    fit, else int64 (`a` itself when it has that type)."""
+    top = bound if bound is not None else 0 if a.size == 0 else int(a.max())
+    small = top < _INT32_MAX
+    return a.astype(np.int32 if small else np.int64, copy=False)
 
 
 # the shared patterns by topology, each with a dict its users keep derived objects in
@@ -258,7 +369,8 @@ def shared_pattern(n_nodes: int, free: np.ndarray, bar_i: np.ndarray, bar_j: np.
                    cable_nodes: list[np.ndarray]) -> Pattern:
     """The Pattern of this topology (node count, free dofs, strand node pairs, cables' node
     sequences), built once per process and shared by every later net of the same topology:
-    a Pattern depends on nothing else and is only read once built. A band's variants, a
+    a Pattern depends on nothing else and is only read once built (the parts it builds
+    on demand follow from it alone: any thread gets the same arrays). A band's variants, a
     fit's trials and repeated solves of one net differ in geometry, laws or loads, not in
     topology. Least recently used patterns go first once SHARED_BYTES are held."""
     digest = hashlib.blake2b(digest_size=20)  # 160 bits: a collision is out of reach

@@ -51,15 +51,11 @@ class NetSystem:
         diagonal of 1: the stiffness of a net under unit force density. Damping a step with
         mu D instead of mu I moves a node without stiffness with its neighbours (a membrane
         shape), not alone along its own out-of-balance force."""
-        eye = np.eye(3)[None]
-        vals = [pair_values((1.0 / self.bars.rest)[:, None, None] * eye).ravel()]
-        for c in self.cables:
-            vals.append(pair_values((1.0 / c.l0)[:, None, None] * eye).ravel())
-            vals.append(np.zeros((3 * len(c.nodes)) ** 2))
-        vals.append(np.zeros(9 * self.n))
-        data = self.pattern.scatter(np.concatenate(vals))
+        data = self.pattern.member_blocks(np.concatenate(
+            [1.0 / self.bars.rest, *(1.0 / c.l0 for c in self.cables)]))
         mean = float(data[self.pattern.diagonal].mean()) if self.pattern.size else 1.0
-        return data / (mean or 1.0)
+        data /= mean or 1.0
+        return data
 
     def membrane_shape(self, b: np.ndarray) -> np.ndarray | None:
         """D^-1 b on the free dofs, solved per direction on the node graph (D is the graph
@@ -167,9 +163,11 @@ def anchored(n: int, nodes: np.ndarray, i: np.ndarray, j: np.ndarray) -> bool:
     of 667 nodes beside the 61 x 21 net: LDL^T returned a finite shape of 3e11)."""
     held = np.ones(n, bool)
     held[nodes] = False
-    graph = sp.coo_matrix((np.ones(len(i)), (i, j)), shape=(n, n))
-    _, label = csgraph.connected_components(graph, directed=False)
-    return bool(np.all(np.isin(label[nodes], label[held])))
+    graph = sp.csr_matrix((np.ones(len(i)), (i, j)), shape=(n, n))  # what csgraph reads
+    count, label = csgraph.connected_components(graph, directed=False)
+    reached = np.zeros(count, bool)  # the parts that hold a held node
+    reached[label[held]] = True
+    return bool(reached[label[nodes]].all())
 
 
 class CableSet:
