@@ -5,7 +5,9 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 from rich.console import Console
@@ -66,8 +68,7 @@ def run(args: argparse.Namespace) -> int:
 
     check_profile_args(args, "materials")
     out = args.out or Path("out") / f"{Path(args.prototype).stem}-series"
-    err = Console(stderr=True, highlight=False)
-    with err.status("reading inputs") as status:
+    with spinner("reading inputs") as status:
         res = api.series(args.prototype, _scales(args.scales), materials=args.materials,
                          net=args.solver_net, out=out, options=run_options(args),
                          progress=lambda s: status.update(f"{s} ..."), bar=not args.json)
@@ -76,6 +77,28 @@ def run(args: argparse.Namespace) -> int:
         return 0
     show(res, out)
     return 0
+
+
+class _Silent:
+    """The spinner's stand-in off a terminal: its text goes nowhere."""
+
+    def update(self, _text: str) -> None:
+        pass
+
+
+@contextlib.contextmanager
+def spinner(text: str) -> Iterator:
+    """The spinner on stderr while the series runs, when stderr is a terminal; elsewhere (a
+    log, a pipe, a benchmark) no spinner at all, not even its refresh thread: rich draws
+    nothing there, and a process running a thread starts its workers from a fork server
+    (printgen.executor.start.start_method), each importing what the cases need again,
+    instead of forking them with it imported."""
+    err = Console(stderr=True, highlight=False)
+    if not err.is_terminal:
+        yield _Silent()
+        return
+    with err.status(text) as status:
+        yield status
 
 
 def show(res, out: Path) -> None:

@@ -20,6 +20,7 @@ from pathlib import Path
 from printgen.barrier.loads import get_load
 from printgen.errors import InputError
 from printgen.executor import open_runner
+from printgen.executor.start import warm_up
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import TIMINGS, check_destination, write_folder
@@ -51,6 +52,9 @@ from printgen.verification.series import (
 from printgen.verification.series_table import Series, summarise
 
 PARALLEL_FROM = 12  # cases from which the series runs on this machine's workers by default
+# what the cases import in a worker: a fork server imports it once, while the inputs are read
+# (printgen.executor.start.warm_up; workers forked from this process have it already)
+JOB_MODULES = ("printgen.verification.series",)
 
 
 @dataclass(repr=False)
@@ -97,6 +101,8 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
     todo = cases(shared, lams)
     if serial is None:
         serial = len(todo) < PARALLEL_FROM and scheduler is None and workers is None
+    if not serial and scheduler is None and workers != 1:
+        warm_up(JOB_MODULES)
     limit = DEFAULT_LIMIT_S if options.time_limit_s is None else options.time_limit_s
     estimate, _ = check_series_budget(  # before the net is even built
         p, len(todo), limit_s=limit, cores=run_cores(serial, workers),
