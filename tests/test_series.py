@@ -182,6 +182,24 @@ def test_cli_writes_the_folder(capsys, tiny, tmp_path):
     captured = capsys.readouterr()
     assert "PETG keeps deflection" in captured.out
     assert "\u2501" not in captured.err  # no progress bar on a stderr that is no terminal
+    # the run's total ends after the figure and the report; the process's wall (the command
+    # line's: the interpreter's start and the imports too) holds it
+    times = json.loads((out / "timings.json").read_text())["timings_s"]
+    assert 0 < times["cases"] < times["total"] <= times["wall"]
+
+
+def test_no_spinner_thread_off_a_terminal():
+    """Off a terminal (pytest captures stderr) the command shows no spinner and starts no
+    thread for it: a process running a thread starts its workers from a fork server, each
+    importing the cases' modules again, instead of forking them with those imported."""
+    import threading
+
+    from printgen.commands.series import spinner
+
+    before = threading.active_count()
+    with spinner("reading inputs") as status:
+        status.update("15 cases ...")
+        assert threading.active_count() == before
 
 
 @pytest.mark.parametrize("argv, word", [

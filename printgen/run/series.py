@@ -159,33 +159,38 @@ def similar_cases(shared: SeriesShared, todo: list[tuple[str, float]]) -> int:
 
 def solve_cases(runner, shared: SeriesShared, todo: list[tuple[str, float]],
                 meanwhile: Callable[[], None] | None = None) -> list[CaseResult]:
-    """Every case of `todo`, in its order, on `runner`: the prototype and the cases that
-    start cold (`starts_cold`) first, then the others from the prototype's states, each
-    round the longest case first; each case whose scene is another's (`same_case`) takes
-    that one's result under its own row. `meanwhile` (work of this process that needs no
-    case) runs in a thread beside the second round when the cases run in other processes
-    (once they are started: a process forking its workers runs no other thread), else after
-    it; its error is raised here."""
+    """Every case of `todo`, in its order, on `runner`: the prototype first, then the other
+    cases that start cold (`starts_cold`), the longest first; then the others from the
+    prototype's states, the longest first, queued as soon as the prototype is solved
+    (`Runner.map_then`: they fill the cores the cold cases leave); each case whose scene is
+    another's (`same_case`) takes that one's result under its own row. `meanwhile` (work of
+    this process that needs no case) runs in a thread beside the cases when they run in other
+    processes (once those are started: a process forking its workers runs no other thread),
+    else after them; its error is raised here."""
     own = sorted((c for c in todo if same_case(shared, c) is None),
                  key=lambda c: _work_rank(shared, c))  # the longest first: an even finish
-    first = [c for c in own if starts_cold(shared, c)]
-    runs = dict(zip(first, runner.map(solve_cold, first, shared=shared, label="series cases"),
-                    strict=True))
-    warm = dataclasses.replace(shared, start=runs[PROTOTYPE][1])
-    rest = [c for c in own if c not in runs]
-    done = {c: r for c, (r, _) in runs.items()}
+    first = [PROTOTYPE, *(c for c in own if starts_cold(shared, c) and c != PROTOTYPE)]
+    rest = [c for c in own if c not in first]
     aside = ThreadPoolExecutor(max_workers=1) if meanwhile and runner.workers > 1 else None
-    chores = aside.submit(meanwhile) if aside and meanwhile else None
+    chores = []
+
+    def then(prototype: tuple[CaseResult, dict]) -> tuple[Callable, list, SeriesShared]:
+        if aside is not None and meanwhile is not None:
+            chores.append(aside.submit(meanwhile))
+        return solve_case, rest, dataclasses.replace(shared, start=prototype[1])
+
     try:
-        done.update(zip(rest, runner.map(solve_case, rest, shared=warm, label="series cases"),
-                        strict=True))
+        cold, warm = runner.map_then(solve_cold, first, then, shared=shared,
+                                     label="series cases")
     finally:
         if aside is not None:
             aside.shutdown(wait=True)
-    if chores is not None:
-        chores.result()
-    elif meanwhile is not None:
+    for f in chores:
+        f.result()
+    if meanwhile is not None and aside is None:
         meanwhile()
+    done = {c: r for c, (r, _) in zip(first, cold, strict=True)}
+    done.update(zip(rest, warm, strict=True))
     return [done[c] if c in done else
             dataclasses.replace(done[same_case(shared, c) or c], row=c[0], scale=c[1])
             for c in todo]
