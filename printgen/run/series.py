@@ -118,14 +118,13 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
     meta: dict = {}
 
     def meanwhile() -> None:  # the folder's needs that do not wait for the cases
-        if out is not None:
-            load_pyplot()
-            meta.update(provenance_record(options.command, prototype=p.path))
+        load_pyplot()
+        meta.update(provenance_record(options.command, prototype=p.path))
 
     t_cases = time.perf_counter()
     with open_runner(scheduler=scheduler, workers=workers, serial=serial,
                      progress=bar) as runner:
-        results = solve_cases(runner, shared, todo, meanwhile)
+        results = solve_cases(runner, shared, todo, None if out is None else meanwhile)
         where = runner.where
     t_cases = time.perf_counter() - t_cases
     scene = "simple-free-top" if not base.cables else f"border cables, {base.mounting}"
