@@ -188,18 +188,23 @@ def test_cli_writes_the_folder(capsys, tiny, tmp_path):
     assert 0 < times["cases"] < times["total"] <= times["wall"]
 
 
-def test_no_spinner_thread_off_a_terminal():
-    """Off a terminal (pytest captures stderr) the command shows no spinner and starts no
-    thread for it: a process running a thread starts its workers from a fork server, each
-    importing the cases' modules again, instead of forking them with those imported."""
+@pytest.mark.parametrize("terminal", ["0", "1"])
+def test_the_status_line_runs_no_thread(monkeypatch, capsys, terminal):
+    """The command's status line starts no thread, on a terminal (drawn when its text
+    changes, then erased) or off one (nothing drawn): a process running a thread starts its
+    workers from a fork server, which imports the cases' modules again, instead of forking
+    them with those imported."""
     import threading
 
     from printgen.commands.series import spinner
 
+    monkeypatch.setenv("TTY_COMPATIBLE", terminal)  # rich's switch: stderr is a terminal or not
     before = threading.active_count()
     with spinner("reading inputs") as status:
         status.update("15 cases ...")
         assert threading.active_count() == before
+    err = capsys.readouterr().err
+    assert ("15 cases ..." in err) == (terminal == "1")
 
 
 @pytest.mark.parametrize("argv, word", [

@@ -80,25 +80,42 @@ def run(args: argparse.Namespace) -> int:
 
 
 class _Silent:
-    """The spinner's stand-in off a terminal: its text goes nowhere."""
+    """The status line's stand-in off a terminal: its text goes nowhere."""
 
     def update(self, _text: str) -> None:
         pass
 
 
+class _Line:
+    """The run's current step, one line on the terminal, drawn again when it changes."""
+
+    def __init__(self, live) -> None:
+        self.live = live
+
+    def update(self, text: str) -> None:
+        from rich.text import Text
+
+        self.live.update(Text(text), refresh=True)
+
+
 @contextlib.contextmanager
 def spinner(text: str) -> Iterator:
-    """The spinner on stderr while the series runs, when stderr is a terminal; elsewhere (a
-    log, a pipe, a benchmark) no spinner at all, not even its refresh thread: rich draws
-    nothing there, and a process running a thread starts its workers from a fork server
-    (printgen.executor.start.start_method), each importing what the cases need again,
-    instead of forking them with it imported."""
+    """The run's current step on stderr while the series runs, when stderr is a terminal
+    (erased at the end); elsewhere (a log, a pipe, a benchmark) nothing. Drawn when the text
+    changes, by no thread of its own (not rich's animated spinner, which refreshes from one):
+    a process running a thread starts its workers from a fork server
+    (printgen.executor.start.start_method), which imports what the cases need again, instead
+    of forking them with it imported. The cases' progress bar, once the workers run, is
+    animated."""
     err = Console(stderr=True, highlight=False)
     if not err.is_terminal:
         yield _Silent()
         return
-    with err.status(text) as status:
-        yield status
+    from rich.live import Live
+    from rich.text import Text
+
+    with Live(Text(text), console=err, auto_refresh=False, transient=True) as live:
+        yield _Line(live)
 
 
 def show(res, out: Path) -> None:
