@@ -182,6 +182,29 @@ def test_cli_writes_the_folder(capsys, tiny, tmp_path):
     captured = capsys.readouterr()
     assert "PETG keeps deflection" in captured.out
     assert "\u2501" not in captured.err  # no progress bar on a stderr that is no terminal
+    # the run's total ends after the figure and the report; the process's wall (the command
+    # line's: the interpreter's start and the imports too) holds it
+    times = json.loads((out / "timings.json").read_text())["timings_s"]
+    assert 0 < times["cases"] < times["total"] <= times["wall"]
+
+
+@pytest.mark.parametrize("terminal", ["0", "1"])
+def test_the_status_line_runs_no_thread(monkeypatch, capsys, terminal):
+    """The command's status line starts no thread, on a terminal (drawn when its text
+    changes, then erased) or off one (nothing drawn): a process running a thread starts its
+    workers from a fork server, which imports the cases' modules again, instead of forking
+    them with those imported."""
+    import threading
+
+    from printgen.commands.series import spinner
+
+    monkeypatch.setenv("TTY_COMPATIBLE", terminal)  # rich's switch: stderr is a terminal or not
+    before = threading.active_count()
+    with spinner("reading inputs") as status:
+        status.update("15 cases ...")
+        assert threading.active_count() == before
+    err = capsys.readouterr().err
+    assert ("15 cases ..." in err) == (terminal == "1")
 
 
 @pytest.mark.parametrize("argv, word", [

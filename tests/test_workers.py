@@ -147,6 +147,32 @@ def test_shared_pool_runs_every_job_of_the_block_on_its_workers(monkeypatch, ser
     assert workers.run_jobs([(pid_of, (0,), {})])[0] not in pids - {os.getpid()}
 
 
+def scaled(factor: int, k: int) -> tuple[int, int]:
+    return factor * k, os.getpid()
+
+
+@pytest.mark.parametrize("serial", [True, False])
+def test_map_then_starts_the_second_tasks_from_the_first_result(monkeypatch, serial):
+    """`Runner.map_then`: the tasks `then` makes of the first item's result run too (on the
+    local pool, queued while the first map still runs), both lists of results in order, the
+    same serially and on two workers."""
+    from printgen.executor import open_runner
+
+    monkeypatch.delenv("PRINTGEN_SERIAL", raising=False)
+    seen = []
+
+    def then(first: tuple[int, int]) -> tuple:
+        seen.append(first[0])
+        return scaled, [1, 2, 3], first[0]
+
+    with open_runner(serial=serial, workers=None if serial else min(2, start.cores())) as run:
+        a, b = run.map_then(scaled, [5, 6, 7], then, shared=10)
+    assert seen == [50]
+    assert [x for x, _ in a] == [50, 60, 70] and [x for x, _ in b] == [50, 100, 150]
+    pids = {p for _, p in a + b}
+    assert pids == {os.getpid()} if serial or start.cores() < 2 else os.getpid() not in pids
+
+
 def test_preload_is_a_no_op_where_workers_fork(monkeypatch):
     """Only a fork server imports ahead: under `fork` nothing is started."""
     started = []

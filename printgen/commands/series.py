@@ -5,7 +5,9 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 from rich.console import Console
@@ -66,8 +68,7 @@ def run(args: argparse.Namespace) -> int:
 
     check_profile_args(args, "materials")
     out = args.out or Path("out") / f"{Path(args.prototype).stem}-series"
-    err = Console(stderr=True, highlight=False)
-    with err.status("reading inputs") as status:
+    with spinner("reading inputs") as status:
         res = api.series(args.prototype, _scales(args.scales), materials=args.materials,
                          net=args.solver_net, out=out, options=run_options(args),
                          progress=lambda s: status.update(f"{s} ..."), bar=not args.json)
@@ -76,6 +77,45 @@ def run(args: argparse.Namespace) -> int:
         return 0
     show(res, out)
     return 0
+
+
+class _Silent:
+    """The status line's stand-in off a terminal: its text goes nowhere."""
+
+    def update(self, _text: str) -> None:
+        pass
+
+
+class _Line:
+    """The run's current step, one line on the terminal, drawn again when it changes."""
+
+    def __init__(self, live) -> None:
+        self.live = live
+
+    def update(self, text: str) -> None:
+        from rich.text import Text
+
+        self.live.update(Text(text), refresh=True)
+
+
+@contextlib.contextmanager
+def spinner(text: str) -> Iterator:
+    """The run's current step on stderr while the series runs, when stderr is a terminal
+    (erased at the end); elsewhere (a log, a pipe, a benchmark) nothing. Drawn when the text
+    changes, by no thread of its own (not rich's animated spinner, which refreshes from one):
+    a process running a thread starts its workers from a fork server
+    (printgen.executor.start.start_method), which imports what the cases need again, instead
+    of forking them with it imported. The cases' progress bar, once the workers run, is
+    animated."""
+    err = Console(stderr=True, highlight=False)
+    if not err.is_terminal:
+        yield _Silent()
+        return
+    from rich.live import Live
+    from rich.text import Text
+
+    with Live(Text(text), console=err, auto_refresh=False, transient=True) as live:
+        yield _Line(live)
 
 
 def show(res, out: Path) -> None:

@@ -55,6 +55,25 @@ class Runner:
                 advance()
             return out
 
+    def map_then(self, fn: Callable[[Any, Any], Any], items: Sequence[Any],
+                 then: Callable[[Any], tuple[Callable[[Any, Any], Any], Sequence[Any], Any]], *,
+                 shared: Any = None, label: str = "sweep") -> tuple[list[Any], list[Any]]:
+        """(`map(fn, items)`, the results of the tasks `then(result of items[0])` gives as
+        (fn2, items2, shared2)): on the local pool those start as soon as the first item's
+        result is in, queued behind the rest of `items`, so that work waiting on one result
+        fills the cores the others leave; serially or on Dask, after the whole first map."""
+        if self.pool is None or self.client is not None:
+            first = self.map(fn, items, shared=shared, label=label)
+            fn2, items2, shared2 = then(first[0])
+            return first, self.map(fn2, items2, shared=shared2, label=label)
+        futures = [self.pool.submit(fn, shared, item) for item in items]
+        fn2, items2, shared2 = then(collect(futures[:1])[0])
+        more = [self.pool.submit(fn2, shared2, item) for item in items2]
+        with _bar(self.progress, label, len(futures) + len(more)) as advance:
+            for _ in as_completed(futures + more):
+                advance()
+        return collect(futures), collect(more)
+
 
 @contextmanager
 def _bar(show: bool, label: str, total: int) -> Iterator[Callable[[], None]]:

@@ -6,7 +6,10 @@ locked, with its manifest):
 - report.html: the sentences, the figure, the table, the law check, the assumptions;
 - report.json: every number of the series (points, curves, law check, assumptions);
 - series.csv: the table; figures/01-scale-series.png and .svg;
-- timings.json: the wall-clock times (the one file that differs between identical runs).
+- timings.json: the wall-clock times (the one file that differs between identical runs):
+  the estimate, the cases, the run up to the folder's writing (figure and report included),
+  and, run from the command line, the process's own ("wall": interpreter start-up and
+  imports too, what its user waits for).
 """
 
 from __future__ import annotations
@@ -14,21 +17,24 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from printgen.barrier.loads import get_load
 from printgen.errors import InputError
 from printgen.executor import open_runner
+from printgen.executor.start import warm_up
 from printgen.inputs.profiles import search_dirs
 from printgen.inputs.prototype import Prototype, load_prototype
 from printgen.outputs import TIMINGS, check_destination, write_folder
 from printgen.outputs.display import Shown, Summary
 from printgen.report.jsonout import dumps
+from printgen.report.plots import load_pyplot
 from printgen.report.series import series_csv, series_figure, series_report
 from printgen.run.budget import DEFAULT_LIMIT_S, check_series_budget, run_cores
 from printgen.run.options import RunOptions
-from printgen.run.provenance import provenance_record
+from printgen.run.provenance import process_seconds, provenance_record
 from printgen.run.shown import series_summary
 from printgen.scene.scenes import SENSOR_FORCE_N
 from printgen.verification.preprint import levels
@@ -51,6 +57,9 @@ from printgen.verification.series import (
 from printgen.verification.series_table import Series, summarise
 
 PARALLEL_FROM = 12  # cases from which the series runs on this machine's workers by default
+# what the cases import in a worker: a fork server imports it once, while the inputs are read
+# (printgen.executor.start.warm_up; workers forked from this process have it already)
+JOB_MODULES = ("printgen.verification.series",)
 
 
 @dataclass(repr=False)
@@ -97,6 +106,8 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
     todo = cases(shared, lams)
     if serial is None:
         serial = len(todo) < PARALLEL_FROM and scheduler is None and workers is None
+    if not serial and scheduler is None and workers != 1:
+        warm_up(JOB_MODULES)
     limit = DEFAULT_LIMIT_S if options.time_limit_s is None else options.time_limit_s
     estimate, _ = check_series_budget(  # before the net is even built
         p, len(todo), limit_s=limit, cores=run_cores(serial, workers),
@@ -104,10 +115,16 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
     base = base_scene(shared)  # geometry errors now, not in a worker
     say(f"{len(todo)} cases ({len(rows)} rows x {len(lams)} scales)"
         + ("" if serial else ", starting the workers"))
+    meta: dict = {}
+
+    def meanwhile() -> None:  # the folder's needs that do not wait for the cases
+        load_pyplot()
+        meta.update(provenance_record(options.command, prototype=p.path))
+
     t_cases = time.perf_counter()
     with open_runner(scheduler=scheduler, workers=workers, serial=serial,
                      progress=bar) as runner:
-        results = solve_cases(runner, shared, todo)
+        results = solve_cases(runner, shared, todo, None if out is None else meanwhile)
         where = runner.where
     t_cases = time.perf_counter() - t_cases
     scene = "simple-free-top" if not base.cables else f"border cables, {base.mounting}"
@@ -120,10 +137,14 @@ def run_series(prototype: str | Path | Prototype, scales: list[float], *,
     run = SeriesRun(s, results, where, record)
     if out is not None:
         say("writing the report")
-        run.files = write_series(run, Path(out), force, inputs,
-                                 provenance_record(options.command, prototype=p.path),
-                                 {"estimate": estimate, "cases": t_cases, "cases_count": len(todo),
-                                  "total": time.perf_counter() - t0})
+        files = series_files(run)
+        timings = {"estimate": estimate, "cases": t_cases, "cases_count": len(todo),
+                   "total": time.perf_counter() - t0}
+        wall = process_seconds() if options.command is not None else None
+        if wall is not None:  # the command line's process: its start-up and imports too
+            timings["wall"] = wall
+        run.files = write_folder(Path(out), {**files, TIMINGS: dumps({"timings_s": timings})},
+                                 force=force, volatile=(TIMINGS,), inputs=inputs, meta=meta)
     return run
 
 
@@ -135,22 +156,40 @@ def similar_cases(shared: SeriesShared, todo: list[tuple[str, float]]) -> int:
         same_case(shared, c) is not None or (c[0] == "similitude" and not shared.net.sensors)))
 
 
-def solve_cases(runner, shared: SeriesShared, todo: list[tuple[str, float]]
-                ) -> list[CaseResult]:
-    """Every case of `todo`, in its order, on `runner`: the prototype and the cases that
-    start cold (`starts_cold`) first, then the others from the prototype's states, each
-    round the longest case first; each case whose scene is another's (`same_case`) takes
-    that one's result under its own row."""
+def solve_cases(runner, shared: SeriesShared, todo: list[tuple[str, float]],
+                meanwhile: Callable[[], None] | None = None) -> list[CaseResult]:
+    """Every case of `todo`, in its order, on `runner`: the prototype first, then the other
+    cases that start cold (`starts_cold`), the longest first; then the others from the
+    prototype's states, the longest first, queued as soon as the prototype is solved
+    (`Runner.map_then`: they fill the cores the cold cases leave); each case whose scene is
+    another's (`same_case`) takes that one's result under its own row. `meanwhile` (work of
+    this process that needs no case) runs in a thread beside the cases when they run in other
+    processes (once those are started: a process forking its workers runs no other thread),
+    else after them; its error is raised here."""
     own = sorted((c for c in todo if same_case(shared, c) is None),
                  key=lambda c: _work_rank(shared, c))  # the longest first: an even finish
-    first = [c for c in own if starts_cold(shared, c)]
-    runs = dict(zip(first, runner.map(solve_cold, first, shared=shared, label="series cases"),
-                    strict=True))
-    warm = dataclasses.replace(shared, start=runs[PROTOTYPE][1])
-    rest = [c for c in own if c not in runs]
-    done = {c: r for c, (r, _) in runs.items()}
-    done.update(zip(rest, runner.map(solve_case, rest, shared=warm, label="series cases"),
-                    strict=True))
+    first = [PROTOTYPE, *(c for c in own if starts_cold(shared, c) and c != PROTOTYPE)]
+    rest = [c for c in own if c not in first]
+    aside = ThreadPoolExecutor(max_workers=1) if meanwhile and runner.workers > 1 else None
+    chores = []
+
+    def then(prototype: tuple[CaseResult, dict]) -> tuple[Callable, list, SeriesShared]:
+        if aside is not None and meanwhile is not None:
+            chores.append(aside.submit(meanwhile))
+        return solve_case, rest, dataclasses.replace(shared, start=prototype[1])
+
+    try:
+        cold, warm = runner.map_then(solve_cold, first, then, shared=shared,
+                                     label="series cases")
+    finally:
+        if aside is not None:
+            aside.shutdown(wait=True)
+    for f in chores:
+        f.result()
+    if meanwhile is not None and aside is None:
+        meanwhile()
+    done = {c: r for c, (r, _) in zip(first, cold, strict=True)}
+    done.update(zip(rest, warm, strict=True))
     return [done[c] if c in done else
             dataclasses.replace(done[same_case(shared, c) or c], row=c[0], scale=c[1])
             for c in todo]
@@ -214,14 +253,13 @@ def scaling_assumptions(shared: SeriesShared) -> list[tuple[str, str, str]]:
     return out
 
 
-def write_series(run: SeriesRun, out: Path, force: bool, inputs: list,
-                 meta: dict, timings: dict) -> list[str]:
-    """The folder, staged and swapped in whole, its manifest with the run's provenance."""
+def series_files(run: SeriesRun) -> dict[str, str | bytes]:
+    """The folder's files but timings.json, by path: the report, its JSON, the table, the
+    figure (`write_folder` stages them and swaps them in whole, with the manifest)."""
     fig = series_figure(run.series)
     rep = series_report(run.series, fig)
     files: dict[str, str | bytes] = {"report.html": rep.html(), "report.json": dumps(run.record),
-                                     "series.csv": series_csv(run.series),
-                                     TIMINGS: dumps({"timings_s": timings})}
+                                     "series.csv": series_csv(run.series)}
     for f in rep.figures:
         files[f"figures/01-{f.name}.png"], files[f"figures/01-{f.name}.svg"] = f.png, f.svg
-    return write_folder(out, files, force=force, volatile=(TIMINGS,), inputs=inputs, meta=meta)
+    return files

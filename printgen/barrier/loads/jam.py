@@ -34,7 +34,6 @@ import math
 from typing import Any
 
 import numpy as np
-from scipy.optimize import brentq
 
 from printgen import solver
 from printgen.barrier.loads import (
@@ -101,8 +100,17 @@ def seepage(hu: float, k: float, porosity: float, thickness: float, log_d: float
         hm, _ = behind_net(q, k, froude)
         return hu - hm - thickness * ergun_gradient(2 * q / (hu + hm), porosity, log_d)
 
-    q = brentq(excess, 0.0, froude * math.sqrt(G * hu**3), xtol=ROOT_TOL)
+    q = _root(excess, 0.0, froude * math.sqrt(G * hu**3))
     return (q, *behind_net(q, k, froude))
+
+
+def _root(f, low: float, high: float) -> float:
+    """The root of `f` in [low, high] to ROOT_TOL (brentq). scipy.optimize is imported here,
+    not with the module: every command that takes --load imports each load case for its help
+    text, and scipy.optimize alone is about 0.1 s of it."""
+    from scipy.optimize import brentq
+
+    return float(brentq(f, low, high, xtol=ROOT_TOL))
 
 
 def _jam(s: SceneView, site: Site, values: dict[str, float]) -> dict[str, float]:
@@ -143,7 +151,7 @@ def levels(s: SceneView, site: Site, **values: float) -> np.ndarray:
             out.append(OVERFLOW)
             continue
         low = behind_net(q, jam["k"], jam["froude"])[0]  # no jam passes q below this
-        hu = brentq(lambda h, q=q: seepage(h, **jam)[0] - q, low, top, xtol=ROOT_TOL)
+        hu = _root(lambda h, q=q: seepage(h, **jam)[0] - q, low, top)
         out.append(hu / s.height)
     return np.unique(np.round(out, 10))
 
