@@ -171,3 +171,51 @@ def test_a_search_over_its_time_limit_is_refused_before_any_work(tmp_path, capsy
     err = capsys.readouterr().err
     assert "this design search is too big: 228,800 nets to screen and 31 to verify" in err, err
     assert "--time-limit" in err and not out.exists()
+
+
+def test_verify_batches_group_one_net_graph_per_job_largest_first(design_1_40):
+    import dataclasses
+
+    from printgen.search.nets import VerifyTask, verify_batches
+
+    def net(d, **kw):
+        return dataclasses.replace(d, net=dataclasses.replace(d.net, **kw))
+
+    fine = net(design_1_40, mesh_x_mm=10.3, mesh_y_mm=4.7)  # four times the nodes
+    tasks = [VerifyTask("a", design_1_40), VerifyTask("b", fine),
+             VerifyTask("c", net(design_1_40, border_width_mm=2.4)),  # one graph with "a"
+             VerifyTask("d", net(fine, material="petg"))]
+    jobs = verify_batches(tasks)
+    assert [[t.key for t in j.tasks] for j in jobs] == [["b", "d"], ["a", "c"]]
+    assert verify_batches(list(reversed(tasks)))[0].tasks[0].key == "d"  # task order kept
+
+
+@pytest.mark.slow  # four sweeps of a coarse 1:40 model and one of its prototype (~1-3 s)
+def test_a_batch_warm_start_keeps_the_cold_scores(design_1_40):
+    import dataclasses
+
+    from conftest import coarse_design_1_40
+
+    from printgen.inputs.prototype import load_prototype
+    from printgen.run.search import prototype_sweep, verify_batch, verify_task
+    from printgen.search.nets import VerifyBatch, VerifyShared, VerifyTask
+
+    p = load_prototype(REALISTIC)
+    d = coarse_design_1_40(2.0)
+    wide = dataclasses.replace(d, net=dataclasses.replace(d.net, border_width_mm=2.4))
+    shared = VerifyShared(p, COARSE_STEP)
+    shared = dataclasses.replace(shared, prototype_run=prototype_sweep(shared, d))
+    cold = [verify_task(shared, VerifyTask(k, x)) for k, x in (("a", d), ("b", wide))]
+    first, again, other = verify_batch(shared, VerifyBatch((
+        VerifyTask("a", d), VerifyTask("a2", d), VerifyTask("b", wide))))
+    levels = round(1.1 / COARSE_STEP) + 1
+    # the same design started from its own converged states: each level is solved at once
+    # (at most one Newton step per level), where the cold path needs several
+    assert again.iterations <= levels < first.iterations
+    # a start, never the answer: the scores agree to the solver's tolerance (SOLVER_TOL is
+    # 1e-7 of the load; the normalised deformations move less than 1e-6 of their peaks)
+    for warm, ref in ((first, cold[0]), (again, cold[0]), (other, cold[1])):
+        assert warm.mismatch == pytest.approx(ref.mismatch, rel=1e-6)
+        for m, v in ref.per_metric.items():
+            assert warm.per_metric[m] == pytest.approx(v, rel=1e-6, abs=1e-9)
+        assert warm.ok == ref.ok and warm.failed_levels == ref.failed_levels

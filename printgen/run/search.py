@@ -42,6 +42,7 @@ from printgen.scaling.record import Design
 from printgen.scaling.similitude import ScaledTargets, scale_targets
 from printgen.search.nets import (
     SearchResult,
+    VerifyBatch,
     VerifyScore,
     VerifyShared,
     VerifyTask,
@@ -60,27 +61,53 @@ from printgen.search.space import (
 from printgen.search.waves import WAVES_VERIFIED
 
 
-def verify_task(shared: VerifyShared, task: VerifyTask) -> VerifyScore:
-    """Solver stage of the search: the verification of one design, as a score, against the
-    prototype's sweep the search made once (`prototype_sweep`; without it, swept here too).
-    Pure: the same task gives the same score in any process (the sweep worker runs it
+def verify_batch(shared: VerifyShared, batch: VerifyBatch) -> list[VerifyScore]:
+    """Solver stage of the search: the verification of each design of `batch` (nets of one
+    graph), as scores, against the prototype's sweep the search made once (`prototype_sweep`;
+    without it, swept here once for the batch: it does not depend on the net). Each model sweep
+    after the first also starts every load level from the batch's earlier converged states
+    there (`sweep`'s guesses: the solver keeps the start of lowest potential and iterates to
+    SOLVER_TOL, so the score is the cold sweep's to the solver tolerance, in fewer iterations).
+    Pure: the same batch gives the same scores in any process (the sweep worker runs it
     serially)."""
     from threadpoolctl import threadpool_limits
 
-    from printgen.verification.preprint import verify, verify_plan
+    from printgen.verification.preprint import verify_plan
 
     lv = search_levels(shared)
+    proto = shared.prototype_run
+    kept: list[dict[float, Any]] = []  # the earlier designs' states: level -> displacements
+
+    def earlier(level: float) -> list[Any]:
+        return [s[float(level)] for s in kept if float(level) in s]
+
+    out = []
     with _serial(), threadpool_limits(limits=1):  # one BLAS thread: the same sums everywhere
-        if shared.prototype_run is None:
-            v = verify(shared.prototype, task.design, lv=lv)
-        else:  # the model alone; the sensors' share does not enter the score
+        for task in batch.tasks:
             plan = verify_plan(shared.prototype, task.design, lv=lv)
+            if proto is None:  # the model alone is compared: the sensors' share is not scored
+                fn, args, kw = plan.jobs()[1]
+                proto = fn(*args, **kw)
             fn, args, kw = plan.jobs()[0]
-            v = plan.verified(fn(*args, **kw), shared.prototype_run)
+            model = fn(*args, **kw, keep_states=True, guesses=earlier if kept else None)
+            kept.append(model.states)
+            out.append(_score(task.key, plan.verified(model, proto), model))
+    return out
+
+
+def verify_task(shared: VerifyShared, task: VerifyTask) -> VerifyScore:
+    """The verification of one design as a score (`verify_batch` of it alone: a cold sweep)."""
+    return verify_batch(shared, VerifyBatch((task,)))[0]
+
+
+def _score(key: str, v: Any, model: Any) -> VerifyScore:
+    """A Verification's score: the RMS over the metrics of their RMS mismatches (and the
+    model sweep's work)."""
     rms = math.sqrt(sum(m.rms_rel**2 for m in v.mismatches) / len(v.mismatches))
     failed = sorted(set(v.prototype.failed) | set(v.model.failed))
-    return VerifyScore(task.key, rms, {m.metric: m.rms_rel for m in v.mismatches},
-                       max(m.max_rel for m in v.mismatches), v.ok, tuple(failed))
+    return VerifyScore(key, rms, {m.metric: m.rms_rel for m in v.mismatches},
+                       max(m.max_rel for m in v.mismatches), v.ok, tuple(failed),
+                       int(sum(model.iterations)), model.cpu_s)
 
 
 def search_levels(shared: VerifyShared) -> Any:
@@ -199,7 +226,7 @@ def search_at_scales(prototype: str | Path | Prototype, scales: list[float], *,
         for s in scales:
             results.append(search(p, s, runner, objective=options.objective,
                                   space=spaces[s], printer=options.printer,
-                                  verifier=verify_task, verify_nets=options.verify_nets,
+                                  verifier=verify_batch, verify_nets=options.verify_nets,
                                   prototype_sweep=prototype_sweep,
                                   level_step=options.level_step, wave_sweep=wave_task))
         where = runner.where

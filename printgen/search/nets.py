@@ -7,7 +7,9 @@ Stages over the space of `search_space` (material x strand section x mesh x bord
 2. with the `deformation` objective, verify the best few with the solver (`verifier`, the
    pre-print verification over h / h_B = 0-1.1) and rank them by their deformation mismatch:
    the best net of each of the `verify_nets` best material x section pairs, each with every
-   border width, and `select`'s pick for comparison;
+   border width, and `select`'s pick for comparison. The candidates whose nets share one graph
+   (meshes, pattern) go to one worker job (`VerifyBatch`), swept in turn, each load level
+   warm-started from the earlier ones' states there;
 3. with the `deformation` objective, nets with printable waved strands, searched by the solver
    on the flume's readings (`printgen.search.waves`): the design takes the best waved net when
    it reads closer to the prototype than the best straight net.
@@ -84,9 +86,39 @@ class VerifyScore:
     max_rel: float
     ok: bool
     failed_levels: tuple[float, ...]
+    iterations: int = 0  # the model sweep's Newton iterations (not in the records: the work)
+    cpu_s: float = 0.0  # the model sweep's CPU time in its process (not in the records)
 
 
-Verifier = Callable[[VerifyShared, VerifyTask], VerifyScore]
+@dataclass(frozen=True)
+class VerifyBatch:
+    """One worker job of the solver stage: designs whose nets share one graph (the same meshes,
+    pattern and size: their solver states have one shape), verified in turn, each load level of
+    a later design's sweep also started from the earlier designs' converged states at that level
+    (the solver keeps the start of lowest potential and iterates to its tolerance: a start,
+    never the answer)."""
+
+    tasks: tuple[VerifyTask, ...]
+
+    def nodes(self) -> float:
+        """The job's size: its designs' net nodes (mesh cells over the barrier), summed."""
+        return sum(t.design.net.width_mm * t.design.net.height_mm
+                   / (t.design.net.mesh_x_mm * t.design.net.mesh_y_mm) for t in self.tasks)
+
+
+def verify_batches(tasks: list[VerifyTask]) -> list[VerifyBatch]:
+    """`tasks` grouped by net graph (in task order within a group), the largest job first:
+    the worker that takes the last job should not start a long one late. The grouping depends
+    on the designs alone, never on the workers: the same scores wherever the search runs."""
+    groups: dict[tuple, list[VerifyTask]] = {}
+    for t in tasks:
+        n = t.design.net
+        groups.setdefault((n.pattern, n.mesh_x_mm, n.mesh_y_mm, n.width_mm, n.height_mm),
+                          []).append(t)
+    return sorted((VerifyBatch(tuple(g)) for g in groups.values()), key=lambda b: -b.nodes())
+
+
+Verifier = Callable[[VerifyShared, VerifyBatch], list[VerifyScore]]
 
 
 @dataclass(frozen=True)
@@ -219,8 +251,9 @@ def search(p: Prototype, scale: float, runner: Runner, *, objective: str = "defo
         shared = VerifyShared(p, level_step)
         if prototype_sweep is not None:
             shared = dataclasses.replace(shared, prototype_run=prototype_sweep(shared, base))
-        scores = runner.map(verifier, tasks, shared=shared,
-                            label=f"1:{t.scale:g} verifying {len(tasks)} nets (solver)")
+        parts = runner.map(verifier, verify_batches(tasks), shared=shared,
+                           label=f"1:{t.scale:g} verifying {len(tasks)} nets (solver)")
+        scores = [v for part in parts for v in part]
         verified = {int(v.key): v for v in scores if v.key != SELECT_KEY}
         select_score = next(v for v in scores if v.key == SELECT_KEY)
     chosen = _choose(objective, screened, verified)
