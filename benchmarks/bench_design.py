@@ -8,7 +8,7 @@ by the membrane law: candidates per second. Stage 2: solver verifications per se
 search runs them: the prototype's sweep made once (timed apart, `prototype_sweep_s`), then the
 stage-two designs of the 1:40 example (the best net of the `VERIFY_NETS` best material x
 section pairs, each with every border width, and select's pick) verified against it at load
-step `LEVEL_STEP`, in the search's jobs (`verify_batches`: the designs of one net graph per
+step `LEVEL_STEP`, in the search's jobs (`solver_batches`: the designs of one net graph per
 job, warm-started from each other). Each row also gives the model sweeps' CPU seconds and
 Newton iterations per verified design (what the machine's load does not change much), the
 serial row the whole stage's CPU seconds per design. Pools and
@@ -68,10 +68,10 @@ def _prototype_run(p, design):
 
 def _stage_times(runner, ctx, points, designs, shared, repeat: int) -> dict:
     from printgen.run.search import verify_batch
-    from printgen.search.nets import VerifyTask, screen_all, verify_batches
+    from printgen.search.nets import VerifyTask, screen_all, solver_batches
 
     best_screen = min(_timed(lambda: screen_all(runner, ctx, points))[0] for _ in range(repeat))
-    jobs = verify_batches([VerifyTask(str(i), d) for i, d in enumerate(designs)])
+    jobs = solver_batches([VerifyTask(str(i), d) for i, d in enumerate(designs)])
     runs = [_timed(lambda: runner.map(verify_batch, jobs, shared=shared)) for _ in range(repeat)]
     wall, cpu, parts = min(runs, key=lambda r: r[0])
     scores = [v for part in parts for v in part]

@@ -173,10 +173,10 @@ def test_a_search_over_its_time_limit_is_refused_before_any_work(tmp_path, capsy
     assert "--time-limit" in err and not out.exists()
 
 
-def test_verify_batches_group_one_net_graph_per_job_largest_first(design_1_40):
+def test_solver_batches_group_one_net_graph_per_job_largest_first(design_1_40):
     import dataclasses
 
-    from printgen.search.nets import VerifyTask, verify_batches
+    from printgen.search.nets import VerifyTask, solver_batches
 
     def net(d, **kw):
         return dataclasses.replace(d, net=dataclasses.replace(d.net, **kw))
@@ -185,9 +185,9 @@ def test_verify_batches_group_one_net_graph_per_job_largest_first(design_1_40):
     tasks = [VerifyTask("a", design_1_40), VerifyTask("b", fine),
              VerifyTask("c", net(design_1_40, border_width_mm=2.4)),  # one graph with "a"
              VerifyTask("d", net(fine, material="petg"))]
-    jobs = verify_batches(tasks)
+    jobs = solver_batches(tasks)
     assert [[t.key for t in j.tasks] for j in jobs] == [["b", "d"], ["a", "c"]]
-    assert verify_batches(list(reversed(tasks)))[0].tasks[0].key == "d"  # task order kept
+    assert solver_batches(list(reversed(tasks)))[0].tasks[0].key == "d"  # task order kept
 
 
 @pytest.mark.slow  # four sweeps of a coarse 1:40 model and one of its prototype (~1-3 s)
@@ -198,7 +198,7 @@ def test_a_batch_warm_start_keeps_the_cold_scores(design_1_40):
 
     from printgen.inputs.prototype import load_prototype
     from printgen.run.search import prototype_sweep, verify_batch, verify_task
-    from printgen.search.nets import VerifyBatch, VerifyShared, VerifyTask
+    from printgen.search.nets import SolverBatch, VerifyShared, VerifyTask
 
     p = load_prototype(REALISTIC)
     d = coarse_design_1_40(2.0)
@@ -206,7 +206,7 @@ def test_a_batch_warm_start_keeps_the_cold_scores(design_1_40):
     shared = VerifyShared(p, COARSE_STEP)
     shared = dataclasses.replace(shared, prototype_run=prototype_sweep(shared, d))
     cold = [verify_task(shared, VerifyTask(k, x)) for k, x in (("a", d), ("b", wide))]
-    first, again, other = verify_batch(shared, VerifyBatch((
+    first, again, other = verify_batch(shared, SolverBatch((
         VerifyTask("a", d), VerifyTask("a2", d), VerifyTask("b", wide))))
     levels = round(1.1 / COARSE_STEP) + 1
     # the same design started from its own converged states: each level is solved at once

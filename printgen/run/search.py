@@ -37,12 +37,12 @@ from printgen.run.budget import DESIGN_LIMIT_S, check_design_budget, run_cores
 from printgen.run.options import RunOptions
 from printgen.run.provenance import provenance_record
 from printgen.run.shown import design_summary
-from printgen.run.wave_sweep import wave_task
+from printgen.run.wave_sweep import wave_batch
 from printgen.scaling.record import Design
 from printgen.scaling.similitude import ScaledTargets, scale_targets
 from printgen.search.nets import (
     SearchResult,
-    VerifyBatch,
+    SolverBatch,
     VerifyScore,
     VerifyShared,
     VerifyTask,
@@ -61,7 +61,7 @@ from printgen.search.space import (
 from printgen.search.waves import WAVES_VERIFIED
 
 
-def verify_batch(shared: VerifyShared, batch: VerifyBatch) -> list[VerifyScore]:
+def verify_batch(shared: VerifyShared, batch: SolverBatch) -> list[VerifyScore]:
     """Solver stage of the search: the verification of each design of `batch` (nets of one
     graph), as scores, against the prototype's sweep the search made once (`prototype_sweep`;
     without it, swept here once for the batch: it does not depend on the net). Each model sweep
@@ -97,7 +97,7 @@ def verify_batch(shared: VerifyShared, batch: VerifyBatch) -> list[VerifyScore]:
 
 def verify_task(shared: VerifyShared, task: VerifyTask) -> VerifyScore:
     """The verification of one design as a score (`verify_batch` of it alone: a cold sweep)."""
-    return verify_batch(shared, VerifyBatch((task,)))[0]
+    return verify_batch(shared, SolverBatch((task,)))[0]
 
 
 def _score(key: str, v: Any, model: Any) -> VerifyScore:
@@ -228,7 +228,7 @@ def search_at_scales(prototype: str | Path | Prototype, scales: list[float], *,
                                   space=spaces[s], printer=options.printer,
                                   verifier=verify_batch, verify_nets=options.verify_nets,
                                   prototype_sweep=prototype_sweep,
-                                  level_step=options.level_step, wave_sweep=wave_task))
+                                  level_step=options.level_step, wave_sweep=wave_batch))
         where = runner.where
     return DesignRun(results, where, design_record(p, results, options),
                      timings={"estimate": estimate, "search": time.perf_counter() - t0})

@@ -8,8 +8,8 @@ Stages over the space of `search_space` (material x strand section x mesh x bord
    pre-print verification over h / h_B = 0-1.1) and rank them by their deformation mismatch:
    the best net of each of the `verify_nets` best material x section pairs, each with every
    border width, and `select`'s pick for comparison. The candidates whose nets share one graph
-   (meshes, pattern) go to one worker job (`VerifyBatch`), swept in turn, each load level
-   warm-started from the earlier ones' states there;
+   (meshes, pattern) go to one worker job (`SolverBatch`), swept in turn, each load level
+   warm-started from the earlier ones' states there (the wave stage's sweeps alike);
 3. with the `deformation` objective, nets with printable waved strands, searched by the solver
    on the flume's readings (`printgen.search.waves`): the design takes the best waved net when
    it reads closer to the prototype than the best straight net.
@@ -24,7 +24,7 @@ after stage 1.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -74,6 +74,11 @@ class VerifyTask:
     key: str
     design: Design
 
+    @property
+    def coarsen(self) -> int:
+        """The mesh multiplier of its sweep: 1, the design's own net."""
+        return 1
+
 
 @dataclass(frozen=True)
 class VerifyScore:
@@ -91,34 +96,44 @@ class VerifyScore:
 
 
 @dataclass(frozen=True)
-class VerifyBatch:
-    """One worker job of the solver stage: designs whose nets share one graph (the same meshes,
-    pattern and size: their solver states have one shape), verified in turn, each load level of
-    a later design's sweep also started from the earlier designs' converged states at that level
-    (the solver keeps the start of lowest potential and iterates to its tolerance: a start,
-    never the answer)."""
+class SolverBatch:
+    """One worker job of a solver stage: tasks (`VerifyTask`, `WaveTask`) whose solver nets
+    share one graph (the same meshes, coarsening, pattern and size: their states have one
+    shape), swept in turn, each load level of a later sweep also started from the earlier
+    sweeps' converged states at that level (the solver keeps the start of lowest potential and
+    iterates to its tolerance: a start, never the answer)."""
 
-    tasks: tuple[VerifyTask, ...]
+    tasks: tuple[Any, ...]
 
     def nodes(self) -> float:
-        """The job's size: its designs' net nodes (mesh cells over the barrier), summed."""
+        """The job's size: its solver nets' nodes (mesh cells over the barrier), summed."""
         return sum(t.design.net.width_mm * t.design.net.height_mm
-                   / (t.design.net.mesh_x_mm * t.design.net.mesh_y_mm) for t in self.tasks)
+                   / (t.design.net.mesh_x_mm * t.design.net.mesh_y_mm * t.coarsen**2)
+                   for t in self.tasks)
 
 
-def verify_batches(tasks: list[VerifyTask]) -> list[VerifyBatch]:
-    """`tasks` grouped by net graph (in task order within a group), the largest job first:
-    the worker that takes the last job should not start a long one late. The grouping depends
-    on the designs alone, never on the workers: the same scores wherever the search runs."""
-    groups: dict[tuple, list[VerifyTask]] = {}
+def solver_batches(tasks: Sequence[Any]) -> list[SolverBatch]:
+    """`tasks` grouped by solver net graph (in task order within a group), the largest job
+    first: the worker that takes the last job should not start a long one late. The grouping
+    depends on the designs alone, never on the workers: the same results wherever the search
+    runs."""
+    groups: dict[tuple, list[Any]] = {}
     for t in tasks:
         n = t.design.net
-        groups.setdefault((n.pattern, n.mesh_x_mm, n.mesh_y_mm, n.width_mm, n.height_mm),
-                          []).append(t)
-    return sorted((VerifyBatch(tuple(g)) for g in groups.values()), key=lambda b: -b.nodes())
+        groups.setdefault((n.pattern, n.mesh_x_mm, n.mesh_y_mm, n.width_mm, n.height_mm,
+                           t.coarsen), []).append(t)
+    return sorted((SolverBatch(tuple(g)) for g in groups.values()), key=lambda b: -b.nodes())
 
 
-Verifier = Callable[[VerifyShared, VerifyBatch], list[VerifyScore]]
+def in_task_order(tasks: Sequence[Any], jobs: list[SolverBatch], parts: list[list[Any]]
+                  ) -> list[Any]:
+    """The results of `jobs` (`parts`, job by job) in the order of `tasks` (keys unique)."""
+    by_key = {t.key: r for job, part in zip(jobs, parts, strict=True)
+              for t, r in zip(job.tasks, part, strict=True)}
+    return [by_key[t.key] for t in tasks]
+
+
+Verifier = Callable[[VerifyShared, SolverBatch], list[VerifyScore]]
 
 
 @dataclass(frozen=True)
@@ -223,7 +238,8 @@ def search(p: Prototype, scale: float, runner: Runner, *, objective: str = "defo
            verifier: Verifier | None = None, verify_nets: int = VERIFY_NETS,
            level_step: float | None = None,
            prototype_sweep: Callable[[VerifyShared, Design], Any] | None = None,
-           wave_sweep: Callable[[VerifyShared, WaveTask], Trial] | None = None) -> SearchResult:
+           wave_sweep: Callable[[VerifyShared, SolverBatch], list[Trial]] | None = None
+           ) -> SearchResult:
     """Run the search at 1:`scale` on `runner`. `verifier` is required for `deformation`;
     `prototype_sweep` makes the prototype's sweep once, before the verifier's tasks share it
     (the prototype is the same for every candidate); `wave_sweep`: the wave stage's solver
@@ -251,7 +267,7 @@ def search(p: Prototype, scale: float, runner: Runner, *, objective: str = "defo
         shared = VerifyShared(p, level_step)
         if prototype_sweep is not None:
             shared = dataclasses.replace(shared, prototype_run=prototype_sweep(shared, base))
-        parts = runner.map(verifier, verify_batches(tasks), shared=shared,
+        parts = runner.map(verifier, solver_batches(tasks), shared=shared,
                            label=f"1:{t.scale:g} verifying {len(tasks)} nets (solver)")
         scores = [v for part in parts for v in part]
         verified = {int(v.key): v for v in scores if v.key != SELECT_KEY}
@@ -264,8 +280,10 @@ def search(p: Prototype, scale: float, runner: Runner, *, objective: str = "defo
         task = wave_sweep  # `shared` as the candidates had it: the one prototype sweep
 
         def sweep(tasks: list[WaveTask]) -> list[Trial]:
-            return runner.map(task, tasks, shared=shared,
-                              label=f"1:{t.scale:g} sweeping {len(tasks)} waved nets (solver)")
+            jobs = solver_batches(tasks)
+            parts = runner.map(task, jobs, shared=shared,
+                               label=f"1:{t.scale:g} sweeping {len(tasks)} waved nets (solver)")
+            return in_task_order(tasks, jobs, parts)
 
         ranked = sorted((s for s in screened if s.feasible), key=rank_key)
         wave = wave_stage(design, ((candidate_design(ctx, s.point, base), s.error_across)
