@@ -286,8 +286,12 @@ def search(p: Prototype, scale: float, runner: Runner, *, objective: str = "defo
             return in_task_order(tasks, jobs, parts)
 
         ranked = sorted((s for s in screened if s.feasible), key=rank_key)
+        def ratios(fn: Callable[[Any, Any], float], items: list[Any]) -> list[float]:
+            return runner.map(fn, items, label=f"1:{t.scale:g} solving {len(items)} nets' "
+                              "softest waves")
+
         wave = wave_stage(design, ((candidate_design(ctx, s.point, base), s.error_across)
-                                   for s in ranked), space, sweep)
+                                   for s in ranked), space, sweep, ratios)
         design = wave.design(design)
     res = SearchResult(p.name, t.scale, objective, space, tuple(screened), verified, base,
                        screen_batch(ctx, [design_point(ctx, base)])[0], select_score,

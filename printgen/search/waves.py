@@ -29,7 +29,8 @@ times stiffer: the same membrane stiffness, the waved strands' own curve) at WAV
 1. nets: per material, the best-ranked printable net of the screen whose small-strain stiffness
    across is at least the target (a wave only softens at small strain), and the chosen net;
    a net whose softest printable wave is still STIFF_LIMIT x the target across is left out
-   (a membrane's strains go as its stiffness^(-2/3): 2 x stiffer reads 37 % low at least);
+   (a membrane's strains go as its stiffness^(-2/3): 2 x stiffer reads 37 % low at least;
+   the nets' softest waves' strand curves are solved on the runner's workers);
 2. on each net, its straight strands and the printable waves by half-wave count in rising
    amplitude, a count's scan stopped once the mid-height at h/h_B = 1 reads more than
    POINT_TOLERANCE high (more amplitude only softens) or the sweep fails;
@@ -50,6 +51,7 @@ import dataclasses
 import math
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -189,6 +191,8 @@ class Trial:
 
 
 Sweeper = Callable[[list[WaveTask]], list[Trial]]
+# (fn, items) -> [fn(None, item) for item in items], in order: the runner's map
+Ratios = Callable[[Callable[[Any, Any], float], list[Any]], list[float]]
 
 
 def printable_waves(n: NetDesign) -> list[Wave]:
@@ -292,28 +296,42 @@ class WaveChoice:
                 "left_out": list(self.left_out)}
 
 
-def wave_nets(chosen: Design, candidates: Iterable[tuple[Design, float]]
-              ) -> tuple[list[NetDesign], list[str]]:
+def wave_nets(chosen: Design, candidates: Iterable[tuple[Design, float]],
+              ratios: Ratios | None = None) -> tuple[list[NetDesign], list[str]]:
     """The nets the stage waves (see the module, step 1): `candidates` are the screen's
     printable nets, best-ranked first, each with its small-strain stiffness across over the
-    target's, less 1 (the screen's); returns the nets and the sentences of those left out."""
-    nets, out, seen = [chosen.net], [], {chosen.net.material}
+    target's, less 1 (the screen's); returns the nets and the sentences of those left out.
+    `ratios` maps `softest_ratio` over the nets tried (each solves its waves' strand curves:
+    the runner's workers; None: here, in turn)."""
+    tried, seen = [], {chosen.net.material}
     for d, error_across in candidates:
         n = d.net
         if n.material in seen or error_across < 0:  # a wave only softens the net
             continue
-        waves = printable_waves(n)
-        if not waves:
+        if not printable_waves(n):
             continue
         seen.add(n.material)
-        straight = membrane_across(n)
-        soft = softest_across(n, waves) / straight * (1 + error_across)
-        if soft > STIFF_LIMIT:
-            out.append(f"{n.material}: its softest printable wave is still {soft:.3g} x the "
+        tried.append((n, error_across))
+    if ratios is None:
+        soft = [softest_ratio(None, item) for item in tried]
+    else:
+        soft = ratios(softest_ratio, tried)
+    nets, out = [chosen.net], []
+    for (n, _), ratio in zip(tried, soft, strict=True):
+        if ratio > STIFF_LIMIT:
+            out.append(f"{n.material}: its softest printable wave is still {ratio:.3g} x the "
                        f"target stiffness across (limit {STIFF_LIMIT:g})")
             continue
         nets.append(n)
     return nets, out
+
+
+def softest_ratio(_: Any, item: tuple[NetDesign, float]) -> float:
+    """The small-strain stiffness across of net `item[0]` with its softest printable wave over
+    the target's (`item[1]`: the straight net's over the target's, less 1). A worker job:
+    module-level, pure."""
+    n, error_across = item
+    return softest_across(n, printable_waves(n)) / membrane_across(n) * (1 + error_across)
 
 
 def membrane_across(n: NetDesign) -> float:
@@ -325,11 +343,12 @@ def membrane_across(n: NetDesign) -> float:
 
 
 def wave_stage(chosen: Design, candidates: Iterable[tuple[Design, float]],
-               space: SearchSpace, sweep: Sweeper) -> WaveChoice:
+               space: SearchSpace, sweep: Sweeper, ratios: Ratios | None = None) -> WaveChoice:
     """The stage (see the module): `chosen` the search's straight net, `candidates` the
     screen's printable nets best-ranked first with their stiffness across over the target's
-    less 1, `space` its bounds, `sweep` the solver (tasks -> trials, in order)."""
-    nets, left_out = wave_nets(chosen, candidates)
+    less 1, `space` its bounds, `sweep` the solver (tasks -> trials, in order), `ratios` where
+    step 1's strand curves are solved (`wave_nets`)."""
+    nets, left_out = wave_nets(chosen, candidates, ratios)
     base = chosen
 
     def run(items: list[NetDesign], coarsen: int = WAVE_COARSEN) -> list[Trial]:
