@@ -13,8 +13,9 @@ The changes are tried cheapest first, every one re-checked with the solver befor
    verdict asks for (softer when too stiff) spread in stiffness and bracketed (`bracketed`),
    are swept against the prototype's sweep the verification already made (never swept again),
    on the band's solver net (the coarsest whose nominal curves stay within the band's refinement
-   tolerance: the design's own on both examples), warm-started level to level; a net that
-   passes on a coarser net is confirmed on its own before it is named. When
+   tolerance: the design's own on both examples), warm-started level to level (a change on
+   the design's own net, `same_net`, also from the design's own sweep at that level); a net
+   that passes on a coarser net is confirmed on its own before it is named. When
    the sensors are too strong the nets are tried with the weaker sensors (with the strong ones
    no net can match: the sensors' pull is not similar).
 
