@@ -371,9 +371,11 @@ class VerifyPlan:
     flow: FlowCheck | None = None  # the model flow and the flume's limits (the verdict's)
     loaded: BarrierScene | None = None  # the prototype, its sensors pulling force x lambda^3
 
-    def jobs(self) -> list[tuple]:
-        """(sweep, args, kwargs) of the model, then of the prototype (run_jobs' form)."""
-        keep = {"keep_states": True}  # each level's state: a start for the bands' variants
+    def jobs(self, *, keep_states: bool = False) -> list[tuple]:
+        """(sweep, args, kwargs) of the model, then of the prototype (run_jobs' form);
+        `keep_states`: each keeps its states (`Run.states`: the bands' variants start from
+        them, `printgen.verification.bands.warm_start`)."""
+        keep = {"keep_states": True} if keep_states else {}
         return [(sweep, (self.ms, self.lv), self.kw_m | keep),
                 (sweep, (self.ps, self.lv), self.kw_p | keep)]
 
