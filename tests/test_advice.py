@@ -193,3 +193,19 @@ def test_make_writes_the_verified_design_and_it_passes_when_made(tmp_path):
     assert again.record["verification"]["ok"] is True
     assert again.record["summary"]["verdict"] in ("PASS", "UNDECIDED")
     assert "advice" not in again.record
+
+
+def test_the_designs_own_states_start_only_the_changes_on_its_own_net():
+    """Another strand on the same mesh has the design's nodes, node for node: the design's
+    states start its sweep; another mesh, or a coarser net, does not."""
+    from conftest import reference_design_1_40
+
+    from printgen.scaling.record import Section
+    from printgen.verification.advice import same_net
+
+    d = reference_design_1_40()
+    strand = dataclasses.replace(d, net=dataclasses.replace(
+        d.net, material="tpu-85a", strand=Section(0.6, 2, (0.35,))))
+    mesh = dataclasses.replace(d, net=dataclasses.replace(d.net, mesh_x_mm=17.37))
+    assert same_net(d, strand, 1) and same_net(d, d, 1)
+    assert not same_net(d, mesh, 1) and not same_net(d, strand, 2)

@@ -16,6 +16,7 @@ from printgen.verification import bands
 from printgen.verification import variants as variants_module
 from printgen.verification.bands import band_verdict, model_band, refinement_test, run_variant
 from printgen.verification.compare import METRICS
+from printgen.verification.preprint import sweep
 from printgen.verification.variants import Variant, model_variants
 
 COARSE = 3  # the 1:40 net with a 3x coarser mesh (50 nodes): fast sweeps
@@ -133,3 +134,26 @@ def test_band_verdict_partly_inside_crossing_and_sign():
     assert v.kind == "crossing"
     neg = band_verdict("lowering", -p, -0.8 * p, -0.5 * p)  # a negative curve: magnitudes
     assert neg.kind == "stiffer" and neg.least == pytest.approx(0.2, rel=1e-9)
+
+
+STATE_TOL = 1e-6  # curves from a warm start within the solver's tolerance: of each peak
+
+
+def test_a_variant_started_from_the_nominal_state_reaches_the_same_curves():
+    """The bottom row held on the bed: the same nodes as the nominal, held at more of them.
+    Started also from the nominal's state at each level (held at rest at its own supports,
+    `preprint.held`), its curves are those of its path from rest, within the solver's
+    tolerance; a slack variant and a coarser net get no start (`warm_start`)."""
+    d = coarse_design_1_40(COARSE)
+    base = SceneOptions(mounting=MOUNTINGS[0])
+    nominal = sweep(build_scene(d, base), LEVELS, keep_states=True)
+    bed = Variant("bed", options=dataclasses.replace(base, bed="held"))
+    start = bands.warm_start(bed, nominal)
+    assert start is nominal.states and len(start) == len(LEVELS)
+    cold, warm = (run_variant(d, bed, LEVELS, 1, None, s) for s in (None, start))
+    for key in METRICS:
+        peak = max(float(np.nanmax(np.abs(cold.deformation.values[key]))), 1e-12)
+        np.testing.assert_allclose(warm.deformation.values[key],
+                                   cold.deformation.values[key], atol=STATE_TOL * peak)
+    assert bands.warm_start(dataclasses.replace(bed, slack=0.01), nominal) is None
+    assert bands.warm_start(bed, nominal, coarsen=2) is None

@@ -59,7 +59,11 @@ def _png(fig) -> PlotBytes:
     buf, svg = io.BytesIO(), io.BytesIO()
     # fixed metadata: the same figure gives the same bytes
     fig.savefig(buf, format="png", dpi=DPI, metadata={"Software": None})
-    fig.set_layout_engine("none")  # the axes keep the positions the PNG's layout gave them
+    # the axes keep the positions the PNG's layout gave them; no engine at all (not "none",
+    # a placeholder engine): savefig lays out a figure that has one in a whole draw first
+    with matplotlib.rc_context({"figure.autolayout": False,
+                                "figure.constrained_layout.use": False}):
+        fig.set_layout_engine(None)
     with matplotlib.rc_context({"svg.hashsalt": SVG_SALT}):
         fig.savefig(svg, format="svg", dpi=DPI, metadata={"Date": None, "Creator": None})
     out = PlotBytes(buf.getvalue())

@@ -322,7 +322,8 @@ def run_advice(prototype: Prototype, design: Design, options: RunOptions, v: Ver
         a = advise(prototype, design, v.prototype,
                    sensors_too_strong=s is not None and s.too_strong,
                    sensor_limit_n=None if s is None else s.limit_n,
-                   coarsen=coarsen, load=options.load, way=direction(v.mismatches))
+                   coarsen=coarsen, load=options.load, way=direction(v.mismatches),
+                   start=v.model.states)
     return a, time.perf_counter() - t
 
 

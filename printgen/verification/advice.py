@@ -13,8 +13,9 @@ The changes are tried cheapest first, every one re-checked with the solver befor
    verdict asks for (softer when too stiff) spread in stiffness and bracketed (`bracketed`),
    are swept against the prototype's sweep the verification already made (never swept again),
    on the band's solver net (the coarsest whose nominal curves stay within the band's refinement
-   tolerance: the design's own on both examples), warm-started level to level; a net that
-   passes on a coarser net is confirmed on its own before it is named. When
+   tolerance: the design's own on both examples), warm-started level to level (a change on
+   the design's own net, `same_net`, also from the design's own sweep at that level); a net
+   that passes on a coarser net is confirmed on its own before it is named. When
    the sensors are too strong the nets are tried with the weaker sensors (with the strong ones
    no net can match: the sensors' pull is not similar).
 
@@ -63,7 +64,14 @@ from printgen.search.screen import Screened, screen_batch
 from printgen.search.space import NetPoint, SearchContext, default_space, grid, search_context
 from printgen.units import MM
 from printgen.verification.compare import METRICS, Mismatch, compare, headlines
-from printgen.verification.preprint import Run, load_keywords, sensor_force, sweep
+from printgen.verification.preprint import (
+    Run,
+    States,
+    from_states,
+    load_keywords,
+    sensor_force,
+    sweep,
+)
 
 ADVICE_NETS = 4  # nets the advice sweeps per round (one pool batch on 2 cores)
 ADVICE_ROUNDS = 2  # rounds: the spread over all candidates, then between the two that bracket
@@ -168,19 +176,34 @@ def weaker_force(limit_n: float) -> float:
 
 
 def model_run(p: Prototype, d: Design, lv: np.ndarray, *, force: float, coarsen: int = 1,
-              load: str | LoadCase | None = None) -> Run:
+              load: str | LoadCase | None = None, start: States | None = None) -> Run:
     """The model `d` swept at levels `lv` with each sensor pulling `force` N, on its net
-    `coarsen` times coarser (a worker job: module-level, picklable)."""
+    `coarsen` times coarser (a worker job: module-level, picklable); `start`: level -> the
+    displacements of a net with the same nodes and supports (`same_net`), one more warm start
+    at that level."""
     kw = load_keywords(p, d, load)[1]
     options = SceneOptions(mounting=lateral_mounting(p), load=kw["load"], sensor_force=force,
                            coarsen=coarsen)
-    return sweep(build_scene(d, options), lv, **kw)
+    return sweep(build_scene(d, options), lv, guesses=from_states(start), **kw)
+
+
+def same_net(d: Design, cand: Design, coarsen: int) -> bool:
+    """Whether `cand`'s solver net has the nodes of `d`'s own, node for node (same pattern,
+    mesh, border, frame and cables: only its strand, or its sensors' pull, differs), so that
+    `d`'s converged state at a level is a start for it there. A start is only a start: the
+    solver begins from the lowest potential of it and the path's own (`solver.solve_path`)
+    and Newton converges to the same equilibrium within its tolerance."""
+    a, b = d.net, cand.net
+    keys = ("pattern", "width_mm", "height_mm", "mesh_x_mm", "mesh_y_mm", "border_width_mm",
+            "wave")
+    return (coarsen == 1 and d.cables == cand.cables
+            and all(getattr(a, k) == getattr(b, k) for k in keys))
 
 
 def _job(p: Prototype, d: Design, lv: np.ndarray, force: float, coarsen: int,
-         load: str | LoadCase | None) -> Run | str:
+         load: str | LoadCase | None, start: States | None = None) -> Run | str:
     try:
-        return model_run(p, d, lv, force=force, coarsen=coarsen, load=load)
+        return model_run(p, d, lv, force=force, coarsen=coarsen, load=load, start=start)
     except SolverError as exc:  # a candidate the solver cannot follow does not pass
         return str(exc)
 
@@ -307,21 +330,25 @@ def direction(mismatches: list[Mismatch]) -> str:
 
 def advise(p: Prototype, d: Design, proto: Run, *, sensors_too_strong: bool,
            sensor_limit_n: float | None, coarsen: int = 1,
-           load: str | LoadCase | None = None, way: str = "") -> Advice:
+           load: str | LoadCase | None = None, way: str = "",
+           start: States | None = None) -> Advice:
     """The advice for design `d` that did not pass (`_advise`), stating whether the prototype
     file has a [flume] table to set a sensor force in."""
     a = _advise(p, d, proto, sensors_too_strong=sensors_too_strong,
-                sensor_limit_n=sensor_limit_n, coarsen=coarsen, load=load, way=way)
+                sensor_limit_n=sensor_limit_n, coarsen=coarsen, load=load, way=way,
+                start=start)
     return dataclasses.replace(a, flume_table=p.flume is not None)
 
 
 def _advise(p: Prototype, d: Design, proto: Run, *, sensors_too_strong: bool,
            sensor_limit_n: float | None, coarsen: int = 1,
-           load: str | LoadCase | None = None, way: str = "") -> Advice:
+           load: str | LoadCase | None = None, way: str = "",
+           start: States | None = None) -> Advice:
     """The advice for design `d` that did not pass; `proto`: the verification's prototype
     sweep (compared levels only), shared by every change; `sensor_limit_n`: the largest sensor
     force within the sensors' share; `coarsen`: the band's solver net; `way`: the design's
-    error (`direction` of its mismatches)."""
+    error (`direction` of its mismatches); `start`: the design's own model sweep's states
+    (`Run.states`), a warm start for every change on the same net (`same_net`)."""
     t0 = time.perf_counter()
     lv = proto.deformation.levels
     force = sensor_force(p)
@@ -330,11 +357,11 @@ def _advise(p: Prototype, d: Design, proto: Run, *, sensors_too_strong: bool,
     if weaker is not None:  # the cheapest change first, alone: it needs no new print
         what = (f"keep the net and use weaker sensors: each wire pulling {weaker:.2g} N "
                 f"instead of {force:.3g} N")
-        tried.append(against(proto, _job(p, d, lv, weaker, 1, load), what, 1))
+        tried.append(against(proto, _job(p, d, lv, weaker, 1, load, start), what, 1))
         if tried[0].passes:
             return Advice(what, None, weaker, "", tuple(tried), 0, time.perf_counter() - t0)
     if d.net.pattern != SEARCHED_PATTERN:  # the search's nets would be another structure
-        return same_mesh(p, d, proto, tried, weaker, way, load, t0)
+        return same_mesh(p, d, proto, tried, weaker, way, load, t0, start)
     ctx, screened, space = screen_nets(p, d)
     own = screen_batch(ctx, [design_point(ctx, d)])[0]
     pool = best_pairs(screened, way, own.membrane_n_per_m)
@@ -343,8 +370,10 @@ def _advise(p: Prototype, d: Design, proto: Run, *, sensors_too_strong: bool,
     named = {id(s): f"print {describe(s)} instead{with_sensors}" for s in pool}
 
     def check(idx: list[int]) -> list[Tried]:
-        runs = run_jobs([(_job, (p, candidate_design(ctx, pool[i].point, d), lv, net_force,
-                                 coarsen, load), {}) for i in idx])
+        cands = [candidate_design(ctx, pool[i].point, d) for i in idx]
+        runs = run_jobs([(_job, (p, c, lv, net_force, coarsen, load,
+                                 start if same_net(d, c, coarsen) else None), {})
+                         for c in cands])
         return [against(proto, r, named[id(pool[i])], coarsen)
                 for i, r in zip(idx, runs, strict=True)]
 
@@ -356,7 +385,8 @@ def _advise(p: Prototype, d: Design, proto: Run, *, sensors_too_strong: bool,
         s = picks[i]
         cand = candidate_design(ctx, s.point, d)
         if coarsen > 1:  # confirmed on its own net before it is named
-            ok = against(proto, _job(p, cand, lv, net_force, 1, load), named[id(s)], 1)
+            ok = against(proto, _job(p, cand, lv, net_force, 1, load,
+                                     start if same_net(d, cand, 1) else None), named[id(s)], 1)
             tried.append(ok)
             if not ok.passes:
                 break
@@ -410,7 +440,8 @@ def strands(p: Prototype, d: Design) -> list[Strand]:
 
 
 def same_mesh(p: Prototype, d: Design, proto: Run, tried: list[Tried], weaker: float | None,
-              way: str, load: str | LoadCase | None, t0: float) -> Advice:
+              way: str, load: str | LoadCase | None, t0: float, start: States | None = None
+              ) -> Advice:
     """The advice for a net the design search does not hold (its pattern is not a diamond):
     the design's own pattern and mesh with another strand. At a fixed pattern and mesh the
     membrane stiffness at small strain is proportional to the strand's E A, so the strands
@@ -431,8 +462,9 @@ def same_mesh(p: Prototype, d: Design, proto: Run, tried: list[Tried], weaker: f
                                                               strand=c.section))
 
     def check(idx: list[int]) -> list[Tried]:
-        runs = run_jobs([(_job, (p, design_of(pool[i]), proto.deformation.levels, force, 1,
-                                 load), {}) for i in idx])
+        cands = [design_of(pool[i]) for i in idx]
+        runs = run_jobs([(_job, (p, c, proto.deformation.levels, force, 1, load,
+                                 start if same_net(d, c, 1) else None), {}) for c in cands])
         return [against(proto, r, f"print {pool[i].text(d.net.pattern)} instead{extra}", 1)
                 for i, r in zip(idx, runs, strict=True)]
 

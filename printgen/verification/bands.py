@@ -8,7 +8,8 @@ Cheap sweeps: the variants run on the coarsest solver net (the design's mesh tim
 `COARSENINGS`, strands k times stiffer: the same membrane stiffness per unit width) whose
 nominal curves stay within `REFINE_TOL` of the design's own net (the refinement test, run
 with the nominal); a variant's curve is then the nominal curve plus the variant's change on
-the coarse net. Every sweep warm-starts each level from the previous one (solver.solve_path)
+the coarse net. Every sweep warm-starts each level from the previous one (solver.solve_path),
+a variant on the nominal's own net also from the nominal's state at that level (`warm_start`),
 and the runs go to worker processes in parallel.
 
 A variant the solver refuses (its sensor wires fold the net, or too few levels converge:
@@ -37,7 +38,7 @@ from printgen.scene.options import SceneOptions, build_scene
 from printgen.trace import span
 from printgen.verification.central import Contribution, central_interval
 from printgen.verification.compare import METRICS
-from printgen.verification.preprint import Run, load_keywords, sweep
+from printgen.verification.preprint import Run, States, from_states, load_keywords, sweep
 from printgen.verification.sensors import scene_sensor_force
 from printgen.verification.variants import Variant, model_variants, prototype_variants
 
@@ -52,11 +53,25 @@ def model_load_kw(p: Prototype, d: Design, load: str | LoadCase | None = None
 
 
 def run_variant(d: Design, v: Variant, lv: np.ndarray, coarsen: int = 1,
-                load_kw: dict | None = None) -> Run:
+                load_kw: dict | None = None, start: States | None = None) -> Run:
     """Sweep the model with variant `v` on the design's mesh times `coarsen` (a worker job:
-    module-level, picklable)."""
+    module-level, picklable); `start`: the nominal's states (`warm_start`)."""
     scene = build_scene(d, dataclasses.replace(v.options, coarsen=coarsen))
-    return sweep(scene, lv, slack=v.slack, **(load_kw or {}))
+    return sweep(scene, lv, slack=v.slack, guesses=from_states(start), **(load_kw or {}))
+
+
+def warm_start(v: Variant, nominal: Run, coarsen: int = 1) -> States | None:
+    """The nominal run's state at each level, one more start for variant `v`'s sweep there
+    (`solver.solve_path`: the solver begins from the lowest potential of its starts, so the
+    answer is the equilibrium it converges to, within its tolerance, whichever start it took;
+    held at rest where the variant's net is held, `preprint.held`), on the nominal's own net
+    only (the nodes must be the same, node for node), and not for a slack variant: slack
+    moves every strand's rest length, and from the taut net's state a slack net can settle in
+    another equilibrium (measured on the 1:40 prototype: curves 24 % of their peak apart),
+    which the path from rest does not."""
+    if coarsen != 1 or v.slack or not nominal.states:
+        return None
+    return nominal.states
 
 
 @dataclass(frozen=True)
@@ -67,10 +82,10 @@ class Refused:
 
 
 def try_variant(d: Design, v: Variant, lv: np.ndarray, coarsen: int = 1,
-                load_kw: dict | None = None) -> Run | Refused:
+                load_kw: dict | None = None, start: States | None = None) -> Run | Refused:
     """`run_variant`, with a refusal of the solver returned as `Refused` (a worker job)."""
     try:
-        return run_variant(d, v, lv, coarsen, load_kw)
+        return run_variant(d, v, lv, coarsen, load_kw, start)
     except SolverError as e:
         return Refused(str(e))
 
@@ -234,7 +249,9 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
         k, change = refinement_test(d, nom, lv, load_kw, nominal_variant, work, ahead)
     # longest first (the worker that takes the last job should not start a long one late)
     order = sorted(range(len(variants)), key=lambda i: -variants[i].effort)
-    jobs: list[tuple] = [(try_variant, (d, variants[i], lv, k, load_kw), {}) for i in order]
+    jobs: list[tuple] = [(try_variant, (d, variants[i], lv, k, load_kw,
+                                        warm_start(variants[i], nominal, k)), {})
+                         for i in order]
     if k > 1:
         jobs.append((run_variant, (d, nominal_variant, lv, k, load_kw), {}))
     started = submit_jobs(jobs)
@@ -263,10 +280,12 @@ def model_band(d: Design, nominal: Run, *, load_kw: dict | None = None,
                 {v.label: v for v in variants}, refused=refused)
 
 
-def run_prototype_variant(p: Prototype, v: Variant, lv: np.ndarray, load_kw: dict | None = None
-                          ) -> Run:
-    """Sweep the prototype with variant `v` (a worker job: module-level, picklable)."""
-    return sweep(build_scene(p, v.options), lv, slack=v.slack, **(load_kw or {}))
+def run_prototype_variant(p: Prototype, v: Variant, lv: np.ndarray, load_kw: dict | None = None,
+                          start: States | None = None) -> Run:
+    """Sweep the prototype with variant `v` (a worker job: module-level, picklable); `start`:
+    its nominal's states (`warm_start`)."""
+    return sweep(build_scene(p, v.options), lv, slack=v.slack, guesses=from_states(start),
+                 **(load_kw or {}))
 
 
 def prototype_jobs(p: Prototype, nominal: Run, load_kw: dict | None = None) -> list[tuple]:
@@ -275,7 +294,8 @@ def prototype_jobs(p: Prototype, nominal: Run, load_kw: dict | None = None) -> l
     mounting = getattr(nominal.scene, "mounting", None)
     lv = nominal.deformation.levels
     return [(run_prototype_variant, (p, dataclasses.replace(v, options=dataclasses.replace(
-        v.options, mounting=mounting)), lv, load_kw), {}) for v in prototype_variants(p)]
+        v.options, mounting=mounting)), lv, load_kw, warm_start(v, nominal)), {})
+        for v in prototype_variants(p)]
 
 
 def prototype_band(p: Prototype, nominal: Run, runs: list[Run]) -> Band:

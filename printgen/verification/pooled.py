@@ -9,8 +9,8 @@ at the pair's levels: run again should a level fail on either barrier, since the
 only the levels both reached), the counter-example; the band's variants (longest first) once
 the pair and the refinement sweep are done; then the nominal pairs of the other load cases of
 `make --loads`, which fill the cores the band's last variants leave idle. The results are
-those of `verify`, `model_band` and `with_cases`, byte for byte: the same sweeps on the same
-nets at the same levels.
+those of `verify` (its pair keeping their states), `model_band` and `with_cases`, byte for
+byte: the same sweeps on the same nets at the same levels, from the same starts.
 """
 
 from __future__ import annotations
@@ -69,7 +69,7 @@ def verify_with_band(p: Prototype, d: Design, *, load: str | LoadCase | None = N
             if alongside is not None:
                 alongside(nominal, coarsen)
 
-        pair = [pool.submit(fn, *args, **kw) for fn, args, kw in plan.jobs()]
+        pair = [pool.submit(fn, *args, **kw) for fn, args, kw in plan.jobs(keep_states=True)]
         loaded = [pool.submit(fn, *args, **kw) for fn, args, kw in plan.sensor_jobs()]
         ahead = ({first: pool.submit(run_variant, d, base, plan.lv, first, plan.kw_m)}
                  if meshable(d, first) else {})

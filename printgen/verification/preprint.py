@@ -148,7 +148,8 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0,
         return loads_at(r)
 
     results = solver.solve_path(net, tracked, lv, tol=SOLVER_TOL, max_cuts=PATH_CUTS,
-                                skip_failed=True, guesses=guesses)
+                                skip_failed=True,
+                                guesses=None if guesses is None else held(guesses, net))
     failed = {float(r.level): r.reason for r in results if not r.converged}
     if len(lv) - len(failed) < min(MIN_COMPARED, len(lv)):
         raise SolverError(f"{s.name}: {len(failed)} of {len(lv)} load levels did not converge, "
@@ -175,6 +176,36 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0,
                int((~net.fixed_dofs).sum()), time.process_time() - cpu0,
                {float(x): r.displacements for x, r in zip(lv, results, strict=False)
                 if r.converged} if keep_states else {})  # a path stopped early is shorter
+
+
+States = dict[float, np.ndarray]  # level -> displacements (m, every solver node): Run.states
+
+
+def from_states(start: States | None) -> Callable[[float], list[np.ndarray]] | None:
+    """`sweep`'s `guesses` from another run's `Run.states`: its state at the same level (None:
+    no start given)."""
+    if not start:
+        return None
+
+    def at(level: float) -> list[np.ndarray]:
+        u = start.get(float(level))
+        return [] if u is None else [u]
+
+    return at
+
+
+def held(guesses: Callable[[float], list[np.ndarray]], net: solver.Net
+         ) -> Callable[[float], list[np.ndarray]]:
+    """`guesses` with every start at rest at `net`'s fixed nodes: a state of a net held
+    elsewhere (another mounting, the bottom row on the bed) is a start here only where this
+    net is free; the solver would otherwise keep the start's displacements at the supports."""
+    fixed = net.fixed_dofs
+
+    def at(level: float) -> list[np.ndarray]:
+        return [np.where(fixed, 0.0, u) if np.shape(u) == fixed.shape else u
+                for u in guesses(level)]
+
+    return at
 
 
 @dataclass(frozen=True, repr=False)
@@ -340,9 +371,13 @@ class VerifyPlan:
     flow: FlowCheck | None = None  # the model flow and the flume's limits (the verdict's)
     loaded: BarrierScene | None = None  # the prototype, its sensors pulling force x lambda^3
 
-    def jobs(self) -> list[tuple]:
-        """(sweep, args, kwargs) of the model, then of the prototype (run_jobs' form)."""
-        return [(sweep, (self.ms, self.lv), self.kw_m), (sweep, (self.ps, self.lv), self.kw_p)]
+    def jobs(self, *, keep_states: bool = False) -> list[tuple]:
+        """(sweep, args, kwargs) of the model, then of the prototype (run_jobs' form);
+        `keep_states`: each keeps its states (`Run.states`: the bands' variants start from
+        them, `printgen.verification.bands.warm_start`)."""
+        keep = {"keep_states": True} if keep_states else {}
+        return [(sweep, (self.ms, self.lv), self.kw_m | keep),
+                (sweep, (self.ps, self.lv), self.kw_p | keep)]
 
     def sensor_jobs(self) -> list[tuple]:
         """The sweep of the prototype with sensors pulling as much of its load as the model's,
