@@ -131,10 +131,11 @@ class Stepper:
 
     def matrix(self, st: State, boost: float = 1.0) -> np.ndarray:
         """CSR data of J + mu D at `st`, mu = MU_FACTOR |R| x boost (floored)."""
-        data = tangent_values(self.ns, st)
+        data = tangent_values(self.ns, st)  # a fresh array: the damping is added in place
         diag = float(np.abs(data[self.ns.pattern.diagonal]).max()) if data.size else 0.0
         mu = max(MU_FACTOR * float(np.linalg.norm(st.r)), MU_MIN * max(diag, 1e-300))
-        return data + boost * mu * self.ns.damping
+        data += boost * mu * self.ns.damping
+        return data
 
     def newton(self, st: State, boost: float = 1.0) -> Factorization:
         return self.factor(self.matrix(st, boost))
@@ -235,7 +236,7 @@ def _active_set_step(ns: NetSystem, st: State, stepper: Stepper, boost: float, f
             break
         fact, step, rhs = trial, new_step, new_rhs
         du = _moved(ns, np.zeros_like(st.u), step)
-        new = slack & (eps + np.einsum("ij,ij->i", nvec, du[b.j] - du[b.i]) / b.rest > 0)
+        new = slack & (eps + np.einsum("ij,ij->i", nvec, _span(b, du)) / b.rest > 0)
         if np.array_equal(new, active):
             break
         active = new
@@ -259,7 +260,7 @@ def _predicted_tensions(ns: NetSystem, st: State, pulls: np.ndarray, step: np.nd
     eps, force, tangent, d, length = st.bar
     b = ns.bars
     du = _moved(ns, np.zeros_like(st.u), step)
-    de = np.einsum("ij,ij->i", d / length[:, None], du[b.j] - du[b.i]) / b.rest
+    de = np.einsum("ij,ij->i", d / length[:, None], _span(b, du)) / b.rest
     model = np.where(force > 0, force + tangent * de, np.where(pulls, ns.first_slope * (eps + de),
                                                                0.0))
     base = force if last is None else last
@@ -281,7 +282,7 @@ class Updated:
         if precondition is not None:
             with np.errstate(all="ignore"):
                 x = refine(self.A, precondition, b, np.zeros_like(b), forcing,
-                           row_sum_norm(self.A))
+                           row_sum_norm(self.A, base.pattern.row_starts))
             if x is not None:
                 return x
         self.stepper.factorizations += 1  # counted like the stepper's own
@@ -301,6 +302,12 @@ def _chord_step(ns: NetSystem, st: State, fact: Factorization) -> State | None:
     if trial.r_norm <= CHORD_RATE * st.r_norm and pi <= pi0 + POTENTIAL_ROUND_OFF * abs(pi0):
         return trial
     return None
+
+
+def _span(b, du: np.ndarray) -> np.ndarray:
+    """du[j] - du[i] of every strand (np.take: a row gather several times quicker than
+    fancy indexing, the same values)."""
+    return np.take(du, b.j, axis=0) - np.take(du, b.i, axis=0)
 
 
 def _moved(ns: NetSystem, u: np.ndarray, step: np.ndarray) -> np.ndarray:

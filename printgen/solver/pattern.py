@@ -190,6 +190,12 @@ class Pattern:
                 + rank[free_dofs[self.rows[at]]])
 
     @cached_property
+    def row_starts(self) -> np.ndarray:
+        """The CSR start of every row that has entries (what `linsolve.row_sum_norm` reduces
+        at: the pattern's alone, so computed once, not at every solve)."""
+        return self.indptr[:-1][np.diff(self.indptr) > 0]
+
+    @cached_property
     def transpose(self) -> np.ndarray:
         """The CSR position of every entry's mirror."""
         return self._mirrors(slice(None))
