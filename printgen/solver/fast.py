@@ -192,7 +192,8 @@ def _newton_step(ns: NetSystem, st: State, stepper: Stepper, reference: float):
     forcing = min(FORCING, st.r_norm / st.f_norm)
     for attempt in range(MU_RETRIES + 1):
         fact, first, rhs = _active_set_step(ns, st, stepper, MU_GROWTH**attempt, forcing)
-        for step in (first, fact.symmetric_solve(rhs)):
+        for which in range(2):  # the symmetric step solved only when the first fails
+            step = first if which == 0 else fact.symmetric_solve(rhs)
             found = None if step is None else _line_search(ns, st, step, reference)
             if found is not None:
                 assert stepper.active is not None  # _active_set_step has just set it

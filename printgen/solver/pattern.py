@@ -336,7 +336,9 @@ class Pattern:
 
     def symmetric_upper(self, data: np.ndarray) -> sp.csc_matrix:
         """Upper triangle (CSC) of the symmetric part (A + A^T) / 2 of the matrix `data`."""
-        sym = 0.5 * (data[self.upper] + data[self.upper_transpose])
+        sym = np.take(data, self.upper)  # 0.5 (a + b), in place: the same numbers
+        sym += np.take(data, self.upper_transpose)
+        sym *= 0.5
         return sp.csc_matrix((sym, *self._upper_index), shape=(self.size, self.size))
 
     def symmetric_upper_csr(self, data: np.ndarray) -> sp.csr_matrix:
