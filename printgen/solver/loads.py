@@ -93,5 +93,6 @@ def total_forces(loads, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         idx, fl, dl = load.evaluate(x)
         dof = (3 * np.asarray(idx, dtype=np.intp)[:, None] + np.arange(3)).ravel()
         f += np.bincount(dof, np.ravel(fl), size)
-        dz += np.bincount(dof, np.ravel(dl), size)
+        if np.any(dl):  # adding zeros changes nothing (dz is never -0.0): skipped
+            dz += np.bincount(dof, np.ravel(dl), size)
     return f.reshape(x.shape), dz.reshape(x.shape)
