@@ -489,35 +489,44 @@ def meets(A: sp.csr_matrix, b: np.ndarray, x: np.ndarray, forcing: float, a_norm
           ) -> bool:
     """x solves A x = b to a backward error of LINEAR_RTOL, or (inexact Newton) to a
     residual max |b - A x| <= forcing max |b|."""
+    return _meets(A, b, x, forcing, a_norm)[0]
+
+
+def _meets(A: sp.csr_matrix, b: np.ndarray, x: np.ndarray, forcing: float, a_norm: float
+           ) -> tuple[bool, np.ndarray | None]:
+    """(`meets`, the residual b - A x it computed, or None): the residual is GMRES's first."""
     if not np.all(np.isfinite(x)):
-        return False
+        return False, None
     b_norm = float(np.abs(b).max()) if b.size else 0.0
-    res = float(np.abs(b - A @ x).max()) if b.size else 0.0
+    r = b - A @ x if b.size else None
+    res = float(np.abs(r).max()) if r is not None else 0.0
     return res <= forcing * b_norm or res <= LINEAR_RTOL * (a_norm * float(np.abs(x).max())
-                                                            + b_norm)
+                                                            + b_norm), r
 
 
 def refine(A: sp.csr_matrix, precondition: Callable[[np.ndarray], np.ndarray], b: np.ndarray,
            x: np.ndarray, forcing: float, a_norm: float) -> np.ndarray | None:
     """x when it `meets` the target, else GMRES on A preconditioned by `precondition` from
     x; None unless the result meets it."""
-    if meets(A, b, x, forcing, a_norm):
+    ok, r = _meets(A, b, x, forcing, a_norm)
+    if ok:
         return x
     if not np.all(np.isfinite(x)):
         return None
     b_norm = float(np.abs(b).max()) if b.size else 0.0
     target = max(forcing * b_norm, GMRES_RTOL * float(np.linalg.norm(b)))
-    x = gmres(A, precondition, b, x, target, GMRES_RESTART)
+    x = gmres(A, precondition, b, x, target, GMRES_RESTART, r)
     return x if meets(A, b, x, forcing, a_norm) else None
 
 
 def gmres(A: sp.csr_matrix, precondition: Callable[[np.ndarray], np.ndarray], b: np.ndarray,
-          x0: np.ndarray, target: float, m: int) -> np.ndarray:
+          x0: np.ndarray, target: float, m: int, r0: np.ndarray | None = None) -> np.ndarray:
     """One cycle of right-preconditioned GMRES(m): x0 + M^-1 V y minimising |b - A x|_2 over
     the Krylov space of A M^-1, stopped when |b - A x|_2 <= target (classical Gram-Schmidt,
     twice; the Hessenberg matrix reduced by Givens rotations as it grows, so the residual
-    norm is known at every step without a least-squares solve)."""
-    r0 = b - A @ x0
+    norm is known at every step without a least-squares solve); r0: b - A x0 when the
+    caller has it."""
+    r0 = b - A @ x0 if r0 is None else r0
     beta = float(np.linalg.norm(r0))
     if beta <= target or beta == 0.0:
         return x0
