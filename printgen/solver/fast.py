@@ -49,7 +49,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .linsolve import Cholmod, Factorization, Ldl, choose_backend, refine, row_sum_norm
+from .linsolve import Cholmod, Factorization, Ldl, choose_backend, lazy_norm, refine
 from .newton import (
     ARMIJO,
     MAX_BACKTRACK,
@@ -283,7 +283,7 @@ class Updated:
         if precondition is not None:
             with np.errstate(all="ignore"):
                 x = refine(self.A, precondition, b, np.zeros_like(b), forcing,
-                           row_sum_norm(self.A, base.pattern.row_starts))
+                           lazy_norm(self.A, base.pattern.row_starts))
             if x is not None:
                 return x
         self.stepper.factorizations += 1  # counted like the stepper's own
