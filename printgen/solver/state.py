@@ -40,6 +40,7 @@ class NetSystem:
         self.damping = self._damping()
         self.incidence = _incidence(self.n, self.bars, self.pattern)
         self.loads: list = []
+        self._dofs: dict = {}  # `loads.total_forces`'s cache of the loads' dofs
         # each strand's slope just above zero strain: its stiffness once a slack strand pulls
         self.first_slope = np.array([law.slopes[0] for law in self.bars.laws])[
             self.bars.law_index] if len(self.bars.laws) else np.zeros(0)
@@ -86,7 +87,7 @@ class NetSystem:
 
     def external(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Nondimensional loads and their z-derivative at nondimensional displacements u."""
-        f, dz = total_forces(self.loads, self.x0 + u * self.L)
+        f, dz = total_forces(self.loads, self.x0 + u * self.L, self._dofs)
         return f / self.S, dz * self.L / self.S
 
 
