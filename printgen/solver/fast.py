@@ -122,6 +122,7 @@ class Stepper:
         self.factorizations = 0
         self.active: np.ndarray | None = None  # slack strands the last step's model stretched
         self.predicted: np.ndarray | None = None  # strand tensions the last step's model reached
+        self.strained: tuple | None = None  # (step, its strand strain increments B step)
 
     def factor(self, data: np.ndarray) -> Factorization:
         fact = Factorization(self.ns.pattern, data, self.backend, self.handle)
@@ -197,8 +198,10 @@ def _newton_step(ns: NetSystem, st: State, stepper: Stepper, reference: float):
             found = None if step is None else _line_search(ns, st, step, reference)
             if found is not None:
                 assert stepper.active is not None  # _active_set_step has just set it
-                stepper.predicted = _predicted_tensions(ns, st, stepper.active, step, found[1],
-                                                        stepper.predicted)
+                known = stepper.strained
+                stepper.predicted = _predicted_tensions(
+                    ns, st, stepper.active, step, found[1], stepper.predicted,
+                    known[1] if known is not None and known[0] is step else None)
                 return fact, found
     return fact, None
 
@@ -237,7 +240,9 @@ def _active_set_step(ns: NetSystem, st: State, stepper: Stepper, boost: float, f
             break
         fact, step, rhs = trial, new_step, new_rhs
         du = _moved(ns, np.zeros_like(st.u), step)
-        new = slack & (eps + np.einsum("ij,ij->i", nvec, _span(b, du)) / b.rest > 0)
+        de = np.einsum("ij,ij->i", nvec, _span(b, du)) / b.rest
+        stepper.strained = (step, de)  # what `_predicted_tensions` needs when it is taken
+        new = slack & (eps + de > 0)
         if np.array_equal(new, active):
             break
         active = new
@@ -253,15 +258,18 @@ def _repass_by_gmres(stepper: Stepper) -> bool:
 
 
 def _predicted_tensions(ns: NetSystem, st: State, pulls: np.ndarray, step: np.ndarray,
-                        alpha: float, last: np.ndarray | None) -> np.ndarray:
+                        alpha: float, last: np.ndarray | None, de: np.ndarray | None = None
+                        ) -> np.ndarray:
     """The strand tensions the step's own model predicts at its end (mixed integration
     point Newton, Magisano, Leonetti & Garcea 2017): the last prediction moved by alpha
     towards the linearised law's tension at the full step, floored at zero (tension only);
-    `pulls`: the slack strands the step stretches (`Stepper.active`)."""
+    `pulls`: the slack strands the step stretches (`Stepper.active`); `de`: the step's
+    strand strain increments when known (`_active_set_step` computed them)."""
     eps, force, tangent, d, length = st.bar
-    b = ns.bars
-    du = _moved(ns, np.zeros_like(st.u), step)
-    de = np.einsum("ij,ij->i", d / length[:, None], _span(b, du)) / b.rest
+    if de is None:
+        b = ns.bars
+        du = _moved(ns, np.zeros_like(st.u), step)
+        de = np.einsum("ij,ij->i", d / length[:, None], _span(b, du)) / b.rest
     model = np.where(force > 0, force + tangent * de, np.where(pulls, ns.first_slope * (eps + de),
                                                                0.0))
     base = force if last is None else last
