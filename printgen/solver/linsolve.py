@@ -457,11 +457,15 @@ class Factorization:
                 x = self.direct(b)
         return x if np.all(np.isfinite(x)) else None
 
+    def _a_norm(self) -> float:
+        """max row sum of |A|, computed once a backward-error test needs it."""
+        if self.a_norm is None:
+            self.a_norm = row_sum_norm(self.A, self.pattern.row_starts)
+        return self.a_norm
+
     def _refined(self, b: np.ndarray, forcing: float) -> np.ndarray | None:
         """The direct solve, then GMRES on A preconditioned by it when that misses the
         target (the follower term, with an LDL^T of S); None unless the target is met."""
-        if self.a_norm is None:
-            self.a_norm = row_sum_norm(self.A)
         direct = self.direct
         if direct is None:
             return None
@@ -469,53 +473,83 @@ class Factorization:
             with np.errstate(all="ignore"):
                 x = direct(b)
                 self.last = (b, x.copy())
-                return refine(self.A, direct, b, x, forcing, self.a_norm)
+                return refine(self.A, direct, b, x, forcing, self._a_norm)
         except Exception:  # noqa: BLE001 - a failing backend: SuperLU decides
             return None
 
 
-def row_sum_norm(A: sp.csr_matrix) -> float:
+Norm = float | Callable[[], float]  # A's row-sum norm, or how to get it when a test needs it
+
+
+def lazy_norm(A: sp.csr_matrix, starts: np.ndarray | None = None) -> Callable[[], float]:
+    """`row_sum_norm(A, starts)`, computed at the first call only (a solve that meets its
+    forcing target never needs it)."""
+    known: list[float] = []
+
+    def norm() -> float:
+        if not known:
+            known.append(row_sum_norm(A, starts))
+        return known[0]
+
+    return norm
+
+
+def row_sum_norm(A: sp.csr_matrix, starts: np.ndarray | None = None) -> float:
     """max row sum of |A| (the infinity norm of the backward-error test), summed over A's
-    stored entries row by row (a tenth of the time of abs(A).sum(axis=1))."""
+    stored entries row by row (a tenth of the time of abs(A).sum(axis=1)); `starts`: the
+    CSR starts of the rows that have entries, when known (`Pattern.row_starts`)."""
     if not A.nnz:
         return 0.0
-    starts = A.indptr[:-1][np.diff(A.indptr) > 0]  # the rows that have entries
+    if starts is None:
+        starts = A.indptr[:-1][np.diff(A.indptr) > 0]  # the rows that have entries
     return float(np.add.reduceat(np.abs(A.data), starts).max())
 
 
-def meets(A: sp.csr_matrix, b: np.ndarray, x: np.ndarray, forcing: float, a_norm: float
+def meets(A: sp.csr_matrix, b: np.ndarray, x: np.ndarray, forcing: float, a_norm: Norm
           ) -> bool:
     """x solves A x = b to a backward error of LINEAR_RTOL, or (inexact Newton) to a
-    residual max |b - A x| <= forcing max |b|."""
+    residual max |b - A x| <= forcing max |b|. a_norm: A's row-sum norm, or a function
+    giving it (called only when the forcing test fails)."""
+    return _meets(A, b, x, forcing, a_norm)[0]
+
+
+def _meets(A: sp.csr_matrix, b: np.ndarray, x: np.ndarray, forcing: float, a_norm: Norm
+           ) -> tuple[bool, np.ndarray | None]:
+    """(`meets`, the residual b - A x it computed, or None): the residual is GMRES's first."""
     if not np.all(np.isfinite(x)):
-        return False
+        return False, None
     b_norm = float(np.abs(b).max()) if b.size else 0.0
-    res = float(np.abs(b - A @ x).max()) if b.size else 0.0
-    return res <= forcing * b_norm or res <= LINEAR_RTOL * (a_norm * float(np.abs(x).max())
-                                                            + b_norm)
+    r = b - A @ x if b.size else None
+    res = float(np.abs(r).max()) if r is not None else 0.0
+    if res <= forcing * b_norm:
+        return True, r
+    norm = a_norm() if callable(a_norm) else a_norm
+    return res <= LINEAR_RTOL * (norm * float(np.abs(x).max()) + b_norm), r
 
 
 def refine(A: sp.csr_matrix, precondition: Callable[[np.ndarray], np.ndarray], b: np.ndarray,
-           x: np.ndarray, forcing: float, a_norm: float) -> np.ndarray | None:
+           x: np.ndarray, forcing: float, a_norm: Norm) -> np.ndarray | None:
     """x when it `meets` the target, else GMRES on A preconditioned by `precondition` from
     x; None unless the result meets it."""
-    if meets(A, b, x, forcing, a_norm):
+    ok, r = _meets(A, b, x, forcing, a_norm)
+    if ok:
         return x
     if not np.all(np.isfinite(x)):
         return None
     b_norm = float(np.abs(b).max()) if b.size else 0.0
     target = max(forcing * b_norm, GMRES_RTOL * float(np.linalg.norm(b)))
-    x = gmres(A, precondition, b, x, target, GMRES_RESTART)
+    x = gmres(A, precondition, b, x, target, GMRES_RESTART, r)
     return x if meets(A, b, x, forcing, a_norm) else None
 
 
 def gmres(A: sp.csr_matrix, precondition: Callable[[np.ndarray], np.ndarray], b: np.ndarray,
-          x0: np.ndarray, target: float, m: int) -> np.ndarray:
+          x0: np.ndarray, target: float, m: int, r0: np.ndarray | None = None) -> np.ndarray:
     """One cycle of right-preconditioned GMRES(m): x0 + M^-1 V y minimising |b - A x|_2 over
     the Krylov space of A M^-1, stopped when |b - A x|_2 <= target (classical Gram-Schmidt,
     twice; the Hessenberg matrix reduced by Givens rotations as it grows, so the residual
-    norm is known at every step without a least-squares solve)."""
-    r0 = b - A @ x0
+    norm is known at every step without a least-squares solve); r0: b - A x0 when the
+    caller has it."""
+    r0 = b - A @ x0 if r0 is None else r0
     beta = float(np.linalg.norm(r0))
     if beta <= target or beta == 0.0:
         return x0
