@@ -25,6 +25,7 @@ import os
 import statistics
 import subprocess
 import sys
+import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -45,6 +46,11 @@ GOAL_SERIES_S = 5.0  # the paper's scale series (simple barrier, 5 scales, steel
 GOAL_241_S = 1.0  # bench solver: simple-pinned 241 x 81 at tol 1e-6
 GOAL_PER_UNKNOWN = 3.0  # CPU per unknown within 3x from 14k to 228k unknowns
 GOAL_OPENSEES = 12.0  # OpenSeesPy / printgen at 61 x 21 (median of paired runs)
+# before each row the machine settles: the rows measure a quiet machine, and one row's
+# processes leave the next a busy one (the series after the design rows: 8.8 against 7.5 s
+# of CPU for the same work, at load 1.6 against 1.0)
+QUIET_LOAD = 1.0  # 1-minute load average a row waits for ...
+SETTLE_MAX_S = 120.0  # ... at most this long (the row records the load it ran at)
 SERIES_SCALES = "1,10,30,50,100"  # the paper's series (Lambert et al. 2023, Fig. 2)
 SERIES_MATERIALS = ("petg",)
 
@@ -220,12 +226,23 @@ def label() -> str:
     return head + ("+changes" if git("status", "--porcelain", "--untracked-files=no") else "")
 
 
+def settle(below: float = QUIET_LOAD, at_most: float = SETTLE_MAX_S) -> float:
+    """Wait until the 1-minute load average is under `below` (at most `at_most` s); the
+    seconds waited."""
+    t = time.perf_counter()
+    while os.getloadavg()[0] >= below and time.perf_counter() - t < at_most:
+        time.sleep(2.0)
+    return time.perf_counter() - t
+
+
 def run(out: Path, rows: list[str], repeat: int, name: str | None = None) -> dict:
     out.mkdir(parents=True, exist_ok=True)
     before = machine()
     table = []
     for key in rows:
-        print(f"bench table: {key} ...", file=sys.stderr, flush=True)
+        waited = settle()
+        print(f"bench table: {key} (after {waited:.0f} s settling, load "
+              f"{os.getloadavg()[0]:.2f}) ...", file=sys.stderr, flush=True)
         table += ROWS[key](out / key, repeat)
     tag = name or label()
     for r in table:
