@@ -61,6 +61,26 @@ from printgen.search.space import (
 from printgen.search.waves import WAVES_VERIFIED
 
 
+class Earlier:
+    """The converged states of a batch's earlier sweeps (level -> displacements each), as a
+    later sweep's `guesses` at a level: starts, never the answer."""
+
+    def __init__(self) -> None:
+        self.kept: list[dict[float, Any]] = []
+
+    def add(self, states: dict[float, Any] | None) -> None:
+        if states:
+            self.kept.append(states)
+
+    def __call__(self, level: float) -> list[Any]:
+        return [s[float(level)] for s in self.kept if float(level) in s]
+
+    @property
+    def guesses(self) -> Earlier | None:
+        """Itself once a sweep is kept (None before: a cold start)."""
+        return self if self.kept else None
+
+
 def verify_batch(shared: VerifyShared, batch: SolverBatch) -> list[VerifyScore]:
     """Solver stage of the search: the verification of each design of `batch` (nets of one
     graph), as scores, against the prototype's sweep the search made once (`prototype_sweep`;
@@ -76,11 +96,7 @@ def verify_batch(shared: VerifyShared, batch: SolverBatch) -> list[VerifyScore]:
 
     lv = search_levels(shared)
     proto = shared.prototype_run
-    kept: list[dict[float, Any]] = []  # the earlier designs' states: level -> displacements
-
-    def earlier(level: float) -> list[Any]:
-        return [s[float(level)] for s in kept if float(level) in s]
-
+    earlier = Earlier()  # the earlier designs' states
     out = []
     with _serial(), threadpool_limits(limits=1):  # one BLAS thread: the same sums everywhere
         for task in batch.tasks:
@@ -89,8 +105,8 @@ def verify_batch(shared: VerifyShared, batch: SolverBatch) -> list[VerifyScore]:
                 fn, args, kw = plan.jobs()[1]
                 proto = fn(*args, **kw)
             fn, args, kw = plan.jobs()[0]
-            model = fn(*args, **kw, keep_states=True, guesses=earlier if kept else None)
-            kept.append(model.states)
+            model = fn(*args, **kw, keep_states=True, guesses=earlier.guesses)
+            earlier.add(model.states)
             out.append(_score(task.key, plan.verified(model, proto), model))
     return out
 

@@ -26,18 +26,14 @@ def wave_batch(shared: VerifyShared, batch: SolverBatch) -> list[Trial]:
     over a soft net) is a trial without readings, its reason in `note`."""
     from threadpoolctl import threadpool_limits
 
-    from printgen.run.search import _serial
+    from printgen.run.search import Earlier, _serial
 
-    kept: list[dict[float, Any]] = []  # the earlier sweeps' states: level -> displacements
-
-    def earlier(level: float) -> list[Any]:
-        return [s[float(level)] for s in kept if float(level) in s]
-
+    earlier = Earlier()  # the earlier sweeps' states
     out = []
     with _serial(), threadpool_limits(limits=1):  # one BLAS thread: the same sums everywhere
         for task in batch.tasks:
-            trial, states = _trial(shared, task, earlier if kept else None)
-            kept += [states] if states else []
+            trial, states = _trial(shared, task, earlier.guesses)
+            earlier.add(states)
             out.append(trial)
     return out
 
