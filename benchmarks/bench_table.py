@@ -46,9 +46,8 @@ GOAL_SERIES_S = 5.0  # the paper's scale series (simple barrier, 5 scales, steel
 GOAL_241_S = 1.0  # bench solver: simple-pinned 241 x 81 at tol 1e-6
 GOAL_PER_UNKNOWN = 3.0  # CPU per unknown within 3x from 14k to 228k unknowns
 GOAL_OPENSEES = 12.0  # OpenSeesPy / printgen at 61 x 21 (median of paired runs)
-# before each row the machine settles: the rows measure a quiet machine, and one row's
-# processes leave the next a busy one (the series after the design rows: 8.8 against 7.5 s
-# of CPU for the same work, at load 1.6 against 1.0)
+# before each row the machine settles: the goals hold for a quiet machine, and a row's
+# processes leave the next one a busy machine that spends more CPU on the same work
 QUIET_LOAD = 1.0  # 1-minute load average a row waits for ...
 SETTLE_MAX_S = 120.0  # ... at most this long (the row records the load it ran at)
 SERIES_SCALES = "1,10,30,50,100"  # the paper's series (Lambert et al. 2023, Fig. 2)
