@@ -142,7 +142,7 @@ STATE_TOL = 1e-6  # curves from a warm start within the solver's tolerance: of e
 def test_a_variant_started_from_the_nominal_state_reaches_the_same_curves():
     """The bottom row held on the bed: the same nodes as the nominal, held at more of them.
     Started also from the nominal's state at each level (held at rest at its own supports,
-    `preprint.held`), its curves are those of its path from rest, within the solver's
+    `solver.solve_path`), its curves are those of its path from rest, within the solver's
     tolerance; a slack variant and a coarser net get no start (`warm_start`)."""
     d = coarse_design_1_40(COARSE)
     base = SceneOptions(mounting=MOUNTINGS[0])

@@ -24,7 +24,7 @@ from printgen.solver.linsolve import (
 from printgen.solver.scenes import simple_scene, square_net
 from printgen.solver.state import NetSystem, evaluate, tangent_values
 
-AGREE = 1e-9  # issue 11: fast and reference displacements agree to 1e-9 of the largest one
+AGREE = 1e-9  # fast and reference displacements agree to 1e-9 of the largest one
 TIGHT = 1e-12  # solver tolerance of both paths here: far below AGREE
 LINEAR = 1e-10  # relative residual |b - A x| / |b| of a checked linear solve
 
@@ -391,3 +391,21 @@ def test_a_finished_nets_handle_serves_the_next_net_of_its_pattern(monkeypatch, 
     del last
     gc.collect()  # a Cholmod handle refers to itself (its bound `solve`)
     assert gone() is None
+
+
+def test_a_guess_is_taken_at_rest_at_the_supports():
+    """A guess displaced at this net's supports (the state of a net held elsewhere) starts the
+    path only where this net is free: the supports stay at rest and the path ends where it
+    ends without the guess (Newton moves free degrees of freedom only, so a support's guessed
+    displacement would otherwise stay in the answer)."""
+    net, loads = _sliding_net()
+    levels = [0.5, 1.0]
+    plain = solve_path(net, lambda r: loads, levels, tol=TIGHT)
+    fixed = net.fixed_dofs
+    off = {lv: np.where(fixed, 0.01, r.displacements) for lv, r in zip(levels, plain,
+                                                                     strict=True)}
+    guessed = solve_path(net, lambda r: loads, levels, tol=TIGHT, guesses=lambda r: [off[r]])
+    for a, b in zip(plain, guessed, strict=True):
+        assert a.converged and b.converged
+        assert not np.any(b.displacements[fixed])
+        assert _agree(a.displacements, b.displacements) < AGREE

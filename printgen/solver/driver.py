@@ -105,13 +105,16 @@ def solve_path(net: Net, loads_at: Callable[[float], Sequence],
     `guesses(level)`: more starts (displacements, m) for a level, e.g. a similar net's
     converged state there; the fast method starts from the lowest potential of these and the
     path's own starts, so a poor guess costs one evaluation, never the answer (a guess of
-    another shape is ignored).
+    another shape is ignored; a guess is taken at rest at this net's supports, since Newton
+    moves the free degrees of freedom only and would keep a guess's displacement there: the
+    state of a net held elsewhere, e.g. another mounting, starts this one where it is free).
     Returns one Result per level. A level that cannot be reached stops the path (strict
     raises SolverError instead); with `skip_failed` its unconverged Result (converged=False,
     with the reason) is kept and the next level starts from the last converged state.
     """
     _check(method)
     fast = FastSolver(net) if method == "fast" else None
+    fixed = net.fixed_dofs
     out: list[Result] = []
     history: list[tuple[float, np.ndarray]] = []
     done = 0.0
@@ -120,7 +123,8 @@ def solve_path(net: Net, loads_at: Callable[[float], Sequence],
         while True:
             if fast is not None:
                 extra = [] if guesses is None else [  # another net's: not a start here
-                    g for g in guesses(target) if np.shape(g) == fast.ns.x0.shape]
+                    np.where(fixed, 0.0, g) for g in guesses(target)
+                    if np.shape(g) == fast.ns.x0.shape]
                 res = fast.solve(loads_at(target), _starts(history, target) + extra, tol,
                                  max_iter, target)
             else:

@@ -64,7 +64,7 @@ def warm_start(v: Variant, nominal: Run, coarsen: int = 1) -> States | None:
     """The nominal run's state at each level, one more start for variant `v`'s sweep there
     (`solver.solve_path`: the solver begins from the lowest potential of its starts, so the
     answer is the equilibrium it converges to, within its tolerance, whichever start it took;
-    held at rest where the variant's net is held, `preprint.held`), on the nominal's own net
+    held at rest where the variant's net is held, `solver.solve_path`), on the nominal's own net
     only (the nodes must be the same, node for node), and not for a slack variant: slack
     moves every strand's rest length, and from the taut net's state a slack net can settle in
     another equilibrium (measured on the 1:40 prototype: curves 24 % of their peak apart),

@@ -148,8 +148,7 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0,
         return loads_at(r)
 
     results = solver.solve_path(net, tracked, lv, tol=SOLVER_TOL, max_cuts=PATH_CUTS,
-                                skip_failed=True,
-                                guesses=None if guesses is None else held(guesses, net))
+                                skip_failed=True, guesses=guesses)
     failed = {float(r.level): r.reason for r in results if not r.converged}
     if len(lv) - len(failed) < min(MIN_COMPARED, len(lv)):
         raise SolverError(f"{s.name}: {len(failed)} of {len(lv)} load levels did not converge, "
@@ -190,20 +189,6 @@ def from_states(start: States | None) -> Callable[[float], list[np.ndarray]] | N
     def at(level: float) -> list[np.ndarray]:
         u = start.get(float(level))
         return [] if u is None else [u]
-
-    return at
-
-
-def held(guesses: Callable[[float], list[np.ndarray]], net: solver.Net
-         ) -> Callable[[float], list[np.ndarray]]:
-    """`guesses` with every start at rest at `net`'s fixed nodes: a state of a net held
-    elsewhere (another mounting, the bottom row on the bed) is a start here only where this
-    net is free; the solver would otherwise keep the start's displacements at the supports."""
-    fixed = net.fixed_dofs
-
-    def at(level: float) -> list[np.ndarray]:
-        return [np.where(fixed, 0.0, u) if np.shape(u) == fixed.shape else u
-                for u in guesses(level)]
 
     return at
 
