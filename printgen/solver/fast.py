@@ -122,7 +122,6 @@ class Stepper:
         self.factorizations = 0
         self.active: np.ndarray | None = None  # slack strands the last step's model stretched
         self.predicted: np.ndarray | None = None  # strand tensions the last step's model reached
-        self.strained: tuple | None = None  # (step, its strand strain increments B step)
 
     def factor(self, data: np.ndarray) -> Factorization:
         fact = Factorization(self.ns.pattern, data, self.backend, self.handle)
@@ -192,25 +191,26 @@ def _newton_step(ns: NetSystem, st: State, stepper: Stepper, reference: float):
     damped tangent indefinite) mu grows tenfold, at most MU_RETRIES times."""
     forcing = min(FORCING, st.r_norm / st.f_norm)
     for attempt in range(MU_RETRIES + 1):
-        fact, first, rhs = _active_set_step(ns, st, stepper, MU_GROWTH**attempt, forcing)
+        fact, first, rhs, strained = _active_set_step(ns, st, stepper, MU_GROWTH**attempt,
+                                                      forcing)
         for which in range(2):  # the symmetric step solved only when the first fails
             step = first if which == 0 else fact.symmetric_solve(rhs)
             found = None if step is None else _line_search(ns, st, step, reference)
             if found is not None:
                 assert stepper.active is not None  # _active_set_step has just set it
-                known = stepper.strained
                 stepper.predicted = _predicted_tensions(
                     ns, st, stepper.active, step, found[1], stepper.predicted,
-                    known[1] if known is not None and known[0] is step else None)
+                    strained if which == 0 else None)
                 return fact, found
     return fact, None
 
 
 def _active_set_step(ns: NetSystem, st: State, stepper: Stepper, boost: float, forcing: float):
-    """(factorization, step, right-hand side): the damped Newton step on the piecewise
-    quadratic model in which a slack strand pulls once the step's linearised strain
-    eps + B s turns positive; the set of such strands is iterated to a fixed point
-    (primal-dual active set), at most PDAS_PASSES times, from the last step's set."""
+    """(factorization, step, right-hand side, the step's strand strain increments B step):
+    the damped Newton step on the piecewise quadratic model in which a slack strand pulls
+    once the step's linearised strain eps + B s turns positive; the set of such strands is
+    iterated to a fixed point (primal-dual active set), at most PDAS_PASSES times, from the
+    last step's set."""
     eps, force, tangent, d, length = st.bar
     b = ns.bars
     slack = force <= 0
@@ -219,7 +219,7 @@ def _active_set_step(ns: NetSystem, st: State, stepper: Stepper, boost: float, f
     if stepper.active is not None:
         active = slack & stepper.active
     fact: Factorization | Updated | None = None
-    step = rhs = None
+    step = rhs = strained = None
     new = active
     geometric = force if stepper.predicted is None else stepper.predicted
     for _ in range(PDAS_PASSES + 1):
@@ -240,14 +240,13 @@ def _active_set_step(ns: NetSystem, st: State, stepper: Stepper, boost: float, f
             break
         fact, step, rhs = trial, new_step, new_rhs
         du = _moved(ns, np.zeros_like(st.u), step)
-        de = np.einsum("ij,ij->i", nvec, _span(b, du)) / b.rest
-        stepper.strained = (step, de)  # what `_predicted_tensions` needs when it is taken
-        new = slack & (eps + de > 0)
+        strained = np.einsum("ij,ij->i", nvec, _span(b, du)) / b.rest
+        new = slack & (eps + strained > 0)
         if np.array_equal(new, active):
             break
         active = new
     stepper.active = new  # the set the last step predicts: the next step's first guess
-    return fact, step, rhs
+    return fact, step, rhs, strained
 
 
 def _repass_by_gmres(stepper: Stepper) -> bool:
