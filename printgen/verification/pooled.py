@@ -4,13 +4,16 @@ steel counter-example, each started as soon as what it needs is known, so that n
 for a pool to finish or for a serial step.
 
 Order of the jobs (the pool takes them first come, first served): the model and the prototype
-(longest first), the band's first refinement sweep (on the net COARSENINGS[0] times coarser,
-at the pair's levels: run again should a level fail on either barrier, since the band keeps
-only the levels both reached), the counter-example; the band's variants (longest first) once
-the pair and the refinement sweep are done; then the nominal pairs of the other load cases of
-`make --loads`, which fill the cores the band's last variants leave idle. The results are
-those of `verify` (its pair keeping their states), `model_band` and `with_cases`, byte for
-byte: the same sweeps on the same nets at the same levels, from the same starts.
+(longest first), the prototype with its sensors scaled (when they pull too much), the band's
+first refinement sweep (on the net COARSENINGS[0] times coarser, at the pair's levels: run
+again should a level fail on either barrier, since the band keeps only the levels both
+reached); once the pair is done, the prototype's variants (their slack one is the longest sweep
+of both examples: started early, it ends with the others) and the counter-example; the model
+band's variants (longest first) once the nominal sweeps and the refinement sweep are done; then
+the nominal pairs of the other load cases of `make --loads`, which fill the cores the band's
+last variants leave idle. The results are those of `verify` (its pair keeping their states),
+`model_band` and `with_cases`, byte for byte: the same sweeps on the same nets at the same
+levels, from the same starts.
 """
 
 from __future__ import annotations
@@ -73,16 +76,19 @@ def verify_with_band(p: Prototype, d: Design, *, load: str | LoadCase | None = N
         loaded = [pool.submit(fn, *args, **kw) for fn, args, kw in plan.sensor_jobs()]
         ahead = ({first: pool.submit(run_variant, d, base, plan.lv, first, plan.kw_m)}
                  if meshable(d, first) else {})
-        ce = pool.submit(steel_counterexample, d.scale) if counterexample else None
         if meanwhile is not None:
             meanwhile()
         with span("verify: nominal sweeps"):
             model, proto = collect(pair)
+            # the prototype's variants start as soon as the pair is done (the loaded
+            # prototype's sweep plays no part in them), ahead of the counter-example: their
+            # slack one is the longest sweep of both examples, the counter-example short and
+            # needed last
+            theirs = [pool.submit(fn, *args, **kw) for fn, args, kw
+                      in prototype_jobs(p, plan.compared(model, proto)[0][0], plan.kw_p)]
+            ce = pool.submit(steel_counterexample, d.scale) if counterexample else None
             v = plan.verified(model, proto, None, collect(loaded)[0] if loaded else None)
             nominal = v
-        # the prototype's variants queue before the model's: they are few and quick
-        theirs = [pool.submit(fn, *args, **kw) for fn, args, kw
-                  in prototype_jobs(p, v.prototype, plan.kw_p)]
         with span("verify: band"):
             band = model_band(d, v.model, load_kw=plan.kw_m, free_section=free_section,
                               ahead=ahead, then=behind_variants)

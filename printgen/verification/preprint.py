@@ -375,18 +375,23 @@ class VerifyPlan:
         """The comparison of the two sweeps, at the levels where both converged (`loaded`:
         the run of `sensor_jobs`)."""
         check = self._sensors(model, loaded)
-        bad = set(proto.failed) | set(model.failed)
-        if bad:  # compare only where both barriers converged
-            keep = np.array([lvl not in bad for lvl in self.lv])
-            proto = _only(proto, keep)
-            model = _only(model, keep)
-        (proto, model), load_rec = stated(self.case, (proto, model),
-                                          (self.kw_p["site"], self.kw_m["site"]))
+        (proto, model), load_rec = self.compared(model, proto)
         mm = compare(proto.deformation, model.deformation)
         start = compare(increments(proto.deformation), increments(model.deformation))
         return Verification(self.case.title, proto, model, mm, explain(mm), ce, start,
                             len(self.lv), load_rec, flow=self.flow, sensors=check,
                             loaded_prototype=loaded)
+
+    def compared(self, model: Run, proto: Run) -> tuple[tuple[Run, Run], dict[str, Any]]:
+        """The runs (prototype, model) as `verified` compares them, at the levels where both
+        converged, with the load case's record (`stated`): the loaded prototype's sweep
+        plays no part, so the prototype's run is known as soon as the pair is."""
+        bad = set(proto.failed) | set(model.failed)
+        if bad:  # compare only where both barriers converged
+            keep = np.array([lvl not in bad for lvl in self.lv])
+            proto = _only(proto, keep)
+            model = _only(model, keep)
+        return stated(self.case, (proto, model), (self.kw_p["site"], self.kw_m["site"]))
 
     def _sensors(self, model: Run, loaded: Run | None) -> SensorCheck:
         force, mm = scene_sensor_force(self.ms), None
