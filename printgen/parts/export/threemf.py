@@ -61,11 +61,17 @@ def prusa_config_from_ini(ini_text: str) -> str:
     return "\n".join(lines) + "\n"
 
 
+VERTEX = '<vertex x="%.6f" y="%.6f" z="%.6f"/>'
+TRIANGLE = '<triangle v1="%d" v2="%d" v3="%d"/>'
+
+
 def _object_xml(oid: int, name: str, mesh) -> str:
     v = np.asarray(mesh.vertices, dtype=float)
     f = np.asarray(mesh.faces, dtype=int)
-    verts = "".join(f'<vertex x="{x:.6f}" y="{y:.6f}" z="{z:.6f}"/>' for x, y, z in v)
-    tris = "".join(f'<triangle v1="{a}" v2="{b}" v3="{c}"/>' for a, b, c in f)
+    # one %-format over the whole array: the text of a per-row f-string ("%.6f" and "{:.6f}"
+    # format a float alike), in a quarter of the time
+    verts = (VERTEX * len(v)) % tuple(v.ravel().tolist())
+    tris = (TRIANGLE * len(f)) % tuple(f.ravel().tolist())
     return (f'<object id="{oid}" name={quoteattr(name)} type="model"><mesh>'
             f"<vertices>{verts}</vertices><triangles>{tris}</triangles></mesh></object>")
 
