@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import sys
+from collections.abc import Iterator
 from typing import TYPE_CHECKING, Any
 
 from rich.console import Console
@@ -174,3 +176,42 @@ def table(title: str, columns: list[str], rows: list[list[str]]) -> Table:
 
 def fmt(v: float | None, spec: str = ".4g") -> str:
     return "-" if v is None else format(v, spec)
+
+
+class _Silent:
+    """The status line's stand-in off a terminal: its text goes nowhere."""
+
+    def update(self, _text: str) -> None:
+        pass
+
+
+class _Line:
+    """The run's current step, one line on the terminal, drawn again when it changes."""
+
+    def __init__(self, live) -> None:
+        self.live = live
+
+    def update(self, text: str) -> None:
+        from rich.text import Text
+
+        self.live.update(Text(text), refresh=True)
+
+
+@contextlib.contextmanager
+def spinner(text: str) -> Iterator:
+    """The run's current step on stderr while a command runs (`make`, `series`), when stderr
+    is a terminal (erased at the end); elsewhere (a log, a pipe, a benchmark) nothing. Drawn
+    when the text changes, by no thread of its own (not rich's animated spinner, which
+    refreshes from one): a process running a thread starts its workers from a fork server
+    (printgen.executor.start.start_method), which imports what the jobs need again, instead
+    of forking them with it imported (make: its helper process; series: the cases' workers,
+    whose progress bar, once they run, is animated)."""
+    err = Console(stderr=True, highlight=False)
+    if not err.is_terminal:
+        yield _Silent()
+        return
+    from rich.live import Live
+    from rich.text import Text
+
+    with Live(Text(text), console=err, auto_refresh=False, transient=True) as live:
+        yield _Line(live)

@@ -8,7 +8,6 @@ import sys
 import time
 from pathlib import Path
 
-from rich.console import Console
 from rich.markup import escape
 
 from printgen.commands.common import (
@@ -21,6 +20,7 @@ from printgen.commands.common import (
     incomplete_code,
     run_options,
     seconds,
+    spinner,
     table,
 )
 from printgen.report.pdf import PAPERS
@@ -60,10 +60,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     check_profile_args(args, "printer")
     out = args.out or Path("out") / f"{Path(args.prototype).stem}-1-{args.scale:g}"
-    err = Console(stderr=True, highlight=False)
     t0 = time.perf_counter()
     options = run_options(args)
-    with err.status("planning") as status:
+    with spinner("planning") as status:  # no thread: make's helper forks with its imports
         ctx = api.make(args.prototype, args.scale, out, options=options,
                        progress=Progress(status))
     seconds = time.perf_counter() - t0

@@ -5,12 +5,8 @@
 from __future__ import annotations
 
 import argparse
-import contextlib
 import sys
-from collections.abc import Iterator
 from pathlib import Path
-
-from rich.console import Console
 
 from printgen.commands.common import (
     add_json_arg,
@@ -20,6 +16,7 @@ from printgen.commands.common import (
     console,
     emit_json,
     run_options,
+    spinner,
     table,
 )
 from printgen.errors import InputError
@@ -77,45 +74,6 @@ def run(args: argparse.Namespace) -> int:
         return 0
     show(res, out)
     return 0
-
-
-class _Silent:
-    """The status line's stand-in off a terminal: its text goes nowhere."""
-
-    def update(self, _text: str) -> None:
-        pass
-
-
-class _Line:
-    """The run's current step, one line on the terminal, drawn again when it changes."""
-
-    def __init__(self, live) -> None:
-        self.live = live
-
-    def update(self, text: str) -> None:
-        from rich.text import Text
-
-        self.live.update(Text(text), refresh=True)
-
-
-@contextlib.contextmanager
-def spinner(text: str) -> Iterator:
-    """The run's current step on stderr while the series runs, when stderr is a terminal
-    (erased at the end); elsewhere (a log, a pipe, a benchmark) nothing. Drawn when the text
-    changes, by no thread of its own (not rich's animated spinner, which refreshes from one):
-    a process running a thread starts its workers from a fork server
-    (printgen.executor.start.start_method), which imports what the cases need again, instead
-    of forking them with it imported. The cases' progress bar, once the workers run, is
-    animated."""
-    err = Console(stderr=True, highlight=False)
-    if not err.is_terminal:
-        yield _Silent()
-        return
-    from rich.live import Live
-    from rich.text import Text
-
-    with Live(Text(text), console=err, auto_refresh=False, transient=True) as live:
-        yield _Line(live)
 
 
 def show(res, out: Path) -> None:
