@@ -9,8 +9,6 @@ import sys
 import time
 from pathlib import Path
 
-from rich.console import Console
-
 from printgen.commands.common import (
     add_json_arg,
     add_load_args,
@@ -20,6 +18,7 @@ from printgen.commands.common import (
     emit_json,
     incomplete_code,
     run_options,
+    spinner,
     table,
 )
 from printgen.verification.measured import COLUMNS, FIT_KINDS, LEVEL_COLUMN
@@ -53,9 +52,8 @@ def run(args: argparse.Namespace) -> int:
 
     folder = args.design.resolve().parent
     out = args.out or folder.with_name(f"{folder.name}-verify")
-    err = Console(stderr=True, highlight=False)
     t0 = time.perf_counter()
-    with err.status("reading inputs") as status:
+    with spinner("reading inputs") as status:  # no thread: the fit's workers fork with its imports
         res = api.verify_design(args.prototype, args.scale, args.design, out,
                                 measured=args.measured, fit=args.fit, options=run_options(args),
                                 progress=lambda s: status.update(f"{s} ..."))
