@@ -20,7 +20,8 @@ from printgen.search.waves import Trial, WaveTask, point_errors, screen_levels
 def wave_batch(shared: VerifyShared, batch: SolverBatch) -> list[Trial]:
     """Sweep each of `batch`'s tasks (nets of one solver graph; a worker job: pure,
     module-level), each load level of a later sweep also started from the earlier sweeps'
-    converged states there (`sweep`'s guesses: a start, never the answer). On its own net
+    load steps to it (`sweep`'s paths: a start, never the answer), each net factorized by
+    the backend of a load path (`sweep`'s path_backend). On its own net
     (`coarsen` 1) at the search's levels, with its deformation mismatch; coarser, at the
     stage's screening levels. A sweep the solver refuses (too few levels, sensor wires folding
     over a soft net) is a trial without readings, its reason in `note`."""
