@@ -5,13 +5,14 @@ from __future__ import annotations
 
 import dataclasses
 import sys
+from collections.abc import Callable
 
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
 from printgen.solver import Hydrostatic, Net, SlidingCable, linear, solve, solve_path
-from printgen.solver.driver import FastSolver
+from printgen.solver.driver import PATH_CHOLMOD_MIN_DOFS, FastSolver, _shifted, path_backend
 from printgen.solver.linsolve import (
     CHOLMOD_MIN_DOFS,
     PARDISO_MIN_DOFS,
@@ -33,16 +34,17 @@ def _agree(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.abs(a - b).max() / np.abs(b).max())
 
 
-def _sliding_net() -> tuple[Net, list]:
-    """A 2 x 1 m square net (0.1 m mesh) on anchors at the bed and the sides, its top edge
-    threaded on a sliding cable between the two top corners, loaded hydrostatically with the
-    water at 90 % of the height (z at the current node height)."""
+def _sliding_net(strand: float = 1e5) -> tuple[Net, list]:
+    """A 2 x 1 m square net (0.1 m mesh; strands of axial stiffness `strand`, N) on anchors
+    at the bed and the sides, its top edge threaded on a sliding cable between the two top
+    corners, loaded hydrostatically with the water at 90 % of the height (z at the current
+    node height)."""
     nodes, el, idx = square_net(2.0, 1.0, 0.1)
     x, z = nodes[:, 0], nodes[:, 2]
     fixed = (x < 1e-9) | (x > 2 - 1e-9) | (z < 1e-9)
     top = idx[:, -1]
     cable = SlidingCable(top, linear(4e5))
-    net = Net(nodes, fixed, el, [linear(1e5)], cables=[cable])
+    net = Net(nodes, fixed, el, [linear(strand)], cables=[cable])
     free = np.flatnonzero(~fixed)
     return net, [Hydrostatic(free, 0.01, 0.9)]
 
@@ -409,3 +411,57 @@ def test_a_guess_is_taken_at_rest_at_the_supports():
         assert a.converged and b.converged
         assert not np.any(b.displacements[fixed])
         assert _agree(a.displacements, b.displacements) < AGREE
+
+
+def test_a_neighbours_path_shifted_onto_this_one_starts_each_level_closer():
+    """`paths`: a net 20 % stiffer, swept first, gives each level of this net's path its load
+    step from the level before, added to this path's state there. The path ends where the
+    cold one ends (a start, never the answer) in fewer Newton iterations in all; an entry of
+    another shape (a net of another graph) and a missing level (None) are passed over."""
+    levels = [0.25, 0.5, 0.75, 1.0]  # the water at these shares of its 0.9 m
+
+    def rising(loads: list) -> Callable[[float], list]:
+        return lambda r: [dataclasses.replace(h, level=h.level * r) for h in loads]
+
+    stiff, loads_s = _sliding_net(1.2e5)
+    kept = {lv: r.displacements for lv, r in zip(
+        levels, solve_path(stiff, rising(loads_s), levels, tol=TIGHT), strict=True)}
+    net, loads = _sliding_net()
+    cold = solve_path(net, rising(loads), levels, tol=TIGHT)
+    other = np.zeros((3, 3))  # another graph's state: not a start here
+    warm = solve_path(net, rising(loads), levels, tol=TIGHT,
+                      paths=lambda r: [kept.get(r), other, None])
+    for a, b in zip(cold, warm, strict=True):
+        assert a.converged and b.converged
+        assert _agree(a.displacements, b.displacements) < AGREE
+    assert sum(r.iterations for r in warm) < sum(r.iterations for r in cold)
+
+
+def test_shifted_starts_add_the_neighbours_step_to_this_paths_state():
+    """The start is this path's last state plus the neighbour's change from that level to the
+    target, at rest at the supports; the neighbour's own state before this path has converged
+    anywhere or where it has no state at the last level; nothing from a net without the
+    target level."""
+    fixed = np.array([[True, True, True], [False, False, False]])
+    u = np.array([[0.0, 0.0, 0.0], [1.0, 2.0, 3.0]])
+    g = {0.5: np.full((2, 3), 0.5), 1.0: np.full((2, 3), 0.75)}
+    [start] = _shifted(lambda r: [g.get(r)], [(0.5, u)], 1.0, fixed)
+    np.testing.assert_array_equal(start, u + np.where(fixed, 0.0, 0.25))
+    [first] = _shifted(lambda r: [g.get(r)], [], 1.0, fixed)
+    np.testing.assert_array_equal(first, np.where(fixed, 0.0, 0.75))
+    [own] = _shifted(lambda r: [g.get(r)], [(0.25, u)], 1.0, fixed)  # none at 0.25
+    np.testing.assert_array_equal(own, np.where(fixed, 0.0, 0.75))
+    assert _shifted(lambda r: [g.get(r)], [(0.5, u)], 0.8, fixed) == []
+
+
+def test_a_load_path_takes_cholmod_from_its_threshold_when_qdldl_would_factorize():
+    """`path_backend`: CHOLMOD from PATH_CHOLMOD_MIN_DOFS unknowns in place of qdldl (when
+    installed), `choose_backend`'s otherwise (PARDISO's preference kept)."""
+    below = PATH_CHOLMOD_MIN_DOFS - 1
+    assert path_backend(below) == choose_backend(below)
+    at = PATH_CHOLMOD_MIN_DOFS
+    single = choose_backend(at)
+    assert path_backend(at) == ("cholmod" if single == "ldl" and cholmod_available()
+                                else single)
+    big = max(PARDISO_MIN_DOFS, CHOLMOD_MIN_DOFS)
+    assert path_backend(big) == choose_backend(big)

@@ -54,13 +54,22 @@ def map_on(c: Any, fn: Any, items: Any, shared: Any, advance: Any) -> list[Any]:
     every worker; `advance()` after each task ends. A failing task raises its error."""
     distributed = distributed_module()
     shared_f = c.scatter(shared, broadcast=True, hash=False)
-    futures = [c.submit(fn, shared_f, item, pure=False) for item in items]
+    futures = [c.submit(_task, fn, shared_f, item, pure=False) for item in items]
     try:
         for _ in distributed.as_completed(futures, loop=c.loop):
             advance()
         return c.gather(futures)
     finally:
         c.cancel([*futures, shared_f])
+
+
+def _task(fn: Any, shared: Any, item: Any) -> Any:
+    """fn(shared, item) on a worker, its heap roomy (`heap.roomy`: distributed's workers fix
+    glibc's thresholds, which maps a solver's larger arrays afresh at each allocation)."""
+    from printgen.executor.heap import roomy
+
+    with roomy():
+        return fn(shared, item)
 
 
 def check_address(address: str) -> str:

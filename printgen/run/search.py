@@ -63,7 +63,8 @@ from printgen.search.waves import WAVES_VERIFIED
 
 class Earlier:
     """The converged states of a batch's earlier sweeps (level -> displacements each), as a
-    later sweep's `guesses` at a level: starts, never the answer."""
+    later sweep's `paths` (`solver.solve_path`: each earlier sweep's load step shifted onto
+    the later one, a start, never the answer)."""
 
     def __init__(self) -> None:
         self.kept: list[dict[float, Any]] = []
@@ -73,10 +74,12 @@ class Earlier:
             self.kept.append(states)
 
     def __call__(self, level: float) -> list[Any]:
-        return [s[float(level)] for s in self.kept if float(level) in s]
+        """Each earlier sweep's state at `level`, None where it has none (one entry per
+        sweep, in one order at every level: `solve_path` pairs them across levels)."""
+        return [s.get(float(level)) for s in self.kept]
 
     @property
-    def guesses(self) -> Earlier | None:
+    def paths(self) -> Earlier | None:
         """Itself once a sweep is kept (None before: a cold start)."""
         return self if self.kept else None
 
@@ -85,11 +88,12 @@ def verify_batch(shared: VerifyShared, batch: SolverBatch) -> list[VerifyScore]:
     """Solver stage of the search: the verification of each design of `batch` (nets of one
     graph), as scores, against the prototype's sweep the search made once (`prototype_sweep`;
     without it, swept here once for the batch: it does not depend on the net). Each model sweep
-    after the first also starts every load level from the batch's earlier converged states
-    there (`sweep`'s guesses: the solver keeps the start of lowest potential and iterates to
-    SOLVER_TOL, so the score is the cold sweep's to the solver tolerance, in fewer iterations).
-    Pure: the same batch gives the same scores in any process (the sweep worker runs it
-    serially)."""
+    after the first also starts every load level from the batch's earlier sweeps' load steps
+    to it, shifted onto its own path (`sweep`'s paths: the solver keeps the start of lowest
+    potential and iterates to SOLVER_TOL, so the score is the cold sweep's to the solver
+    tolerance, in fewer iterations), each factorized by the backend of a load path
+    (`sweep`'s path_backend). Pure: the same batch gives the same scores in any process (the
+    sweep worker runs it serially)."""
     from threadpoolctl import threadpool_limits
 
     from printgen.verification.preprint import verify_plan
@@ -100,12 +104,13 @@ def verify_batch(shared: VerifyShared, batch: SolverBatch) -> list[VerifyScore]:
     out = []
     with _serial(), threadpool_limits(limits=1):  # one BLAS thread: the same sums everywhere
         for task in batch.tasks:
-            plan = verify_plan(shared.prototype, task.design, lv=lv)
+            plan = verify_plan(shared.prototype, task.design, lv=lv, sensors=False,
+                               prototype=None if proto is None else proto.scene)
             if proto is None:  # the model alone is compared: the sensors' share is not scored
                 fn, args, kw = plan.jobs()[1]
                 proto = fn(*args, **kw)
             fn, args, kw = plan.jobs()[0]
-            model = fn(*args, **kw, keep_states=True, guesses=earlier.guesses)
+            model = fn(*args, **kw, keep_states=True, paths=earlier.paths, path_backend=True)
             earlier.add(model.states)
             out.append(_score(task.key, plan.verified(model, proto), model))
     return out

@@ -20,7 +20,8 @@ from printgen.search.waves import Trial, WaveTask, point_errors, screen_levels
 def wave_batch(shared: VerifyShared, batch: SolverBatch) -> list[Trial]:
     """Sweep each of `batch`'s tasks (nets of one solver graph; a worker job: pure,
     module-level), each load level of a later sweep also started from the earlier sweeps'
-    converged states there (`sweep`'s guesses: a start, never the answer). On its own net
+    load steps to it (`sweep`'s paths: a start, never the answer), each net factorized by
+    the backend of a load path (`sweep`'s path_backend). On its own net
     (`coarsen` 1) at the search's levels, with its deformation mismatch; coarser, at the
     stage's screening levels. A sweep the solver refuses (too few levels, sensor wires folding
     over a soft net) is a trial without readings, its reason in `note`."""
@@ -32,7 +33,7 @@ def wave_batch(shared: VerifyShared, batch: SolverBatch) -> list[Trial]:
     out = []
     with _serial(), threadpool_limits(limits=1):  # one BLAS thread: the same sums everywhere
         for task in batch.tasks:
-            trial, states = _trial(shared, task, earlier.guesses)
+            trial, states = _trial(shared, task, earlier.paths)
             earlier.add(states)
             out.append(trial)
     return out
@@ -43,7 +44,7 @@ def wave_task(shared: VerifyShared, task: WaveTask) -> Trial:
     return wave_batch(shared, SolverBatch((task,)))[0]
 
 
-def _trial(shared: VerifyShared, task: WaveTask, guesses: Any
+def _trial(shared: VerifyShared, task: WaveTask, paths: Any
            ) -> tuple[Trial, dict[float, Any]]:
     """One task's trial and its sweep's converged states (none when the solver refused)."""
     from printgen.run.search import search_levels
@@ -55,15 +56,17 @@ def _trial(shared: VerifyShared, task: WaveTask, guesses: Any
     lv = search_levels(shared) if own else screen_levels()
     force = sensor_force(p)
     trial = Trial(d.net, sensor_force_n=force, coarsen=task.coarsen)
-    plan = verify_plan(p, d, lv=lv)
     proto = shared.prototype_run
+    plan = verify_plan(p, d, lv=lv, sensors=False,
+                       prototype=None if proto is None else proto.scene)
     if proto is None:
         fn, args, kw = plan.jobs()[1]
         proto = fn(*args, **kw)
     ms = plan.ms if own else build_scene(d, SceneOptions(
         mounting=plan.ms.mounting, load=plan.case, sensor_force=force, coarsen=task.coarsen))
     try:
-        model = sweep(ms, plan.lv, guesses=guesses, keep_states=True, **plan.kw_m)
+        model = sweep(ms, plan.lv, paths=paths, keep_states=True, path_backend=True,
+                      **plan.kw_m)
     except SolverError as e:
         return dataclasses.replace(trial, note=str(e)), {}
     md, pd = model.deformation, proto.deformation

@@ -9,7 +9,7 @@ Stages over the space of `search_space` (material x strand section x mesh x bord
    the best net of each of the `verify_nets` best material x section pairs, each with every
    border width, and `select`'s pick for comparison. The candidates whose nets share one graph
    (meshes, pattern) go to one worker job (`SolverBatch`), swept in turn, each load level
-   warm-started from the earlier ones' states there (the wave stage's sweeps alike);
+   warm-started from the earlier ones' load steps to it (the wave stage's sweeps alike);
 3. with the `deformation` objective, nets with printable waved strands, searched by the solver
    on the flume's readings (`printgen.search.waves`): the design takes the best waved net when
    it reads closer to the prototype than the best straight net.
@@ -100,8 +100,8 @@ class SolverBatch:
     """One worker job of a solver stage: tasks (`VerifyTask`, `WaveTask`) whose solver nets
     share one graph (the same meshes, coarsening, pattern and size: their states have one
     shape), swept in turn, each load level of a later sweep also started from the earlier
-    sweeps' converged states at that level (the solver keeps the start of lowest potential and
-    iterates to its tolerance: a start, never the answer)."""
+    sweeps' load steps to that level, shifted onto its own path (the solver keeps the start of
+    lowest potential and iterates to its tolerance: a start, never the answer)."""
 
     tasks: tuple[Any, ...]
 

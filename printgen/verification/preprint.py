@@ -32,6 +32,7 @@ from printgen.scene.options import SceneOptions, build_scene
 from printgen.scene.pressure import loads_function
 from printgen.scene.scenes import SENSOR_FORCE_N, BarrierScene, lateral_mounting, noted
 from printgen.scene.solvernet import build, hold_share, wire_slack
+from printgen.solver.driver import path_backend as backend_of_path
 from printgen.solver.loads import total_forces
 from printgen.units import MM
 from printgen.verification.compare import (
@@ -132,15 +133,20 @@ class Run:
 
 def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0,
           guesses: Callable[[float], list[np.ndarray]] | None = None, keep_states: bool = False,
-          **load_kw: Any) -> Run:
+          paths: Callable[[float], list[np.ndarray | None]] | None = None,
+          path_backend: bool = False, **load_kw: Any) -> Run:
     """Solve the load path (`load_kw`: the load case and site of `loads_function`); levels
     that do not converge are kept in `Run.failed` (left out of the comparison); SolverError
-    only when fewer than MIN_COMPARED levels converge. `guesses`: more warm starts per level
-    (`solver.solve_path`); `keep_states`: keep each converged level's displacements (m, every
-    solver node) in `Run.states`, a warm start for a similar net."""
+    only when fewer than MIN_COMPARED levels converge. `guesses`: more warm starts per level,
+    `paths`: other nets' converged paths, shifted onto this one as starts (`solver.solve_path`);
+    `keep_states`: keep each converged level's displacements (m, every solver node) in
+    `Run.states`, a warm start for a similar net; `path_backend`: the linear backend of
+    `solver.driver.path_backend` (the design search's batches, which factorize one net graph
+    hundreds of times) instead of the single solve's (make's sweeps keep theirs)."""
     t0, cpu0 = time.perf_counter(), time.process_time()
     net, ex = build(s, slack=slack)
     loads_at = loads_function(s, **load_kw)
+    unknowns = int((~net.fixed_dofs).sum())
 
     def tracked(r: float) -> list:  # one progress report per load level tried
         check_deadline(f"{s.name}'s load sweep at h/h_B = {float(r):.3g}")
@@ -148,7 +154,8 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0,
         return loads_at(r)
 
     results = solver.solve_path(net, tracked, lv, tol=SOLVER_TOL, max_cuts=PATH_CUTS,
-                                skip_failed=True, guesses=guesses)
+                                skip_failed=True, guesses=guesses, paths=paths,
+                                backend=backend_of_path(unknowns) if path_backend else None)
     failed = {float(r.level): r.reason for r in results if not r.converged}
     if len(lv) - len(failed) < min(MIN_COMPARED, len(lv)):
         raise SolverError(f"{s.name}: {len(failed)} of {len(lv)} load levels did not converge, "
@@ -172,7 +179,7 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0,
               if r.converged and np.any(np.isclose(r.level, SHAPE_LEVELS))}
     return Run(s, d, [r.iterations for r in results], time.perf_counter() - t0, failed, shapes,
                share, ",".join(sorted({r.backend for r in results})),
-               int((~net.fixed_dofs).sum()), time.process_time() - cpu0,
+               unknowns, time.process_time() - cpu0,
                {float(x): r.displacements for x, r in zip(lv, results, strict=False)
                 if r.converged} if keep_states else {})  # a path stopped early is shorter
 
@@ -329,16 +336,19 @@ class Verification(Shown):
         }
 
 
-def barriers(p: Prototype, d: Design, load: str | LoadCase | None, mounting: str | None
-              ) -> tuple[LoadCase, dict[str, Any], dict[str, Any], BarrierScene, BarrierScene]:
+def barriers(p: Prototype, d: Design, load: str | LoadCase | None, mounting: str | None,
+             prototype: BarrierScene | None = None
+             ) -> tuple[LoadCase, dict[str, Any], dict[str, Any], BarrierScene, BarrierScene]:
     """(the load case, the prototype's and the model's sweep keywords, their scenes), both
-    mounted by `mounting` (default: the prototype file's [flume] lateral)."""
+    mounted by `mounting` (default: the prototype file's [flume] lateral); `prototype`: the
+    prototype's scene when the caller built it already (it does not depend on the design)."""
     mounting = mounting or lateral_mounting(p)
     kw_p, kw_m = load_keywords(p, d, load)
     case = kw_m["load"]
     options = SceneOptions(mounting=mounting, load=case)
     model = dataclasses.replace(options, sensor_force=sensor_force(p))
-    return case, kw_p, kw_m, build_scene(p, options), build_scene(d, model)
+    ps = prototype if prototype is not None else build_scene(p, options)
+    return case, kw_p, kw_m, ps, build_scene(d, model)
 
 
 @dataclass(frozen=True)
@@ -403,14 +413,18 @@ class VerifyPlan:
 
 
 def verify_plan(p: Prototype, d: Design, *, load: str | LoadCase | None = None,
-                lv: np.ndarray | None = None, mounting: str | None = None) -> VerifyPlan:
-    """The sweeps of `verify` (default levels: the usual ones and the case's own)."""
-    case, kw_p, kw_m, ps, ms = barriers(p, d, load, mounting)
+                lv: np.ndarray | None = None, mounting: str | None = None,
+                prototype: BarrierScene | None = None, sensors: bool = True) -> VerifyPlan:
+    """The sweeps of `verify` (default levels: the usual ones and the case's own).
+    `prototype`: the prototype's scene, already built under the same load case and mounting
+    (the design search's one prototype sweep's); `sensors`: False when the caller does not
+    sweep `sensor_jobs` (no loaded prototype scene is built)."""
+    case, kw_p, kw_m, ps, ms = barriers(p, d, load, mounting, prototype)
     if lv is None:  # the usual levels and the case's own (the jam's discharge steps)
         own = case.levels_for(ms, kw_m["site"])
         lv = levels() if own is None else np.unique(np.concatenate([levels(), own]))
     force, loaded = sensor_force(p), None
-    if needs_loaded_prototype(ms, force):  # forces scale as lambda^-3
+    if sensors and needs_loaded_prototype(ms, force):  # forces scale as lambda^-3
         loaded = build_scene(p, SceneOptions(mounting=ps.mounting, load=case,
                                              sensor_force=force * d.scale**3))
     return VerifyPlan(case, kw_p, kw_m, ps, ms, np.asarray(lv, dtype=float),
