@@ -92,8 +92,8 @@ def verify_batch(shared: VerifyShared, batch: SolverBatch) -> list[VerifyScore]:
     to it, shifted onto its own path (`sweep`'s paths: the solver keeps the start of lowest
     potential and iterates to SOLVER_TOL, so the score is the cold sweep's to the solver
     tolerance, in fewer iterations), each factorized by the backend of a load path
-    (`sweep`'s path_backend). Pure: the same batch gives the same scores in any process (the
-    sweep worker runs it serially)."""
+    (`solver.driver.path_backend`, as every sweep). Pure: the same batch gives the same
+    scores in any process (the sweep worker runs it serially)."""
     from threadpoolctl import threadpool_limits
 
     from printgen.verification.preprint import verify_plan
@@ -110,7 +110,7 @@ def verify_batch(shared: VerifyShared, batch: SolverBatch) -> list[VerifyScore]:
                 fn, args, kw = plan.jobs()[1]
                 proto = fn(*args, **kw)
             fn, args, kw = plan.jobs()[0]
-            model = fn(*args, **kw, keep_states=True, paths=earlier.paths, path_backend=True)
+            model = fn(*args, **kw, keep_states=True, paths=earlier.paths)
             earlier.add(model.states)
             out.append(_score(task.key, plan.verified(model, proto), model))
     return out

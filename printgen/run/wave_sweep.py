@@ -21,7 +21,7 @@ def wave_batch(shared: VerifyShared, batch: SolverBatch) -> list[Trial]:
     """Sweep each of `batch`'s tasks (nets of one solver graph; a worker job: pure,
     module-level), each load level of a later sweep also started from the earlier sweeps'
     load steps to it (`sweep`'s paths: a start, never the answer), each net factorized by
-    the backend of a load path (`sweep`'s path_backend). On its own net
+    the backend of a load path (`solver.driver.path_backend`, as every sweep). On its own net
     (`coarsen` 1) at the search's levels, with its deformation mismatch; coarser, at the
     stage's screening levels. A sweep the solver refuses (too few levels, sensor wires folding
     over a soft net) is a trial without readings, its reason in `note`."""
@@ -65,7 +65,7 @@ def _trial(shared: VerifyShared, task: WaveTask, paths: Any
     ms = plan.ms if own else build_scene(d, SceneOptions(
         mounting=plan.ms.mounting, load=plan.case, sensor_force=force, coarsen=task.coarsen))
     try:
-        model = sweep(ms, plan.lv, paths=paths, keep_states=True, path_backend=True,
+        model = sweep(ms, plan.lv, paths=paths, keep_states=True,
                       **plan.kw_m)
     except SolverError as e:
         return dataclasses.replace(trial, note=str(e)), {}

@@ -134,15 +134,15 @@ class Run:
 def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0,
           guesses: Callable[[float], list[np.ndarray]] | None = None, keep_states: bool = False,
           paths: Callable[[float], list[np.ndarray | None]] | None = None,
-          path_backend: bool = False, **load_kw: Any) -> Run:
+          **load_kw: Any) -> Run:
     """Solve the load path (`load_kw`: the load case and site of `loads_function`); levels
     that do not converge are kept in `Run.failed` (left out of the comparison); SolverError
     only when fewer than MIN_COMPARED levels converge. `guesses`: more warm starts per level,
     `paths`: other nets' converged paths, shifted onto this one as starts (`solver.solve_path`);
     `keep_states`: keep each converged level's displacements (m, every solver node) in
-    `Run.states`, a warm start for a similar net; `path_backend`: the linear backend of
-    `solver.driver.path_backend` (the design search's batches, which factorize one net graph
-    hundreds of times) instead of the single solve's (make's sweeps keep theirs)."""
+    `Run.states`, a warm start for a similar net. The linear backend is a load path's
+    (`solver.driver.path_backend`: a sweep factorizes its net tens to hundreds of times, so
+    CHOLMOD's analysis pays back from smaller nets than in a single solve)."""
     t0, cpu0 = time.perf_counter(), time.process_time()
     net, ex = build(s, slack=slack)
     loads_at = loads_function(s, **load_kw)
@@ -155,7 +155,7 @@ def sweep(s: BarrierScene, lv: np.ndarray, *, slack: float = 0.0,
 
     results = solver.solve_path(net, tracked, lv, tol=SOLVER_TOL, max_cuts=PATH_CUTS,
                                 skip_failed=True, guesses=guesses, paths=paths,
-                                backend=backend_of_path(unknowns) if path_backend else None)
+                                backend=backend_of_path(unknowns))
     failed = {float(r.level): r.reason for r in results if not r.converged}
     if len(lv) - len(failed) < min(MIN_COMPARED, len(lv)):
         raise SolverError(f"{s.name}: {len(failed)} of {len(lv)} load levels did not converge, "
