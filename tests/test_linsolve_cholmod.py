@@ -215,8 +215,12 @@ def test_a_nested_dissection_order_factorizes_the_same_system(monkeypatch):
     called = []
     monkeypatch.setattr(linsolve, "nested_dissection",
                         lambda pattern: called.append(pattern) or order)
+    from cvxopt import cholmod
+
+    options = dict(cholmod.options)
     fact = Factorization(ns.pattern, data, "cholmod")
     assert called == [ns.pattern] and isinstance(fact.handle, Cholmod)
+    assert cholmod.options == options  # the one-method setting of the analysis undone
     x = fact.solve(b)
     assert _residual(fact.A, x, b) < LINEAR
     assert _agree(x, amd) < LINEAR
