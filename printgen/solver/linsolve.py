@@ -446,6 +446,28 @@ class Cholmod:
         return np.asarray(x).ravel()
 
 
+def cholmod_solve(upper: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray | None:
+    """X with A X = rhs (columns) by CHOLMOD's Cholesky of the symmetric positive definite A
+    given by its upper triangle (CSC, rows sorted), analysed on AMD; None when A is not
+    positive definite. One factorization for all the columns."""
+    import cvxopt
+    from cvxopt import cholmod
+
+    n = upper.shape[0]
+    cols = np.repeat(np.arange(n), np.diff(upper.indptr))
+    matrix = cvxopt.spmatrix(cvxopt.matrix(upper.data.astype(np.float64)),
+                             cvxopt.matrix(upper.indices.astype(np.int64)),
+                             cvxopt.matrix(cols.astype(np.int64)), (n, n))
+    try:
+        factor = _analyse(matrix, None)
+        cholmod.numeric(matrix, factor)
+    except ArithmeticError:  # not positive definite
+        return None
+    x = cvxopt.matrix(np.asfortranarray(rhs, dtype=np.float64))
+    cholmod.solve(factor, x)
+    return np.asarray(x).reshape(rhs.shape)
+
+
 class Factorization:
     """One factorization of A = J + mu D; `solve` returns None when A is singular.
 
