@@ -124,13 +124,14 @@ def metis_available() -> bool:
 def nested_dissection(pattern: Pattern) -> np.ndarray | None:
     """METIS's nested-dissection order of the pattern's free dofs, computed on the node graph
     (`Pattern.node_adjacency`: a ninth of the dof graph's entries, so a ninth of the work)
-    and expanded node by node; None without `pymetis` or without a node."""
+    and expanded node by node; None without `pymetis` or without two coupled nodes (then
+    CHOLMOD's AMD orders the little there is)."""
     try:
         import pymetis
     except ImportError:
         return None
     xadj, adjncy = pattern.node_adjacency()
-    if len(xadj) < 2:
+    if not len(adjncy):
         return None
     if hasattr(pymetis, "CSRAdjacency"):
         perm, _ = pymetis.nested_dissection(adjacency=pymetis.CSRAdjacency(xadj, adjncy))
