@@ -172,13 +172,24 @@ def test_cholmod_takes_an_upper_triangle_in_any_row_order():
         assert _residual(full, handle.solve(b), b) <= LINEAR
 
 
-def test_the_node_graph_is_the_tangent_pattern_collapsed_to_nodes():
+def _with_rollers(net: Net) -> Net:
+    """`net` with some free nodes held in one or two directions only (1 or 2 free dofs)."""
+    fixed = np.array(net.fixed_dofs, dtype=bool)
+    fixed[5::7, 1] = True
+    fixed[3::11, [0, 2]] = True
+    return Net(net.nodes, fixed, net.elements, net.laws, element_law=net.element_law,
+               cables=net.cables)
+
+
+@pytest.mark.parametrize("rollers", [False, True])
+def test_the_node_graph_is_the_tangent_pattern_collapsed_to_nodes(rollers):
     """`Pattern.node_adjacency`: two nodes with free dofs are adjacent exactly where the
     tangent has an entry between their dofs (strands, the cable's segments and dense block),
     symmetric, no self-loops; `dof_order` of the nodes in their own order is every free dof
-    in its own order, and of a shuffled node order each node's dofs together, in order."""
+    in its own order, and of a shuffled node order each node's dofs together, in order
+    (nodes with 1, 2 or 3 free dofs when `rollers`)."""
     net, _ = _sliding_net()
-    ns = NetSystem(net)
+    ns = NetSystem(_with_rollers(net) if rollers else net)
     pattern = ns.pattern
     xadj, adjncy = pattern.node_adjacency()
     node = np.flatnonzero(ns.free) // 3
