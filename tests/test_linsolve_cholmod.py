@@ -170,3 +170,83 @@ def test_cholmod_takes_an_upper_triangle_in_any_row_order():
         S = pattern.symmetric_upper(scale)
         full = S + sp.triu(S, 1).T
         assert _residual(full, handle.solve(b), b) <= LINEAR
+
+
+def _with_rollers(net: Net) -> Net:
+    """`net` with some free nodes held in one or two directions only (1 or 2 free dofs)."""
+    fixed = np.array(net.fixed_dofs, dtype=bool)
+    fixed[5::7, 1] = True
+    fixed[3::11, [0, 2]] = True
+    return Net(net.nodes, fixed, net.elements, net.laws, element_law=net.element_law,
+               cables=net.cables)
+
+
+@pytest.mark.parametrize("rollers", [False, True])
+def test_the_node_graph_is_the_tangent_pattern_collapsed_to_nodes(rollers):
+    """`Pattern.node_adjacency`: two nodes with free dofs are adjacent exactly where the
+    tangent has an entry between their dofs (strands, the cable's segments and dense block),
+    symmetric, no self-loops; `dof_order` of the nodes in their own order is every free dof
+    in its own order, and of a shuffled node order each node's dofs together, in order
+    (nodes with 1, 2 or 3 free dofs when `rollers`)."""
+    net, _ = _sliding_net()
+    ns = NetSystem(_with_rollers(net) if rollers else net)
+    pattern = ns.pattern
+    xadj, adjncy = pattern.node_adjacency()
+    node = np.flatnonzero(ns.free) // 3
+    nodes, of_dof = np.unique(node, return_inverse=True)
+    rows = np.repeat(np.arange(pattern.size), np.diff(pattern.indptr))
+    pairs = {(int(a), int(b)) for a, b in zip(of_dof[rows], of_dof[pattern.cols], strict=True)
+             if a != b}
+    graph = {(int(a), int(b)) for a in range(len(nodes)) for b in adjncy[xadj[a]:xadj[a + 1]]}
+    assert graph == pairs and all((b, a) in graph for a, b in graph)
+    assert len(xadj) == len(nodes) + 1 and len(adjncy) == len(graph)  # no pair twice
+    np.testing.assert_array_equal(pattern.dof_order(np.arange(len(nodes))),
+                                  np.arange(pattern.size))
+    shuffled = np.random.default_rng(2).permutation(len(nodes))
+    order = pattern.dof_order(shuffled)
+    np.testing.assert_array_equal(of_dof[order], np.repeat(shuffled, np.bincount(of_dof)[shuffled]))
+    assert np.all(np.diff(order)[np.diff(of_dof[order]) == 0] == 1)
+
+
+def test_a_nested_dissection_order_factorizes_the_same_system(monkeypatch):
+    """From METIS_MIN_DOFS unknowns CHOLMOD is analysed on METIS's nested-dissection order
+    of the node graph (a permutation of the free dofs): the solves are those of the AMD
+    analysis to round-off, and a net of that size solves to the same answer."""
+    pytest.importorskip("pymetis")
+    from printgen.solver import linsolve
+
+    net, loads = _sliding_net()
+    ns, data = _tangent(net, loads)
+    order = linsolve.nested_dissection(ns.pattern)
+    assert order is not None
+    np.testing.assert_array_equal(np.sort(order), np.arange(ns.pattern.size))
+    b = np.random.default_rng(3).normal(size=ns.pattern.size)
+    amd = Factorization(ns.pattern, data, "cholmod").solve(b)
+    monkeypatch.setattr(linsolve, "METIS_MIN_DOFS", 0)
+    called = []
+    monkeypatch.setattr(linsolve, "nested_dissection",
+                        lambda pattern: called.append(pattern) or order)
+    from cvxopt import cholmod
+
+    options = dict(cholmod.options)
+    fact = Factorization(ns.pattern, data, "cholmod")
+    assert called == [ns.pattern] and isinstance(fact.handle, Cholmod)
+    assert cholmod.options == options  # the one-method setting of the analysis undone
+    x = fact.solve(b)
+    assert _residual(fact.A, x, b) < LINEAR
+    assert _agree(x, amd) < LINEAR
+    reference = solve(net, loads, tol=TIGHT, method="reference")
+    fast = FastSolver(net, "cholmod").solve(loads, [], TIGHT, 400)
+    assert fast.converged and _agree(fast.displacements, reference.displacements) < AGREE
+
+
+def test_without_pymetis_the_analysis_keeps_amd(monkeypatch):
+    """`pymetis` not importable: no order (CHOLMOD's own AMD), whatever the net's size."""
+    import sys
+
+    from printgen.solver import linsolve
+
+    monkeypatch.setitem(sys.modules, "pymetis", None)  # import now raises ImportError
+    assert not linsolve.metis_available()
+    net, _ = _sliding_net()
+    assert linsolve.nested_dissection(NetSystem(net).pattern) is None

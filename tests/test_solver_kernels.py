@@ -20,6 +20,8 @@ from printgen.solver.state import NetSystem, evaluate, ray_potential, tangent_va
 
 KERNEL = 1e-14  # relative: the same products and sums, only reassociated (BLAS, bincount)
 MEMBRANE = 1e-12  # relative residual of a direct sparse solve of the net's Laplacian
+SHAPES_AGREE = 1e-10  # two direct solves of one small net's Laplacian (well conditioned:
+# they differ by round-off times its condition number) agree to this, relative
 LAWS = [linear(2.0), piecewise([0.01], [1.0, 0.3]), piecewise([0.002, 0.01, 0.05],
                                                                [0.5, 2.0, 1.0, 4.0])]
 
@@ -200,6 +202,27 @@ def test_membrane_shape_solves_the_damping_system(large):
     c = float(b @ Dv) / float(Dv @ Dv)
     assert c > 0
     assert np.abs(c * Dv - b).max() <= MEMBRANE * np.abs(b).max()
+
+
+def test_membrane_shape_by_cholmod_is_the_ldlt_s(monkeypatch):
+    """From LAPLACIAN_CHOLMOD_MIN_NODES nodes (here from none) CHOLMOD's Cholesky solves the
+    Laplacian, per direction with the rollers' own free-node sets: the shape of qdldl's
+    LDL^T to round-off."""
+    from printgen.solver import state
+    from printgen.solver.linsolve import cholmod_available, ldl_available
+
+    if not (cholmod_available() and ldl_available()):
+        pytest.skip("cvxopt or qdldl not installed")
+    monkeypatch.setattr(state, "pardiso_available", lambda: False)
+    b = np.random.default_rng(5).normal(size=NetSystem(_partly_fixed_net()).pattern.size)
+    plain = NetSystem(_partly_fixed_net()).membrane_shape(b)
+    called = []
+    real = state.cholmod_solve
+    monkeypatch.setattr(state, "cholmod_solve", lambda u, r: called.append(u.shape) or real(u, r))
+    monkeypatch.setattr(state, "LAPLACIAN_CHOLMOD_MIN_NODES", 0)
+    shape = NetSystem(_partly_fixed_net()).membrane_shape(b)
+    assert called and plain is not None and shape is not None
+    assert np.abs(shape - plain).max() <= SHAPES_AGREE * np.abs(plain).max()
 
 
 def test_membrane_shape_of_a_net_with_a_part_hanging_on_nothing_is_none():

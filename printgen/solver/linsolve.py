@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import threading
 import time
 from collections.abc import Callable
 from typing import Any
@@ -71,6 +72,12 @@ CHOLMOD_MIN_DOFS = 4_000  # from here on CHOLMOD's supernodal Cholesky beats qdl
 # backend_table). Along a load path the analysis is paid once: a load path of the 1:20
 # verification (4.2k unknowns, 23 levels) 1.25 s with qdldl, 0.72 s with CHOLMOD
 
+METIS_MIN_DOFS = 100_000  # from here on CHOLMOD's analysis orders the tangent by METIS's
+# nested dissection of the node graph (`pymetis`, when installed) instead of AMD: a numeric
+# factorization ~12 % and a solve ~10 % cheaper at 228k unknowns for an ordering of ~0.25 s;
+# below, a solve's factorizations save about what the ordering costs
+# (benchmarks/measurements.md#linsolve-metis-min-dofs)
+
 PHASES = {11: "analysis", 22: "factorization", 33: "solve"}  # MKL's phases, as Pardiso counts
 
 
@@ -103,6 +110,34 @@ def cholmod_available() -> bool:
     except ImportError:
         return False
     return True
+
+
+def metis_available() -> bool:
+    """True when METIS's nested dissection (`pymetis`) imports."""
+    try:
+        import pymetis  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def nested_dissection(pattern: Pattern) -> np.ndarray | None:
+    """METIS's nested-dissection order of the pattern's free dofs, computed on the node graph
+    (`Pattern.node_adjacency`: a ninth of the dof graph's entries, so a ninth of the work)
+    and expanded node by node; None without `pymetis` or without two coupled nodes (then
+    CHOLMOD's AMD orders the little there is)."""
+    try:
+        import pymetis
+    except ImportError:
+        return None
+    xadj, adjncy = pattern.node_adjacency()
+    if not len(adjncy):
+        return None
+    if hasattr(pymetis, "CSRAdjacency"):
+        perm, _ = pymetis.nested_dissection(adjacency=pymetis.CSRAdjacency(xadj, adjncy))
+    else:  # pymetis before 2025 takes the arrays themselves
+        perm, _ = pymetis.nested_dissection(xadj=xadj, adjncy=adjncy)
+    return pattern.dof_order(np.asarray(perm, dtype=np.intp))
 
 
 _PARDISO_FAILED: list[bool] = []  # an import of pypardiso failed in this process
@@ -290,26 +325,54 @@ class Ldl:
         self.solve = self.qdldl.solve
 
 
+_CHOLMOD_OPTIONS = threading.Lock()  # cvxopt's CHOLMOD options are one dict per process
+
+
+def _analyse(matrix: Any, order: np.ndarray | None) -> Any:
+    """CHOLMOD's symbolic factorization of cvxopt's upper triangle `matrix`: on `order` (a
+    permutation of its rows) alone when given, else on CHOLMOD's own AMD ordering. With an
+    order, CHOLMOD's default strategy would also compute AMD's to compare (0.1 s of its
+    0.2 s at 228k unknowns, and METIS's was the one kept): one method only (nmethods 1)."""
+    import cvxopt
+    from cvxopt import cholmod
+
+    with _CHOLMOD_OPTIONS:
+        if order is None:
+            return cholmod.symbolic(matrix, uplo="U")
+        saved = dict(cholmod.options)
+        cholmod.options["nmethods"] = 1
+        try:
+            return cholmod.symbolic(matrix, p=cvxopt.matrix(order.astype(np.int64)), uplo="U")
+        finally:
+            cholmod.options.clear()
+            cholmod.options.update(saved)
+
+
 class Cholmod:
     """The "cholmod" backend's object of one net: CHOLMOD's supernodal Cholesky L L^T of S
-    (cvxopt's build), its ordering (AMD) and symbolic analysis once per pattern, then numeric
-    factorizations only, which replace the values of one cvxopt matrix in place. The first
-    S that is not positive definite (the follower term's symmetric part, or a tangent made
-    indefinite by the line search's trial states) turns the net to the "ldl" backend's
-    LDL^T (qdldl) for good, or raises when that is not installed.
+    (cvxopt's build), its ordering (AMD; from METIS_MIN_DOFS unknowns METIS's nested
+    dissection of the node graph when `pymetis` is installed, `nested_dissection`) and
+    symbolic analysis once per pattern, then numeric factorizations only, which replace the
+    values of one cvxopt matrix in place. The first S that is not positive definite (the
+    follower term's symmetric part, or a tangent made indefinite by the line search's trial
+    states) turns the net to the "ldl" backend's LDL^T (qdldl) for good, or raises when that
+    is not installed.
 
     Why this one (1 thread, the simple scene's S): qdldl's LDL^T is column by column, and a
     2D net's factor fills in (0.26 s a numeric factorization at 57k unknowns, 3.9 s at 228k);
     CHOLMOD's supernodal blocks take 0.05 and 0.33 s on the same AMD ordering. Tried and
     dropped: CHOLMOD's simplicial LDL^T (cvxopt's supernodal = 0) and cholespy, no faster
-    than qdldl; SuperLU on a METIS nested-dissection order (pymetis), 0.52 s at 58k; a METIS
-    order fed to CHOLMOD, 20 % off the numeric factorization at 228k but 0.6 s to compute
-    and one more dependency; re-passes by GMRES on the last factorization (the "ldl" way),
-    more Newton iterations and twice the CPU at 57k; a nested-dissection order from the
-    nodes' positions (recursive bisection, no dependency), 0.30 s a numeric factorization at
-    228k as AMD's; re-passes as a low-rank update of the last factorization (Woodbury), which
-    needs one solve per changed strand: cvxopt solves the right-hand sides one by one (0.05 s
-    each at 228k, 6 for a factorization's cost) while a re-pass there changes 2-604 strands."""
+    than qdldl; SuperLU on a METIS nested-dissection order (pymetis), 0.52 s at 58k; METIS
+    on the dof graph (0.6 s at 228k: the node graph has a ninth of its entries); CHOLMOD's
+    other settings through cvxopt (postordering off, nmethods 2 or 9, supernodal forced),
+    0.34-0.35 s a numeric factorization at 228k as the defaults'; re-passes by GMRES on the
+    last factorization (the "ldl" way), more Newton iterations and twice the CPU at 57k,
+    and solved exactly that way 5-30 preconditioned solves each at 228k (a factorization
+    costs 6); a nested-dissection order from the nodes' positions (recursive bisection, no
+    dependency), 0.30 s a numeric factorization at 228k as AMD's; re-passes as a low-rank
+    update of the last factorization (Woodbury), which needs one solve per changed strand:
+    cvxopt solves the right-hand sides one by one (0.05 s each at 228k, 6 for a
+    factorization's cost) while a re-pass there changes 2-604 strands."""
 
     def __init__(self) -> None:
         self.matrix: Any = None  # cvxopt's spmatrix of the upper triangle (values replaced)
@@ -348,7 +411,8 @@ class Cholmod:
                 cvxopt.matrix(self._ordered(upper.data).astype(np.float64)),
                 cvxopt.matrix(self._ordered(upper.indices).astype(np.int64)),
                 cvxopt.matrix(self._ordered(cols).astype(np.int64)), (n, n))
-            self.symbolic = cholmod.symbolic(self.matrix, uplo="U")
+            self.symbolic = _analyse(self.matrix, nested_dissection(pattern)
+                                     if n >= METIS_MIN_DOFS else None)
             self.source = pattern
             if len(self.matrix.V) != upper.nnz:  # cvxopt merged or dropped slots
                 raise ValueError("cvxopt's matrix lost entries of the pattern")
@@ -381,6 +445,28 @@ class Cholmod:
         cholmod.solve(self.symbolic, x)
         self._count("solve", t0)
         return np.asarray(x).ravel()
+
+
+def cholmod_solve(upper: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray | None:
+    """X with A X = rhs (columns) by CHOLMOD's Cholesky of the symmetric positive definite A
+    given by its upper triangle (CSC, rows sorted), analysed on AMD; None when A is not
+    positive definite. One factorization for all the columns."""
+    import cvxopt
+    from cvxopt import cholmod
+
+    n = upper.shape[0]
+    cols = np.repeat(np.arange(n), np.diff(upper.indptr))
+    matrix = cvxopt.spmatrix(cvxopt.matrix(upper.data.astype(np.float64)),
+                             cvxopt.matrix(upper.indices.astype(np.int64)),
+                             cvxopt.matrix(cols.astype(np.int64)), (n, n))
+    try:
+        factor = _analyse(matrix, None)
+        cholmod.numeric(matrix, factor)
+    except ArithmeticError:  # not positive definite
+        return None
+    x = cvxopt.matrix(np.asfortranarray(rhs, dtype=np.float64))
+    cholmod.solve(factor, x)
+    return np.asarray(x).reshape(rhs.shape)
 
 
 class Factorization:

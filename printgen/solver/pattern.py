@@ -140,6 +140,7 @@ class Pattern:
             groups.append((kind, p, inverse[at:at + p.size].reshape(p.shape)))
             at += p.size
         self._slot_parts = (groups, index, fmask, offset, rank, ecol)
+        self._node_ptr = node_ptr  # each node's first node entry (they come row by row)
         self._mirror_parts = (np.searchsorted(node_keys, ecol * n + erow), offset, rank,
                               free_dofs)  # node entry (q, p) of each (p, q)
         entry, sym = self._entries(n, ecol, width, row_start[free_dofs // 3], row_len, index,
@@ -177,6 +178,29 @@ class Pattern:
         lo, hi = np.minimum(a, b), np.maximum(a, b)
         self._block_diagonal = np.flatnonzero(a == b)  # on their node block's diagonal
         return entry, lo * (5 - lo) // 2 + hi  # SYM_INDEX[a, b]: 0, 1, 2 / 3, 4 / 5
+
+    def node_adjacency(self) -> tuple[np.ndarray, np.ndarray]:
+        """The graph of the nodes that have a free dof, as CSR (xadj, adjncy; no self-loops,
+        nodes numbered in the order of their dofs): two nodes adjacent where the tangent
+        couples them (a strand, a cable's segment or dense block). What a nested-dissection
+        ordering of the tangent reads: a ninth of the dof graph's entries."""
+        fmask, ecol = self._slot_parts[2], self._slot_parts[5]
+        has: np.ndarray = np.asarray(fmask.any(axis=1))
+        rank = np.cumsum(has) - 1
+        erow = np.repeat(np.arange(len(has)), np.diff(self._node_ptr))
+        keep = has[erow] & has[ecol] & (erow != ecol)
+        count = np.bincount(rank[erow[keep]], minlength=int(has.sum()))
+        return np.concatenate([[0], np.cumsum(count)]), rank[ecol[keep]]
+
+    def dof_order(self, node_order: np.ndarray) -> np.ndarray:
+        """The free dofs node by node, the nodes in `node_order` (numbered as in
+        `node_adjacency`), each node's dofs in their own order."""
+        width = self._slot_parts[2].sum(axis=1)
+        width = width[width > 0]
+        first = np.cumsum(width) - width
+        take = width[node_order]
+        return (np.repeat(first[node_order], take) + np.arange(int(take.sum()))
+                - np.repeat(np.cumsum(take) - take, take))
 
     @cached_property
     def rows(self) -> np.ndarray:

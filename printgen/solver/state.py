@@ -17,7 +17,14 @@ import scipy.sparse.linalg as spla
 from scipy.sparse import csgraph
 
 from .assemble import Bars, bar_energy, nondimensional, strand_laws
-from .linsolve import PARDISO_MIN_DOFS, Pardiso, ldl_available, pardiso_available
+from .linsolve import (
+    PARDISO_MIN_DOFS,
+    Pardiso,
+    cholmod_available,
+    cholmod_solve,
+    ldl_available,
+    pardiso_available,
+)
 from .loads import total_forces
 from .model import Net
 from .pattern import SYM_PAIRS, pair_values, shared_extras, shared_pattern
@@ -104,13 +111,20 @@ def _incidence(n: int, bars: Bars, pattern) -> sp.csr_matrix:
     return out if extras is None else extras.setdefault("incidence", out)
 
 
+LAPLACIAN_CHOLMOD_MIN_NODES = 10_000  # from here on CHOLMOD's supernodal Cholesky of the
+# membrane start's Laplacian beats qdldl's LDL^T, which fills in column by column (1 thread,
+# CPU, simple-pinned: a tie at 4.6k nodes, 19k 0.017 against 0.022 s, 76k 0.09 against
+# 0.17 s: benchmarks/measurements.md#state-laplacian-cholmod-min-nodes)
+
+
 def _laplacian_solve(n: int, nodes: np.ndarray, edges: tuple, rhs: np.ndarray,
                      spare: dict | None = None) -> np.ndarray | None:
     """X with L X = rhs, L the weighted graph Laplacian (edges: i, j, weight) of the n nodes
     restricted to `nodes` (the others held); None when L is singular (some nodes reach no
     held one). From PARDISO_MIN_DOFS unknowns (3 per node) by PARDISO's Cholesky when
-    installed, else by qdldl's LDL^T of L's upper triangle when installed (half of
-    SuperLU's time on the 61 x 21 net), else SuperLU.
+    installed, else from LAPLACIAN_CHOLMOD_MIN_NODES nodes by CHOLMOD's when installed, else
+    by qdldl's LDL^T of L's upper triangle when installed (half of SuperLU's time on the 61
+    x 21 net), else SuperLU.
 
     spare: a dict kept with the net's topology (`pattern.shared_extras`), which L's
     anchoring and qdldl's object (its ordering) depend on alone: the next net of that
@@ -135,6 +149,11 @@ def _laplacian_solve(n: int, nodes: np.ndarray, edges: tuple, rhs: np.ndarray,
         if x is not None:
             return x
     upper = upper.tocsc()
+    if len(nodes) >= LAPLACIAN_CHOLMOD_MIN_NODES and cholmod_available():
+        upper.sum_duplicates()  # sorted rows, as cvxopt's matrix takes them
+        x = cholmod_solve(upper, rhs)
+        if x is not None:
+            return x
     try:
         with np.errstate(all="ignore"):
             if ldl_available():
