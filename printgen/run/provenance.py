@@ -24,7 +24,7 @@ TIME_KEYS = ("timings_s", "seconds", "time_s")  # record keys that hold wall-clo
 # The packages whose versions can move the outputs' numbers or bytes (meshes, solver, figures);
 # the same inputs with other versions may differ in the last digits (values within ~1e-4).
 PACKAGES = ("numpy", "scipy", "manifold3d", "trimesh", "shapely", "matplotlib", "qdldl",
-            "cvxopt", "pypardiso")
+            "cvxopt", "pymetis", "pypardiso")
 
 
 def split_timings(record: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
