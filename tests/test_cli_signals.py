@@ -59,9 +59,10 @@ def descendants(pid: int) -> list[int]:
 
 
 def start_and_wait_for_workers(out: Path) -> subprocess.Popen:
-    proc = subprocess.Popen([str(PRINTGEN), "make", str(REALISTIC), "-s", "40", "--out",
-                             str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, start_new_session=True)
+    with passed_on():
+        proc = subprocess.Popen([str(PRINTGEN), "make", str(REALISTIC), "-s", "40", "--out",
+                                 str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                text=True, start_new_session=True)
     deadline = time.monotonic() + REACH_VERIFICATION_S
     while len(descendants(proc.pid)) < 3:  # the verification's worker and its two workers
         assert proc.poll() is None, proc.communicate()
@@ -139,18 +140,24 @@ def processes(n: int, or_after_s: float) -> Callable[[subprocess.Popen, float], 
                              or time.monotonic() - t0 >= or_after_s)
 
 
+PASSED_ON = (signal.SIGHUP, signal.SIGINT)  # the signals a run's shell may have ignored
+
+
 @contextlib.contextmanager
-def hangup_passed_on():
-    """A test run under nohup ignores SIGHUP, and so would printgen (an ignored signal stays
-    ignored across exec): a caught one is reset to the default in the child instead."""
-    ignored = signal.getsignal(signal.SIGHUP) is signal.SIG_IGN
-    if ignored:
-        signal.signal(signal.SIGHUP, lambda *_: None)
+def passed_on():
+    """The signals the cases send, as a terminal's session delivers them: a test run under
+    nohup ignores SIGHUP, one a shell started in the background without job control ignores
+    SIGINT, and so would printgen (an ignored signal stays ignored across exec, and printgen
+    keeps it so, as a nohup'd program should): caught here instead, printgen's handler takes
+    it in this process and a child starts with its default."""
+    ignored = [s for s in PASSED_ON if signal.getsignal(s) is signal.SIG_IGN]
+    for s in ignored:
+        signal.signal(s, lambda *_: None)
     try:
         yield
     finally:
-        if ignored:
-            signal.signal(signal.SIGHUP, signal.SIG_IGN)
+        for s in ignored:
+            signal.signal(s, signal.SIG_IGN)
 
 
 def signalled(tmp_path: Path, argv: list[str], sigs: list[signal.Signals],
@@ -161,7 +168,7 @@ def signalled(tmp_path: Path, argv: list[str], sigs: list[signal.Signals],
     stderr and OUT once no process of the session is left."""
     out = tmp_path / "out"
     write_folder(out, PREVIOUS)
-    with hangup_passed_on():
+    with passed_on():
         proc = subprocess.Popen([*prefix, str(PRINTGEN), *argv, "--out", str(out)],
                                 stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                                 start_new_session=True)
@@ -261,7 +268,7 @@ def test_a_signal_a_library_swallowed_stops_the_run_before_its_swap(tmp_path, ca
 
 def test_a_second_signal_does_not_cut_the_first_ones_cleanup_short():
     cleaned = []
-    with pytest.raises(signals.Interrupted) as exc, signals.signals_raise():
+    with passed_on(), pytest.raises(signals.Interrupted) as exc, signals.signals_raise():
         try:
             os.kill(os.getpid(), signal.SIGINT)
             time.sleep(0.2)
