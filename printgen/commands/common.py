@@ -199,13 +199,13 @@ class _Line:
 
 @contextlib.contextmanager
 def spinner(text: str) -> Iterator:
-    """The run's current step on stderr while a command runs (`make`, `series`), when stderr
-    is a terminal (erased at the end); elsewhere (a log, a pipe, a benchmark) nothing. Drawn
-    when the text changes, by no thread of its own (not rich's animated spinner, which
-    refreshes from one): a process running a thread starts its workers from a fork server
-    (printgen.executor.start.start_method), which imports what the jobs need again, instead
-    of forking them with it imported (make: its helper process; series: the cases' workers,
-    whose progress bar, once they run, is animated)."""
+    """The run's current step on stderr while a command runs (`make`, `verify`, `series`),
+    when stderr is a terminal (erased at the end); elsewhere (a log, a pipe, a benchmark)
+    nothing. Drawn when the text changes, by no thread of its own (not rich's animated
+    spinner, which refreshes from one): a process running a thread starts its workers from a
+    fork server (printgen.executor.start.start_method), which imports what the jobs need
+    again, instead of forking them with it imported (make: its helper process; verify: its
+    fit's workers; series: the cases' workers, whose progress bar, once they run, is animated)."""
     err = Console(stderr=True, highlight=False)
     if not err.is_terminal:
         yield _Silent()

@@ -348,6 +348,23 @@ def _analyse(matrix: Any, order: np.ndarray | None) -> Any:
             cholmod.options.update(saved)
 
 
+def _cvxopt_upper(upper: sp.csc_matrix) -> tuple[Any, np.ndarray | None]:
+    """cvxopt's spmatrix of the upper triangle `upper` (CSC), and the order its entries were
+    taken in: cvxopt's, column then row (None: the CSC's own, when its rows are sorted)."""
+    import cvxopt
+
+    n = upper.shape[0]
+    cols = np.repeat(np.arange(n), np.diff(upper.indptr))
+    order = None if upper.has_sorted_indices else np.lexsort((upper.indices, cols))
+
+    def taken(a: np.ndarray) -> np.ndarray:
+        return a if order is None else a[order]
+
+    return cvxopt.spmatrix(cvxopt.matrix(taken(upper.data).astype(np.float64)),
+                           cvxopt.matrix(taken(upper.indices).astype(np.int64)),
+                           cvxopt.matrix(taken(cols).astype(np.int64)), (n, n)), order
+
+
 class Cholmod:
     """The "cholmod" backend's object of one net: CHOLMOD's supernodal Cholesky L L^T of S
     (cvxopt's build), its ordering (AMD; from METIS_MIN_DOFS unknowns METIS's nested
@@ -404,13 +421,7 @@ class Cholmod:
         t0 = time.process_time()
         if self.source is not pattern:  # a new net's pattern: analyse it
             n = upper.shape[0]
-            cols = np.repeat(np.arange(n), np.diff(upper.indptr))
-            # cvxopt's order: column, then row (the pattern's own when its rows are sorted)
-            self.order = None if upper.has_sorted_indices else np.lexsort((upper.indices, cols))
-            self.matrix = cvxopt.spmatrix(
-                cvxopt.matrix(self._ordered(upper.data).astype(np.float64)),
-                cvxopt.matrix(self._ordered(upper.indices).astype(np.int64)),
-                cvxopt.matrix(self._ordered(cols).astype(np.int64)), (n, n))
+            self.matrix, self.order = _cvxopt_upper(upper)
             self.symbolic = _analyse(self.matrix, nested_dissection(pattern)
                                      if n >= METIS_MIN_DOFS else None)
             self.source = pattern
@@ -454,11 +465,7 @@ def cholmod_solve(upper: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray | None:
     import cvxopt
     from cvxopt import cholmod
 
-    n = upper.shape[0]
-    cols = np.repeat(np.arange(n), np.diff(upper.indptr))
-    matrix = cvxopt.spmatrix(cvxopt.matrix(upper.data.astype(np.float64)),
-                             cvxopt.matrix(upper.indices.astype(np.int64)),
-                             cvxopt.matrix(cols.astype(np.int64)), (n, n))
+    matrix, _ = _cvxopt_upper(upper)
     try:
         factor = _analyse(matrix, None)
         cholmod.numeric(matrix, factor)
